@@ -1,0 +1,39 @@
+#include "skybake/atmosphere.h"
+
+#include <cmath>
+
+namespace skybake {
+
+glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth_deg) {
+  const double kDegToRad = M_PI / 180.0;
+  double elevation = elevation_deg * kDegToRad;
+  double azimuth = azimuth_deg * kDegToRad;
+  // North = -Z, East = +X: azimuth 0 -> -Z, azimuth 90 -> +X.
+  return {std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
+          -std::cos(azimuth) * std::cos(elevation)};
+}
+
+gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySettings& q,
+                                   const EffectSettings& effects, const Rgb& output_scale) {
+  auto v4 = [](const Rgb& rgb, double w) {
+    return gpu::vec4{float(rgb[0]), float(rgb[1]), float(rgb[2]), float(w)};
+  };
+  gpu::GpuAtmosphere g{};
+  g.rayleigh_scattering = v4(a.rayleigh_scattering_per_km, a.rayleigh_scale_height_km);
+  g.mie_scattering = v4(a.mie_scattering_per_km, a.mie_scale_height_km);
+  g.mie_extinction = v4(a.mie_extinction_per_km, a.mie_g);
+  g.absorption_extinction = v4(a.ozone_absorption_per_km, a.ozone_peak_altitude_km);
+  g.ground_albedo = v4(a.ground_albedo, a.ozone_half_width_km);
+  g.solar_irradiance = v4(a.solar_irradiance, a.sun_angular_radius_rad);
+  g.radii = {float(a.bottom_radius_km), float(a.top_radius_km),
+             float(a.observer_altitude_m * 1e-3), float(a.limb_darkening_u)};
+  g.output_scale = v4(output_scale, 0.0);
+  g.lut_sizes = {q.transmittance_width, q.transmittance_height, q.multiscattering_size,
+                 q.multiscattering_size};
+  g.samples = {q.view_steps, q.transmittance_steps, q.multiscattering_steps, q.integrator};
+  g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground,
+               q.multiscattering_sqrt_dirs};
+  return g;
+}
+
+}  // namespace skybake

@@ -1,0 +1,555 @@
+// Reading, validating and resolving sky styles.
+//
+// Every key of a style is declared once, in VisitStyle(), with its type and
+// valid range. The same declaration drives reading (StyleReader), writing the
+// resolved TOML for provenance (StyleWriter), and the unknown-key check.
+#include "skybake/config.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <toml++/toml.h>
+
+namespace skybake {
+namespace {
+
+// --------------------------------------------------------------- ranges
+
+struct Range {
+  double min;
+  double max;
+  bool min_open;
+  bool max_open;
+  bool Contains(double v) const {
+    if (min_open ? !(v > min) : !(v >= min)) return false;
+    if (max_open ? !(v < max) : !(v <= max)) return false;
+    return true;
+  }
+  std::string Describe() const {
+    return fmt::format("{}{}, {}{}", min_open ? '(' : '[', min, max, max_open ? ')' : ']');
+  }
+};
+
+constexpr double kInf = HUGE_VAL;
+constexpr Range kPositive{0.0, kInf, true, true};
+constexpr Range kNonNegative{0.0, kInf, false, true};
+constexpr Range kAnyFinite{-kInf, kInf, true, true};
+constexpr Range kUnit{0.0, 1.0, false, false};
+constexpr Range kOpenUnitSymmetric{-1.0, 1.0, true, true};
+constexpr Range kElevation{-90.0, 90.0, false, false};
+constexpr Range kSunRadius{0.0, 0.5, true, false};
+
+// Documented limits (README "Limits"): beyond these a bake would need more
+// than the memory budget or hours of lavapipe time.
+constexpr int kMaxCubeSize = 8192;
+constexpr int kMaxLatlongHeight = 8192;
+constexpr int kMaxSteps = 4096;
+constexpr int kMaxLutSize = 4096;
+
+std::string JoinNames(const std::vector<std::string>& names) {
+  std::string out;
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (i) out += i + 1 == names.size() ? " or " : ", ";
+    out += "'" + names[i] + "'";
+  }
+  return out;
+}
+
+int EditDistance(std::string_view a, std::string_view b) {
+  std::vector<int> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = int(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    int diagonal = row[0];
+    row[0] = int(i);
+    for (size_t j = 1; j <= b.size(); ++j) {
+      int up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+// A name is safe as an output file name component: no separators, no "..",
+// no leading dot, printable ASCII.
+bool IsSafeFileName(const std::string& name) {
+  if (name.empty() || name.size() > 128 || name[0] == '.') return false;
+  for (char c : name) {
+    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '-' || c == '.' || c == '+';
+    if (!ok) return false;
+  }
+  return name.find("..") == std::string::npos;
+}
+
+// --------------------------------------------------------------- the schema
+
+// Calls the visitor once per key of a style, in file order.
+template <class Visitor>
+void VisitStyle(SkyStyle& s, Visitor& v) {
+  AtmosphereParams& a = s.atmosphere;
+  v.Real("atmosphere.bottom_radius_km", a.bottom_radius_km, kPositive);
+  v.Real("atmosphere.top_radius_km", a.top_radius_km, kPositive);
+  v.Real("atmosphere.observer_altitude_m", a.observer_altitude_m, kNonNegative);
+  v.Triple("atmosphere.ground_albedo", a.ground_albedo, kUnit);
+  v.Triple("atmosphere.rayleigh.scattering_per_km", a.rayleigh_scattering_per_km, kNonNegative);
+  v.Real("atmosphere.rayleigh.scale_height_km", a.rayleigh_scale_height_km, kPositive);
+  v.Triple("atmosphere.mie.scattering_per_km", a.mie_scattering_per_km, kNonNegative);
+  v.Triple("atmosphere.mie.extinction_per_km", a.mie_extinction_per_km, kNonNegative);
+  v.Real("atmosphere.mie.scale_height_km", a.mie_scale_height_km, kPositive);
+  v.Real("atmosphere.mie.g", a.mie_g, kOpenUnitSymmetric);
+  v.Triple("atmosphere.ozone.absorption_per_km", a.ozone_absorption_per_km, kNonNegative);
+  v.Real("atmosphere.ozone.peak_altitude_km", a.ozone_peak_altitude_km, kNonNegative);
+  v.Real("atmosphere.ozone.half_width_km", a.ozone_half_width_km, kPositive);
+
+  v.Real("sun.elevation_deg", s.sun.elevation_deg, kElevation);
+  v.Real("sun.azimuth_deg", s.sun.azimuth_deg, kAnyFinite);
+  v.Real("sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadius);
+  v.Triple("sun.irradiance", a.solar_irradiance, kNonNegative);
+  v.Real("sun.limb_darkening_u", a.limb_darkening_u, kUnit);
+
+  v.Bool("effects.multiple_scattering", s.effects.multiple_scattering);
+  v.Bool("effects.sun_disc", s.effects.sun_disc);
+  v.Bool("effects.ground", s.effects.ground);
+
+  QualitySettings& q = s.quality;
+  v.Int("quality.view_steps", q.view_steps, 1, kMaxSteps);
+  v.Int("quality.transmittance_steps", q.transmittance_steps, 1, kMaxSteps);
+  v.Int("quality.multiscattering_steps", q.multiscattering_steps, 1, kMaxSteps);
+  v.Int("quality.multiscattering_sqrt_directions", q.multiscattering_sqrt_dirs, 1, 64);
+  v.Int("quality.transmittance_lut_width", q.transmittance_width, 2, kMaxLutSize);
+  v.Int("quality.transmittance_lut_height", q.transmittance_height, 2, kMaxLutSize);
+  v.Int("quality.multiscattering_lut_size", q.multiscattering_size, 2, kMaxLutSize);
+
+  v.Int("render.cube_size", s.render.cube_size, 1, kMaxCubeSize);
+  v.Int("render.latlong_height", s.render.latlong_height, 1, kMaxLatlongHeight);
+
+  OutputSettings& o = s.output;
+  v.FileName("output.basename", o.basename);
+  v.Choice("output.pixel_type", o.pixel_type, {{"half", PixelType::kHalf}, {"float", PixelType::kFloat}});
+  v.Choice("output.compression", o.compression,
+           {{"none", std::string("none")}, {"rle", std::string("rle")}, {"zips", std::string("zips")},
+            {"zip", std::string("zip")}, {"piz", std::string("piz")}});
+  v.Choice("output.overflow", o.overflow,
+           {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
+  v.Choice("output.units", o.units,
+           {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
+  v.Bool("output.faces", o.faces);
+  v.Bool("output.cube_strip", o.cube_strip);
+  v.Bool("output.latlong", o.latlong);
+  v.Bool("output.preview", o.preview);
+  v.FileNames("output.face_names", o.face_names, 6);
+
+  v.Bool("preview.auto_exposure", s.preview.auto_exposure);
+  v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
+}
+
+// --------------------------------------------------------------- reading
+
+class StyleReader {
+ public:
+  StyleReader(const toml::table& root, std::string file, std::vector<ConfigError>& errors)
+      : root_(root), file_(std::move(file)), errors_(errors) {}
+
+  void Real(const char* path, double& out, const Range& range) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    std::optional<double> value = node->value<double>();  // accepts integers too
+    if (!value || node->is_boolean()) {
+      Error(node, path, fmt::format("expected a number, got {}", TypeName(*node)));
+      return;
+    }
+    if (!std::isfinite(*value)) {
+      Error(node, path, "must be a finite number (got " + FormatNumber(*value) + ")");
+      return;
+    }
+    if (!range.Contains(*value)) {
+      Error(node, path, fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
+      return;
+    }
+    out = *value;
+  }
+
+  void Triple(const char* path, Rgb& out, const Range& range) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (node->is_number()) {  // a scalar sets all three channels
+      double value = 0.0;
+      Real(path, value, range);
+      out = {value, value, value};
+      return;
+    }
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != 3) {
+      Error(node, path, "expected a number or an array of 3 numbers [680 nm, 550 nm, 440 nm]");
+      return;
+    }
+    Rgb result = out;
+    for (size_t i = 0; i < 3; ++i) {
+      const toml::node& item = *array->get(i);
+      std::optional<double> value = item.value<double>();
+      std::string item_path = fmt::format("{}[{}]", path, i);
+      if (!value || item.is_boolean()) {
+        Error(&item, item_path, fmt::format("expected a number, got {}", TypeName(item)));
+        return;
+      }
+      if (!std::isfinite(*value)) {
+        Error(&item, item_path, "must be a finite number (got " + FormatNumber(*value) + ")");
+        return;
+      }
+      if (!range.Contains(*value)) {
+        Error(&item, item_path,
+              fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
+        return;
+      }
+      result[i] = *value;
+    }
+    out = result;
+  }
+
+  void Int(const char* path, int& out, int min, int max) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_integer()) {
+      Error(node, path, fmt::format("expected an integer, got {}", TypeName(*node)));
+      return;
+    }
+    int64_t value = node->as_integer()->get();
+    if (value < min || value > max) {
+      Error(node, path, fmt::format("{} is out of range [{}, {}]", value, min, max));
+      return;
+    }
+    out = int(value);
+  }
+
+  void Bool(const char* path, bool& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_boolean()) {
+      Error(node, path, fmt::format("expected true or false, got {}", TypeName(*node)));
+      return;
+    }
+    out = node->as_boolean()->get();
+  }
+
+  template <class T>
+  void Choice(const char* path, T& out, std::initializer_list<std::pair<const char*, T>> choices) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    std::vector<std::string> names;
+    for (const auto& c : choices) names.push_back(c.first);
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(names), TypeName(*node)));
+      return;
+    }
+    const std::string& text = node->as_string()->get();
+    for (const auto& c : choices) {
+      if (text == c.first) {
+        out = c.second;
+        return;
+      }
+    }
+    Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(names)));
+  }
+
+  void FileName(const char* path, std::string& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      return;
+    }
+    const std::string& text = node->as_string()->get();
+    if (!IsSafeFileName(text)) {
+      Error(node, path,
+            fmt::format("'{}' is not a plain file name: use letters, digits, '_', '-', '.', '+', "
+                        "no '/' or '..', not starting with '.'", text));
+      return;
+    }
+    out = text;
+  }
+
+  void FileNames(const char* path, std::vector<std::string>& out, size_t count) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || array->size() != count) {
+      Error(node, path, fmt::format("expected an array of {} file names", count));
+      return;
+    }
+    std::vector<std::string> result;
+    for (size_t i = 0; i < count; ++i) {
+      const toml::node& item = *array->get(i);
+      std::string item_path = fmt::format("{}[{}]", path, i);
+      if (!item.is_string() || !IsSafeFileName(item.as_string()->get())) {
+        Error(&item, item_path, "expected a plain file name (letters, digits, '_', '-', '.', '+')");
+        return;
+      }
+      result.push_back(item.as_string()->get());
+    }
+    out = result;
+  }
+
+  // Reports every key of the file that no Visit call asked for.
+  void ReportUnknownKeys() { WalkUnknown(root_, ""); }
+
+ private:
+  const toml::node* Find(const char* path) {
+    known_.insert(path);
+    std::string prefix;
+    for (std::string_view rest = path; !rest.empty();) {  // parent tables are known too
+      size_t dot = rest.find('.');
+      if (dot == std::string_view::npos) break;
+      prefix += std::string(rest.substr(0, dot));
+      known_.insert(prefix);
+      prefix += '.';
+      rest.remove_prefix(dot + 1);
+    }
+    toml::node_view<const toml::node> view = root_.at_path(path);
+    return view.node();
+  }
+
+  void WalkUnknown(const toml::table& table, const std::string& prefix) {
+    for (const auto& [key, node] : table) {
+      std::string path = prefix + std::string(key.str());
+      if (!known_.count(path)) {
+        Error(&node, path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
+        continue;
+      }
+      if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
+    }
+  }
+
+  std::string Suggest(const std::string& path) const {
+    std::string best;
+    int best_distance = 1 << 30;
+    for (const std::string& candidate : known_) {
+      int d = EditDistance(path, candidate);
+      if (d < best_distance) {
+        best_distance = d;
+        best = candidate;
+      }
+    }
+    // Suggest only near misses: at most a third of the key's length.
+    if (best.empty() || best_distance > std::max<int>(2, int(path.size()) / 3)) return "";
+    return fmt::format(" (did you mean '{}'?)", best);
+  }
+
+  static std::string TypeName(const toml::node& node) {
+    switch (node.type()) {
+      case toml::node_type::string: return "a string";
+      case toml::node_type::integer: return "an integer";
+      case toml::node_type::floating_point: return "a number";
+      case toml::node_type::boolean: return "a boolean";
+      case toml::node_type::array: return "an array";
+      case toml::node_type::table: return "a table";
+      default: return "a date or time";
+    }
+  }
+
+  static std::string FormatNumber(double v) { return fmt::format("{}", v); }
+
+  void Error(const toml::node* node, const std::string& path, const std::string& message) {
+    ConfigError e;
+    e.file = file_;
+    if (node && node->source().begin) {
+      e.line = int(node->source().begin.line);
+      e.column = int(node->source().begin.column);
+      if (node->source().path) e.file = *node->source().path;
+    }
+    e.key = path;
+    e.message = message;
+    errors_.push_back(std::move(e));
+  }
+
+  const toml::table& root_;
+  std::string file_;
+  std::vector<ConfigError>& errors_;
+  std::set<std::string> known_;
+};
+
+// --------------------------------------------------------------- writing
+
+class StyleWriter {
+ public:
+  void Real(const char* path, double& v, const Range&) { Put(path, v); }
+  void Triple(const char* path, Rgb& v, const Range&) { Put(path, toml::array{v[0], v[1], v[2]}); }
+  void Int(const char* path, int& v, int, int) { Put(path, int64_t(v)); }
+  void Bool(const char* path, bool& v) { Put(path, v); }
+  template <class T>
+  void Choice(const char* path, T& v, std::initializer_list<std::pair<const char*, T>> choices) {
+    for (const auto& c : choices)
+      if (c.second == v) Put(path, std::string(c.first));
+  }
+  void FileName(const char* path, std::string& v) { Put(path, v); }
+  void FileNames(const char* path, std::vector<std::string>& v, size_t) {
+    toml::array array;
+    for (const std::string& s : v) array.push_back(s);
+    Put(path, std::move(array));
+  }
+  const toml::table& table() const { return root_; }
+
+ private:
+  template <class T>
+  void Put(std::string_view path, T&& value) {
+    toml::table* table = &root_;
+    size_t dot;
+    while ((dot = path.find('.')) != std::string_view::npos) {
+      std::string_view part = path.substr(0, dot);
+      auto [it, inserted] = table->insert(part, toml::table{});
+      table = it->second.as_table();
+      path.remove_prefix(dot + 1);
+    }
+    table->insert_or_assign(path, std::forward<T>(value));
+  }
+  toml::table root_;
+};
+
+// --------------------------------------------------------------- overrides
+
+// Applies "a.b.c=value" on top of `root`. The value is TOML ("0.5", "[1,2,3]",
+// "\"half\""); a bare word that is not valid TOML is taken as a string.
+void ApplyOverride(toml::table& root, const std::string& text, std::vector<ConfigError>& errors) {
+  std::string name = "--set " + text;
+  size_t eq = text.find('=');
+  auto fail = [&](const std::string& message) {
+    ConfigError e;
+    e.file = "--set";
+    e.key = eq == std::string::npos ? text : text.substr(0, eq);
+    e.message = message;
+    errors.push_back(e);
+  };
+  if (eq == std::string::npos || eq == 0) {
+    fail("expected key.path=value, e.g. --set sun.elevation_deg=10");
+    return;
+  }
+  std::string key = text.substr(0, eq);
+  std::string value = text.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value, name);
+  } catch (const toml::parse_error&) {
+    try {
+      parsed = toml::parse("v = \"" + value + "\"", name);
+    } catch (const toml::parse_error& e) {
+      fail(fmt::format("value '{}' is not valid TOML: {}", value, e.description()));
+      return;
+    }
+  }
+  toml::table* table = &root;
+  std::string_view path = key;
+  size_t dot;
+  while ((dot = path.find('.')) != std::string_view::npos) {
+    std::string_view part = path.substr(0, dot);
+    auto [it, inserted] = table->insert(part, toml::table{});
+    if (!it->second.is_table()) {
+      fail(fmt::format("'{}' is not a table", part));
+      return;
+    }
+    table = it->second.as_table();
+    path.remove_prefix(dot + 1);
+  }
+  if (path.empty()) {
+    fail("empty key");
+    return;
+  }
+  table->insert_or_assign(path, std::move(*parsed.get("v")));
+}
+
+}  // namespace
+
+std::string ConfigError::Format() const {
+  std::string where = file;
+  if (line > 0) where += fmt::format(":{}:{}", line, column);
+  return fmt::format("{}: {}: {}", where, key, message);
+}
+
+Rgb OutputScale(OutputUnits units) {
+  if (units == OutputUnits::kSpectral) return {1.0, 1.0, 1.0};
+  // Bruneton 2017, SKY_SPECTRAL_RADIANCE_TO_LUMINANCE (lm/W): 683 lm/W, the
+  // CIE 1931 tables and the XYZ -> sRGB matrix, for 680/550/440 nm samples.
+  return {114974.916437, 71305.954816, 65310.548555};
+}
+
+ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
+                           const std::vector<std::string>& overrides) {
+  ConfigResult result;
+  result.style.source_path = name;
+  toml::table root;
+  try {
+    root = toml::parse(toml_text, name);
+  } catch (const toml::parse_error& e) {
+    ConfigError error;
+    error.file = name;
+    error.line = int(e.source().begin.line);
+    error.column = int(e.source().begin.column);
+    error.key = "(syntax)";
+    error.message = std::string(e.description());
+    result.errors.push_back(error);
+    return result;
+  }
+  for (const std::string& o : overrides) ApplyOverride(root, o, result.errors);
+
+  StyleReader reader(root, name, result.errors);
+  VisitStyle(result.style, reader);
+  reader.ReportUnknownKeys();
+
+  // Cross-field checks, located at the second key.
+  const AtmosphereParams& a = result.style.atmosphere;
+  auto locate = [&](const char* path) {
+    ConfigError e;
+    e.file = name;
+    e.key = path;
+    if (const toml::node* node = root.at_path(path).node(); node && node->source().begin) {
+      e.line = int(node->source().begin.line);
+      e.column = int(node->source().begin.column);
+      if (node->source().path) e.file = *node->source().path;
+    }
+    return e;
+  };
+  if (!(a.top_radius_km > a.bottom_radius_km)) {
+    ConfigError e = locate("atmosphere.top_radius_km");
+    e.message = fmt::format("top radius {} km must be above the bottom radius {} km",
+                            a.top_radius_km, a.bottom_radius_km);
+    result.errors.push_back(e);
+  }
+  for (int c = 0; c < 3; ++c) {
+    if (a.mie_extinction_per_km[c] < a.mie_scattering_per_km[c]) {
+      ConfigError e = locate("atmosphere.mie.extinction_per_km");
+      e.message = fmt::format("extinction {} must be at least the scattering {} (channel {})",
+                              a.mie_extinction_per_km[c], a.mie_scattering_per_km[c], c);
+      result.errors.push_back(e);
+      break;
+    }
+  }
+  if (!result.ok()) return result;
+
+  StyleWriter writer;
+  VisitStyle(result.style, writer);
+  std::ostringstream resolved;
+  resolved << writer.table();
+  result.style.resolved_toml = resolved.str();
+  return result;
+}
+
+ConfigResult LoadSkyStyle(const std::string& path, const std::vector<std::string>& overrides) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    ConfigResult result;
+    ConfigError e;
+    e.file = path;
+    e.key = "(file)";
+    e.message = "cannot open the style file: check the path";
+    result.errors.push_back(e);
+    return result;
+  }
+  std::stringstream text;
+  text << in.rdbuf();
+  return ParseSkyStyle(text.str(), path, overrides);
+}
+
+}  // namespace skybake

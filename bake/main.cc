@@ -1,0 +1,169 @@
+// skybake: bakes physical, art-directable skies into HDR environment maps.
+//
+//   skybake bake <style.toml> [--out DIR] [--size N] [--set key=value ...]
+//   skybake check <style.toml> [--set key=value ...]
+//   skybake devices
+//
+// main reads as the pipeline: parse, validate, bake (device, pipelines,
+// LUTs, render, files, preview), report.
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "skybake/config.h"
+#include "skybake/exr_io.h"
+#include "skybake/pipeline.h"
+#include "skybake/vulkan_context.h"
+
+namespace {
+
+using namespace skybake;
+
+void PrintErrors(const std::vector<ConfigError>& errors) {
+  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", e.Format().c_str());
+  std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
+               errors.size() == 1 ? "" : "s");
+}
+
+bool EnvFlag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v && std::string(v) != "0";
+}
+
+int RunDevices() {
+  std::vector<DeviceInfo> devices = VulkanContext::ListDevices();
+  if (devices.empty()) {
+    std::fprintf(stderr,
+                 "skybake: error: no Vulkan device found; on Debian 'apt-get install libvulkan1 "
+                 "mesa-vulkan-drivers'\n");
+    return kExitVulkan;
+  }
+  for (const DeviceInfo& d : devices) {
+    std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(),
+                d.api_version.c_str(), d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
+  }
+  return kExitOk;
+}
+
+struct BakeArgs {
+  std::string style_path;
+  std::string out_dir = "out";
+  int size = 0;
+  int device = -1;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  bool validation = false;
+};
+
+int RunBake(const BakeArgs& args, bool check_only) {
+  // Parse and validate: every error at once, before any GPU work.
+  std::vector<std::string> overrides = args.overrides;
+  if (args.size > 0) {
+    overrides.push_back(fmt::format("render.cube_size={}", args.size));
+    overrides.push_back(fmt::format("render.latlong_height={}", args.size));
+  }
+  ConfigResult config = LoadSkyStyle(args.style_path, overrides);
+  if (!config.ok()) {
+    PrintErrors(config.errors);
+    return kExitConfig;
+  }
+  if (check_only) {
+    std::printf("%s: ok\n", args.style_path.c_str());
+    return kExitOk;
+  }
+
+  // Bake: device, pipelines, LUTs, render, files, preview.
+  BakeOptions options;
+  options.out_dir = args.out_dir;
+  options.vulkan.device_index = args.device;
+  options.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  if (!args.quiet) {
+    options.progress = [](const StageReport& s) {
+      std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
+    };
+  }
+  BakeResult result = BakeStyle(config.style, options);
+
+  // Report: the files, then anything the validation layer said.
+  for (const BakedFile& f : result.files)
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+  if (result.half_scale != 1.0)
+    std::fprintf(stderr,
+                 "skybake: warning: values exceeded half range; every EXR was scaled by %.9g "
+                 "(recorded as skybake:scale and whiteLuminance)\n",
+                 result.half_scale);
+  if (result.validation_messages > 0) {
+    std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d message%s\n",
+                 result.validation_messages, result.validation_messages == 1 ? "" : "s");
+    return kExitVulkan;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"skybake " SKYBAKE_VERSION
+               ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
+               "into OpenEXR environment maps with Vulkan compute.\n"
+               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style, 4 Vulkan, 5 output."};
+  app.require_subcommand(1);
+  app.get_formatter()->column_width(34);
+
+  BakeArgs args;
+  auto add_style_options = [&](CLI::App* cmd) {
+    cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
+        ->required();
+    cmd->add_option("--set", args.overrides,
+                    "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
+  };
+
+  CLI::App* bake = app.add_subcommand("bake", "Bake a style into EXR cube faces, cube strip, latlong and a PNG preview");
+  add_style_options(bake);
+  bake->add_option("--out", args.out_dir, "Output folder")->capture_default_str();
+  bake->add_option("--size", args.size,
+                   "Cube face size N; also sets the latlong to 2N x N (default: the style's, 512)")
+      ->check(CLI::Range(1, 8192));
+  bake->add_option("--device", args.device, "Vulkan device index from 'skybake devices' (default: best)");
+  bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
+  bake->add_flag("--vulkan-validation", args.validation,
+                 "Load the Khronos validation layer; any message fails the bake (also "
+                 "SKYBAKE_VULKAN_VALIDATION=1)");
+
+  CLI::App* check = app.add_subcommand("check", "Validate a style without baking");
+  add_style_options(check);
+
+  CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+
+  try {
+    if (devices->parsed()) return RunDevices();
+    if (check->parsed()) return RunBake(args, true);
+    return RunBake(args, false);
+  } catch (const VulkanUnavailable& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitVulkan;
+  } catch (const VulkanError& e) {
+    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", e.what());
+    return kExitVulkan;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitOutput;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitOutput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());
+    return kExitInternal;
+  }
+}

@@ -1,0 +1,180 @@
+#include "skybake/reference_model.h"
+
+#include <algorithm>
+#include <thread>
+
+#include <type_traits>
+
+#include <glm/glm.hpp>
+
+namespace skybake {
+namespace reference {
+
+#define SKYBAKE_REAL double
+#include "glsl_compat.h"
+
+// The LUTs the shared code reads through its hooks. Set by the model before
+// each call; thread_local so that worker threads can evaluate in parallel.
+struct LutView {
+  const std::vector<glm::dvec3>* transmittance = nullptr;
+  const std::vector<glm::dvec3>* multiscattering = nullptr;
+  int transmittance_width = 0;
+  int multiscattering_width = 0;
+};
+thread_local LutView g_luts;
+
+vec3 TransmittanceLutTexel(int x, int y) {
+  return (*g_luts.transmittance)[size_t(y) * g_luts.transmittance_width + x];
+}
+vec3 MultipleScatteringLutTexel(int x, int y) {
+  return (*g_luts.multiscattering)[size_t(y) * g_luts.multiscattering_width + x];
+}
+
+#include "atmosphere.glsl"
+#include "envmap.glsl"
+
+}  // namespace reference
+
+struct ReferenceModel::Impl {
+  reference::AtmosphereParameters atm;
+  glm::dvec3 output_scale;
+  std::vector<glm::dvec3> transmittance;
+  std::vector<glm::dvec3> multiscattering;
+
+  void Bind() const {
+    reference::g_luts.transmittance = &transmittance;
+    reference::g_luts.multiscattering = &multiscattering;
+    reference::g_luts.transmittance_width = atm.transmittance_width;
+    reference::g_luts.multiscattering_width = atm.multiscattering_width;
+  }
+};
+
+namespace {
+
+// Runs fn(i) for i in [0, n) on all hardware threads; each thread binds the LUTs.
+template <class Fn>
+void ParallelFor(size_t n, const ReferenceModel::Impl* impl, Fn fn) {
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t) {
+    pool.emplace_back([&, t] {
+      impl->Bind();
+      for (size_t i = t; i < n; i += threads) fn(i);
+    });
+  }
+  for (auto& th : pool) th.join();
+}
+
+glm::dvec3 ToVec(const Rgb& rgb) { return {rgb[0], rgb[1], rgb[2]}; }
+
+}  // namespace
+
+ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings& q,
+                               const EffectSettings& effects, const Rgb& output_scale)
+    : impl_(new Impl) {
+  reference::AtmosphereParameters& atm = impl_->atm;
+  atm.bottom_radius = a.bottom_radius_km;
+  atm.top_radius = a.top_radius_km;
+  atm.observer_altitude = a.observer_altitude_m * 1e-3;
+  atm.rayleigh_scattering = ToVec(a.rayleigh_scattering_per_km);
+  atm.rayleigh_scale_height = a.rayleigh_scale_height_km;
+  atm.mie_scattering = ToVec(a.mie_scattering_per_km);
+  atm.mie_extinction = ToVec(a.mie_extinction_per_km);
+  atm.mie_scale_height = a.mie_scale_height_km;
+  atm.mie_g = a.mie_g;
+  atm.absorption_extinction = ToVec(a.ozone_absorption_per_km);
+  atm.ozone_peak_altitude = a.ozone_peak_altitude_km;
+  atm.ozone_half_width = a.ozone_half_width_km;
+  atm.ground_albedo = ToVec(a.ground_albedo);
+  atm.solar_irradiance = ToVec(a.solar_irradiance);
+  atm.sun_angular_radius = a.sun_angular_radius_rad;
+  atm.limb_darkening = a.limb_darkening_u;
+  atm.transmittance_width = q.transmittance_width;
+  atm.transmittance_height = q.transmittance_height;
+  atm.multiscattering_width = q.multiscattering_size;
+  atm.multiscattering_height = q.multiscattering_size;
+  atm.view_steps = q.view_steps;
+  atm.transmittance_steps = q.transmittance_steps;
+  atm.multiscattering_steps = q.multiscattering_steps;
+  atm.multiscattering_sqrt_dirs = q.multiscattering_sqrt_dirs;
+  atm.integrator = q.integrator;
+  atm.multiple_scattering = effects.multiple_scattering;
+  atm.sun_disc = effects.sun_disc;
+  atm.ground = effects.ground;
+  impl_->output_scale = ToVec(output_scale);
+  impl_->transmittance.assign(size_t(q.transmittance_width) * q.transmittance_height, glm::dvec3(1.0));
+  impl_->multiscattering.assign(size_t(q.multiscattering_size) * q.multiscattering_size, glm::dvec3(0.0));
+}
+
+ReferenceModel::~ReferenceModel() { delete impl_; }
+ReferenceModel::ReferenceModel(ReferenceModel&& other) noexcept : impl_(other.impl_) {
+  other.impl_ = nullptr;
+}
+
+void ReferenceModel::PrecomputeLuts() {
+  const reference::AtmosphereParameters& atm = impl_->atm;
+  int tw = atm.transmittance_width;
+  ParallelFor(impl_->transmittance.size(), impl_, [&](size_t i) {
+    impl_->transmittance[i] = reference::ComputeTransmittanceLutTexel(atm, int(i % tw), int(i / tw));
+  });
+  if (atm.multiple_scattering) {
+    int mw = atm.multiscattering_width;
+    ParallelFor(impl_->multiscattering.size(), impl_, [&](size_t i) {
+      impl_->multiscattering[i] =
+          reference::ComputeMultipleScatteringLutTexel(atm, int(i % mw), int(i / mw));
+    });
+  }
+}
+
+glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& sun) const {
+  impl_->Bind();
+  return reference::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
+}
+
+std::vector<glm::dvec3> ViewDirections(const ViewRequest& v) {
+  std::vector<glm::dvec3> dirs(size_t(v.width) * v.height);
+  for (int y = 0; y < v.height; ++y) {
+    for (int x = 0; x < v.width; ++x) {
+      glm::dvec3 d(0.0, 1.0, 0.0);
+      if (v.mapping == MAPPING_LATLONG)
+        d = reference::DirectionFromLatLongPixel(x, y, v.width, v.height);
+      else if (v.mapping == MAPPING_CUBE_STRIP)
+        d = reference::DirectionFromCubeStripPixel(x, y, v.width);
+      else if (v.mapping == MAPPING_VULKAN_FACE)
+        d = reference::DirectionFromVulkanCubeTexel(v.face, x, y, v.width);
+      dirs[size_t(y) * v.width + x] = d;
+    }
+  }
+  return dirs;
+}
+
+std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const ViewRequest& view) const {
+  std::vector<glm::dvec3> dirs = ViewDirections(view);
+  std::vector<double> image(dirs.size() * 4);
+  ParallelFor(dirs.size(), impl_, [&](size_t i) {
+    glm::dvec3 l = reference::ComputeSkyRadiance(impl_->atm, dirs[i], sun) * impl_->output_scale;
+    image[4 * i + 0] = l.x;
+    image[4 * i + 1] = l.y;
+    image[4 * i + 2] = l.z;
+    image[4 * i + 3] = 1.0;
+  });
+  return image;
+}
+
+glm::dvec3 ReferenceModel::TransmittanceFromLut(double altitude_km, double mu) const {
+  impl_->Bind();
+  double r = impl_->atm.bottom_radius + altitude_km;
+  return reference::GetTransmittanceToTopBoundary(impl_->atm, r, altitude_km, mu);
+}
+
+glm::dvec3 ReferenceModel::TransmittanceDirect(double altitude_km, double mu, int steps) const {
+  double r = impl_->atm.bottom_radius + altitude_km;
+  return glm::exp(-reference::ComputeOpticalDepthToTopBoundary(impl_->atm, r, altitude_km, mu, steps));
+}
+
+const std::vector<glm::dvec3>& ReferenceModel::transmittance_lut() const { return impl_->transmittance; }
+const std::vector<glm::dvec3>& ReferenceModel::multiscattering_lut() const {
+  return impl_->multiscattering;
+}
+
+}  // namespace skybake

@@ -1,0 +1,366 @@
+#include "skybake/sky_renderer.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include "shaders/multiscattering_lut.spv.h"
+#include "shaders/sky_render.spv.h"
+#include "shaders/transmittance_lut.spv.h"
+
+namespace skybake {
+namespace {
+
+uint32_t GroupCount(int texels, int local_size) {
+  return uint32_t((texels + local_size - 1) / local_size);
+}
+
+}  // namespace
+
+SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
+                         const QualitySettings& quality, const EffectSettings& effects,
+                         const Rgb& output_scale, bool output_directions)
+    : context_(context), effects_(effects), output_directions_(output_directions) {
+  gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
+  VkDevice device = context_.device();
+
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  transmittance_buffer_ = CreateBuffer(
+      VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
+  multiscattering_buffer_ = CreateBuffer(
+      VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
+  output_buffer_ = CreateBuffer(16 * 64, storage);
+
+  VkDescriptorSetLayoutBinding bindings[4] = {};
+  for (uint32_t i = 0; i < 4; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType =
+        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set_info.bindingCount = 4;
+  set_info.pBindings = bindings;
+  VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout_));
+
+  VkPushConstantRange push_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::SkyPush)};
+  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout_info.setLayoutCount = 1;
+  layout_info.pSetLayouts = &set_layout_;
+  layout_info.pushConstantRangeCount = 1;
+  layout_info.pPushConstantRanges = &push_range;
+  VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
+
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}};
+  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 2;
+  pool_info.pPoolSizes = pool_sizes;
+  VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &descriptor_pool_));
+  VkDescriptorSetAllocateInfo alloc_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc_info.descriptorPool = descriptor_pool_;
+  alloc_info.descriptorSetCount = 1;
+  alloc_info.pSetLayouts = &set_layout_;
+  VK_CHECK(vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
+  UpdateDescriptors();
+
+  // Pipelines are built once per renderer, never per frame.
+  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv), false);
+  multiscattering_pipeline_ =
+      CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv), false);
+  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), true);
+
+  VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  command_pool_info.queueFamilyIndex = context_.queue_family();
+  VK_CHECK(vkCreateCommandPool(device, &command_pool_info, nullptr, &command_pool_));
+  VkCommandBufferAllocateInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cb_info.commandPool = command_pool_;
+  cb_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cb_info.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(device, &cb_info, &command_buffer_));
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_));
+
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, families.data());
+  timestamps_supported_ = families[context_.queue_family()].timestampValidBits > 0 &&
+                          context_.properties().limits.timestampPeriod > 0.0f;
+}
+
+SkyRenderer::~SkyRenderer() {
+  VkDevice device = context_.device();
+  vkDeviceWaitIdle(device);
+  if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
+  vkDestroyFence(device, fence_, nullptr);
+  vkDestroyCommandPool(device, command_pool_, nullptr);
+  vkDestroyPipeline(device, sky_pipeline_, nullptr);
+  vkDestroyPipeline(device, multiscattering_pipeline_, nullptr);
+  vkDestroyPipeline(device, transmittance_pipeline_, nullptr);
+  vkDestroyDescriptorPool(device, descriptor_pool_, nullptr);
+  vkDestroyPipelineLayout(device, pipeline_layout_, nullptr);
+  vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
+  DestroyBuffer(output_buffer_);
+  DestroyBuffer(multiscattering_buffer_);
+  DestroyBuffer(transmittance_buffer_);
+  DestroyBuffer(atmosphere_buffer_);
+}
+
+SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
+  VkDevice device = context_.device();
+  Buffer b;
+  b.size = size;
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VK_CHECK(vkCreateBuffer(device, &info, nullptr, &b.buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, b.buffer, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  // Host-visible so results are read without a staging copy; cached memory
+  // makes the read-back fast where the device offers it.
+  alloc.memoryTypeIndex = context_.FindMemoryType(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+      VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+  VkResult result = vkAllocateMemory(device, &alloc, nullptr, &b.memory);
+  if (result != VK_SUCCESS) {
+    vkDestroyBuffer(device, b.buffer, nullptr);
+    throw VulkanError("cannot allocate " + std::to_string(size >> 20) +
+                          " MiB of Vulkan memory (" + VkResultName(result) +
+                          "): lower render.cube_size or render.latlong_height",
+                      result);
+  }
+  VK_CHECK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
+  VK_CHECK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  return b;
+}
+
+void SkyRenderer::DestroyBuffer(Buffer& b) {
+  VkDevice device = context_.device();
+  if (b.mapped) vkUnmapMemory(device, b.memory);
+  if (b.buffer) vkDestroyBuffer(device, b.buffer, nullptr);
+  if (b.memory) vkFreeMemory(device, b.memory, nullptr);
+  b = Buffer{};
+}
+
+void SkyRenderer::EnsureOutputCapacity(VkDeviceSize bytes) {
+  if (bytes <= output_buffer_.size) return;
+  DestroyBuffer(output_buffer_);
+  output_buffer_ = CreateBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  UpdateDescriptors();
+}
+
+void SkyRenderer::UpdateDescriptors() {
+  VkDescriptorBufferInfo infos[4] = {
+      {atmosphere_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {transmittance_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {multiscattering_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
+  };
+  VkWriteDescriptorSet writes[4] = {};
+  for (uint32_t i = 0; i < 4; ++i) {
+    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[i].dstSet = descriptor_set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType =
+        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_.device(), 4, writes, 0, nullptr);
+}
+
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool specialize_effects) {
+  VkDevice device = context_.device();
+  VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  module_info.codeSize = bytes;
+  module_info.pCode = code;
+  VkShaderModule module;
+  VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
+
+  // Specialization constants 0..3 of common.glsl: the optional effects.
+  VkBool32 values[4] = {effects_.multiple_scattering, effects_.sun_disc, effects_.ground,
+                        output_directions_};
+  VkSpecializationMapEntry entries[4];
+  for (uint32_t i = 0; i < 4; ++i) entries[i] = {i, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32)};
+  VkSpecializationInfo specialization{4, entries, sizeof(values), values};
+
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = specialize_effects ? &specialization : nullptr;
+  info.layout = pipeline_layout_;
+  VkPipeline pipeline;
+  VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(device, module, nullptr);
+  VK_CHECK(result);
+  return pipeline;
+}
+
+void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
+                         const std::vector<bool>& barrier_after) {
+  VkDevice device = context_.device();
+  uint32_t queries = uint32_t(2 * dispatches.size());
+  if (timestamps_supported_ && queries > query_capacity_) {
+    if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
+    VkQueryPoolCreateInfo qinfo{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qinfo.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qinfo.queryCount = std::max<uint32_t>(queries, 16);
+    VK_CHECK(vkCreateQueryPool(device, &qinfo, nullptr, &query_pool_));
+    query_capacity_ = qinfo.queryCount;
+  }
+
+  VK_CHECK(vkResetCommandBuffer(command_buffer_, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(command_buffer_, &begin));
+  if (timestamps_supported_) vkCmdResetQueryPool(command_buffer_, query_pool_, 0, queries);
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1,
+                          &descriptor_set_, 0, nullptr);
+  for (size_t i = 0; i < dispatches.size(); ++i) {
+    const Dispatch& d = dispatches[i];
+    if (timestamps_supported_)
+      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * i));
+    vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, d.pipeline);
+    vkCmdPushConstants(command_buffer_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       sizeof(gpu::SkyPush), &d.push);
+    vkCmdDispatch(command_buffer_, d.groups_x, d.groups_y, 1);
+    if (timestamps_supported_)
+      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, query_pool_,
+                          uint32_t(2 * i + 1));
+    if (barrier_after[i]) {
+      // Orders this dispatch's LUT writes before the next dispatch's LUT reads.
+      VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+      vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+    }
+  }
+  // Makes every shader write of the submission visible to host reads after the fence.
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+  VK_CHECK(vkEndCommandBuffer(command_buffer_));
+
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer_;
+  VK_CHECK(vkResetFences(device, 1, &fence_));
+  VK_CHECK(vkQueueSubmit(context_.queue(), 1, &submit, fence_));
+  VK_CHECK(vkWaitForFences(device, 1, &fence_, VK_TRUE, UINT64_MAX));
+
+  timings_.clear();
+  std::vector<uint64_t> stamps(queries, 0);
+  if (timestamps_supported_ && queries > 0)
+    VK_CHECK(vkGetQueryPoolResults(device, query_pool_, 0, queries, stamps.size() * sizeof(uint64_t),
+                                   stamps.data(), sizeof(uint64_t),
+                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  double period_ns = context_.properties().limits.timestampPeriod;
+  for (size_t i = 0; i < dispatches.size(); ++i) {
+    PassTiming t;
+    t.name = dispatches[i].name;
+    if (timestamps_supported_) t.gpu_ms = double(stamps[2 * i + 1] - stamps[2 * i]) * period_ns * 1e-6;
+    timings_.push_back(t);
+  }
+}
+
+void SkyRenderer::PrecomputeLuts() {
+  std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  gpu::SkyPush push{};
+  dispatches.push_back({"transmittance LUT", transmittance_pipeline_, push,
+                        GroupCount(gpu_atmosphere_.lut_sizes.x, SKYBAKE_LOCAL_SIZE_X),
+                        GroupCount(gpu_atmosphere_.lut_sizes.y, SKYBAKE_LOCAL_SIZE_Y)});
+  barriers.push_back(true);
+  if (effects_.multiple_scattering) {
+    dispatches.push_back({"multiple-scattering LUT", multiscattering_pipeline_, push,
+                          GroupCount(gpu_atmosphere_.lut_sizes.z, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(gpu_atmosphere_.lut_sizes.w, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+  }
+  Submit(dispatches, barriers);
+  ++counters_.transmittance_lut_builds;
+  if (effects_.multiple_scattering) ++counters_.multiscattering_lut_builds;
+  luts_ready_ = true;
+}
+
+std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
+                                                    const std::vector<ViewRequest>& views) {
+  if (!luts_ready_ && !output_directions_) PrecomputeLuts();
+  std::vector<size_t> offsets;
+  size_t total = 0;
+  for (const ViewRequest& v : views) {
+    offsets.push_back(total);
+    total += size_t(v.width) * v.height;
+  }
+  EnsureOutputCapacity(std::max<size_t>(total, 1) * 16);
+
+  static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+  std::vector<Dispatch> dispatches;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewRequest& v = views[i];
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    push.view = {v.mapping, v.width, v.height, v.face};
+    push.offsets = {int32_t(offsets[i]), 0, 0, 0};
+    std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
+                       : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
+                                                          : "directions";
+    dispatches.push_back({name, sky_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
+  }
+  // Views write disjoint ranges of the output buffer: no barriers between them.
+  Submit(dispatches, std::vector<bool>(dispatches.size(), false));
+  ++counters_.frames;
+
+  std::vector<std::vector<float>> images;
+  const float* data = static_cast<const float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < views.size(); ++i) {
+    size_t count = size_t(views[i].width) * views[i].height * 4;
+    images.emplace_back(data + offsets[i] * 4, data + offsets[i] * 4 + count);
+  }
+  return images;
+}
+
+std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
+                                                 const std::vector<glm::dvec3>& directions) {
+  if (!luts_ready_) PrecomputeLuts();
+  EnsureOutputCapacity(std::max<size_t>(directions.size(), 1) * 16);
+  float* data = static_cast<float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < directions.size(); ++i) {
+    data[4 * i + 0] = float(directions[i].x);
+    data[4 * i + 1] = float(directions[i].y);
+    data[4 * i + 2] = float(directions[i].z);
+    data[4 * i + 3] = 0.0f;
+  }
+  ViewRequest view;
+  view.mapping = MAPPING_DIRECTIONS;
+  view.width = int(directions.size());
+  view.height = 1;
+  return Render(sun, {view})[0];
+}
+
+std::vector<float> SkyRenderer::ReadTransmittanceLut() const {
+  const float* data = static_cast<const float*>(transmittance_buffer_.mapped);
+  return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.x) * gpu_atmosphere_.lut_sizes.y * 4);
+}
+
+std::vector<float> SkyRenderer::ReadMultipleScatteringLut() const {
+  const float* data = static_cast<const float*>(multiscattering_buffer_.mapped);
+  return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.z) * gpu_atmosphere_.lut_sizes.w * 4);
+}
+
+}  // namespace skybake

@@ -1,0 +1,77 @@
+// The physical atmosphere and the sky render settings, as the host sees them.
+//
+// Frame: +Y up, right-handed; North = -Z, East = +X (so +Z is South).
+// Units are in the field names: lengths in km unless named _m, scattering
+// and absorption coefficients in km^-1, angles in degrees unless named _rad.
+// Defaults are the Earth values of Hillaire 2020 (demo) and Bruneton 2017
+// (precomputed_atmospheric_scattering, demo.cc), as collected in
+// shared/CONVENTIONS.md. RGB triplets are the wavelengths 680, 550, 440 nm.
+#pragma once
+
+#include <array>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/gpu_shared.h"
+
+namespace skybake {
+
+using Rgb = std::array<double, 3>;
+
+struct AtmosphereParams {
+  double bottom_radius_km = 6360.0;  // Hillaire 2020 and Bruneton 2017
+  double top_radius_km = 6460.0;     // Hillaire 2020 (Bruneton 2017: 6420)
+  double observer_altitude_m = 0.0;  // above bottom_radius_km
+  Rgb ground_albedo = {0.1, 0.1, 0.1};  // Bruneton 2017 (Hillaire 2020: 0)
+
+  Rgb rayleigh_scattering_per_km = {5.802e-3, 13.558e-3, 33.100e-3};  // both papers
+  double rayleigh_scale_height_km = 8.0;
+
+  Rgb mie_scattering_per_km = {3.996e-3, 3.996e-3, 3.996e-3};  // both papers
+  Rgb mie_extinction_per_km = {4.440e-3, 4.440e-3, 4.440e-3};  // scattering + absorption
+  double mie_scale_height_km = 1.2;
+  double mie_g = 0.8;  // Cornette-Shanks anisotropy, Bruneton 2017
+
+  Rgb ozone_absorption_per_km = {0.650e-3, 1.881e-3, 0.085e-3};  // at the peak, both papers
+  double ozone_peak_altitude_km = 25.0;  // tent: 0 at 10 km, 1 at 25 km, 0 at 40 km
+  double ozone_half_width_km = 15.0;
+
+  // Solar irradiance at the top of the atmosphere, W m^-2 nm^-1
+  // (Bruneton 2017 demo; Hillaire 2020 normalises it to 1).
+  Rgb solar_irradiance = {1.474, 1.8504, 1.91198};
+  double sun_angular_radius_rad = 0.004675;  // both papers
+  // Linear limb-darkening coefficient u, I(m) = I0 (1 - u (1 - m)):
+  // 0.6 is the classical visible-band value (Eddington approximation).
+  double limb_darkening_u = 0.6;
+};
+
+// Integration settings. The defaults are the `production` preset.
+struct QualitySettings {
+  int view_steps = 48;                // ray-march steps per output texel
+  int transmittance_steps = 256;      // quadrature points per transmittance texel
+  int multiscattering_steps = 20;     // Hillaire 2020 uses 20
+  int multiscattering_sqrt_dirs = 8;  // 64 directions, Hillaire 2020
+  int transmittance_width = 256;      // Hillaire 2020: 256 x 64
+  int transmittance_height = 64;
+  int multiscattering_size = 32;      // Hillaire 2020: 32 x 32
+  int integrator = INTEGRATOR_ANALYTIC;
+};
+
+// Optional physical effects; each off effect is compiled out of the shaders.
+struct EffectSettings {
+  bool multiple_scattering = true;
+  bool sun_disc = true;
+  bool ground = true;
+};
+
+// Unit vector towards the Sun from its elevation above the horizon and its
+// azimuth clockwise from North (compass bearing), in degrees.
+glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth_deg);
+
+// Packs the parameters into the uniform block the shaders read. `output_scale`
+// multiplies radiance per channel (see OutputUnits in config.h).
+gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& atmosphere,
+                                   const QualitySettings& quality,
+                                   const EffectSettings& effects, const Rgb& output_scale);
+
+}  // namespace skybake

@@ -1,0 +1,57 @@
+// Writing OpenEXR environment maps and PNG previews, safely: each file is
+// written under a temporary name in its destination folder and renamed into
+// place only once complete, so a crash never leaves a truncated file.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "skybake/config.h"
+
+namespace skybake {
+
+// A file could not be written, or a value cannot be represented.
+class OutputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// RGBA float pixels, rows from the top.
+struct RgbaImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> rgba;
+};
+
+constexpr double kHalfMax = 65504.0;
+
+struct ExrWriteOptions {
+  PixelType pixel_type = PixelType::kHalf;
+  std::string compression = "zip";
+  int envmap = -1;               // -1: none; 0: ENVMAP_LATLONG; 1: ENVMAP_CUBE
+  double scale = 1.0;            // multiplies every value before writing
+  double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
+  std::map<std::string, std::string> attributes;  // provenance string attributes
+};
+
+// Largest value over the RGB channels of the images; throws OutputError if
+// any value is NaN, infinite or negative (never written).
+double CheckedMaxValue(const std::vector<const RgbaImage*>& images);
+
+// The power-of-two scale that brings `max_value` within half range, 1 when it
+// already fits; with OverflowPolicy::kRefuse, throws OutputError instead.
+double HalfRangeScale(double max_value, OverflowPolicy policy);
+
+// Writes R, G, B channels; returns the size of the written file in bytes.
+uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options);
+
+// Writes an 8-bit sRGB PNG through OpenImageIO.
+uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+
+// Temporary name beside `path` for a write in progress (hidden, pid-tagged).
+std::string TemporaryPathFor(const std::string& path);
+
+}  // namespace skybake

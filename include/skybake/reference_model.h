@@ -1,0 +1,53 @@
+// The double-precision CPU reference of the sky renderer. It compiles the
+// same shared source as the shaders (shaders/atmosphere.glsl and
+// shaders/envmap.glsl) with Real = double, so every function has the same
+// name and structure on both sides and tests can put them side by side.
+// Tests use it; bakes do not.
+#pragma once
+
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/atmosphere.h"
+#include "skybake/sky_renderer.h"
+
+namespace skybake {
+
+class ReferenceModel {
+ public:
+  ReferenceModel(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                 const EffectSettings& effects, const Rgb& output_scale);
+  ~ReferenceModel();
+  ReferenceModel(ReferenceModel&&) noexcept;
+
+  // Builds the LUTs (multi-threaded over texels).
+  void PrecomputeLuts();
+
+  // Radiance times output_scale along unit `view` with the Sun along unit `sun`.
+  glm::dvec3 Radiance(const glm::dvec3& view, const glm::dvec3& sun) const;
+
+  // RGBA image of one view, as SkyRenderer::Render returns it.
+  std::vector<double> RenderView(const glm::dvec3& sun, const ViewRequest& view) const;
+
+  // Transmittance from altitude (km) to the top along mu, read from the LUT,
+  // and computed directly with `steps` quadrature points.
+  glm::dvec3 TransmittanceFromLut(double altitude_km, double mu) const;
+  glm::dvec3 TransmittanceDirect(double altitude_km, double mu, int steps) const;
+
+  const std::vector<glm::dvec3>& transmittance_lut() const;
+  const std::vector<glm::dvec3>& multiscattering_lut() const;
+
+ // Implementation (the shared code instantiated in double); public so that
+  // helpers in reference_model.cc can name it.
+  struct Impl;
+
+ private:
+  Impl* impl_;
+};
+
+// Direction of each texel of a view, from the shared mapping code in double
+// precision (rows from the top).
+std::vector<glm::dvec3> ViewDirections(const ViewRequest& view);
+
+}  // namespace skybake

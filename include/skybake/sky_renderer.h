@@ -1,0 +1,121 @@
+// The GPU sky renderer: builds the transmittance and multiple-scattering LUTs
+// once per atmosphere, then renders any number of output views (latlong,
+// cube strip, Vulkan cube faces, explicit directions) per sun position, all
+// views of a frame in one submission. Each pass is timed with GPU timestamps.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/atmosphere.h"
+#include "skybake/vulkan_context.h"
+
+namespace skybake {
+
+// One output view. `mapping` is a MAPPING_* of gpu_shared.h.
+struct ViewRequest {
+  int mapping = MAPPING_LATLONG;
+  int width = 0;
+  int height = 0;
+  int face = 0;  // MAPPING_VULKAN_FACE: 0..5 = +X -X +Y -Y +Z -Z
+};
+
+struct PassTiming {
+  std::string name;
+  double gpu_ms = 0.0;  // from timestamps; 0 when the device has none
+};
+
+// What the renderer has done, for tests and progress reports.
+struct RenderCounters {
+  int transmittance_lut_builds = 0;
+  int multiscattering_lut_builds = 0;
+  int frames = 0;
+};
+
+class SkyRenderer {
+ public:
+  // With `output_directions`, views contain the unit direction of each texel
+  // (xyz) instead of radiance: the shader-side mapping, for tests.
+  SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
+              const QualitySettings& quality, const EffectSettings& effects,
+              const Rgb& output_scale, bool output_directions = false);
+  ~SkyRenderer();
+  SkyRenderer(const SkyRenderer&) = delete;
+  SkyRenderer& operator=(const SkyRenderer&) = delete;
+
+  // Builds the transmittance LUT, then the multiple-scattering LUT (only when
+  // multiple scattering is on). Called automatically by the first Render.
+  void PrecomputeLuts();
+
+  // Renders every view for the sun direction (unit, towards the Sun) and
+  // returns one RGBA float image per view, rows from the top.
+  std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
+                                         const std::vector<ViewRequest>& views);
+
+  // Radiance (RGBA) along each unit direction.
+  std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
+                                      const std::vector<glm::dvec3>& directions);
+
+  // LUT contents (RGBA float per texel, row-major), for tests.
+  std::vector<float> ReadTransmittanceLut() const;
+  std::vector<float> ReadMultipleScatteringLut() const;
+
+  const std::vector<PassTiming>& last_timings() const { return timings_; }
+  const RenderCounters& counters() const { return counters_; }
+
+ private:
+  struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+  };
+  struct Dispatch {
+    std::string name;
+    VkPipeline pipeline;
+    gpu::SkyPush push;
+    uint32_t groups_x, groups_y;
+  };
+
+  Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  void DestroyBuffer(Buffer& buffer);
+  void EnsureOutputCapacity(VkDeviceSize bytes);
+  void UpdateDescriptors();
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool specialize_effects);
+  // Records the dispatches into one command buffer, submits, waits, and
+  // records per-dispatch timings. A barrier follows every dispatch that a
+  // later one reads (`barrier_after`).
+  void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
+
+  VulkanContext& context_;
+  gpu::GpuAtmosphere gpu_atmosphere_{};
+  EffectSettings effects_;
+  bool output_directions_ = false;
+  bool luts_ready_ = false;
+
+  Buffer atmosphere_buffer_;
+  Buffer transmittance_buffer_;
+  Buffer multiscattering_buffer_;
+  Buffer output_buffer_;
+
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
+  VkPipeline transmittance_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool query_pool_ = VK_NULL_HANDLE;
+  uint32_t query_capacity_ = 0;
+  bool timestamps_supported_ = false;
+
+  std::vector<PassTiming> timings_;
+  RenderCounters counters_;
+};
+
+}  // namespace skybake

@@ -1,0 +1,107 @@
+// Headless Vulkan compute context: instance, one physical device, one compute
+// queue. No window, no surface.
+//
+// Device choice: a discrete GPU, else an integrated GPU, else a virtual GPU,
+// else the CPU implementation (Mesa lavapipe). Every rejected device is
+// listed with the reason. With validation on, the Khronos validation layer is
+// loaded and every message it emits is counted and printed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace skybake {
+
+// No usable Vulkan driver or device: the message names the package to install.
+class VulkanUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A Vulkan call failed (out of memory, device lost, ...).
+class VulkanError : public std::runtime_error {
+ public:
+  VulkanError(const std::string& what, VkResult result)
+      : std::runtime_error(what), result(result) {}
+  VkResult result;
+};
+
+const char* VkResultName(VkResult result);
+
+#define VK_CHECK(call)                                                                   \
+  do {                                                                                   \
+    VkResult vk_check_result_ = (call);                                                  \
+    if (vk_check_result_ != VK_SUCCESS)                                                  \
+      throw ::skybake::VulkanError(std::string(#call) + " failed with " +                \
+                                       ::skybake::VkResultName(vk_check_result_) + " at " + \
+                                       __FILE__ + ":" + std::to_string(__LINE__),        \
+                                   vk_check_result_);                                    \
+  } while (0)
+
+struct DeviceInfo {
+  int index = 0;
+  std::string name;
+  std::string type;  // "discrete GPU", "integrated GPU", "virtual GPU", "CPU", "other"
+  std::string api_version;
+  std::string driver;
+  bool usable = false;
+  std::string rejected_because;  // empty when usable
+};
+
+struct VulkanOptions {
+  int device_index = -1;      // -1: choose the best usable device
+  bool validation = false;    // load VK_LAYER_KHRONOS_validation
+  bool print_messages = true; // print validation messages to stderr
+};
+
+class VulkanContext {
+ public:
+  explicit VulkanContext(const VulkanOptions& options);
+  ~VulkanContext();
+  VulkanContext(const VulkanContext&) = delete;
+  VulkanContext& operator=(const VulkanContext&) = delete;
+
+  // Lists every physical device and whether it can run skybake.
+  static std::vector<DeviceInfo> ListDevices();
+
+  VkDevice device() const { return device_; }
+  VkPhysicalDevice physical_device() const { return physical_device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queue_family() const { return queue_family_; }
+  const DeviceInfo& device_info() const { return device_info_; }
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+
+  // Number of validation messages (warnings and errors) seen so far.
+  int validation_message_count() const { return validation_messages_; }
+  const std::vector<std::string>& validation_messages() const { return messages_; }
+
+  // Memory type with all `required` flags among `type_bits`; prefers `preferred` too.
+  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
+                          VkMemoryPropertyFlags preferred) const;
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL DebugCallback(
+      VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT types,
+      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  DeviceInfo device_info_;
+  bool print_messages_ = true;
+  int validation_messages_ = 0;
+  std::vector<std::string> messages_;
+};
+
+}  // namespace skybake

@@ -1,0 +1,475 @@
+// The physical atmosphere, written once in the common GLSL/C++ subset (see
+// glsl_prelude.glsl). The compute shaders include it with Real = float; the
+// CPU reference (bake/reference_model.cc) includes it with Real = double.
+//
+// Model: Hillaire 2020, "A Scalable and Production Ready Sky and Atmosphere
+// Rendering Technique" (EGSR 2020), with the LUT parametrisation of Bruneton
+// 2017 ("precomputed_atmospheric_scattering"):
+//   - Rayleigh scattering, exponential density, no absorption;
+//   - Mie scattering and absorption, exponential density, Cornette-Shanks phase;
+//   - ozone absorption in a tent profile (no scattering);
+//   - transmittance LUT (r, mu), multiple-scattering LUT (altitude, mu_s),
+//     and the in-scattered radiance ray-marched per output texel.
+//
+// Frames and units: lengths in km, coefficients in km^-1, angles in radians.
+// Positions are planet-centred; the observer stands on the +Y axis, so the
+// local zenith is +Y. r = distance to the planet centre, mu = cosine of the
+// view zenith angle, mu_s = cosine of the sun zenith angle, nu = cosine of the
+// angle between the view and sun directions.
+//
+// Numerical care (Earth scale in float32):
+//   - r is always carried together with `altitude` = r - bottom_radius, and
+//     every difference of nearly equal radii is formed from altitudes;
+//   - ray-sphere distances use the root that involves no subtraction of
+//     nearly equal terms (the "q" form of the quadratic);
+//   - 1 - nu and 1 + nu come from |v - s|^2 / 2 and |v + s|^2 / 2.
+//
+// Hooks each side must define before including this file:
+//   vec3 TransmittanceLutTexel(int x, int y);
+//   vec3 MultipleScatteringLutTexel(int x, int y);
+#ifndef SKYBAKE_ATMOSPHERE_GLSL
+#define SKYBAKE_ATMOSPHERE_GLSL
+
+CONST_REAL kPi = 3.14159265358979323846;
+
+struct AtmosphereParameters {
+  Real bottom_radius;           // km, planet radius
+  Real top_radius;              // km, top of the atmosphere
+  Real observer_altitude;       // km above bottom_radius
+  vec3 rayleigh_scattering;     // km^-1 at altitude 0
+  Real rayleigh_scale_height;   // km
+  vec3 mie_scattering;          // km^-1 at altitude 0
+  vec3 mie_extinction;          // km^-1 at altitude 0 (scattering + absorption)
+  Real mie_scale_height;        // km
+  Real mie_g;                   // Cornette-Shanks anisotropy, in (-1, 1)
+  vec3 absorption_extinction;   // ozone, km^-1 at the tent peak
+  Real ozone_peak_altitude;     // km
+  Real ozone_half_width;        // km
+  vec3 ground_albedo;           // Lambertian, unitless
+  vec3 solar_irradiance;        // at the top of the atmosphere, output units
+  Real sun_angular_radius;      // rad
+  Real limb_darkening;          // u of the linear law I(m) = I0 (1 - u (1 - m))
+  int transmittance_width;      // texels along mu
+  int transmittance_height;     // texels along r
+  int multiscattering_width;    // texels along mu_s
+  int multiscattering_height;   // texels along altitude
+  int view_steps;               // ray-march steps per output texel
+  int transmittance_steps;      // quadrature points per transmittance texel
+  int multiscattering_steps;    // ray-march steps per multi-scattering direction
+  int multiscattering_sqrt_dirs;// directions per multi-scattering texel = this^2
+  int integrator;               // INTEGRATOR_* of gpu_shared.h
+  bool multiple_scattering;     // add Hillaire's multiple-scattering term
+  bool sun_disc;                // add the limb-darkened solar disc
+  bool ground;                  // add the sunlit Lambertian ground
+};
+
+// ---------------------------------------------------------------- medium
+
+struct MediumSample {
+  vec3 rayleigh_scattering;  // km^-1
+  vec3 mie_scattering;       // km^-1
+  vec3 extinction;           // km^-1, all three constituents
+};
+
+MediumSample SampleMedium(IN(AtmosphereParameters) atm, Real altitude) {
+  Real h = max(altitude, 0.0);
+  Real rayleigh_density = exp(-h / atm.rayleigh_scale_height);
+  Real mie_density = exp(-h / atm.mie_scale_height);
+  Real ozone_density =
+      max(0.0, 1.0 - abs(h - atm.ozone_peak_altitude) / atm.ozone_half_width);
+  MediumSample m;
+  m.rayleigh_scattering = atm.rayleigh_scattering * rayleigh_density;
+  m.mie_scattering = atm.mie_scattering * mie_density;
+  m.extinction = m.rayleigh_scattering + atm.mie_extinction * mie_density +
+                 atm.absorption_extinction * ozone_density;
+  return m;
+}
+
+// ---------------------------------------------------------------- geometry
+
+Real ClampCosine(Real mu) { return clamp(mu, -1.0, 1.0); }
+
+// Altitude of the point at distance t along the ray (r, mu), from
+// r_t^2 - R_b^2 = altitude (r + R_b) + t (2 r mu + t), without forming
+// r_t - R_b from two nearly equal radii.
+Real AltitudeAlongRay(IN(AtmosphereParameters) atm, Real r, Real altitude, Real mu,
+                      Real t) {
+  Real excess = altitude * (r + atm.bottom_radius) + t * (2.0 * r * mu + t);
+  Real r_t = sqrt(max(atm.bottom_radius * atm.bottom_radius + excess, 0.0));
+  return excess / (r_t + atm.bottom_radius);
+}
+
+// Distance from a point inside the atmosphere (r <= top_radius) to the top
+// boundary along mu. The discriminant is (R_t - r)(R_t + r) + (r mu)^2.
+Real DistanceToTopBoundary(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                           Real mu) {
+  Real top_minus_r = max((atm.top_radius - atm.bottom_radius) - altitude, 0.0);
+  Real c = top_minus_r * (atm.top_radius + r);  // R_t^2 - r^2 >= 0
+  Real discriminant = c + (r * mu) * (r * mu);
+  Real root = sqrt(max(discriminant, 0.0));
+  if (mu > 0.0) return c / (root + r * mu);
+  return root - r * mu;
+}
+
+// True when the ray (r, mu) hits the ground.
+bool RayIntersectsGround(IN(AtmosphereParameters) atm, Real r, Real altitude, Real mu) {
+  Real discriminant = (r * mu) * (r * mu) - altitude * (r + atm.bottom_radius);
+  return mu < 0.0 && discriminant >= 0.0;
+}
+
+// Distance to the ground along a ray that hits it (RayIntersectsGround).
+Real DistanceToBottomBoundary(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                              Real mu) {
+  Real c = altitude * (r + atm.bottom_radius);  // r^2 - R_b^2 >= 0
+  Real discriminant = max((r * mu) * (r * mu) - c, 0.0);
+  return c / (sqrt(discriminant) - r * mu);
+}
+
+// For an observer above the top boundary: distance to where the ray enters
+// the atmosphere, or -1 when it misses it.
+Real DistanceToAtmosphereEntry(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                               Real mu) {
+  Real c = (altitude - (atm.top_radius - atm.bottom_radius)) * (r + atm.top_radius);
+  Real discriminant = (r * mu) * (r * mu) - c;
+  if (mu >= 0.0 || discriminant < 0.0) return -1.0;
+  return c / (sqrt(discriminant) - r * mu);
+}
+
+// ---------------------------------------------------------------- LUT access
+
+// Maps [0, 1] to texel-centre coordinates of a texture of `size` texels, so
+// that 0 and 1 fall on the centres of the first and last texels.
+Real TextureCoordFromUnitRange(Real x, int size) {
+  return 0.5 / Real(size) + x * (1.0 - 1.0 / Real(size));
+}
+
+Real UnitRangeFromTextureCoord(Real u, int size) {
+  return (u - 0.5 / Real(size)) / (1.0 - 1.0 / Real(size));
+}
+
+// Bilinear interpolation computed by hand from texel fetches (hardware
+// filtering quantises its weights to 1/256 on lavapipe).
+vec3 SampleTransmittanceLut(IN(AtmosphereParameters) atm, vec2 uv) {
+  Real x = clamp(uv.x, 0.0, 1.0) * Real(atm.transmittance_width) - 0.5;
+  Real y = clamp(uv.y, 0.0, 1.0) * Real(atm.transmittance_height) - 0.5;
+  Real x0f = clamp(floor(x), 0.0, Real(atm.transmittance_width - 1));
+  Real y0f = clamp(floor(y), 0.0, Real(atm.transmittance_height - 1));
+  Real fx = clamp(x - x0f, 0.0, 1.0);
+  Real fy = clamp(y - y0f, 0.0, 1.0);
+  int x0 = int(x0f);
+  int y0 = int(y0f);
+  int x1 = min(x0 + 1, atm.transmittance_width - 1);
+  int y1 = min(y0 + 1, atm.transmittance_height - 1);
+  vec3 a = mix(TransmittanceLutTexel(x0, y0), TransmittanceLutTexel(x1, y0), fx);
+  vec3 b = mix(TransmittanceLutTexel(x0, y1), TransmittanceLutTexel(x1, y1), fx);
+  return mix(a, b, fy);
+}
+
+vec3 SampleMultipleScatteringLut(IN(AtmosphereParameters) atm, vec2 uv) {
+  Real x = clamp(uv.x, 0.0, 1.0) * Real(atm.multiscattering_width) - 0.5;
+  Real y = clamp(uv.y, 0.0, 1.0) * Real(atm.multiscattering_height) - 0.5;
+  Real x0f = clamp(floor(x), 0.0, Real(atm.multiscattering_width - 1));
+  Real y0f = clamp(floor(y), 0.0, Real(atm.multiscattering_height - 1));
+  Real fx = clamp(x - x0f, 0.0, 1.0);
+  Real fy = clamp(y - y0f, 0.0, 1.0);
+  int x0 = int(x0f);
+  int y0 = int(y0f);
+  int x1 = min(x0 + 1, atm.multiscattering_width - 1);
+  int y1 = min(y0 + 1, atm.multiscattering_height - 1);
+  vec3 a = mix(MultipleScatteringLutTexel(x0, y0), MultipleScatteringLutTexel(x1, y0), fx);
+  vec3 b = mix(MultipleScatteringLutTexel(x0, y1), MultipleScatteringLutTexel(x1, y1), fx);
+  return mix(a, b, fy);
+}
+
+// ---------------------------------------------------------------- transmittance LUT
+
+// Bruneton 2017 parametrisation: x_r = rho / H, x_mu = (d - d_min) / (d_max - d_min),
+// with H the distance to the top along the horizon seen from the ground,
+// rho the same from radius r, d the distance to the top along mu.
+vec2 TransmittanceUvFromRMu(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                            Real mu) {
+  Real thickness = atm.top_radius - atm.bottom_radius;
+  Real H = sqrt(thickness * (atm.top_radius + atm.bottom_radius));
+  Real rho = sqrt(max(altitude * (r + atm.bottom_radius), 0.0));
+  Real d = DistanceToTopBoundary(atm, r, altitude, mu);
+  Real d_min = max(thickness - altitude, 0.0);
+  Real d_max = rho + H;
+  Real x_mu = 0.0;
+  if (d_max > d_min) x_mu = (d - d_min) / (d_max - d_min);
+  Real x_r = rho / H;
+  vec2 uv;
+  uv.x = TextureCoordFromUnitRange(x_mu, atm.transmittance_width);
+  uv.y = TextureCoordFromUnitRange(x_r, atm.transmittance_height);
+  return uv;
+}
+
+struct RadiusAndCosine {
+  Real r;
+  Real altitude;
+  Real mu;
+};
+
+RadiusAndCosine RMuFromTransmittanceTexel(IN(AtmosphereParameters) atm, int x, int y) {
+  Real thickness = atm.top_radius - atm.bottom_radius;
+  Real H = sqrt(thickness * (atm.top_radius + atm.bottom_radius));
+  Real x_mu = UnitRangeFromTextureCoord((Real(x) + 0.5) / Real(atm.transmittance_width),
+                                        atm.transmittance_width);
+  Real x_r = UnitRangeFromTextureCoord((Real(y) + 0.5) / Real(atm.transmittance_height),
+                                       atm.transmittance_height);
+  Real rho = H * x_r;
+  RadiusAndCosine result;
+  result.r = sqrt(rho * rho + atm.bottom_radius * atm.bottom_radius);
+  result.altitude = rho * rho / (result.r + atm.bottom_radius);
+  Real d_min = max(thickness - result.altitude, 0.0);
+  Real d_max = rho + H;
+  Real d = d_min + x_mu * (d_max - d_min);
+  // H^2 - rho^2 = R_t^2 - r^2 = d_min (R_t + r): formed from d_min so that the
+  // top row (d_min -> 0) does not divide two rounding errors.
+  result.mu = 1.0;
+  if (d > 0.0)
+    result.mu = ClampCosine((d_min * (atm.top_radius + result.r) - d * d) / (2.0 * result.r * d));
+  return result;
+}
+
+// Optical depth (dimensionless, per channel) from (r, mu) to the top of the
+// atmosphere, composite midpoint rule with `steps` points.
+vec3 ComputeOpticalDepthToTopBoundary(IN(AtmosphereParameters) atm, Real r,
+                                      Real altitude, Real mu, int steps) {
+  Real t_max = DistanceToTopBoundary(atm, r, altitude, mu);
+  Real dt = t_max / Real(steps);
+  vec3 depth = vec3(0.0);
+  for (int i = 0; i < steps; ++i) {
+    Real t = (Real(i) + 0.5) * dt;
+    depth += SampleMedium(atm, AltitudeAlongRay(atm, r, altitude, mu, t)).extinction;
+  }
+  return depth * dt;
+}
+
+vec3 ComputeTransmittanceLutTexel(IN(AtmosphereParameters) atm, int x, int y) {
+  RadiusAndCosine rm = RMuFromTransmittanceTexel(atm, x, y);
+  return exp(-ComputeOpticalDepthToTopBoundary(atm, rm.r, rm.altitude, rm.mu,
+                                               atm.transmittance_steps));
+}
+
+vec3 GetTransmittanceToTopBoundary(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                                   Real mu) {
+  return SampleTransmittanceLut(atm, TransmittanceUvFromRMu(atm, r, altitude, mu));
+}
+
+// Transmittance to the Sun, times the fraction of the solar disc above the
+// horizon (Bruneton 2017), which keeps the terminator continuous.
+vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                           Real mu_s) {
+  Real sin_theta_h = atm.bottom_radius / r;
+  Real cos_theta_h = -sqrt(max(altitude * (r + atm.bottom_radius), 0.0)) / r;
+  Real visible = smoothstep(-sin_theta_h * atm.sun_angular_radius,
+                            sin_theta_h * atm.sun_angular_radius, mu_s - cos_theta_h);
+  return GetTransmittanceToTopBoundary(atm, r, altitude, mu_s) * visible;
+}
+
+// ---------------------------------------------------------------- phase functions
+
+// Rayleigh phase function, sr^-1.
+Real RayleighPhase(Real nu) { return 3.0 / (16.0 * kPi) * (1.0 + nu * nu); }
+
+// Cornette-Shanks phase function, sr^-1. The denominator 1 + g^2 - 2 g nu is
+// formed as (1 - g)^2 + 2 g (1 - nu) for g >= 0 and (1 + g)^2 - 2 g (1 + nu)
+// for g < 0: both sums of non-negative terms, exact near g = +/-1.
+Real MiePhase(Real g, vec3 view, vec3 sun) {
+  vec3 d_minus = view - sun;
+  vec3 d_plus = view + sun;
+  Real one_minus_nu = 0.5 * dot(d_minus, d_minus);
+  Real one_plus_nu = 0.5 * dot(d_plus, d_plus);
+  Real nu = 1.0 - one_minus_nu;
+  Real denom = (1.0 - g) * (1.0 - g) + 2.0 * g * one_minus_nu;
+  if (g < 0.0) denom = (1.0 + g) * (1.0 + g) - 2.0 * g * one_plus_nu;
+  Real k = 3.0 / (8.0 * kPi) * (1.0 - g * g) / (2.0 + g * g);
+  return k * (1.0 + nu * nu) / (denom * sqrt(denom));
+}
+
+// ---------------------------------------------------------------- quadrature helpers
+
+// (1 - exp(-x)) / x for x >= 0, accurate as x -> 0 (series below 0.01,
+// where 1 - exp(-x) would lose digits in float32).
+Real OneMinusExpOverX(Real x) {
+  if (x < 0.01) return 1.0 - x * (0.5 - x * (1.0 / 6.0 - x / 24.0));
+  return (1.0 - exp(-x)) / x;
+}
+
+vec3 OneMinusExpOverX3(vec3 x) {
+  vec3 result;
+  result.x = OneMinusExpOverX(x.x);
+  result.y = OneMinusExpOverX(x.y);
+  result.z = OneMinusExpOverX(x.z);
+  return result;
+}
+
+// ---------------------------------------------------------------- multiple-scattering LUT
+
+struct MultipleScatteringTerms {
+  vec3 second_order;  // L_2nd order of Hillaire eq. 6, per unit solar irradiance
+  vec3 transfer;      // f_ms of Hillaire eq. 8
+};
+
+// One direction of Hillaire's eq. 6 and eq. 8: isotropic phase, sunlit
+// medium plus the sunlit Lambertian ground at the end of the ray.
+MultipleScatteringTerms IntegrateMultipleScatteringRay(IN(AtmosphereParameters) atm,
+                                                       Real r, Real altitude, vec3 view,
+                                                       vec3 sun) {
+  Real mu = view.y;
+  Real mu_s = sun.y;
+  Real nu = dot(view, sun);
+  bool hits_ground = RayIntersectsGround(atm, r, altitude, mu);
+  Real t_max = hits_ground ? DistanceToBottomBoundary(atm, r, altitude, mu)
+                           : DistanceToTopBoundary(atm, r, altitude, mu);
+  Real dt = t_max / Real(atm.multiscattering_steps);
+  CONST_REAL isotropic_phase = 1.0 / (4.0 * kPi);
+  vec3 transmittance = vec3(1.0);
+  MultipleScatteringTerms terms;
+  terms.second_order = vec3(0.0);
+  terms.transfer = vec3(0.0);
+  for (int i = 0; i < atm.multiscattering_steps; ++i) {
+    Real t = (Real(i) + 0.5) * dt;
+    Real h = AltitudeAlongRay(atm, r, altitude, mu, t);
+    Real r_t = atm.bottom_radius + h;
+    Real mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
+    MediumSample m = SampleMedium(atm, h);
+    vec3 scattering = m.rayleigh_scattering + m.mie_scattering;
+    vec3 step_integral = dt * OneMinusExpOverX3(m.extinction * dt);  // int_0^dt exp(-sigma s) ds
+    vec3 sun_transmittance = GetTransmittanceToSun(atm, r_t, h, mu_s_t);
+    terms.second_order += transmittance * scattering * sun_transmittance * isotropic_phase * step_integral;
+    terms.transfer += transmittance * scattering * step_integral;
+    transmittance *= exp(-m.extinction * dt);
+  }
+  if (hits_ground) {
+    Real mu_s_ground = ClampCosine((r * mu_s + t_max * nu) / atm.bottom_radius);
+    vec3 sun_transmittance = GetTransmittanceToSun(atm, atm.bottom_radius, 0.0, mu_s_ground);
+    terms.second_order += transmittance * sun_transmittance * max(mu_s_ground, 0.0) *
+                          atm.ground_albedo / kPi;
+  }
+  return terms;
+}
+
+// Psi_ms of Hillaire eq. 10 for texel (x, y): x along mu_s in [-1, 1],
+// y along altitude in [0, top - bottom]. Directions sample the sphere
+// uniformly on a sqrt_dirs x sqrt_dirs stratified grid.
+vec3 ComputeMultipleScatteringLutTexel(IN(AtmosphereParameters) atm, int x, int y) {
+  Real mu_s = -1.0 + 2.0 * (Real(x) + 0.5) / Real(atm.multiscattering_width);
+  Real altitude = (atm.top_radius - atm.bottom_radius) * (Real(y) + 0.5) /
+                  Real(atm.multiscattering_height);
+  Real r = atm.bottom_radius + altitude;
+  vec3 sun;
+  sun.x = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+  sun.y = mu_s;
+  sun.z = 0.0;
+  int n = atm.multiscattering_sqrt_dirs;
+  vec3 second_order = vec3(0.0);
+  vec3 transfer = vec3(0.0);
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      Real cos_theta = 1.0 - 2.0 * (Real(i) + 0.5) / Real(n);
+      Real sin_theta = sqrt(max(1.0 - cos_theta * cos_theta, 0.0));
+      Real phi = 2.0 * kPi * (Real(j) + 0.5) / Real(n);
+      vec3 view;
+      view.x = sin_theta * cos(phi);
+      view.y = cos_theta;
+      view.z = sin_theta * sin(phi);
+      MultipleScatteringTerms terms = IntegrateMultipleScatteringRay(atm, r, altitude, view, sun);
+      second_order += terms.second_order;
+      transfer += terms.transfer;
+    }
+  }
+  Real inv_count = 1.0 / Real(n * n);
+  second_order *= inv_count;
+  transfer *= inv_count;
+  return second_order / (vec3(1.0) - min(transfer, vec3(0.999)));
+}
+
+vec3 GetMultipleScattering(IN(AtmosphereParameters) atm, Real altitude, Real mu_s) {
+  vec2 uv;
+  uv.x = 0.5 + 0.5 * mu_s;
+  uv.y = altitude / (atm.top_radius - atm.bottom_radius);
+  return SampleMultipleScatteringLut(atm, uv);
+}
+
+// ---------------------------------------------------------------- sky radiance
+
+// Radiance of the limb-darkened solar disc at angle `theta` from its centre,
+// per unit solar irradiance: I(m) = I0 (1 - u (1 - m)), m = sqrt(1 - (theta/alpha)^2),
+// normalised so that the disc integrates to the irradiance:
+// I0 = 1 / (pi alpha^2 (1 - u / 3)).
+Real SunDiscRadiance(IN(AtmosphereParameters) atm, Real theta) {
+  Real alpha = atm.sun_angular_radius;
+  if (theta >= alpha) return 0.0;
+  Real x = theta / alpha;
+  Real m = sqrt(max(1.0 - x * x, 0.0));
+  Real u = atm.limb_darkening;
+  return (1.0 - u * (1.0 - m)) / (kPi * alpha * alpha * (1.0 - u / 3.0));
+}
+
+// Radiance reaching the observer along unit direction `view` (world frame,
+// +Y up) with the Sun along unit `sun`, in the units of solar_irradiance.
+vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  Real altitude = atm.observer_altitude;
+  Real r = atm.bottom_radius + altitude;
+  Real mu = ClampCosine(view.y);
+  Real mu_s = ClampCosine(sun.y);
+  Real nu = ClampCosine(dot(view, sun));
+  vec3 radiance = vec3(0.0);
+  vec3 transmittance = vec3(1.0);
+  bool in_atmosphere = true;
+
+  // An observer above the atmosphere first travels to where the ray enters it.
+  if (altitude > atm.top_radius - atm.bottom_radius) {
+    Real t_entry = DistanceToAtmosphereEntry(atm, r, altitude, mu);
+    if (t_entry < 0.0) {
+      in_atmosphere = false;
+    } else {
+      Real r_entry = atm.top_radius;
+      mu = ClampCosine((r * mu + t_entry) / r_entry);
+      mu_s = ClampCosine((r * mu_s + t_entry * nu) / r_entry);
+      r = r_entry;
+      altitude = atm.top_radius - atm.bottom_radius;
+    }
+  }
+
+  bool hits_ground = false;
+  if (in_atmosphere) {
+    hits_ground = RayIntersectsGround(atm, r, altitude, mu);
+    Real t_max = hits_ground ? DistanceToBottomBoundary(atm, r, altitude, mu)
+                             : DistanceToTopBoundary(atm, r, altitude, mu);
+    Real dt = t_max / Real(atm.view_steps);
+    Real rayleigh_phase = RayleighPhase(nu);
+    Real mie_phase = MiePhase(atm.mie_g, view, sun);
+    for (int i = 0; i < atm.view_steps; ++i) {
+      Real t = (Real(i) + 0.5) * dt;
+      Real h = AltitudeAlongRay(atm, r, altitude, mu, t);
+      Real r_t = atm.bottom_radius + h;
+      Real mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
+      MediumSample m = SampleMedium(atm, h);
+      vec3 sun_transmittance = GetTransmittanceToSun(atm, r_t, h, mu_s_t);
+      vec3 source = (m.rayleigh_scattering * rayleigh_phase + m.mie_scattering * mie_phase) *
+                    sun_transmittance;
+      if (atm.multiple_scattering)
+        source += (m.rayleigh_scattering + m.mie_scattering) * GetMultipleScattering(atm, h, mu_s_t);
+      // Hillaire 2020 eq. 5 per step: the source is constant over the step and
+      // the transmittance is integrated exactly, int_0^dt exp(-sigma s) ds.
+      radiance += transmittance * source * (dt * OneMinusExpOverX3(m.extinction * dt));
+      transmittance *= exp(-m.extinction * dt);
+    }
+    if (hits_ground && atm.ground) {
+      Real mu_s_ground = ClampCosine((r * mu_s + t_max * nu) / atm.bottom_radius);
+      vec3 sun_transmittance = GetTransmittanceToSun(atm, atm.bottom_radius, 0.0, mu_s_ground);
+      radiance += transmittance * sun_transmittance * max(mu_s_ground, 0.0) * atm.ground_albedo / kPi;
+    }
+  }
+
+  if (atm.sun_disc && !hits_ground) {
+    vec3 d = view - sun;
+    Real theta = 2.0 * asin(min(0.5 * length(d), 1.0));
+    radiance += transmittance * SunDiscRadiance(atm, theta);
+  }
+  return radiance * atm.solar_irradiance;
+}
+
+#endif  // SKYBAKE_ATMOSPHERE_GLSL

@@ -1,0 +1,79 @@
+// Declarations shared by every compute shader: the uniform block, the LUT and
+// output buffers, the push constants, the LUT fetch hooks of atmosphere.glsl,
+// and the specialization constants that compile optional effects out.
+#ifndef SKYBAKE_COMMON_GLSL
+#define SKYBAKE_COMMON_GLSL
+
+#include "glsl_prelude.glsl"
+#include "skybake/gpu_shared.h"
+
+layout(local_size_x = SKYBAKE_LOCAL_SIZE_X, local_size_y = SKYBAKE_LOCAL_SIZE_Y) in;
+
+layout(std140, set = 0, binding = BINDING_ATMOSPHERE) uniform AtmosphereBlock {
+  GpuAtmosphere gpu_atmosphere;
+};
+layout(std430, set = 0, binding = BINDING_TRANSMITTANCE) buffer TransmittanceBuffer {
+  vec4 transmittance_texels[];
+};
+layout(std430, set = 0, binding = BINDING_MULTISCATTERING) buffer MultiScatteringBuffer {
+  vec4 multiscattering_texels[];
+};
+layout(std430, set = 0, binding = BINDING_OUTPUT) buffer OutputBuffer {
+  vec4 output_texels[];
+};
+layout(push_constant) uniform PushBlock {
+  SkyPush push;
+};
+
+// Optional effects (EffectSettings); off effects are compiled out.
+layout(constant_id = 0) const bool kMultipleScattering = true;
+layout(constant_id = 1) const bool kSunDisc = true;
+layout(constant_id = 2) const bool kGround = true;
+// Writes the texel direction instead of radiance (mapping tests).
+layout(constant_id = 3) const bool kOutputDirection = false;
+
+vec3 TransmittanceLutTexel(int x, int y) {
+  return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;
+}
+
+vec3 MultipleScatteringLutTexel(int x, int y) {
+  return multiscattering_texels[y * gpu_atmosphere.lut_sizes.z + x].xyz;
+}
+
+#include "atmosphere.glsl"
+#include "envmap.glsl"
+
+AtmosphereParameters AtmosphereFromUniform() {
+  AtmosphereParameters atm;
+  atm.bottom_radius = gpu_atmosphere.radii.x;
+  atm.top_radius = gpu_atmosphere.radii.y;
+  atm.observer_altitude = gpu_atmosphere.radii.z;
+  atm.rayleigh_scattering = gpu_atmosphere.rayleigh_scattering.xyz;
+  atm.rayleigh_scale_height = gpu_atmosphere.rayleigh_scattering.w;
+  atm.mie_scattering = gpu_atmosphere.mie_scattering.xyz;
+  atm.mie_extinction = gpu_atmosphere.mie_extinction.xyz;
+  atm.mie_scale_height = gpu_atmosphere.mie_scattering.w;
+  atm.mie_g = gpu_atmosphere.mie_extinction.w;
+  atm.absorption_extinction = gpu_atmosphere.absorption_extinction.xyz;
+  atm.ozone_peak_altitude = gpu_atmosphere.absorption_extinction.w;
+  atm.ozone_half_width = gpu_atmosphere.ground_albedo.w;
+  atm.ground_albedo = gpu_atmosphere.ground_albedo.xyz;
+  atm.solar_irradiance = gpu_atmosphere.solar_irradiance.xyz;
+  atm.sun_angular_radius = gpu_atmosphere.solar_irradiance.w;
+  atm.limb_darkening = gpu_atmosphere.radii.w;
+  atm.transmittance_width = gpu_atmosphere.lut_sizes.x;
+  atm.transmittance_height = gpu_atmosphere.lut_sizes.y;
+  atm.multiscattering_width = gpu_atmosphere.lut_sizes.z;
+  atm.multiscattering_height = gpu_atmosphere.lut_sizes.w;
+  atm.view_steps = gpu_atmosphere.samples.x;
+  atm.transmittance_steps = gpu_atmosphere.samples.y;
+  atm.multiscattering_steps = gpu_atmosphere.samples.z;
+  atm.multiscattering_sqrt_dirs = gpu_atmosphere.effects.w;
+  atm.integrator = gpu_atmosphere.samples.w;
+  atm.multiple_scattering = kMultipleScattering;
+  atm.sun_disc = kSunDisc;
+  atm.ground = kGround;
+  return atm;
+}
+
+#endif  // SKYBAKE_COMMON_GLSL

@@ -1,0 +1,29 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// In-scattered radiance for every texel of one output view (latlong, cube
+// strip, Vulkan cube face, or a list of directions).
+#include "common.glsl"
+
+vec3 ViewDirection(ivec2 texel) {
+  int mapping = push.view.x;
+  if (mapping == MAPPING_LATLONG)
+    return DirectionFromLatLongPixel(float(texel.x), float(texel.y), push.view.y, push.view.z);
+  if (mapping == MAPPING_CUBE_STRIP) return DirectionFromCubeStripPixel(texel.x, texel.y, push.view.y);
+  if (mapping == MAPPING_VULKAN_FACE)
+    return DirectionFromVulkanCubeTexel(push.view.w, texel.x, texel.y, push.view.y);
+  return normalize(output_texels[push.offsets.x + texel.y * push.view.y + texel.x].xyz);
+}
+
+void main() {
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (texel.x >= push.view.y || texel.y >= push.view.z) return;
+  vec3 view = ViewDirection(texel);
+  uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
+  if (kOutputDirection) {
+    output_texels[index] = vec4(view, 0.0);
+    return;
+  }
+  AtmosphereParameters atm = AtmosphereFromUniform();
+  vec3 radiance = ComputeSkyRadiance(atm, view, push.sun_direction.xyz);
+  output_texels[index] = vec4(radiance * gpu_atmosphere.output_scale.xyz, 1.0);
+}
