@@ -117,6 +117,16 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("effects.ground", s.effects.ground);
 
   QualitySettings& q = s.quality;
+  v.Preset("quality.preset", s.quality_preset, q);  // first: the keys below refine it
+  v.Choice("quality.integrator", q.integrator,
+           {{"analytic", INTEGRATOR_ANALYTIC}, {"midpoint", INTEGRATOR_MIDPOINT},
+            {"trapezoid", INTEGRATOR_TRAPEZOID}, {"simpson", INTEGRATOR_SIMPSON}});
+  v.Int("quality.light_steps", q.light_steps, 0, kMaxSteps);
+  v.Choice("quality.step_distribution", q.step_distribution,
+           {{"uniform", STEPS_UNIFORM}, {"quadratic", STEPS_QUADRATIC}});
+  v.Bool("quality.sky_view_lut", q.sky_view_lut);
+  v.Int("quality.sky_view_lut_width", q.sky_view_width, 4, kMaxLutSize);
+  v.Int("quality.sky_view_lut_height", q.sky_view_height, 4, kMaxLutSize);
   v.Int("quality.view_steps", q.view_steps, 1, kMaxSteps);
   v.Int("quality.transmittance_steps", q.transmittance_steps, 1, kMaxSteps);
   v.Int("quality.multiscattering_steps", q.multiscattering_steps, 1, kMaxSteps);
@@ -256,6 +266,23 @@ class StyleReader {
     Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(names)));
   }
 
+  void Preset(const char* path, std::string& name, QualitySettings& quality) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    std::vector<std::string> list = QualityPresetNames();
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TypeName(*node)));
+      return;
+    }
+    const std::string& text = node->as_string()->get();
+    if (std::find(list.begin(), list.end(), text) == list.end()) {
+      Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(list)));
+      return;
+    }
+    name = text;
+    quality = QualityPreset(text);
+  }
+
   void FileName(const char* path, std::string& out) {
     const toml::node* node = Find(path);
     if (!node) return;
@@ -390,6 +417,7 @@ class StyleWriter {
       if (c.second == v) Put(path, std::string(c.first));
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
+  void Preset(const char* path, std::string& name, QualitySettings&) { Put(path, name); }
   void FileNames(const char* path, std::vector<std::string>& v, size_t) {
     toml::array array;
     for (const std::string& s : v) array.push_back(s);

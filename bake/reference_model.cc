@@ -108,6 +108,7 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
   atm.multiscattering_sqrt_dirs = q.multiscattering_sqrt_dirs;
   atm.integrator = q.integrator;
   atm.light_steps = q.light_steps;
+  atm.step_distribution = q.step_distribution;
   atm.sky_view_width = q.sky_view_width;
   atm.sky_view_height = q.sky_view_height;
   impl_->use_skyview = q.sky_view_lut;

@@ -60,6 +60,7 @@ struct AtmosphereParameters {
   int multiscattering_sqrt_dirs;// directions per multi-scattering texel = this^2
   int integrator;               // INTEGRATOR_* of gpu_shared.h
   int light_steps;              // 0: sun transmittance from the LUT; N: N-step march
+  int step_distribution;        // STEPS_UNIFORM or STEPS_QUADRATIC (gpu_shared.h)
   int sky_view_width;           // sky-view LUT texels along the azimuth from the Sun
   int sky_view_height;          // sky-view LUT texels along the zenith angle
   bool multiple_scattering;     // add Hillaire's multiple-scattering term
@@ -493,8 +494,18 @@ struct InScattering {
   vec3 transmittance;  // along the whole ray
 };
 
-// The single-scattering integral L = int_0^t_max T(t) S(t) dt over
-// `view_steps` uniform steps, with the rule atm.integrator.
+// Where the view samples go: t(u) for u in [0, 1], uniform or quadratic
+// (u^2 puts them near the observer, where a horizontal ray's density is:
+// its altitude grows as t^2 / 2R). dt/du is the Jacobian of the mapping.
+Real StepPosition(IN(AtmosphereParameters) atm, Real t_max, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? t_max * u * u : t_max * u;
+}
+Real StepJacobian(IN(AtmosphereParameters) atm, Real t_max, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? 2.0 * t_max * u : t_max;
+}
+
+// The single-scattering integral L = int_0^t_max T(t) S(t) dt with
+// `view_steps` steps placed by StepPosition, with the rule atm.integrator.
 InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray, vec3 view,
                                    vec3 sun) {
   InScattering result;
@@ -502,55 +513,74 @@ InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
   result.transmittance = vec3(1.0);
   int n = atm.view_steps;
   if (atm.integrator == INTEGRATOR_SIMPSON) n += n % 2;  // Simpson needs an even count
-  Real dt = ray.t_max / Real(n);
+  Real du = 1.0 / Real(n);
+  Real t_max = ray.t_max;
   Real rayleigh_phase = RayleighPhase(ray.nu);
   Real mie_phase = MiePhase(atm.mie_g, view, sun);
 
   if (atm.integrator == INTEGRATOR_ANALYTIC || atm.integrator == INTEGRATOR_MIDPOINT) {
+    Real t_start = 0.0;
     for (int i = 0; i < n; ++i) {
-      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, (Real(i) + 0.5) * dt);
-      vec3 step_transmittance = exp(-s.extinction * dt);
+      Real t_end = StepPosition(atm, t_max, Real(i + 1) * du);
+      Real t_mid = StepPosition(atm, t_max, (Real(i) + 0.5) * du);
+      Real dt = t_end - t_start;
+      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_mid);
       if (atm.integrator == INTEGRATOR_ANALYTIC) {
         // Hillaire 2020 eq. 5 per step: the source is constant over the step
         // and the transmittance is integrated exactly, int_0^dt exp(-sigma s) ds.
         result.radiance += result.transmittance * s.source * (dt * OneMinusExpOverX3(s.extinction * dt));
       } else {
-        // Midpoint rule: integrand at the step centre, T from the optical
+        // Midpoint rule: integrand at the step's sample, T from the optical
         // depth accumulated by the same rule.
-        result.radiance += result.transmittance * exp(-s.extinction * (0.5 * dt)) * s.source * dt;
+        result.radiance += result.transmittance * exp(-s.extinction * (t_mid - t_start)) * s.source * dt;
       }
-      result.transmittance *= step_transmittance;
+      result.transmittance *= exp(-s.extinction * dt);
+      t_start = t_end;
     }
   } else if (atm.integrator == INTEGRATOR_TRAPEZOID) {
-    // Nodes t_i = i dt; optical depth by the trapezoidal rule between nodes.
+    // Nodes u_i = i du in the mapped variable, integrand f(t(u)) dt/du; the
+    // optical depth to each node by the same rule.
     ScatteringSample previous = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
+    Real w_previous = StepJacobian(atm, t_max, 0.0);
     vec3 depth = vec3(0.0);
-    result.radiance = 0.5 * dt * previous.source;
+    result.radiance = 0.5 * du * w_previous * previous.source;
     for (int i = 1; i <= n; ++i) {
-      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, Real(i) * dt);
-      depth += 0.5 * dt * (previous.extinction + s.extinction);
-      Real weight = i == n ? 0.5 * dt : dt;
-      result.radiance += weight * exp(-depth) * s.source;
+      Real u = Real(i) * du;
+      Real w = StepJacobian(atm, t_max, u);
+      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u));
+      depth += 0.5 * du * (w_previous * previous.extinction + w * s.extinction);
+      Real weight = i == n ? 0.5 * du : du;
+      result.radiance += weight * w * exp(-depth) * s.source;
       previous = s;
+      w_previous = w;
     }
     result.transmittance = exp(-depth);
   } else {
-    // Simpson: weights dt/3 (1, 4, 2, 4, ..., 4, 1) on nodes t_i = i dt. The
+    // Simpson: weights du/3 (1, 4, 2, 4, ..., 4, 1) on nodes u_i = i du. The
     // optical depth to each node is integrated to the same order: over a
     // pair of steps by Simpson, to the middle node by the three-point rule
-    // int_{t0}^{t1} f = dt/12 (5 f0 + 8 f1 - f2).
+    // int_{u0}^{u1} f = du/12 (5 f0 + 8 f1 - f2).
     ScatteringSample s0 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
+    Real w0 = StepJacobian(atm, t_max, 0.0);
     vec3 depth = vec3(0.0);
-    result.radiance = (dt / 3.0) * s0.source;
+    result.radiance = (du / 3.0) * w0 * s0.source;
     for (int i = 0; i < n; i += 2) {
-      ScatteringSample s1 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, Real(i + 1) * dt);
-      ScatteringSample s2 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, Real(i + 2) * dt);
-      vec3 depth_mid = depth + (dt / 12.0) * (5.0 * s0.extinction + 8.0 * s1.extinction - s2.extinction);
-      depth += (dt / 3.0) * (s0.extinction + 4.0 * s1.extinction + s2.extinction);
+      Real u1 = Real(i + 1) * du;
+      Real u2 = Real(i + 2) * du;
+      Real w1 = StepJacobian(atm, t_max, u1);
+      Real w2 = StepJacobian(atm, t_max, u2);
+      ScatteringSample s1 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u1));
+      ScatteringSample s2 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u2));
+      vec3 e0 = w0 * s0.extinction;
+      vec3 e1 = w1 * s1.extinction;
+      vec3 e2 = w2 * s2.extinction;
+      vec3 depth_mid = depth + (du / 12.0) * (5.0 * e0 + 8.0 * e1 - e2);
+      depth += (du / 3.0) * (e0 + 4.0 * e1 + e2);
       Real end_weight = i + 2 == n ? 1.0 : 2.0;
-      result.radiance += (dt / 3.0) * (4.0 * exp(-max(depth_mid, vec3(0.0))) * s1.source +
-                                       end_weight * exp(-depth) * s2.source);
+      result.radiance += (du / 3.0) * (4.0 * w1 * exp(-max(depth_mid, vec3(0.0))) * s1.source +
+                                       end_weight * w2 * exp(-depth) * s2.source);
       s0 = s2;
+      w0 = w2;
     }
     result.transmittance = exp(-depth);
   }
@@ -644,8 +674,9 @@ SkyViewCoordinates SkyViewDirectionFromTexel(IN(AtmosphereParameters) atm, int x
     Real s = 1.0 - v;
     c.zenith_angle = horizon * (1.0 - s * s);
   } else {
+    // Just below the horizon on the first row: the limit seen from the ground side.
     Real v = Real(y - half_height) / Real(atm.sky_view_height - half_height - 1);
-    c.zenith_angle = horizon + (kPi - horizon) * v * v;
+    c.zenith_angle = horizon + (kPi - horizon) * max(v * v, 1e-6);
   }
   return c;
 }
@@ -670,19 +701,37 @@ vec3 SunInSkyViewFrame(Real mu_s) {
 // solar irradiance, for the Sun at cosine zenith mu_s.
 vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_s) {
   SkyViewCoordinates c = SkyViewDirectionFromTexel(atm, x, y);
-  return ComputeSkyRadianceWithoutSun(atm, ViewFromSkyViewCoordinates(c), SunInSkyViewFrame(mu_s)).radiance;
+  vec3 view = ViewFromSkyViewCoordinates(c);
+  if (y < atm.sky_view_height / 2) {
+    // The horizon row must stay on the sky side: cos(horizon) rounds below
+    // the exact horizon cosine in float32, so clamp to the latter, formed
+    // without cancellation (0 exactly for an observer on the ground).
+    Real h = atm.observer_altitude;
+    Real r = atm.bottom_radius + h;
+    Real mu_horizon = -sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r;
+    if (h <= atm.top_radius - atm.bottom_radius && view.y < mu_horizon) {
+      Real horizontal = length(vec2(view.x, view.z));
+      Real scale = horizontal > 0.0 ? sqrt(max(1.0 - mu_horizon * mu_horizon, 0.0)) / horizontal : 0.0;
+      view.x *= scale;
+      view.z *= scale;
+      view.y = mu_horizon;
+    }
+  }
+  return ComputeSkyRadianceWithoutSun(atm, view, SunInSkyViewFrame(mu_s)).radiance;
 }
 
 // Bilinear read of the sky-view LUT, by hand, never across the horizon: the
 // grid is exact at texel centres, which SkyViewDirectionFromTexel places on
 // the zenith, the horizon (from either side) and the nadir.
-vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azimuth) {
+// `ground` selects the half: it comes from the same ray test as the march
+// (RayIntersectsGround), not from comparing rounded angles.
+vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azimuth, bool ground) {
   Real horizon = HorizonZenithAngle(atm);
   int half_height = atm.sky_view_height / 2;
   Real fy = 0.0;
   int y0 = 0;
   int y_last = 0;
-  if (zenith_angle < horizon) {
+  if (!ground) {
     Real s = sqrt(max(1.0 - clamp(zenith_angle / horizon, 0.0, 1.0), 0.0));
     Real y = (1.0 - s) * Real(half_height - 1);
     y0 = int(min(floor(y), Real(half_height - 2)));
@@ -716,9 +765,9 @@ vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3
   Real azimuth = 0.0;
   if (vx > 0.0 && sx > 0.0)
     azimuth = acos(ClampCosine((view.x * sun.x + view.z * sun.z) / (vx * sx)));
-  vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth);
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ray.in_atmosphere && ray.hits_ground);
   if (atm.sun_disc) {
-    SkyRay ray = SetUpSkyRay(atm, view, sun);
     if (ray.in_atmosphere && !ray.hits_ground) {
       radiance += SunDiscContribution(atm, view, sun,
                                       GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));

@@ -82,6 +82,7 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.multiscattering_sqrt_dirs = gpu_atmosphere.effects.w;
   atm.integrator = kIntegrator;
   atm.light_steps = gpu_atmosphere.render.x;
+  atm.step_distribution = gpu_atmosphere.render.w;
   atm.sky_view_width = gpu_atmosphere.render.y;
   atm.sky_view_height = gpu_atmosphere.render.z;
   atm.multiple_scattering = kMultipleScattering;

@@ -90,7 +90,9 @@ TEST(SkyRendererTest, GrazingRaysMatchReference) {
   // Directions at and around the horizon, where the ray length jumps from
   // the top boundary to the ground: exactly horizontal, +/-1e-6, +/-1e-3 rad.
   const AtmosphereParams atmosphere;
-  const QualitySettings quality;
+  QualitySettings sky_view;
+  sky_view.sky_view_lut = true;
+  for (const QualitySettings& quality : {QualitySettings{}, sky_view}) {
   EffectSettings effects;
   effects.sun_disc = false;
   SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
@@ -104,6 +106,7 @@ TEST(SkyRendererTest, GrazingRaysMatchReference) {
   }
   for (double sun_elevation : {60.0, 2.0, -4.0}) {
     glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 100.0);
+    reference.PrepareSun(sun);
     std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
     ExpectFiniteNonNegative(gpu, "grazing");
     std::vector<double> ref;
@@ -112,7 +115,9 @@ TEST(SkyRendererTest, GrazingRaysMatchReference) {
       ref.insert(ref.end(), {l.x, l.y, l.z, 1.0});
     }
     Comparison c = Compare(gpu, ref, 1e-4);
-    EXPECT_LE(c.max_relative_error, 1e-3) << "sun elevation " << sun_elevation;
+    EXPECT_LE(c.max_relative_error, 1e-3) << "sun elevation " << sun_elevation << " sky-view "
+                                          << quality.sky_view_lut;
+  }
   }
   testing::ExpectNoValidationMessages();
 }
@@ -226,6 +231,47 @@ TEST(SkyRendererTest, ValuesAreFiniteForEveryEffectCombination) {
     for (double elevation : {90.0, 0.0, -18.0}) {
       auto images = renderer.Render(SunDirectionFromElevationAzimuth(elevation, 0.0), TestViews());
       for (const auto& image : images) ExpectFiniteNonNegative(image, "effects " + std::to_string(mask));
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+}  // namespace
+}  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// The per-frame sky-view LUT path and every integrator, GPU against the
+// double reference running the same algorithm.
+TEST(SkyRendererTest, IntegratorsAndSkyViewPathMatchReference) {
+  const AtmosphereParams atmosphere;
+  std::vector<QualitySettings> variants;
+  for (int integrator : {INTEGRATOR_ANALYTIC, INTEGRATOR_MIDPOINT, INTEGRATOR_TRAPEZOID, INTEGRATOR_SIMPSON}) {
+    QualitySettings q;
+    q.integrator = integrator;
+    q.view_steps = 24;
+    q.light_steps = integrator == INTEGRATOR_ANALYTIC ? 0 : 8;
+    variants.push_back(q);
+  }
+  QualitySettings sky_view;
+  sky_view.sky_view_lut = true;
+  sky_view.sky_view_width = 96;
+  sky_view.sky_view_height = 54;
+  variants.push_back(sky_view);
+  const ViewRequest view{MAPPING_LATLONG, 32, 16, 0};
+  for (const QualitySettings& q : variants) {
+    SkyRenderer renderer(testing::Vulkan(), atmosphere, q, EffectSettings{}, {1, 1, 1});
+    ReferenceModel reference(atmosphere, q, EffectSettings{}, {1, 1, 1});
+    reference.PrecomputeLuts();
+    for (double elevation : {30.0, 2.0}) {
+      glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 135.0);
+      reference.PrepareSun(sun);
+      std::vector<float> gpu = renderer.Render(sun, {view})[0];
+      ExpectFiniteNonNegative(gpu, "variant");
+      Comparison c = Compare(gpu, reference.RenderView(sun, view), 1e-4);
+      EXPECT_LE(c.max_relative_error, 1e-3) << "integrator " << q.integrator << " sky-view " << q.sky_view_lut
+                                            << " elevation " << elevation;
     }
   }
   testing::ExpectNoValidationMessages();

@@ -39,6 +39,10 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define INTEGRATOR_TRAPEZOID 2  // composite trapezoidal rule (Galaj 2019 eq. 6)
 #define INTEGRATOR_SIMPSON 3    // composite Simpson rule (Galaj 2019 eq. 8)
 
+// Placement of the view-ray samples (GpuAtmosphere.render.w).
+#define STEPS_UNIFORM 0    // t = t_max u (Galaj 2019)
+#define STEPS_QUADRATIC 1  // t = t_max u^2, denser near the observer
+
 // Workgroup size of every 2D compute shader.
 #define SKYBAKE_LOCAL_SIZE_X 8
 #define SKYBAKE_LOCAL_SIZE_Y 8
@@ -55,7 +59,7 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 lut_sizes;             // x,y: transmittance LUT; z,w: multiple-scattering LUT
   ivec4 samples;               // x: view steps; y: transmittance LUT steps; z: multi-scattering steps; w: integrator
   ivec4 effects;               // x: multiple scattering on; y: sun disc on; z: ground on; w: ms sqrt(directions)
-  ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: unused
+  ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
 };
 
 SKYBAKE_GPU_STRUCT(SkyPush) {
