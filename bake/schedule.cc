@@ -312,14 +312,15 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
       if (!range->get("start") || !range->get("end") || !range->get("step_minutes"))
         r.Error(times, key, "a time range needs start, end and step_minutes, e.g. "
                             "{ start = 06:00:00, end = 20:00:00, step_minutes = 15 }");
-      if (start && end && step && date && place_ok) {
+      if (start && end && step) {
         auto seconds = [](const toml::time& t) { return t.hour * 3600.0 + t.minute * 60.0 + t.second + t.nanosecond * 1e-9; };
         double s0 = seconds(*start), s1 = seconds(*end);
         if (!(*step > 0.0)) {
           r.Error(range->get("step_minutes"), key + ".step_minutes", "must be above 0");
         } else if (s1 < s0) {
           r.Error(range->get("end"), key + ".end", "end is before start: a range stays within one day");
-        } else if (std::optional<std::vector<double>> steps = r.Steps(times, key, s0, s1, *step * 60.0)) {
+        } else if (std::optional<std::vector<double>> steps = r.Steps(times, key, s0, s1, *step * 60.0);
+                   steps && date && place_ok) {
           for (double sec : *steps) {
             toml::time t;
             double whole = std::floor(sec + 1e-6);
@@ -434,8 +435,20 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
   for (size_t i = 0; i < frames.size(); ++i) {
     ScheduleFrame& f = frames[i];
     f.number = first_frame + int(i);
-    if (schedule.clock_times)
-      f.hours_from_start = (JulianDayUt(*f.time) - JulianDayUt(*frames[0].time)) * 24.0;
+    if (schedule.clock_times) {
+      // Whole days from the Julian days of the two midnights (exact in
+      // double), then the clock difference, so that 15 minutes is 0.25 h exactly.
+      auto midnight = [](CivilTime t) {
+        t.hour = t.minute = 0;
+        t.second = 0.0;
+        return JulianDayUt(t) + t.utc_offset_hours / 24.0;
+      };
+      auto clock_hours = [](const CivilTime& t) {
+        return t.hour + t.minute / 60.0 + t.second / 3600.0 - t.utc_offset_hours;
+      };
+      f.hours_from_start = std::round(midnight(*f.time) - midnight(*frames[0].time)) * 24.0 +
+                           clock_hours(*f.time) - clock_hours(*frames[0].time);
+    }
   }
   const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
   for (size_t i = 0; i < frames.size(); ++i) {
