@@ -6,12 +6,15 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <memory>
 #include <set>
 
 #include <unistd.h>
 
 #include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
 #include <nlohmann/json.hpp>
 #include <OpenImageIO/imageio.h>
 
@@ -173,6 +176,39 @@ TEST_F(Sequence, GltfValidatorReportsNoErrorsOrWarnings) {
        p = output.find("0 errors, 0 warnings", p + 1))
     ++count;
   EXPECT_EQ(count, 4u);
+}
+
+// Rotates v by the glTF quaternion [x, y, z, w].
+glm::dvec3 Rotate(const json& q, const glm::dvec3& v) {
+  glm::dquat quat(q[3].get<double>(), q[0].get<double>(), q[1].get<double>(), q[2].get<double>());
+  return quat * v;
+}
+
+TEST_F(Sequence, GltfSunShinesAwayFromTheBakedSun) {
+  std::ifstream in(out_dir_ + "/sequence/sky.gltf");
+  json gltf = json::parse(in);
+  ASSERT_EQ(gltf["extensionsUsed"].size(), 2u);
+  for (const json& name : gltf["extensionsUsed"]) EXPECT_NE(name.get<std::string>(), "KHR_materials_emissive_strength");
+  const json& sun_node = gltf["nodes"][1];
+  ASSERT_EQ(sun_node["extensions"]["KHR_lights_punctual"]["light"].get<int>(), 0);
+  EXPECT_EQ(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["type"].get<std::string>(), "directional");
+  // The light (the highest-sun frame, the last) shines along the node's -Z.
+  const FrameResult& last = result_->frames.back();
+  EXPECT_LT(glm::length(Rotate(sun_node["rotation"], {0, 0, -1}) + last.sun_direction), 1e-6);
+  EXPECT_NEAR(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(),
+              last.sun_illuminance_lux, 1e-6 * last.sun_illuminance_lux);
+  // Every animation key points the light away from its frame's sun.
+  const json& sampler = gltf["animations"][0]["samplers"][0];
+  const json& output = gltf["accessors"][sampler["output"].get<int>()];
+  const json& view = gltf["bufferViews"][output["bufferView"].get<int>()];
+  ASSERT_EQ(output["count"].get<int>(), 24);
+  std::ifstream bin(out_dir_ + "/sequence/sky.bin", std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(bin)), std::istreambuf_iterator<char>());
+  const float* keys = reinterpret_cast<const float*>(bytes.data() + view["byteOffset"].get<size_t>());
+  for (int k = 0; k < 24; ++k) {
+    json q = {keys[4 * k], keys[4 * k + 1], keys[4 * k + 2], keys[4 * k + 3]};
+    EXPECT_LT(glm::length(Rotate(q, {0, 0, -1}) + result_->frames[k].sun_direction), 1e-5) << "key " << k;
+  }
 }
 
 // Mean sRGB colour of the top tenth of a screenshot.
