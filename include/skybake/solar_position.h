@@ -6,6 +6,9 @@
 // result is the geometric (airless) direction: the sky model has no
 // refraction, so neither has the sun that drives it.
 //
+// libnova keeps static caches (nutation), so call this from one thread at a
+// time; repeated calls agree to about 1e-5 degrees, not bit for bit.
+//
 // Conventions: latitude north positive, longitude east positive, degrees.
 // Azimuth is a compass bearing, clockwise from North (East = 90). The world
 // frame is skybake's: +Y up, North = -Z, East = +X.
