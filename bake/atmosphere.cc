@@ -33,6 +33,7 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.samples = {q.view_steps, q.transmittance_steps, q.multiscattering_steps, q.integrator};
   g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground,
                q.multiscattering_sqrt_dirs};
+  g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, 0};
   return g;
 }
 

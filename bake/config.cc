@@ -330,7 +330,7 @@ class StyleReader {
     for (const auto& [key, node] : table) {
       std::string path = prefix + std::string(key.str());
       if (!known_.count(path)) {
-        Error(&node, path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
+        ErrorAt(key.source(), path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
         continue;
       }
       if (opaque_.count(path)) continue;
@@ -368,12 +368,16 @@ class StyleReader {
   static std::string FormatNumber(double v) { return fmt::format("{}", v); }
 
   void Error(const toml::node* node, const std::string& path, const std::string& message) {
+    ErrorAt(node ? node->source() : toml::source_region{}, path, message);
+  }
+
+  void ErrorAt(const toml::source_region& where, const std::string& path, const std::string& message) {
     ConfigError e;
     e.file = file_;
-    if (node && node->source().begin) {
-      e.line = int(node->source().begin.line);
-      e.column = int(node->source().begin.column);
-      if (node->source().path) e.file = *node->source().path;
+    if (where.begin) {
+      e.line = int(where.begin.line);
+      e.column = int(where.begin.column);
+      if (where.path) e.file = *where.path;
     }
     e.key = path;
     e.message = message;

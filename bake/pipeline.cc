@@ -160,6 +160,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
   // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
   RendererCache renderers(context, result);
+  renderers.Main(first);
+  timer.Finish("pipelines");
   renderers.Main(first).PrecomputeLuts();
   for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
   timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}",
@@ -329,6 +331,9 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       std::string path = path_of(style.output.basename + "_latlong" + number + ".exr");
       add_file(frame, path, "latlong", WriteExr(path, *latlong, latlong_exr));
     }
+    timer.Finish("write EXR", fmt::format("{} files, {} compression, {}", frame.files.size(),
+                                          style.output.compression,
+                                          style.output.pixel_type == PixelType::kHalf ? "half" : "float"));
 
     // Preview (and glTF texture): exposure, ACES, sRGB; one exposure for a sequence.
     if (latlong && (style.output.preview || style.gltf.enabled)) {
@@ -350,10 +355,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       }
     }
     frame.write_seconds = SecondsSince(write_start);
-    timer.Finish("write", fmt::format("{} files, {} compression, {}, EV100 {:.2f}", frame.files.size(),
-                                      style.output.compression,
-                                      style.output.pixel_type == PixelType::kHalf ? "half" : "float",
-                                      ev100.value_or(0.0)));
+    if (ev100) timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
     for (const BakedFile& f : frame.files) result.files.push_back(f);
     result.frames.push_back(std::move(frame));
   }

@@ -55,6 +55,14 @@ struct QualitySettings {
   int transmittance_height = 64;
   int multiscattering_size = 32;      // Hillaire 2020: 32 x 32
   int integrator = INTEGRATOR_ANALYTIC;
+  // Sun transmittance at each view sample: 0 reads the transmittance LUT,
+  // N > 0 marches N midpoint steps towards the Sun (Galaj 2019's light samples).
+  int light_steps = 0;
+  // In-scattering per output texel: ray-marched (false), or read from a
+  // per-frame sky-view LUT of this size (Hillaire 2020 section 5.3).
+  bool sky_view_lut = false;
+  int sky_view_width = 384;
+  int sky_view_height = 216;
 };
 
 // Optional physical effects; each off effect is compiled out of the shaders.
