@@ -335,6 +335,23 @@ std::vector<StudyCase> StudyCases(bool quick) {
       cases.push_back(MakeCase(INTEGRATOR_SIMPSON, v, 0));
       cases.push_back(MakeCase(INTEGRATOR_SIMPSON, v, 0, false, 0, 0, STEPS_QUADRATIC));
     }
+  // A finer transmittance LUT (1024 x 256, 1024 quadrature points) removes
+  // the interpolation floor of the 256 x 64 one.
+  auto fine_lut = [](StudyCase c) {
+    c.quality.transmittance_width = 1024;
+    c.quality.transmittance_height = 256;
+    c.quality.transmittance_steps = 1024;
+    c.name += " T1024";
+    return c;
+  };
+  if (!quick) {
+    for (int v : {64, 128, 256}) {
+      cases.push_back(fine_lut(MakeCase(INTEGRATOR_ANALYTIC, v, 0, false, 0, 0, STEPS_QUADRATIC)));
+      cases.push_back(fine_lut(MakeCase(INTEGRATOR_SIMPSON, v, 0, false, 0, 0, STEPS_QUADRATIC)));
+    }
+    cases.push_back(fine_lut(MakeCase(INTEGRATOR_SIMPSON, 128, 0, true, 768, 432, STEPS_QUADRATIC)));
+    cases.push_back(fine_lut(MakeCase(INTEGRATOR_SIMPSON, 128, 0, true, 1536, 864, STEPS_QUADRATIC)));
+  }
   for (auto [w, h] : quick ? std::vector<std::pair<int, int>>{{192, 108}}
                            : std::vector<std::pair<int, int>>{{192, 108}, {384, 216}, {768, 432}})
     cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, w, h, STEPS_QUADRATIC));
