@@ -52,6 +52,8 @@ AtmosphereParameters FromParams(const AtmosphereParams& a) {
   atm.solar_irradiance = v(a.solar_irradiance);
   atm.sun_angular_radius = a.sun_angular_radius_rad;
   atm.limb_darkening = a.limb_darkening_u;
+  atm.mie = true;
+  atm.ozone = true;
   return atm;
 }
 

@@ -50,6 +50,7 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground,
                q.multiscattering_sqrt_dirs};
   g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, q.step_distribution};
+  g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
   return g;
 }
 

@@ -116,6 +116,10 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("effects.multiple_scattering", s.effects.multiple_scattering);
   v.Bool("effects.sun_disc", s.effects.sun_disc);
   v.Bool("effects.ground", s.effects.ground);
+  v.Bool("effects.mie", s.effects.mie);
+  v.Bool("effects.ozone", s.effects.ozone);
+  v.Real("effects.multiple_scattering_strength", s.effects.multiple_scattering_strength, kNonNegative);
+  v.Real("effects.sun_disc_strength", s.effects.sun_disc_strength, kNonNegative);
 
   QualitySettings& q = s.quality;
   v.Preset("quality.preset", s.quality_preset, q);  // first: the keys below refine it

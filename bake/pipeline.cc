@@ -59,9 +59,9 @@ struct FramePlan {
   glm::dvec3 sun{0, 1, 0};
 };
 
-// The renderers for one atmosphere: as styled, and without the sun disc (for
-// the sky-only SH and, by difference, the disc itself). Rebuilt only when a
-// frame changes what the shaders see.
+// The renderer for one atmosphere (it also renders without the disc, for the
+// sky-only SH, from the same LUTs). Rebuilt only when a frame changes what
+// the shaders see.
 class RendererCache {
  public:
   RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
@@ -72,26 +72,11 @@ class RendererCache {
   }
   // The renderer of the last frame.
   SkyRenderer& Current() { return *main_; }
-  // Without the disc; the main renderer when the style has none.
-  SkyRenderer& NoDisc(const SkyStyle& style) {
-    Update(style);
-    if (!style.effects.sun_disc) return *main_;
-    if (!no_disc_) {
-      EffectSettings effects = style.effects;
-      effects.sun_disc = false;
-      no_disc_ = std::make_unique<SkyRenderer>(context_, style.atmosphere, style.quality, effects,
-                                               OutputScale(style.output.units));
-      ++result_.renderer_builds;
-    }
-    return *no_disc_;
-  }
-
  private:
   void Update(const SkyStyle& style) {
     gpu::GpuAtmosphere key =
         ToGpuAtmosphere(style.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
     if (main_ && std::memcmp(&key, &key_, sizeof key) == 0) return;
-    no_disc_.reset();
     main_.reset();
     main_ = std::make_unique<SkyRenderer>(context_, style.atmosphere, style.quality, style.effects,
                                           OutputScale(style.output.units));
@@ -101,7 +86,7 @@ class RendererCache {
 
   VulkanContext& context_;
   BakeResult& result_;
-  std::unique_ptr<SkyRenderer> main_, no_disc_;
+  std::unique_ptr<SkyRenderer> main_;
   gpu::GpuAtmosphere key_{};
 };
 
@@ -242,11 +227,10 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     // irradiance it delivers (centre radiance times its limb-darkened solid
     // angle), which point-sampled texels would alias.
     const std::vector<float> with_disc = renderer.RenderDirections(plan.sun, {plan.sun});
-    SkyRenderer& sky_only = renderers.NoDisc(style);
-    const std::vector<float> without_disc = sky_only.RenderDirections(plan.sun, {plan.sun});
+    const std::vector<float> without_disc = renderer.RenderDirections(plan.sun, {plan.sun}, false);
     std::vector<ViewRequest> sh_views = ShViews(style);
-    std::vector<std::vector<float>> sh_faces = sky_only.Render(plan.sun, sh_views);
-    for (const PassTiming& t : sky_only.last_timings()) frame.gpu_passes.push_back(t);
+    std::vector<std::vector<float>> sh_faces = renderer.Render(plan.sun, sh_views, false);
+    for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
     const double alpha = style.atmosphere.sun_angular_radius_rad;
     const double disc_solid_angle = M_PI * alpha * alpha * (1.0 - style.atmosphere.limb_darkening_u / 3.0);
     for (int c = 0; c < 3; ++c)

@@ -71,10 +71,11 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   UpdateDescriptors();
 
   // Pipelines are built once per renderer, never per frame.
-  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv));
-  multiscattering_pipeline_ = CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv));
-  if (quality.sky_view_lut) skyview_pipeline_ = CreatePipeline(kSkyviewLutSpv, sizeof(kSkyviewLutSpv));
-  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv));
+  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv), false);
+  multiscattering_pipeline_ =
+      CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv), false);
+  if (quality.sky_view_lut) skyview_pipeline_ = CreatePipeline(kSkyviewLutSpv, sizeof(kSkyviewLutSpv), false);
+  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), effects.sun_disc);
 
   VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -104,6 +105,7 @@ SkyRenderer::~SkyRenderer() {
   vkDestroyCommandPool(device, command_pool_, nullptr);
   vkDestroyPipeline(device, sky_pipeline_, nullptr);
   if (skyview_pipeline_) vkDestroyPipeline(device, skyview_pipeline_, nullptr);
+  if (sky_no_disc_pipeline_) vkDestroyPipeline(device, sky_no_disc_pipeline_, nullptr);
   vkDestroyPipeline(device, multiscattering_pipeline_, nullptr);
   vkDestroyPipeline(device, transmittance_pipeline_, nullptr);
   vkDestroyDescriptorPool(device, descriptor_pool_, nullptr);
@@ -183,7 +185,7 @@ void SkyRenderer::UpdateDescriptors() {
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
 }
 
-VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc) {
   VkDevice device = context_.device();
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = bytes;
@@ -197,12 +199,12 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
   struct {
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
     int32_t integrator;
-    VkBool32 sky_view;
-  } values = {effects_.multiple_scattering, effects_.sun_disc, effects_.ground, output_directions_,
-              quality_.integrator, quality_.sky_view_lut};
-  const VkSpecializationMapEntry entries[6] = {
-      {0, 0, 4}, {1, 4, 4}, {2, 8, 4}, {3, 12, 4}, {10, 16, 4}, {11, 20, 4}};
-  VkSpecializationInfo specialization{6, entries, sizeof(values), &values};
+    VkBool32 sky_view, mie, ozone;
+  } values = {effects_.multiple_scattering, sun_disc, effects_.ground, output_directions_,
+              quality_.integrator, quality_.sky_view_lut, effects_.mie, effects_.ozone};
+  const VkSpecializationMapEntry entries[8] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+                                               {10, 16, 4}, {11, 20, 4}, {12, 24, 4}, {13, 28, 4}};
+  VkSpecializationInfo specialization{8, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -215,6 +217,7 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
   VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(device, module, nullptr);
   VK_CHECK(result);
+  ++counters_.pipelines;
   return pipeline;
 }
 
@@ -309,7 +312,12 @@ void SkyRenderer::PrecomputeLuts() {
 }
 
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
-                                                    const std::vector<ViewRequest>& views) {
+                                                    const std::vector<ViewRequest>& views, bool sun_disc) {
+  VkPipeline sky_pipeline = sky_pipeline_;
+  if (!sun_disc && effects_.sun_disc) {
+    if (!sky_no_disc_pipeline_) sky_no_disc_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), false);
+    sky_pipeline = sky_no_disc_pipeline_;
+  }
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
   std::vector<size_t> offsets;
   size_t total = 0;
@@ -322,7 +330,10 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
-  if (quality_.sky_view_lut && !output_directions_) {
+  if (quality_.sky_view_lut && !output_directions_ && !(skyview_ready_ && skyview_sun_ == sun)) {
+    // The sky-view LUT depends on the sun only: built once per sun position.
+    skyview_ready_ = true;
+    skyview_sun_ = sun;
     // The sky-view LUT for this Sun, read by every view below.
     gpu::SkyPush push{};
     push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
@@ -342,7 +353,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                        : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
                        : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
                                                           : "directions";
-    dispatches.push_back({name, sky_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+    dispatches.push_back({name, sky_pipeline, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
     // Views write disjoint ranges of the output buffer: no barriers between them.
     barriers.push_back(false);
@@ -360,7 +371,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
 }
 
 std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
-                                                 const std::vector<glm::dvec3>& directions) {
+                                                 const std::vector<glm::dvec3>& directions, bool sun_disc) {
   if (!luts_ready_) PrecomputeLuts();
   EnsureOutputCapacity(std::max<size_t>(directions.size(), 1) * 16);
   float* data = static_cast<float*>(output_buffer_.mapped);
@@ -374,7 +385,7 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
   view.mapping = MAPPING_DIRECTIONS;
   view.width = int(directions.size());
   view.height = 1;
-  return Render(sun, {view})[0];
+  return Render(sun, {view}, sun_disc)[0];
 }
 
 std::vector<float> SkyRenderer::ReadTransmittanceLut() const {

@@ -66,6 +66,10 @@ struct AtmosphereParameters {
   bool multiple_scattering;     // add Hillaire's multiple-scattering term
   bool sun_disc;                // add the limb-darkened solar disc
   bool ground;                  // add the sunlit Lambertian ground
+  bool mie;                     // aerosols present
+  bool ozone;                   // ozone absorption present
+  Real multiple_scattering_strength;  // multiplies Psi_ms
+  Real sun_disc_strength;       // multiplies the disc radiance
 };
 
 // ---------------------------------------------------------------- medium
@@ -79,14 +83,19 @@ struct MediumSample {
 MediumSample SampleMedium(IN(AtmosphereParameters) atm, Real altitude) {
   Real h = max(altitude, 0.0);
   Real rayleigh_density = exp(-h / atm.rayleigh_scale_height);
-  Real mie_density = exp(-h / atm.mie_scale_height);
-  Real ozone_density =
-      max(0.0, 1.0 - abs(h - atm.ozone_peak_altitude) / atm.ozone_half_width);
   MediumSample m;
   m.rayleigh_scattering = atm.rayleigh_scattering * rayleigh_density;
-  m.mie_scattering = atm.mie_scattering * mie_density;
-  m.extinction = m.rayleigh_scattering + atm.mie_extinction * mie_density +
-                 atm.absorption_extinction * ozone_density;
+  m.mie_scattering = vec3(0.0);
+  m.extinction = m.rayleigh_scattering;
+  if (atm.mie) {
+    Real mie_density = exp(-h / atm.mie_scale_height);
+    m.mie_scattering = atm.mie_scattering * mie_density;
+    m.extinction += atm.mie_extinction * mie_density;
+  }
+  if (atm.ozone) {
+    Real ozone_density = max(0.0, 1.0 - abs(h - atm.ozone_peak_altitude) / atm.ozone_half_width);
+    m.extinction += atm.absorption_extinction * ozone_density;
+  }
   return m;
 }
 
@@ -484,7 +493,8 @@ ScatteringSample SampleScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
   sample_.source = (m.rayleigh_scattering * rayleigh_phase + m.mie_scattering * mie_phase) *
                    sun_transmittance;
   if (atm.multiple_scattering)
-    sample_.source += (m.rayleigh_scattering + m.mie_scattering) * GetMultipleScattering(atm, h, mu_s_t);
+    sample_.source += (m.rayleigh_scattering + m.mie_scattering) *
+                      (GetMultipleScattering(atm, h, mu_s_t) * atm.multiple_scattering_strength);
   sample_.extinction = m.extinction;
   return sample_;
 }
@@ -516,7 +526,7 @@ InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
   Real du = 1.0 / Real(n);
   Real t_max = ray.t_max;
   Real rayleigh_phase = RayleighPhase(ray.nu);
-  Real mie_phase = MiePhase(atm.mie_g, view, sun);
+  Real mie_phase = atm.mie ? MiePhase(atm.mie_g, view, sun) : 0.0;
 
   if (atm.integrator == INTEGRATOR_ANALYTIC || atm.integrator == INTEGRATOR_MIDPOINT) {
     Real t_start = 0.0;
@@ -615,7 +625,7 @@ InScattering ComputeSkyRadianceWithoutSun(IN(AtmosphereParameters) atm, vec3 vie
 vec3 SunDiscContribution(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, vec3 transmittance) {
   vec3 d = view - sun;
   Real theta = 2.0 * asin(min(0.5 * length(d), 1.0));
-  return transmittance * SunDiscRadiance(atm, theta);
+  return transmittance * (SunDiscRadiance(atm, theta) * atm.sun_disc_strength);
 }
 
 // Radiance along `view` in the units of solar_irradiance, ray-marched.

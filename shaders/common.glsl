@@ -32,6 +32,8 @@ layout(push_constant) uniform PushBlock {
 layout(constant_id = 0) const bool kMultipleScattering = true;
 layout(constant_id = 1) const bool kSunDisc = true;
 layout(constant_id = 2) const bool kGround = true;
+layout(constant_id = 12) const bool kMie = true;
+layout(constant_id = 13) const bool kOzone = true;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
 // Quadrature rule (INTEGRATOR_*) and whether output texels read the sky-view
@@ -88,6 +90,10 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.multiple_scattering = kMultipleScattering;
   atm.sun_disc = kSunDisc;
   atm.ground = kGround;
+  atm.mie = kMie;
+  atm.ozone = kOzone;
+  atm.multiple_scattering_strength = gpu_atmosphere.strengths.x;
+  atm.sun_disc_strength = gpu_atmosphere.strengths.y;
   return atm;
 }
 

@@ -97,10 +97,15 @@ TEST_F(Sequence, TwentyFourFramesOneRendererNoValidationMessages) {
   EXPECT_EQ(result_->validation_messages, 0);
   EXPECT_EQ(single_->validation_messages, 0);
   ASSERT_EQ(result_->frames.size(), 24u);
-  // One renderer with the sun disc and one without, for the whole sequence:
-  // the atmosphere never changes, so the LUTs are built once each.
-  EXPECT_EQ(result_->renderer_builds, 2);
+  // One renderer for the whole sequence (the disc-less SH views use a variant
+  // pipeline of the same renderer): the atmosphere never changes, so the
+  // transmittance and multiple-scattering LUTs are built once, the per-sun
+  // sky-view LUT once per frame.
+  EXPECT_EQ(result_->renderer_builds, 1);
   EXPECT_EQ(result_->counters.transmittance_lut_builds, 1);
+  EXPECT_EQ(result_->counters.multiscattering_lut_builds, 1);
+  EXPECT_EQ(result_->counters.skyview_lut_builds, QualitySettings{}.sky_view_lut ? 24 : 0);
+  EXPECT_EQ(result_->counters.frames >= 24, true);
   for (int frame = 1; frame <= 24; ++frame)
     for (const char* name : {"sky_px", "sky_nz", "sky_cube", "sky_latlong"})
       EXPECT_TRUE(fs::exists(fmt::format("{}/sequence/{}.{:04d}.exr", out_dir_, name, frame))) << name << " " << frame;

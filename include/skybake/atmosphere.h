@@ -77,7 +77,11 @@ std::vector<std::string> QualityPresetNames();
 struct EffectSettings {
   bool multiple_scattering = true;
   bool sun_disc = true;
-  bool ground = true;
+  bool ground = true;            // the sunlit ground and its bounce into multiple scattering
+  bool mie = true;               // aerosols
+  bool ozone = true;             // ozone absorption
+  double multiple_scattering_strength = 1.0;  // artistic multiplier of Hillaire's Psi_ms
+  double sun_disc_strength = 1.0;             // artistic multiplier of the disc radiance
 };
 
 // Unit vector towards the Sun from its elevation above the horizon and its

@@ -60,6 +60,7 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 samples;               // x: view steps; y: transmittance LUT steps; z: multi-scattering steps; w: integrator
   ivec4 effects;               // x: multiple scattering on; y: sun disc on; z: ground on; w: ms sqrt(directions)
   ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
+  vec4 strengths;              // x: multiple-scattering strength; y: sun-disc strength; zw: unused
 };
 
 SKYBAKE_GPU_STRUCT(SkyPush) {
@@ -69,7 +70,7 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuAtmosphere) == 12 * 16, "GpuAtmosphere must be vec4-packed");
+static_assert(sizeof(GpuAtmosphere) == 13 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 3 * 16, "SkyPush must be vec4-packed");
 }  // namespace skybake::gpu
 #endif

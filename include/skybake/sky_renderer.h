@@ -33,6 +33,7 @@ struct RenderCounters {
   int multiscattering_lut_builds = 0;
   int skyview_lut_builds = 0;
   int frames = 0;
+  int pipelines = 0;  // compute pipelines compiled
 };
 
 class SkyRenderer {
@@ -52,12 +53,14 @@ class SkyRenderer {
 
   // Renders every view for the sun direction (unit, towards the Sun) and
   // returns one RGBA float image per view, rows from the top.
+  // With `sun_disc` false, a variant without the disc (compiled once, on
+  // first use) renders from the same LUTs.
   std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
-                                         const std::vector<ViewRequest>& views);
+                                         const std::vector<ViewRequest>& views, bool sun_disc = true);
 
   // Radiance (RGBA) along each unit direction.
   std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
-                                      const std::vector<glm::dvec3>& directions);
+                                      const std::vector<glm::dvec3>& directions, bool sun_disc = true);
 
   // LUT contents (RGBA float per texel, row-major), for tests.
   std::vector<float> ReadTransmittanceLut() const;
@@ -84,7 +87,7 @@ class SkyRenderer {
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
   void UpdateDescriptors();
-  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes);
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc);
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
   // later one reads (`barrier_after`).
@@ -98,6 +101,8 @@ class SkyRenderer {
   EffectSettings effects_;
   bool output_directions_ = false;
   bool luts_ready_ = false;
+  bool skyview_ready_ = false;
+  glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
 
   Buffer atmosphere_buffer_;
   Buffer transmittance_buffer_;
@@ -113,6 +118,7 @@ class SkyRenderer {
   VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
   VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline sky_no_disc_pipeline_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
