@@ -49,7 +49,8 @@ uint64_t FileSize(const std::string& path) {
 
 std::string TemporaryPathFor(const std::string& path) {
   std::filesystem::path p(path);
-  std::string name = "." + p.filename().string() + fmt::format(".tmp{}", ::getpid());
+  // One fmt call: GCC 12's -Wrestrict misfires on `"." + std::string&&`.
+  std::string name = fmt::format(".{}.tmp{}", p.filename().string(), ::getpid());
   return (p.parent_path() / name).string();
 }
 

@@ -19,6 +19,8 @@ using vec4 = glm::vec<4, Real, glm::defaultp>;
 using ivec2 = glm::ivec2;
 using glm::abs;
 using glm::asin;
+using glm::atan;
+using glm::cross;
 using glm::clamp;
 using glm::cos;
 using glm::dot;

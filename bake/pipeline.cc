@@ -57,8 +57,12 @@ BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options) {
   timer.Finish("device", fmt::format("{} ({})", context.device_info().name, context.device_info().type));
 
   // Pipelines: compiled once, with the effects as specialization constants.
+  // The hue principle acts on the atmosphere (its Rayleigh constants), the
+  // other AOAS principles per texel; saturation is judged in Rec.709 luminance RGB.
   const Rgb output_scale = OutputScale(style.output.units);
-  SkyRenderer renderer(context, style.atmosphere, style.quality, style.effects, output_scale);
+  const AtmosphereParams atmosphere = StyledAtmosphere(style.atmosphere, style.aoas);
+  const AoasInputs aoas = ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance));
+  SkyRenderer renderer(context, atmosphere, style.quality, style.effects, output_scale, false, aoas);
   timer.Finish("pipelines");
 
   // LUTs: transmittance, then multiple scattering.

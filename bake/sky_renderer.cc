@@ -10,6 +10,12 @@
 namespace skybake {
 namespace {
 
+// Bindings 0..4 of gpu_shared.h; the atmosphere and AOAS blocks are uniform.
+constexpr uint32_t kBindingCount = 5;
+bool IsUniformBinding(uint32_t binding) {
+  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS;
+}
+
 uint32_t GroupCount(int texels, int local_size) {
   return uint32_t((texels + local_size - 1) / local_size);
 }
@@ -18,30 +24,36 @@ uint32_t GroupCount(int texels, int local_size) {
 
 SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
                          const QualitySettings& quality, const EffectSettings& effects,
-                         const Rgb& output_scale, bool output_directions)
-    : context_(context), effects_(effects), output_directions_(output_directions) {
+                         const Rgb& output_scale, bool output_directions,
+                         const AoasInputs& aoas)
+    : context_(context),
+      effects_(effects),
+      aoas_switches_(aoas.switches),
+      output_directions_(output_directions) {
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
   VkDevice device = context_.device();
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
   transmittance_buffer_ = CreateBuffer(
       VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
   multiscattering_buffer_ = CreateBuffer(
       VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
   output_buffer_ = CreateBuffer(16 * 64, storage);
 
-  VkDescriptorSetLayoutBinding bindings[4] = {};
-  for (uint32_t i = 0; i < 4; ++i) {
+  VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i].binding = i;
-    bindings[i].descriptorType =
-        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
   VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = 4;
+  set_info.bindingCount = kBindingCount;
   set_info.pBindings = bindings;
   VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout_));
 
@@ -53,7 +65,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   layout_info.pPushConstantRanges = &push_range;
   VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
 
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
                                         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
@@ -108,6 +120,7 @@ SkyRenderer::~SkyRenderer() {
   DestroyBuffer(output_buffer_);
   DestroyBuffer(multiscattering_buffer_);
   DestroyBuffer(transmittance_buffer_);
+  DestroyBuffer(aoas_buffer_);
   DestroyBuffer(atmosphere_buffer_);
 }
 
@@ -158,23 +171,24 @@ void SkyRenderer::EnsureOutputCapacity(VkDeviceSize bytes) {
 }
 
 void SkyRenderer::UpdateDescriptors() {
-  VkDescriptorBufferInfo infos[4] = {
+  VkDescriptorBufferInfo infos[kBindingCount] = {
       {atmosphere_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {transmittance_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {multiscattering_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {aoas_buffer_.buffer, 0, VK_WHOLE_SIZE},
   };
-  VkWriteDescriptorSet writes[4] = {};
-  for (uint32_t i = 0; i < 4; ++i) {
+  VkWriteDescriptorSet writes[kBindingCount] = {};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
     writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
     writes[i].dstSet = descriptor_set_;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType =
-        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[i].pBufferInfo = &infos[i];
   }
-  vkUpdateDescriptorSets(context_.device(), 4, writes, 0, nullptr);
+  vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
 }
 
 VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool specialize_effects) {
@@ -185,12 +199,17 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   VkShaderModule module;
   VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
 
-  // Specialization constants 0..3 of common.glsl: the optional effects.
-  VkBool32 values[4] = {effects_.multiple_scattering, effects_.sun_disc, effects_.ground,
-                        output_directions_};
-  VkSpecializationMapEntry entries[4];
-  for (uint32_t i = 0; i < 4; ++i) entries[i] = {i, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32)};
-  VkSpecializationInfo specialization{4, entries, sizeof(values), values};
+  // Specialization constants 0..3 of common.glsl: the optional effects;
+  // 4..7: the AOAS principles that act per texel.
+  constexpr uint32_t kConstants = 8;
+  VkBool32 values[kConstants] = {effects_.multiple_scattering, effects_.sun_disc,
+                                 effects_.ground,           output_directions_,
+                                 aoas_switches_.skydome,    aoas_switches_.ambiguity,
+                                 aoas_switches_.cloud_noise, aoas_switches_.cloud_shapes};
+  VkSpecializationMapEntry entries[kConstants];
+  for (uint32_t i = 0; i < kConstants; ++i)
+    entries[i] = {i, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32)};
+  VkSpecializationInfo specialization{kConstants, entries, sizeof(values), values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;

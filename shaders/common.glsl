@@ -21,6 +21,9 @@ layout(std430, set = 0, binding = BINDING_MULTISCATTERING) buffer MultiScatterin
 layout(std430, set = 0, binding = BINDING_OUTPUT) buffer OutputBuffer {
   vec4 output_texels[];
 };
+layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
+  GpuAoas gpu_aoas;
+};
 layout(push_constant) uniform PushBlock {
   SkyPush push;
 };
@@ -31,6 +34,12 @@ layout(constant_id = 1) const bool kSunDisc = true;
 layout(constant_id = 2) const bool kGround = true;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
+// The AOAS principles (AoasSwitches); a style that does not use one compiles
+// it out. The sky hue needs no switch: it is the Rayleigh vector itself.
+layout(constant_id = 4) const bool kSkydome = false;
+layout(constant_id = 5) const bool kAmbiguity = false;
+layout(constant_id = 6) const bool kCloudNoise = false;
+layout(constant_id = 7) const bool kCloudShapes = false;
 
 vec3 TransmittanceLutTexel(int x, int y) {
   return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;
@@ -40,7 +49,12 @@ vec3 MultipleScatteringLutTexel(int x, int y) {
   return multiscattering_texels[y * gpu_atmosphere.lut_sizes.z + x].xyz;
 }
 
+vec4 ShapeSegmentStart(int i) { return gpu_aoas.shape_segments[2 * i]; }
+vec4 ShapeSegmentEnd(int i) { return gpu_aoas.shape_segments[2 * i + 1]; }
+int PerlinPermutation(int i) { return gpu_aoas.perlin_permutation[i >> 2][i & 3]; }
+
 #include "atmosphere.glsl"
+#include "aoas.glsl"
 #include "envmap.glsl"
 
 AtmosphereParameters AtmosphereFromUniform() {
@@ -74,6 +88,28 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.sun_disc = kSunDisc;
   atm.ground = kGround;
   return atm;
+}
+
+AoasParameters AoasFromUniform() {
+  AoasParameters aoas;
+  aoas.dome_radius = gpu_aoas.dome.x;
+  aoas.viewer_position = gpu_aoas.viewer.xyz;
+  aoas.l_pt = gpu_aoas.dome.y;
+  aoas.perturbation_grain = gpu_aoas.dome.z;
+  aoas.perturbation_offset = gpu_aoas.perturbation_offset.xyz;
+  aoas.s_noise = gpu_aoas.noise.x;
+  aoas.noise_octaves = gpu_aoas.counts.y;
+  aoas.noise_threshold = gpu_aoas.noise.y;
+  aoas.noise_strength = gpu_aoas.noise.z;
+  aoas.noise_offset = gpu_aoas.noise_offset.xyz;
+  aoas.shape_strength = gpu_aoas.noise.w;
+  aoas.shape_segment_count = min(gpu_aoas.counts.x, AOAS_MAX_SHAPE_SEGMENTS);
+  aoas.color_scale = gpu_aoas.color_scale.xyz;
+  aoas.skydome = kSkydome;
+  aoas.ambiguity = kAmbiguity;
+  aoas.cloud_noise = kCloudNoise;
+  aoas.cloud_shapes = kCloudShapes;
+  return aoas;
 }
 
 #endif  // SKYBAKE_COMMON_GLSL
