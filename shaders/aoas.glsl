@@ -58,9 +58,9 @@ int PerlinHash(int i) { return PerlinPermutation(i & 255); }
 Real PerlinFade(Real t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
 
 // Dot product of (x, y, z) with one of the 12 edge directions of a cube,
-// (+-1, +-1, 0) and permutations, picked by the low 4 bits of `hash`
-// (16 cases: the 12 directions, with (1,1,0), (-1,1,0), (0,-1,1), (0,-1,-1)
-// repeated), as in Perlin 2002.
+// (+-1, +-1, 0) and permutations, picked by the low 4 bits of `hash`: the
+// 16 cases of Perlin's 2002 reference code, the 12 directions with (1,1,0),
+// (-1,1,0), (0,-1,1), (0,-1,-1) repeated (as cases 12, 14, 13, 15).
 Real PerlinGradient(int hash, Real x, Real y, Real z) {
   int h = hash & 15;
   Real u = h < 8 ? x : y;
