@@ -328,6 +328,25 @@ TEST(SkydomeTest, ViewerHeightIsAltitudeInAtmosphereThicknesses) {
   }
 }
 
+TEST(SkydomeTest, OffAxisViewerSeesTheSkyOfItsApex) {
+  // A viewer at (0.3, 0.4, 0) R has apex direction (0.6, 0.8, 0) and stands
+  // 0.5 thicknesses = 50 km up (eq. 2). Looking along its apex it sees the
+  // zenith of a 50 km observer whose Sun is as high above its local horizon
+  // as the dome's Sun is above the plane normal to the apex.
+  SkyStyle dome = Style(std::string(kFastQuality) +
+                        "[skydome]\nenabled = true\nradius = 2.0\nviewer_position = [0.6, 0.8, 0.0]\n");
+  SkyStyle physical = Style(std::string(kFastQuality) + "[atmosphere]\nobserver_altitude_m = 50000.0\n");
+  ReferenceModel a = Reference(dome), b = Reference(physical);
+  const glm::dvec3 apex(0.6, 0.8, 0.0);
+  for (double sun_elevation : {70.0, 20.0, 5.0}) {
+    glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 90.0);  // towards the tilt
+    double local_elevation = std::asin(glm::dot(sun, apex)) * 180.0 / M_PI;
+    glm::dvec3 local_sun = SunDirectionFromElevationAzimuth(local_elevation, 0.0);
+    glm::dvec3 la = a.StyledRadiance(apex, sun), lb = b.StyledRadiance({0, 1, 0}, local_sun);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(la[c] / lb[c], 1.0, 1e-6) << sun_elevation;
+  }
+}
+
 TEST(SkydomeTest, ScalingTheDomeDoesNotChangeTheSky) {
   // Fig. 7: same viewer position relative to the dome, dome radius x0.001 to
   // x1000, with every dome-space principle on. lavapipe, 64 x 32 latlong and
@@ -603,6 +622,61 @@ TEST(AoasHueTest, HueStyledSkyKeepsThePhysicalLuminanceProfile) {
     RecordProperty(std::string("profile_deviation_") + (color + 1), std::to_string(worst));
     EXPECT_LT(worst, 0.10) << color;
     EXPECT_NEAR(zenith_ratio, 1.0, 0.02) << color;
+  }
+}
+
+// ------------------------------------------------------------------ style keys
+
+TEST(AoasConfigTest, ReportsMistakesWithTheirPlace) {
+  auto errors = [](const std::string& toml) {
+    ConfigResult r = ParseSkyStyle(toml, "s.toml");
+    std::string all;
+    for (const ConfigError& e : r.errors) all += e.Format() + "\n";
+    return all;
+  };
+  EXPECT_NE(errors("[hue]\ncolor = \"ffcc33\"\n").find("s.toml:2:9: hue.color: expected a colour"),
+            std::string::npos);
+  EXPECT_NE(errors("[skydome]\nenabled = true\nviewer_position = [0.0, 1.5, 0.0]\n")
+                .find("the viewer must be inside the dome"),
+            std::string::npos);
+  EXPECT_NE(errors("[skydome]\nenabled = true\nviewer_position = [0.0, -0.1, 0.0]\n")
+                .find("above the ground plane"),
+            std::string::npos);
+  EXPECT_NE(errors("[clouds]\nocatves = 3\n").find("did you mean 'clouds.octaves'"), std::string::npos);
+  EXPECT_NE(errors("[clouds]\nthreshold = 1.0\n").find("out of range"), std::string::npos);
+  EXPECT_NE(errors("[[shapes.shape]]\nkind = \"point\"\npoints = [[10.0, 20.0]]\nradius = 3\n")
+                .find("shapes.shape[0].radius: unknown key"),
+            std::string::npos);
+  EXPECT_NE(errors("[[shapes.shape]]\nkind = \"spline\"\npoints = [[10.0, 20.0]]\n")
+                .find("at least 2 points"),
+            std::string::npos);
+  EXPECT_NE(errors("[[shapes.shape]]\npoints = [[100.0, 20.0]]\n").find("shapes.shape[0].points[0]"),
+            std::string::npos);
+  EXPECT_NE(errors("[shapes]\nenabled = true\n").find("no [[shapes.shape]]"), std::string::npos);
+  // 25 spline spans of 8 arcs each exceed the 192 arcs a style may have.
+  std::string many = "[shapes]\nenabled = true\n[[shapes.shape]]\nkind = \"spline\"\npoints = [";
+  for (int i = 0; i < 26; ++i) many += fmt::format("{}[10.0, {}.0]", i ? ", " : "", i * 10);
+  many += "]\n";
+  EXPECT_NE(errors(many).find("at most 192 fit"), std::string::npos);
+  // A target colour decides the vector, and the resolved style records both.
+  ConfigResult ok = ParseSkyStyle("[hue]\nenabled = true\ncolor = \"#FFCC33\"\n", "s.toml", {"aoas.seed=9"});
+  ASSERT_TRUE(ok.ok());
+  EXPECT_EQ(ok.style.aoas.seed, 9u);
+  EXPECT_GT(ok.style.aoas.hue.rayleigh_per_km[0], ok.style.aoas.hue.rayleigh_per_km[2]);
+  EXPECT_NE(ok.style.resolved_toml.find("#FFCC33"), std::string::npos);
+  ConfigResult again = ParseSkyStyle(ok.style.resolved_toml, "resolved.toml");
+  ASSERT_TRUE(again.ok()) << again.errors[0].Format();
+  EXPECT_EQ(again.style.aoas.hue.rayleigh_per_km, ok.style.aoas.hue.rayleigh_per_km);
+}
+
+TEST(AoasConfigTest, ShippedShapeStylesRoundTripThroughTheResolvedToml) {
+  for (const char* name : {"smiley_clouds", "heart_clouds"}) {
+    ConfigResult a = LoadSkyStyle(testing::SourceDir() + "/configs/styles/" + name + ".toml");
+    ASSERT_TRUE(a.ok());
+    ConfigResult b = ParseSkyStyle(a.style.resolved_toml, "resolved.toml");
+    ASSERT_TRUE(b.ok()) << b.errors[0].Format();
+    ASSERT_EQ(ShapeArcs(a.style.aoas.shapes).size(), ShapeArcs(b.style.aoas.shapes).size());
+    EXPECT_EQ(b.style.resolved_toml, a.style.resolved_toml);
   }
 }
 
