@@ -13,6 +13,22 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
           -std::cos(azimuth) * std::cos(elevation)};
 }
 
+QualitySettings QualityPreset(const std::string& name) {
+  QualitySettings q;  // production
+  if (name == "draft") {
+    q.view_steps = 16;
+  } else if (name == "reference") {
+    q.view_steps = 256;
+    q.integrator = INTEGRATOR_SIMPSON;
+    q.transmittance_width = 1024;
+    q.transmittance_height = 256;
+    q.transmittance_steps = 1024;
+  }
+  return q;
+}
+
+std::vector<std::string> QualityPresetNames() { return {"draft", "production", "reference"}; }
+
 gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySettings& q,
                                    const EffectSettings& effects, const Rgb& output_scale) {
   auto v4 = [](const Rgb& rgb, double w) {
@@ -33,6 +49,7 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.samples = {q.view_steps, q.transmittance_steps, q.multiscattering_steps, q.integrator};
   g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground,
                q.multiscattering_sqrt_dirs};
+  g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, q.step_distribution};
   return g;
 }
 

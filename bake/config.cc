@@ -125,6 +125,16 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("effects.ground", s.effects.ground);
 
   QualitySettings& q = s.quality;
+  v.Preset("quality.preset", s.quality_preset, q);  // first: the keys below refine it
+  v.Choice("quality.integrator", q.integrator,
+           {{"analytic", INTEGRATOR_ANALYTIC}, {"midpoint", INTEGRATOR_MIDPOINT},
+            {"trapezoid", INTEGRATOR_TRAPEZOID}, {"simpson", INTEGRATOR_SIMPSON}});
+  v.Int("quality.light_steps", q.light_steps, 0, kMaxSteps);
+  v.Choice("quality.step_distribution", q.step_distribution,
+           {{"uniform", STEPS_UNIFORM}, {"quadratic", STEPS_QUADRATIC}});
+  v.Bool("quality.sky_view_lut", q.sky_view_lut);
+  v.Int("quality.sky_view_lut_width", q.sky_view_width, 4, kMaxLutSize);
+  v.Int("quality.sky_view_lut_height", q.sky_view_height, 4, kMaxLutSize);
   v.Int("quality.view_steps", q.view_steps, 1, kMaxSteps);
   v.Int("quality.transmittance_steps", q.transmittance_steps, 1, kMaxSteps);
   v.Int("quality.multiscattering_steps", q.multiscattering_steps, 1, kMaxSteps);
@@ -285,6 +295,23 @@ class StyleReader {
       }
     }
     Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(names)));
+  }
+
+  void Preset(const char* path, std::string& name, QualitySettings& quality) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    std::vector<std::string> list = QualityPresetNames();
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TypeName(*node)));
+      return;
+    }
+    const std::string& text = node->as_string()->get();
+    if (std::find(list.begin(), list.end(), text) == list.end()) {
+      Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(list)));
+      return;
+    }
+    name = text;
+    quality = QualityPreset(text);
   }
 
   void FileName(const char* path, std::string& out) {
@@ -460,7 +487,7 @@ class StyleReader {
     for (const auto& [key, node] : table) {
       std::string path = prefix + std::string(key.str());
       if (!known_.count(path)) {
-        Error(&node, path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
+        ErrorAt(key.source(), path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
         continue;
       }
       if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
@@ -497,12 +524,16 @@ class StyleReader {
   static std::string FormatNumber(double v) { return fmt::format("{}", v); }
 
   void Error(const toml::node* node, const std::string& path, const std::string& message) {
+    ErrorAt(node ? node->source() : toml::source_region{}, path, message);
+  }
+
+  void ErrorAt(const toml::source_region& where, const std::string& path, const std::string& message) {
     ConfigError e;
     e.file = file_;
-    if (node && node->source().begin) {
-      e.line = int(node->source().begin.line);
-      e.column = int(node->source().begin.column);
-      if (node->source().path) e.file = *node->source().path;
+    if (where.begin) {
+      e.line = int(where.begin.line);
+      e.column = int(where.begin.column);
+      if (where.path) e.file = *where.path;
     }
     e.key = path;
     e.message = message;
@@ -529,6 +560,7 @@ class StyleWriter {
       if (c.second == v) Put(path, std::string(c.first));
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
+  void Preset(const char* path, std::string& name, QualitySettings&) { Put(path, name); }
   void Uint(const char* path, uint32_t& v) { Put(path, int64_t(v)); }
   void Vector(const char* path, glm::dvec3& v, const Range&) { Put(path, toml::array{v.x, v.y, v.z}); }
   void Color(const char* path, std::string& v) {

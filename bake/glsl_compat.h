@@ -18,6 +18,7 @@ using vec3 = glm::vec<3, Real, glm::defaultp>;
 using vec4 = glm::vec<4, Real, glm::defaultp>;
 using ivec2 = glm::ivec2;
 using glm::abs;
+using glm::acos;
 using glm::asin;
 using glm::atan;
 using glm::cross;
@@ -57,6 +58,16 @@ inline Real smoothstep(A lo, B hi, C x) requires(std::is_arithmetic_v<A> && std:
                                                  std::is_arithmetic_v<C> &&
                                                  !(std::is_same_v<A, B> && std::is_same_v<B, C>)) {
   return glm::smoothstep(Real(lo), Real(hi), Real(x));
+}
+// GLSL multiplies a float vector by a double literal (the literal becomes
+// float); glm needs the scalar type to match.
+template <glm::length_t L>
+inline glm::vec<L, float, glm::defaultp> operator*(double a, const glm::vec<L, float, glm::defaultp>& v) {
+  return float(a) * v;
+}
+template <glm::length_t L>
+inline glm::vec<L, float, glm::defaultp> operator*(const glm::vec<L, float, glm::defaultp>& v, double a) {
+  return v * float(a);
 }
 #ifndef IN
 #define IN(T) const T&

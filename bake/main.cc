@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "skybake/accuracy.h"
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
 #include "skybake/gallery.h"
@@ -213,6 +214,14 @@ int main(int argc, char** argv) {
 
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
 
+  AccuracyStudyOptions study;
+  CLI::App* accuracy = app.add_subcommand(
+      "accuracy", "Run the accuracy-versus-time study of every integrator and write its tables and plot");
+  accuracy->add_option("--out", study.out_dir, "Folder for accuracy_results.md, accuracy.csv, accuracy.png")
+      ->capture_default_str();
+  accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
+  accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -222,6 +231,12 @@ int main(int argc, char** argv) {
 
   try {
     if (devices->parsed()) return RunDevices();
+    if (accuracy->parsed()) {
+      study.progress = [](const std::string& line) { std::fprintf(stderr, "skybake: %s\n", line.c_str()); };
+      std::string report = RunAccuracyStudy(study);
+      std::printf("%s", report.c_str());
+      return kExitOk;
+    }
     if (check->parsed()) return RunBake(args, true);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
     return RunBake(args, false);

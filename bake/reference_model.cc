@@ -18,8 +18,10 @@ namespace reference {
 struct LutView {
   const std::vector<glm::dvec3>* transmittance = nullptr;
   const std::vector<glm::dvec3>* multiscattering = nullptr;
+  const std::vector<glm::dvec3>* skyview = nullptr;
   int transmittance_width = 0;
   int multiscattering_width = 0;
+  int skyview_width = 0;
 };
 thread_local LutView g_luts;
 
@@ -28,6 +30,9 @@ vec3 TransmittanceLutTexel(int x, int y) {
 }
 vec3 MultipleScatteringLutTexel(int x, int y) {
   return (*g_luts.multiscattering)[size_t(y) * g_luts.multiscattering_width + x];
+}
+vec3 SkyViewLutTexel(int x, int y) {
+  return (*g_luts.skyview)[size_t(y) * g_luts.skyview_width + x];
 }
 
 // The shape arcs the shared code reads through its hooks (as the GPU reads
@@ -58,10 +63,14 @@ struct ReferenceModel::Impl {
   glm::dvec3 output_scale;
   std::vector<glm::dvec3> transmittance;
   std::vector<glm::dvec3> multiscattering;
+  std::vector<glm::dvec3> skyview;
+  bool use_skyview = false;
 
   void Bind() const {
     reference::g_luts.transmittance = &transmittance;
     reference::g_luts.multiscattering = &multiscattering;
+    reference::g_luts.skyview = &skyview;
+    reference::g_luts.skyview_width = atm.sky_view_width;
     reference::g_luts.transmittance_width = atm.transmittance_width;
     reference::g_luts.multiscattering_width = atm.multiscattering_width;
     reference::g_aoas = &gpu_aoas;
@@ -144,6 +153,11 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
   atm.multiscattering_steps = q.multiscattering_steps;
   atm.multiscattering_sqrt_dirs = q.multiscattering_sqrt_dirs;
   atm.integrator = q.integrator;
+  atm.light_steps = q.light_steps;
+  atm.step_distribution = q.step_distribution;
+  atm.sky_view_width = q.sky_view_width;
+  atm.sky_view_height = q.sky_view_height;
+  impl_->use_skyview = q.sky_view_lut;
   atm.multiple_scattering = effects.multiple_scattering;
   atm.sun_disc = effects.sun_disc;
   atm.ground = effects.ground;
@@ -172,14 +186,27 @@ void ReferenceModel::PrecomputeLuts() {
   }
 }
 
+void ReferenceModel::PrepareSun(const glm::dvec3& sun) {
+  if (!impl_->use_skyview) return;
+  const reference::AtmosphereParameters& atm = impl_->atm;
+  impl_->skyview.assign(size_t(atm.sky_view_width) * atm.sky_view_height, glm::dvec3(0.0));
+  int w = atm.sky_view_width;
+  ParallelFor(impl_->skyview.size(), impl_, [&](size_t i) {
+    impl_->skyview[i] = reference::ComputeSkyViewLutTexel(atm, int(i % w), int(i / w), sun.y);
+  });
+}
+
 glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& sun) const {
   impl_->Bind();
+  if (impl_->use_skyview)
+    return reference::ComputeSkyRadianceFromSkyView(impl_->atm, view, sun) * impl_->output_scale;
   return reference::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
 }
 
 glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
   impl_->Bind();
-  return reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun) * impl_->output_scale;
+  return reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
+         impl_->output_scale;
 }
 
 std::vector<glm::dvec3> ViewDirections(const ViewRequest& v) {
@@ -203,8 +230,9 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
   std::vector<glm::dvec3> dirs = ViewDirections(view);
   std::vector<double> image(dirs.size() * 4);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {
-    glm::dvec3 l =
-        reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun) * impl_->output_scale;
+    glm::dvec3 l = reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun,
+                                                       impl_->use_skyview) *
+                   impl_->output_scale;
     image[4 * i + 0] = l.x;
     image[4 * i + 1] = l.y;
     image[4 * i + 2] = l.z;

@@ -5,13 +5,13 @@
 
 #include "shaders/multiscattering_lut.spv.h"
 #include "shaders/sky_render.spv.h"
+#include "shaders/skyview_lut.spv.h"
 #include "shaders/transmittance_lut.spv.h"
 
 namespace skybake {
 namespace {
 
-// Bindings 0..4 of gpu_shared.h; the atmosphere and AOAS blocks are uniform.
-constexpr uint32_t kBindingCount = 5;
+// Of the bindings of gpu_shared.h, the atmosphere and AOAS blocks are uniform.
 bool IsUniformBinding(uint32_t binding) {
   return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS;
 }
@@ -27,6 +27,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
                          const Rgb& output_scale, bool output_directions,
                          const AoasInputs& aoas)
     : context_(context),
+      quality_(quality),
       effects_(effects),
       aoas_switches_(aoas.switches),
       output_directions_(output_directions) {
@@ -43,6 +44,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   multiscattering_buffer_ = CreateBuffer(
       VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
   output_buffer_ = CreateBuffer(16 * 64, storage);
+  skyview_buffer_ = CreateBuffer(
+      quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 16 : 16, storage);
 
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -66,7 +69,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
 
   VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3}};
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = 2;
@@ -80,10 +83,10 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   UpdateDescriptors();
 
   // Pipelines are built once per renderer, never per frame.
-  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv), false);
-  multiscattering_pipeline_ =
-      CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv), false);
-  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), true);
+  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv));
+  multiscattering_pipeline_ = CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv));
+  if (quality.sky_view_lut) skyview_pipeline_ = CreatePipeline(kSkyviewLutSpv, sizeof(kSkyviewLutSpv));
+  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv));
 
   VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -112,11 +115,13 @@ SkyRenderer::~SkyRenderer() {
   vkDestroyFence(device, fence_, nullptr);
   vkDestroyCommandPool(device, command_pool_, nullptr);
   vkDestroyPipeline(device, sky_pipeline_, nullptr);
+  if (skyview_pipeline_) vkDestroyPipeline(device, skyview_pipeline_, nullptr);
   vkDestroyPipeline(device, multiscattering_pipeline_, nullptr);
   vkDestroyPipeline(device, transmittance_pipeline_, nullptr);
   vkDestroyDescriptorPool(device, descriptor_pool_, nullptr);
   vkDestroyPipelineLayout(device, pipeline_layout_, nullptr);
   vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
+  DestroyBuffer(skyview_buffer_);
   DestroyBuffer(output_buffer_);
   DestroyBuffer(multiscattering_buffer_);
   DestroyBuffer(transmittance_buffer_);
@@ -176,6 +181,7 @@ void SkyRenderer::UpdateDescriptors() {
       {transmittance_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {multiscattering_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {skyview_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {aoas_buffer_.buffer, 0, VK_WHOLE_SIZE},
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
@@ -191,7 +197,7 @@ void SkyRenderer::UpdateDescriptors() {
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
 }
 
-VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool specialize_effects) {
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
   VkDevice device = context_.device();
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = bytes;
@@ -199,24 +205,30 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   VkShaderModule module;
   VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
 
-  // Specialization constants 0..3 of common.glsl: the optional effects;
-  // 4..7: the AOAS principles that act per texel.
-  constexpr uint32_t kConstants = 8;
-  VkBool32 values[kConstants] = {effects_.multiple_scattering, effects_.sun_disc,
-                                 effects_.ground,           output_directions_,
-                                 aoas_switches_.skydome,    aoas_switches_.ambiguity,
-                                 aoas_switches_.cloud_noise, aoas_switches_.cloud_shapes};
-  VkSpecializationMapEntry entries[kConstants];
-  for (uint32_t i = 0; i < kConstants; ++i)
-    entries[i] = {i, uint32_t(i * sizeof(VkBool32)), sizeof(VkBool32)};
-  VkSpecializationInfo specialization{kConstants, entries, sizeof(values), values};
+  // Specialization constants of common.glsl: ids 0..3 the optional effects,
+  // 4..7 the AOAS principles that act per texel, 10..11 the quality
+  // settings. Every pipeline gets them all; a shader that does not use one
+  // ignores it.
+  struct {
+    VkBool32 multiple_scattering, sun_disc, ground, output_directions;
+    VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
+    int32_t integrator;
+    VkBool32 sky_view;
+  } values = {effects_.multiple_scattering, effects_.sun_disc,      effects_.ground,
+              output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
+              aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
+              quality_.integrator,          quality_.sky_view_lut};
+  const VkSpecializationMapEntry entries[10] = {{0, 0, 4},  {1, 4, 4},  {2, 8, 4},   {3, 12, 4},
+                                                {4, 16, 4}, {5, 20, 4}, {6, 24, 4},  {7, 28, 4},
+                                                {10, 32, 4}, {11, 36, 4}};
+  VkSpecializationInfo specialization{10, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
   info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
   info.stage.module = module;
   info.stage.pName = "main";
-  info.stage.pSpecializationInfo = specialize_effects ? &specialization : nullptr;
+  info.stage.pSpecializationInfo = &specialization;
   info.layout = pipeline_layout_;
   VkPipeline pipeline;
   VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
@@ -328,6 +340,17 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
 
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  if (quality_.sky_view_lut && !output_directions_) {
+    // The sky-view LUT for this Sun, read by every view below.
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    dispatches.push_back({"sky-view LUT", skyview_pipeline_, push,
+                          GroupCount(quality_.sky_view_width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(quality_.sky_view_height, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+    ++counters_.skyview_lut_builds;
+  }
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
     gpu::SkyPush push{};
@@ -340,9 +363,10 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                                                           : "directions";
     dispatches.push_back({name, sky_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
+    // Views write disjoint ranges of the output buffer: no barriers between them.
+    barriers.push_back(false);
   }
-  // Views write disjoint ranges of the output buffer: no barriers between them.
-  Submit(dispatches, std::vector<bool>(dispatches.size(), false));
+  Submit(dispatches, barriers);
   ++counters_.frames;
 
   std::vector<std::vector<float>> images;

@@ -287,12 +287,13 @@ vec3 ScaleSaturation(vec3 rgb, Real factor) {
 
 // Radiance of the styled sky for texel direction `w` (unit; the dome
 // fragment R w seen from the dome centre) with the Sun along unit `sun`,
-// in the units of ComputeSkyRadiance. Applies, in order: the skydome
+// in the units of ComputeSkyRadiance (read from the sky-view LUT with
+// `use_sky_view`, as ComputeSkyRadianceFromSkyView). Applies, in order: the skydome
 // transform (eq. 1-2), the perturbation (eq. 5-6), the physical radiance
 // (the hue principle acts through atm.rayleigh_scattering), then the cloud
 // saturation (eq. 7-8 and the shapes), judged in `color_scale` RGB.
 vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) aoas, vec3 w,
-                              vec3 sun) {
+                              vec3 sun, bool use_sky_view) {
   AtmosphereParameters earth = atm;
   vec3 fragment = w * aoas.dome_radius;
   vec3 viewer;
@@ -316,7 +317,11 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
     view = RotateApexToZenith(view, apex);
     sun_local = RotateApexToZenith(sun, apex);
   }
-  vec3 radiance = ComputeSkyRadiance(earth, view, sun_local);
+  // The sky-view LUT is built for the configured observer and Sun; the
+  // skydome moves the observer and turns the Sun, so it ray-marches instead.
+  vec3 radiance;
+  if (use_sky_view && !aoas.skydome) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
+  else radiance = ComputeSkyRadiance(earth, view, sun_local);
   if (aoas.cloud_noise || aoas.cloud_shapes) {
     Real keep = 1.0;
     // Noise clouds live in the sky half of the dome, above the ground plane.

@@ -27,6 +27,7 @@
 // Hooks each side must define before including this file:
 //   vec3 TransmittanceLutTexel(int x, int y);
 //   vec3 MultipleScatteringLutTexel(int x, int y);
+//   vec3 SkyViewLutTexel(int x, int y);
 #ifndef SKYBAKE_ATMOSPHERE_GLSL
 #define SKYBAKE_ATMOSPHERE_GLSL
 
@@ -58,6 +59,10 @@ struct AtmosphereParameters {
   int multiscattering_steps;    // ray-march steps per multi-scattering direction
   int multiscattering_sqrt_dirs;// directions per multi-scattering texel = this^2
   int integrator;               // INTEGRATOR_* of gpu_shared.h
+  int light_steps;              // 0: sun transmittance from the LUT; N: N-step march
+  int step_distribution;        // STEPS_UNIFORM or STEPS_QUADRATIC (gpu_shared.h)
+  int sky_view_width;           // sky-view LUT texels along the azimuth from the Sun
+  int sky_view_height;          // sky-view LUT texels along the zenith angle
   bool multiple_scattering;     // add Hillaire's multiple-scattering term
   bool sun_disc;                // add the limb-darkened solar disc
   bool ground;                  // add the sunlit Lambertian ground
@@ -407,67 +412,368 @@ Real SunDiscRadiance(IN(AtmosphereParameters) atm, Real theta) {
   return (1.0 - u * (1.0 - m)) / (kPi * alpha * alpha * (1.0 - u / 3.0));
 }
 
-// Radiance reaching the observer along unit direction `view` (world frame,
-// +Y up) with the Sun along unit `sun`, in the units of solar_irradiance.
-vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  Real altitude = atm.observer_altitude;
-  Real r = atm.bottom_radius + altitude;
-  Real mu = ClampCosine(view.y);
-  Real mu_s = ClampCosine(sun.y);
-  Real nu = ClampCosine(dot(view, sun));
-  vec3 radiance = vec3(0.0);
-  vec3 transmittance = vec3(1.0);
-  bool in_atmosphere = true;
+// Transmittance from (r_t, mu_s_t) to the Sun, times the visible fraction of
+// the disc: from the LUT, or (light_steps > 0) by a midpoint march of
+// light_steps steps, Galaj 2019's "light samples".
+vec3 SunTransmittance(IN(AtmosphereParameters) atm, Real r_t, Real h, Real mu_s_t) {
+  if (atm.light_steps <= 0) return GetTransmittanceToSun(atm, r_t, h, mu_s_t);
+  Real sin_theta_h = atm.bottom_radius / r_t;
+  Real cos_theta_h = -sqrt(max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
+  Real visible = smoothstep(-sin_theta_h * atm.sun_angular_radius,
+                            sin_theta_h * atm.sun_angular_radius, mu_s_t - cos_theta_h);
+  if (visible <= 0.0) return vec3(0.0);
+  return exp(-ComputeOpticalDepthToTopBoundary(atm, r_t, h, mu_s_t, atm.light_steps)) * visible;
+}
 
-  // An observer above the atmosphere first travels to where the ray enters it.
-  if (altitude > atm.top_radius - atm.bottom_radius) {
-    Real t_entry = DistanceToAtmosphereEntry(atm, r, altitude, mu);
+// The view ray of one texel after moving an observer above the atmosphere to
+// where the ray enters it.
+struct SkyRay {
+  Real r;
+  Real altitude;
+  Real mu;
+  Real mu_s;
+  Real nu;
+  bool in_atmosphere;
+  bool hits_ground;
+  Real t_max;
+};
+
+SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray;
+  ray.altitude = atm.observer_altitude;
+  ray.r = atm.bottom_radius + ray.altitude;
+  ray.mu = ClampCosine(view.y);
+  ray.mu_s = ClampCosine(sun.y);
+  ray.nu = ClampCosine(dot(view, sun));
+  ray.in_atmosphere = true;
+  ray.hits_ground = false;
+  ray.t_max = 0.0;
+  if (ray.altitude > atm.top_radius - atm.bottom_radius) {
+    Real t_entry = DistanceToAtmosphereEntry(atm, ray.r, ray.altitude, ray.mu);
     if (t_entry < 0.0) {
-      in_atmosphere = false;
-    } else {
-      Real r_entry = atm.top_radius;
-      mu = ClampCosine((r * mu + t_entry) / r_entry);
-      mu_s = ClampCosine((r * mu_s + t_entry * nu) / r_entry);
-      r = r_entry;
-      altitude = atm.top_radius - atm.bottom_radius;
+      ray.in_atmosphere = false;
+      return ray;
+    }
+    Real r_entry = atm.top_radius;
+    ray.mu = ClampCosine((ray.r * ray.mu + t_entry) / r_entry);
+    ray.mu_s = ClampCosine((ray.r * ray.mu_s + t_entry * ray.nu) / r_entry);
+    ray.r = r_entry;
+    ray.altitude = atm.top_radius - atm.bottom_radius;
+  }
+  ray.hits_ground = RayIntersectsGround(atm, ray.r, ray.altitude, ray.mu);
+  ray.t_max = ray.hits_ground ? DistanceToBottomBoundary(atm, ray.r, ray.altitude, ray.mu)
+                              : DistanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu);
+  return ray;
+}
+
+// In-scattering source (per unit solar irradiance, sr^-1 km^-1) and
+// extinction at distance t along the ray.
+struct ScatteringSample {
+  vec3 source;
+  vec3 extinction;
+};
+
+ScatteringSample SampleScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
+                                  Real rayleigh_phase, Real mie_phase, Real t) {
+  Real h = AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, t);
+  Real r_t = atm.bottom_radius + h;
+  Real mu_s_t = ClampCosine((ray.r * ray.mu_s + t * ray.nu) / r_t);
+  MediumSample m = SampleMedium(atm, h);
+  vec3 sun_transmittance = SunTransmittance(atm, r_t, h, mu_s_t);
+  ScatteringSample sample_;
+  sample_.source = (m.rayleigh_scattering * rayleigh_phase + m.mie_scattering * mie_phase) *
+                   sun_transmittance;
+  if (atm.multiple_scattering)
+    sample_.source += (m.rayleigh_scattering + m.mie_scattering) * GetMultipleScattering(atm, h, mu_s_t);
+  sample_.extinction = m.extinction;
+  return sample_;
+}
+
+struct InScattering {
+  vec3 radiance;       // per unit solar irradiance
+  vec3 transmittance;  // along the whole ray
+};
+
+// Where the view samples go: t(u) for u in [0, 1], uniform or quadratic
+// (u^2 puts them near the observer, where a horizontal ray's density is:
+// its altitude grows as t^2 / 2R). dt/du is the Jacobian of the mapping.
+Real StepPosition(IN(AtmosphereParameters) atm, Real t_max, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? t_max * u * u : t_max * u;
+}
+Real StepJacobian(IN(AtmosphereParameters) atm, Real t_max, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? 2.0 * t_max * u : t_max;
+}
+
+// The single-scattering integral L = int_0^t_max T(t) S(t) dt with
+// `view_steps` steps placed by StepPosition, with the rule atm.integrator.
+InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray, vec3 view,
+                                   vec3 sun) {
+  InScattering result;
+  result.radiance = vec3(0.0);
+  result.transmittance = vec3(1.0);
+  int n = atm.view_steps;
+  if (atm.integrator == INTEGRATOR_SIMPSON) n += n % 2;  // Simpson needs an even count
+  Real du = 1.0 / Real(n);
+  Real t_max = ray.t_max;
+  Real rayleigh_phase = RayleighPhase(ray.nu);
+  Real mie_phase = MiePhase(atm.mie_g, view, sun);
+
+  if (atm.integrator == INTEGRATOR_ANALYTIC || atm.integrator == INTEGRATOR_MIDPOINT) {
+    Real t_start = 0.0;
+    for (int i = 0; i < n; ++i) {
+      Real t_end = StepPosition(atm, t_max, Real(i + 1) * du);
+      Real t_mid = StepPosition(atm, t_max, (Real(i) + 0.5) * du);
+      Real dt = t_end - t_start;
+      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_mid);
+      if (atm.integrator == INTEGRATOR_ANALYTIC) {
+        // Hillaire 2020 eq. 5 per step: the source is constant over the step
+        // and the transmittance is integrated exactly, int_0^dt exp(-sigma s) ds.
+        result.radiance += result.transmittance * s.source * (dt * OneMinusExpOverX3(s.extinction * dt));
+      } else {
+        // Midpoint rule: integrand at the step's sample, T from the optical
+        // depth accumulated by the same rule.
+        result.radiance += result.transmittance * exp(-s.extinction * (t_mid - t_start)) * s.source * dt;
+      }
+      result.transmittance *= exp(-s.extinction * dt);
+      t_start = t_end;
+    }
+  } else if (atm.integrator == INTEGRATOR_TRAPEZOID) {
+    // Nodes u_i = i du in the mapped variable, integrand f(t(u)) dt/du; the
+    // optical depth to each node by the same rule.
+    ScatteringSample previous = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
+    Real w_previous = StepJacobian(atm, t_max, 0.0);
+    vec3 depth = vec3(0.0);
+    result.radiance = 0.5 * du * w_previous * previous.source;
+    for (int i = 1; i <= n; ++i) {
+      Real u = Real(i) * du;
+      Real w = StepJacobian(atm, t_max, u);
+      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u));
+      depth += 0.5 * du * (w_previous * previous.extinction + w * s.extinction);
+      Real weight = i == n ? 0.5 * du : du;
+      result.radiance += weight * w * exp(-depth) * s.source;
+      previous = s;
+      w_previous = w;
+    }
+    result.transmittance = exp(-depth);
+  } else {
+    // Simpson: weights du/3 (1, 4, 2, 4, ..., 4, 1) on nodes u_i = i du. The
+    // optical depth to each node is integrated to the same order: over a
+    // pair of steps by Simpson, to the middle node by the three-point rule
+    // int_{u0}^{u1} f = du/12 (5 f0 + 8 f1 - f2).
+    ScatteringSample s0 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
+    Real w0 = StepJacobian(atm, t_max, 0.0);
+    vec3 depth = vec3(0.0);
+    result.radiance = (du / 3.0) * w0 * s0.source;
+    for (int i = 0; i < n; i += 2) {
+      Real u1 = Real(i + 1) * du;
+      Real u2 = Real(i + 2) * du;
+      Real w1 = StepJacobian(atm, t_max, u1);
+      Real w2 = StepJacobian(atm, t_max, u2);
+      ScatteringSample s1 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u1));
+      ScatteringSample s2 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u2));
+      vec3 e0 = w0 * s0.extinction;
+      vec3 e1 = w1 * s1.extinction;
+      vec3 e2 = w2 * s2.extinction;
+      vec3 depth_mid = depth + (du / 12.0) * (5.0 * e0 + 8.0 * e1 - e2);
+      depth += (du / 3.0) * (e0 + 4.0 * e1 + e2);
+      Real end_weight = i + 2 == n ? 1.0 : 2.0;
+      result.radiance += (du / 3.0) * (4.0 * w1 * exp(-max(depth_mid, vec3(0.0))) * s1.source +
+                                       end_weight * w2 * exp(-depth) * s2.source);
+      s0 = s2;
+      w0 = w2;
+    }
+    result.transmittance = exp(-depth);
+  }
+  return result;
+}
+
+// Radiance of the sunlit Lambertian ground at the end of a ray that hits it,
+// per unit solar irradiance, before the view transmittance.
+vec3 GroundRadiance(IN(AtmosphereParameters) atm, IN(SkyRay) ray) {
+  Real mu_s_ground = ClampCosine((ray.r * ray.mu_s + ray.t_max * ray.nu) / atm.bottom_radius);
+  vec3 sun_transmittance = GetTransmittanceToSun(atm, atm.bottom_radius, 0.0, mu_s_ground);
+  return sun_transmittance * max(mu_s_ground, 0.0) * atm.ground_albedo / kPi;
+}
+
+// Radiance reaching the observer along unit direction `view` (world frame,
+// +Y up) with the Sun along unit `sun`, without the solar disc, and the
+// transmittance along the view ray (0 where it hits the ground).
+InScattering ComputeSkyRadianceWithoutSun(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  InScattering result;
+  result.radiance = vec3(0.0);
+  result.transmittance = vec3(1.0);
+  if (!ray.in_atmosphere) return result;
+  result = IntegrateInScattering(atm, ray, view, sun);
+  if (ray.hits_ground) {
+    if (atm.ground) result.radiance += result.transmittance * GroundRadiance(atm, ray);
+    result.transmittance = vec3(0.0);  // the Sun is behind the ground
+  }
+  return result;
+}
+
+vec3 SunDiscContribution(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, vec3 transmittance) {
+  vec3 d = view - sun;
+  Real theta = 2.0 * asin(min(0.5 * length(d), 1.0));
+  return transmittance * SunDiscRadiance(atm, theta);
+}
+
+// Radiance along `view` in the units of solar_irradiance, ray-marched.
+vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  InScattering sky = ComputeSkyRadianceWithoutSun(atm, view, sun);
+  vec3 radiance = sky.radiance;
+  if (atm.sun_disc) radiance += SunDiscContribution(atm, view, sun, sky.transmittance);
+  return radiance * atm.solar_irradiance;
+}
+
+// ---------------------------------------------------------------- sky-view LUT
+
+// Hillaire 2020 section 5.3: the sky seen from the observer, per frame, in a
+// frame where the Sun has azimuth 0. x: azimuth from the Sun in [0, pi]
+// (the sky is symmetric about the Sun's vertical plane); y: zenith angle,
+// with a square-root mapping that puts texels near the horizon, the upper
+// half above it and the lower half below it.
+struct SkyViewCoordinates {
+  Real azimuth;       // from the Sun, [0, pi]
+  Real zenith_angle;  // [0, pi]
+};
+
+// Zenith angle of the horizon seen by the observer (>= pi/2).
+Real HorizonZenithAngle(IN(AtmosphereParameters) atm) {
+  Real h = atm.observer_altitude;
+  Real r = atm.bottom_radius + h;
+  if (h > atm.top_radius - atm.bottom_radius) {
+    // From space the "horizon" is the limb of the atmosphere's top.
+    return kPi - asin(min(atm.top_radius / r, 1.0));
+  }
+  return kPi - asin(min(atm.bottom_radius / r, 1.0));
+}
+
+vec2 SkyViewUvFromDirection(IN(AtmosphereParameters) atm, Real zenith_angle, Real azimuth) {
+  Real horizon = HorizonZenithAngle(atm);
+  vec2 uv;
+  uv.x = clamp(azimuth / kPi, 0.0, 1.0);
+  if (zenith_angle < horizon) {
+    Real x = clamp(zenith_angle / horizon, 0.0, 1.0);
+    uv.y = 0.5 * (1.0 - sqrt(1.0 - x));
+  } else {
+    Real x = clamp((zenith_angle - horizon) / (kPi - horizon), 0.0, 1.0);
+    uv.y = 0.5 + 0.5 * sqrt(x);
+  }
+  return uv;
+}
+
+SkyViewCoordinates SkyViewDirectionFromTexel(IN(AtmosphereParameters) atm, int x, int y) {
+  Real horizon = HorizonZenithAngle(atm);
+  // Texel centres in each half, so that no texel straddles the horizon.
+  int half_height = atm.sky_view_height / 2;
+  SkyViewCoordinates c;
+  c.azimuth = kPi * Real(x) / Real(atm.sky_view_width - 1);
+  if (y < half_height) {
+    Real v = Real(y) / Real(half_height - 1);  // 0 at the zenith, 1 at the horizon
+    Real s = 1.0 - v;
+    c.zenith_angle = horizon * (1.0 - s * s);
+  } else {
+    // Just below the horizon on the first row: the limit seen from the ground side.
+    Real v = Real(y - half_height) / Real(atm.sky_view_height - half_height - 1);
+    c.zenith_angle = horizon + (kPi - horizon) * max(v * v, 1e-6);
+  }
+  return c;
+}
+
+vec3 ViewFromSkyViewCoordinates(IN(SkyViewCoordinates) c) {
+  vec3 view;
+  view.x = sin(c.zenith_angle) * cos(c.azimuth);
+  view.y = cos(c.zenith_angle);
+  view.z = sin(c.zenith_angle) * sin(c.azimuth);
+  return view;
+}
+
+vec3 SunInSkyViewFrame(Real mu_s) {
+  vec3 sun;
+  sun.x = sqrt(max(1.0 - mu_s * mu_s, 0.0));
+  sun.y = mu_s;
+  sun.z = 0.0;
+  return sun;
+}
+
+// One texel of the sky-view LUT: the radiance without the disc, per unit
+// solar irradiance, for the Sun at cosine zenith mu_s.
+vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_s) {
+  SkyViewCoordinates c = SkyViewDirectionFromTexel(atm, x, y);
+  vec3 view = ViewFromSkyViewCoordinates(c);
+  if (y < atm.sky_view_height / 2) {
+    // The horizon row must stay on the sky side: cos(horizon) rounds below
+    // the exact horizon cosine in float32, so clamp to the latter, formed
+    // without cancellation (0 exactly for an observer on the ground).
+    Real h = atm.observer_altitude;
+    Real r = atm.bottom_radius + h;
+    Real mu_horizon = -sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r;
+    if (h <= atm.top_radius - atm.bottom_radius && view.y < mu_horizon) {
+      Real horizontal = length(vec2(view.x, view.z));
+      Real scale = horizontal > 0.0 ? sqrt(max(1.0 - mu_horizon * mu_horizon, 0.0)) / horizontal : 0.0;
+      view.x *= scale;
+      view.z *= scale;
+      view.y = mu_horizon;
     }
   }
+  return ComputeSkyRadianceWithoutSun(atm, view, SunInSkyViewFrame(mu_s)).radiance;
+}
 
-  bool hits_ground = false;
-  if (in_atmosphere) {
-    hits_ground = RayIntersectsGround(atm, r, altitude, mu);
-    Real t_max = hits_ground ? DistanceToBottomBoundary(atm, r, altitude, mu)
-                             : DistanceToTopBoundary(atm, r, altitude, mu);
-    Real dt = t_max / Real(atm.view_steps);
-    Real rayleigh_phase = RayleighPhase(nu);
-    Real mie_phase = MiePhase(atm.mie_g, view, sun);
-    for (int i = 0; i < atm.view_steps; ++i) {
-      Real t = (Real(i) + 0.5) * dt;
-      Real h = AltitudeAlongRay(atm, r, altitude, mu, t);
-      Real r_t = atm.bottom_radius + h;
-      Real mu_s_t = ClampCosine((r * mu_s + t * nu) / r_t);
-      MediumSample m = SampleMedium(atm, h);
-      vec3 sun_transmittance = GetTransmittanceToSun(atm, r_t, h, mu_s_t);
-      vec3 source = (m.rayleigh_scattering * rayleigh_phase + m.mie_scattering * mie_phase) *
-                    sun_transmittance;
-      if (atm.multiple_scattering)
-        source += (m.rayleigh_scattering + m.mie_scattering) * GetMultipleScattering(atm, h, mu_s_t);
-      // Hillaire 2020 eq. 5 per step: the source is constant over the step and
-      // the transmittance is integrated exactly, int_0^dt exp(-sigma s) ds.
-      radiance += transmittance * source * (dt * OneMinusExpOverX3(m.extinction * dt));
-      transmittance *= exp(-m.extinction * dt);
-    }
-    if (hits_ground && atm.ground) {
-      Real mu_s_ground = ClampCosine((r * mu_s + t_max * nu) / atm.bottom_radius);
-      vec3 sun_transmittance = GetTransmittanceToSun(atm, atm.bottom_radius, 0.0, mu_s_ground);
-      radiance += transmittance * sun_transmittance * max(mu_s_ground, 0.0) * atm.ground_albedo / kPi;
-    }
+// Bilinear read of the sky-view LUT, by hand, never across the horizon: the
+// grid is exact at texel centres, which SkyViewDirectionFromTexel places on
+// the zenith, the horizon (from either side) and the nadir.
+// `ground` selects the half: it comes from the same ray test as the march
+// (RayIntersectsGround), not from comparing rounded angles.
+vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azimuth, bool ground) {
+  Real horizon = HorizonZenithAngle(atm);
+  int half_height = atm.sky_view_height / 2;
+  Real fy = 0.0;
+  int y0 = 0;
+  int y_last = 0;
+  if (!ground) {
+    Real s = sqrt(max(1.0 - clamp(zenith_angle / horizon, 0.0, 1.0), 0.0));
+    Real y = (1.0 - s) * Real(half_height - 1);
+    y0 = int(min(floor(y), Real(half_height - 2)));
+    fy = y - Real(y0);
+    y_last = half_height - 1;
+  } else {
+    Real v = sqrt(clamp((zenith_angle - horizon) / (kPi - horizon), 0.0, 1.0));
+    Real y = v * Real(atm.sky_view_height - half_height - 1);
+    int local = int(min(floor(y), Real(atm.sky_view_height - half_height - 2)));
+    fy = y - Real(local);
+    y0 = half_height + local;
+    y_last = atm.sky_view_height - 1;
   }
+  int y1 = min(y0 + 1, y_last);
+  Real x = clamp(azimuth / kPi, 0.0, 1.0) * Real(atm.sky_view_width - 1);
+  int x0 = int(min(floor(x), Real(atm.sky_view_width - 2)));
+  Real fx = x - Real(x0);
+  int x1 = x0 + 1;
+  vec3 a = mix(SkyViewLutTexel(x0, y0), SkyViewLutTexel(x1, y0), fx);
+  vec3 b = mix(SkyViewLutTexel(x0, y1), SkyViewLutTexel(x1, y1), fx);
+  return mix(a, b, fy);
+}
 
-  if (atm.sun_disc && !hits_ground) {
-    vec3 d = view - sun;
-    Real theta = 2.0 * asin(min(0.5 * length(d), 1.0));
-    radiance += transmittance * SunDiscRadiance(atm, theta);
+// Radiance along `view` read from the sky-view LUT (built for this Sun), plus
+// the solar disc seen through the transmittance LUT.
+vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  Real zenith_angle = acos(ClampCosine(view.y));
+  // Azimuth between the horizontal projections of view and sun.
+  Real vx = length(vec2(view.x, view.z));
+  Real sx = length(vec2(sun.x, sun.z));
+  Real azimuth = 0.0;
+  if (vx > 0.0 && sx > 0.0)
+    azimuth = acos(ClampCosine((view.x * sun.x + view.z * sun.z) / (vx * sx)));
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ray.in_atmosphere && ray.hits_ground);
+  if (atm.sun_disc) {
+    if (ray.in_atmosphere && !ray.hits_ground) {
+      radiance += SunDiscContribution(atm, view, sun,
+                                      GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));
+    } else if (!ray.in_atmosphere) {
+      radiance += SunDiscContribution(atm, view, sun, vec3(1.0));
+    }
   }
   return radiance * atm.solar_irradiance;
 }

@@ -21,6 +21,9 @@ layout(std430, set = 0, binding = BINDING_MULTISCATTERING) buffer MultiScatterin
 layout(std430, set = 0, binding = BINDING_OUTPUT) buffer OutputBuffer {
   vec4 output_texels[];
 };
+layout(std430, set = 0, binding = BINDING_SKYVIEW) buffer SkyViewBuffer {
+  vec4 skyview_texels[];
+};
 layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
   GpuAoas gpu_aoas;
 };
@@ -40,6 +43,10 @@ layout(constant_id = 4) const bool kSkydome = false;
 layout(constant_id = 5) const bool kAmbiguity = false;
 layout(constant_id = 6) const bool kCloudNoise = false;
 layout(constant_id = 7) const bool kCloudShapes = false;
+// Quadrature rule (INTEGRATOR_*) and whether output texels read the sky-view
+// LUT instead of ray-marching; ids from 10 on are the quality settings.
+layout(constant_id = 10) const int kIntegrator = INTEGRATOR_ANALYTIC;
+layout(constant_id = 11) const bool kUseSkyView = false;
 
 vec3 TransmittanceLutTexel(int x, int y) {
   return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;
@@ -47,6 +54,10 @@ vec3 TransmittanceLutTexel(int x, int y) {
 
 vec3 MultipleScatteringLutTexel(int x, int y) {
   return multiscattering_texels[y * gpu_atmosphere.lut_sizes.z + x].xyz;
+}
+
+vec3 SkyViewLutTexel(int x, int y) {
+  return skyview_texels[y * gpu_atmosphere.render.y + x].xyz;
 }
 
 vec4 ShapeSegmentStart(int i) { return gpu_aoas.shape_segments[2 * i]; }
@@ -83,7 +94,11 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.transmittance_steps = gpu_atmosphere.samples.y;
   atm.multiscattering_steps = gpu_atmosphere.samples.z;
   atm.multiscattering_sqrt_dirs = gpu_atmosphere.effects.w;
-  atm.integrator = gpu_atmosphere.samples.w;
+  atm.integrator = kIntegrator;
+  atm.light_steps = gpu_atmosphere.render.x;
+  atm.step_distribution = gpu_atmosphere.render.w;
+  atm.sky_view_width = gpu_atmosphere.render.y;
+  atm.sky_view_height = gpu_atmosphere.render.z;
   atm.multiple_scattering = kMultipleScattering;
   atm.sun_disc = kSunDisc;
   atm.ground = kGround;

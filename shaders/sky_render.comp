@@ -25,6 +25,6 @@ void main() {
   }
   AtmosphereParameters atm = AtmosphereFromUniform();
   AoasParameters aoas = AoasFromUniform();
-  vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz);
+  vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz, kUseSkyView);
   output_texels[index] = vec4(radiance * gpu_atmosphere.output_scale.xyz, 1.0);
 }

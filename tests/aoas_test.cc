@@ -34,6 +34,7 @@ namespace f64 {
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
+vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 vec4 ShapeSegmentStart(int) { return vec4(0.0); }
 vec4 ShapeSegmentEnd(int) { return vec4(0.0); }
 constexpr int kSharedPermutation[256] = {SKYBAKE_PERLIN_PERMUTATION};

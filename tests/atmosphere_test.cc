@@ -25,6 +25,7 @@ namespace f64 {
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
+vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #include "atmosphere.glsl"
 }  // namespace f64
 #undef SKYBAKE_ATMOSPHERE_GLSL
@@ -34,6 +35,7 @@ namespace f32 {
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0f); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0f); }
+vec3 SkyViewLutTexel(int, int) { return vec3(0.0f); }
 #include "atmosphere.glsl"
 }  // namespace f32
 

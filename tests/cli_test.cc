@@ -1,0 +1,159 @@
+// The skybake binary end to end: a full bake under the validation layer, the
+// files read back by an independent reader (OpenImageIO), exit codes.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include <sys/wait.h>
+
+#include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
+
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+struct CommandRun {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+CommandRun Skybake(const std::string& args, const std::string& env = "") {
+  std::string command = env + " " + SKYBAKE_BINARY + " " + args + " 2>&1";
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
+  int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string FreshDir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("skybake_cli_" + name + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir.string();
+}
+
+std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
+
+struct ExrInfo {
+  int width = 0, height = 0, channels = 0;
+  std::string textureformat;
+  OIIO::TypeDesc format;
+  bool has_config = false, has_chromaticities = false;
+};
+
+ExrInfo Inspect(const std::string& path) {
+  ExrInfo info;
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) return info;
+  const OIIO::ImageSpec& spec = in->spec();
+  info.width = spec.width;
+  info.height = spec.height;
+  info.channels = spec.nchannels;
+  info.format = spec.format;
+  info.textureformat = spec.get_string_attribute("textureformat");
+  info.has_config = !spec.get_string_attribute("skybake:config").empty();
+  info.has_chromaticities = spec.find_attribute("chromaticities") != nullptr;
+  return info;
+}
+
+TEST(CliTest, FullBakeUnderValidationWritesReadableFiles) {
+  std::string out = FreshDir("bake");
+  CommandRun run = Skybake("bake " + Style() + " --size 16 --out " + out + " --vulkan-validation");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.output.find("validation"), std::string::npos) << run.output;
+  // One progress line per stage, with its time.
+  for (const char* stage : {"device", "pipelines", "LUTs", "render", "write EXR", "preview"})
+    EXPECT_NE(run.output.find(std::string("skybake: ") + stage), std::string::npos) << stage;
+
+  for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"}) {
+    ExrInfo f = Inspect(out + "/sky_" + face + ".exr");
+    EXPECT_EQ(f.width, 16) << face;
+    EXPECT_EQ(f.height, 16) << face;
+    EXPECT_EQ(f.channels, 3) << face;
+    EXPECT_EQ(f.format, OIIO::TypeDesc::HALF) << face;
+    EXPECT_TRUE(f.has_config && f.has_chromaticities) << face;
+  }
+  ExrInfo cube = Inspect(out + "/sky_cube.exr");
+  EXPECT_EQ(cube.width, 16);
+  EXPECT_EQ(cube.height, 96);
+  EXPECT_EQ(cube.textureformat, "CubeFace Environment");
+  ExrInfo latlong = Inspect(out + "/sky_latlong.exr");
+  EXPECT_EQ(latlong.width, 32);
+  EXPECT_EQ(latlong.height, 16);
+  EXPECT_EQ(latlong.textureformat, "LatLong Environment");
+  EXPECT_TRUE(latlong.has_config && latlong.has_chromaticities);
+  ExrInfo preview = Inspect(out + "/sky_latlong.png");
+  EXPECT_EQ(preview.width, 32);
+  EXPECT_EQ(preview.format, OIIO::TypeDesc::UINT8);
+  std::filesystem::remove_all(out);
+}
+
+TEST(CliTest, FloatOutputNeedsNoScale) {
+  std::string out = FreshDir("float");
+  CommandRun run = Skybake("bake " + Style() + " --size 8 -q --set output.pixel_type=float --out " + out);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(run.output.find("scaled"), std::string::npos) << run.output;
+  EXPECT_EQ(Inspect(out + "/sky_latlong.exr").format, OIIO::TypeDesc::FLOAT);
+  std::filesystem::remove_all(out);
+}
+
+TEST(CliTest, RefusedOverflowWritesNothing) {
+  std::string out = FreshDir("refuse");
+  CommandRun run = Skybake("bake " + Style() + " --size 8 -q --set output.overflow=refuse --out " + out);
+  EXPECT_EQ(run.exit_code, 5) << run.output;
+  EXPECT_NE(run.output.find("exceeds the half-float maximum"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("output.pixel_type"), std::string::npos) << "names the fix";
+  size_t files = 0;
+  if (std::filesystem::exists(out))
+    for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(out)) ++files;
+  EXPECT_EQ(files, 0u);
+  std::filesystem::remove_all(out);
+}
+
+TEST(CliTest, InvalidStyleExitsWithConfigCodeBeforeAnyGpuWork) {
+  std::string out = FreshDir("invalid");
+  CommandRun run = Skybake("bake " + Style() + " --set atmosphere.mie.g=1.5 --set sun.elevatoin_deg=3 --out " + out);
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("atmosphere.mie.g: 1.5 is out of range (-1, 1)"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("did you mean 'sun.elevation_deg'?"), std::string::npos) << run.output;
+  EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliTest, CheckValidatesOnly) {
+  CommandRun ok = Skybake("check " + Style());
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  CommandRun bad = Skybake("check " + Style() + " --set render.cube_size=0");
+  EXPECT_EQ(bad.exit_code, 3) << bad.output;
+}
+
+TEST(CliTest, MissingVulkanDriverNamesThePackage) {
+  CommandRun run = Skybake("bake " + Style() + " --size 4 --out " + FreshDir("nodriver"),
+                    "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");
+  EXPECT_EQ(run.exit_code, 4) << run.output;
+  EXPECT_NE(run.output.find("mesa-vulkan-drivers"), std::string::npos) << run.output;
+}
+
+TEST(CliTest, DevicesListsLavapipe) {
+  CommandRun run = Skybake("devices");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("usable"), std::string::npos) << run.output;
+}
+
+TEST(CliTest, HelpShowsDefaultsAndUsageErrorsExitTwo) {
+  CommandRun help = Skybake("bake --help");
+  EXPECT_EQ(help.exit_code, 0);
+  EXPECT_NE(help.output.find("--out TEXT=out"), std::string::npos) << help.output;
+  CommandRun usage = Skybake("bake");
+  EXPECT_EQ(usage.exit_code, 2) << usage.output;
+}
+
+}  // namespace
+}  // namespace skybake

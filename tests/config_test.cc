@@ -1,0 +1,142 @@
+// Sky style parsing: defaults, overrides, and user errors that name the
+// place (file:line:column, key path) and the fix, all reported at once.
+#include <gtest/gtest.h>
+
+#include "skybake/config.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+std::vector<std::string> Messages(const ConfigResult& r) {
+  std::vector<std::string> out;
+  for (const ConfigError& e : r.errors) out.push_back(e.Format());
+  return out;
+}
+
+TEST(ConfigTest, DefaultStyleParsesToEarthDefaults) {
+  ConfigResult r = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml");
+  ASSERT_TRUE(r.ok()) << ::testing::PrintToString(Messages(r));
+  const AtmosphereParams defaults;
+  EXPECT_EQ(r.style.atmosphere.bottom_radius_km, defaults.bottom_radius_km);
+  EXPECT_EQ(r.style.atmosphere.rayleigh_scattering_per_km, defaults.rayleigh_scattering_per_km);
+  EXPECT_EQ(r.style.atmosphere.mie_g, defaults.mie_g);
+  EXPECT_EQ(r.style.atmosphere.ground_albedo, defaults.ground_albedo);
+  EXPECT_EQ(r.style.quality.view_steps, QualitySettings{}.view_steps);
+  EXPECT_EQ(r.style.sun.elevation_deg, 35.0);
+  EXPECT_FALSE(r.style.resolved_toml.empty());
+}
+
+TEST(ConfigTest, EmptyStyleIsAllDefaults) {
+  ConfigResult r = ParseSkyStyle("", "empty.toml");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r.style.render.cube_size, 512);
+  EXPECT_EQ(r.style.output.pixel_type, PixelType::kHalf);
+}
+
+TEST(ConfigTest, ResolvedTomlRoundTrips) {
+  ConfigResult a = ParseSkyStyle("[sun]\nelevation_deg = 12.5\n[output]\npixel_type = \"float\"\n", "a.toml");
+  ASSERT_TRUE(a.ok());
+  ConfigResult b = ParseSkyStyle(a.style.resolved_toml, "resolved.toml");
+  ASSERT_TRUE(b.ok()) << ::testing::PrintToString(Messages(b));
+  EXPECT_EQ(b.style.resolved_toml, a.style.resolved_toml);
+  EXPECT_EQ(b.style.sun.elevation_deg, 12.5);
+  EXPECT_EQ(b.style.output.pixel_type, PixelType::kFloat);
+}
+
+TEST(ConfigTest, OverridesApplyOnTop) {
+  ConfigResult r = ParseSkyStyle("[sun]\nelevation_deg = 30\n", "s.toml",
+                                 {"sun.elevation_deg=5", "atmosphere.ground_albedo=[0.2,0.3,0.4]",
+                                  "output.pixel_type=float", "render.cube_size=64"});
+  ASSERT_TRUE(r.ok()) << ::testing::PrintToString(Messages(r));
+  EXPECT_EQ(r.style.sun.elevation_deg, 5.0);
+  EXPECT_EQ(r.style.atmosphere.ground_albedo, (Rgb{0.2, 0.3, 0.4}));
+  EXPECT_EQ(r.style.output.pixel_type, PixelType::kFloat);
+  EXPECT_EQ(r.style.render.cube_size, 64);
+}
+
+TEST(ConfigTest, UnknownKeyIsLocatedWithSuggestion) {
+  ConfigResult r = ParseSkyStyle("[atmosphere.mie]\nscale_heigth_km = 1.2\n", "noon.toml");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].Format(),
+            "noon.toml:2:1: atmosphere.mie.scale_heigth_km: unknown key 'scale_heigth_km' "
+            "(did you mean 'atmosphere.mie.scale_height_km'?)");
+}
+
+TEST(ConfigTest, AllErrorsAreReportedAtOnce) {
+  ConfigResult r = ParseSkyStyle(
+      "[atmosphere]\n"
+      "bottom_radius_km = -1.0\n"
+      "[atmosphere.mie]\n"
+      "g = 1.0\n"
+      "[render]\n"
+      "cube_size = 0\n"
+      "[output]\n"
+      "pixel_type = \"double\"\n",
+      "bad.toml");
+  std::vector<std::string> m = Messages(r);
+  ASSERT_EQ(m.size(), 4u) << ::testing::PrintToString(m);
+  EXPECT_EQ(m[0], "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range (0, inf)");
+  EXPECT_EQ(m[1], "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)");
+  EXPECT_EQ(m[2], "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]");
+  EXPECT_EQ(m[3], "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'");
+}
+
+TEST(ConfigTest, TopRadiusMustBeAboveBottom) {
+  ConfigResult r = ParseSkyStyle("[atmosphere]\ntop_radius_km = 6000.0\n", "r.toml");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].Format(),
+            "r.toml:2:17: atmosphere.top_radius_km: top radius 6000 km must be above the bottom "
+            "radius 6360 km");
+}
+
+TEST(ConfigTest, WrongTypesAndNonFiniteNumbers) {
+  ConfigResult r = ParseSkyStyle(
+      "[sun]\nelevation_deg = \"high\"\nazimuth_deg = nan\n[effects]\nsun_disc = 1\n"
+      "[atmosphere]\nground_albedo = [0.1, 0.2]\n",
+      "t.toml");
+  std::vector<std::string> m = Messages(r);
+  ASSERT_EQ(m.size(), 4u) << ::testing::PrintToString(m);
+  EXPECT_EQ(m[0],
+            "t.toml:7:17: atmosphere.ground_albedo: expected a number or an array of 3 numbers "
+            "[680 nm, 550 nm, 440 nm]");
+  EXPECT_EQ(m[1], "t.toml:2:17: sun.elevation_deg: expected a number, got a string");
+  EXPECT_EQ(m[2], "t.toml:3:15: sun.azimuth_deg: must be a finite number (got nan)");
+  EXPECT_EQ(m[3], "t.toml:5:12: effects.sun_disc: expected true or false, got an integer");
+}
+
+TEST(ConfigTest, OutputNamesCannotEscapeTheOutputFolder) {
+  for (const char* name : {"../sky", "/etc/sky", "a/b", ".hidden", ""}) {
+    ConfigResult r = ParseSkyStyle(std::string("[output]\nbasename = \"") + name + "\"\n", "o.toml");
+    ASSERT_EQ(r.errors.size(), 1u) << name;
+    EXPECT_EQ(r.errors[0].key, "output.basename");
+  }
+  ConfigResult faces = ParseSkyStyle(
+      "[output]\nface_names = [\"px\", \"nx\", \"../py\", \"ny\", \"pz\", \"nz\"]\n", "f.toml");
+  ASSERT_EQ(faces.errors.size(), 1u);
+  EXPECT_EQ(faces.errors[0].key, "output.face_names[2]");
+}
+
+TEST(ConfigTest, SyntaxErrorIsLocated) {
+  ConfigResult r = ParseSkyStyle("[sun]\nelevation_deg = = 3\n", "syntax.toml");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].file, "syntax.toml");
+  EXPECT_EQ(r.errors[0].line, 2);
+}
+
+TEST(ConfigTest, BadOverrideIsReported) {
+  ConfigResult r = ParseSkyStyle("", "s.toml", {"sun.elevation_deg", "sun.elevation_deg=200"});
+  std::vector<std::string> m = Messages(r);
+  ASSERT_EQ(m.size(), 2u) << ::testing::PrintToString(m);
+  EXPECT_EQ(m[0], "--set: sun.elevation_deg: expected key.path=value, e.g. --set sun.elevation_deg=10");
+  EXPECT_EQ(m[1], "--set sun.elevation_deg=200:1:5: sun.elevation_deg: 200 is out of range [-90, 90]");
+}
+
+TEST(ConfigTest, MissingFileIsReported) {
+  ConfigResult r = LoadSkyStyle("/nonexistent/style.toml");
+  ASSERT_EQ(r.errors.size(), 1u);
+  EXPECT_EQ(r.errors[0].Format(), "/nonexistent/style.toml: (file): cannot open the style file: check the path");
+}
+
+}  // namespace
+}  // namespace skybake

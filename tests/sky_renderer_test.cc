@@ -1,0 +1,281 @@
+// The lavapipe renderer (float32) against the double-precision CPU reference
+// compiled from the same source, under the Khronos validation layer.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+#include <glm/glm.hpp>
+
+#include "skybake/envmap.h"
+#include "skybake/reference_model.h"
+#include "skybake/sky_renderer.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+struct Comparison {
+  double max_relative_error = 0.0;
+  size_t compared = 0;
+  size_t skipped = 0;
+};
+
+// Relative error per channel wherever the reference exceeds `floor` times
+// the image maximum (the criterion).
+Comparison Compare(const std::vector<float>& gpu, const std::vector<double>& ref, double floor) {
+  double max_value = 0.0;
+  for (size_t i = 0; i < ref.size(); ++i)
+    if (i % 4 != 3) max_value = std::max(max_value, ref[i]);
+  Comparison c;
+  for (size_t i = 0; i < ref.size(); ++i) {
+    if (i % 4 == 3) continue;
+    if (ref[i] <= floor * max_value) {
+      ++c.skipped;
+      continue;
+    }
+    c.max_relative_error = std::max(c.max_relative_error, std::abs(gpu[i] - ref[i]) / ref[i]);
+    ++c.compared;
+  }
+  return c;
+}
+
+void ExpectFiniteNonNegative(const std::vector<float>& image, const std::string& what) {
+  size_t bad = 0;
+  for (float v : image)
+    if (!std::isfinite(v) || v < 0.0f) ++bad;
+  EXPECT_EQ(bad, 0u) << what << ": NaN, Inf or negative values";
+}
+
+std::vector<ViewRequest> TestViews() {
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 64, 32, 0}, {MAPPING_CUBE_STRIP, 16, 96, 0}};
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, 16, 16, face});
+  return views;
+}
+
+TEST(SkyRendererTest, GpuMatchesDoubleReference) {
+  const AtmosphereParams atmosphere;  // Earth defaults
+  const QualitySettings quality;
+  const EffectSettings effects;
+  const Rgb scale = {1.0, 1.0, 1.0};
+  SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, scale);
+  ReferenceModel reference(atmosphere, quality, effects, scale);
+  reference.PrecomputeLuts();
+  const std::vector<ViewRequest> views = TestViews();
+  for (double elevation : {60.0, 10.0, 2.0, -4.0}) {
+    glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 135.0);
+    std::vector<std::vector<float>> gpu = renderer.Render(sun, views);
+    size_t compared = 0, total = 0;
+    double worst = 0.0;
+    for (size_t v = 0; v < views.size(); ++v) {
+      std::string what = "elevation " + std::to_string(elevation) + " view " + std::to_string(v);
+      ExpectFiniteNonNegative(gpu[v], what);
+      Comparison c = Compare(gpu[v], reference.RenderView(sun, views[v]), 1e-4);
+      EXPECT_LE(c.max_relative_error, 1e-3) << what << " (" << c.compared << " values compared)";
+      compared += c.compared;
+      total += c.compared + c.skipped;
+      worst = std::max(worst, c.max_relative_error);
+    }
+    // The criterion must cover the sky, not only a few texels: at least the
+    // upper hemisphere (the unlit ground below a set sun may fall under the floor).
+    EXPECT_GE(compared * 5, total * 2) << "elevation " << elevation;
+    std::printf("sun elevation %5.1f deg: max relative error %.3g over %zu of %zu values\n",
+                elevation, worst, compared, total);
+  }
+  EXPECT_EQ(renderer.counters().transmittance_lut_builds, 1);
+  EXPECT_EQ(renderer.counters().multiscattering_lut_builds, 1);
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SkyRendererTest, GrazingRaysMatchReference) {
+  // Directions at and around the horizon, where the ray length jumps from
+  // the top boundary to the ground: exactly horizontal, +/-1e-6, +/-1e-3 rad.
+  const AtmosphereParams atmosphere;
+  QualitySettings sky_view;
+  sky_view.sky_view_lut = true;
+  for (const QualitySettings& quality : {QualitySettings{}, sky_view}) {
+  EffectSettings effects;
+  effects.sun_disc = false;
+  SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
+  ReferenceModel reference(atmosphere, quality, effects, {1, 1, 1});
+  reference.PrecomputeLuts();
+  std::vector<glm::dvec3> dirs;
+  for (double azimuth = 0.0; azimuth < 360.0; azimuth += 30.0) {
+    for (double elevation_rad : {0.0, 1e-6, -1e-6, 1e-3, -1e-3, 0.02}) {
+      dirs.push_back(SunDirectionFromElevationAzimuth(elevation_rad * 180.0 / M_PI, azimuth));
+    }
+  }
+  for (double sun_elevation : {60.0, 2.0, -4.0}) {
+    glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 100.0);
+    reference.PrepareSun(sun);
+    std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
+    ExpectFiniteNonNegative(gpu, "grazing");
+    std::vector<double> ref;
+    for (const glm::dvec3& d : dirs) {
+      glm::dvec3 l = reference.Radiance(glm::dvec3(glm::vec3(d)), sun);  // same float-rounded direction
+      ref.insert(ref.end(), {l.x, l.y, l.z, 1.0});
+    }
+    Comparison c = Compare(gpu, ref, 1e-4);
+    EXPECT_LE(c.max_relative_error, 1e-3) << "sun elevation " << sun_elevation << " sky-view "
+                                          << quality.sky_view_lut;
+  }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SkyRendererTest, SunDiscMatchesReferenceAndIsLimbDarkened) {
+  const AtmosphereParams atmosphere;
+  const QualitySettings quality;
+  const EffectSettings effects;
+  SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
+  ReferenceModel reference(atmosphere, quality, effects, {1, 1, 1});
+  reference.PrecomputeLuts();
+  glm::dvec3 sun = SunDirectionFromElevationAzimuth(30.0, 200.0);
+  // Directions across the disc, at fractions of the angular radius from its
+  // centre (rotated about an axis perpendicular to the sun direction).
+  glm::dvec3 axis = glm::normalize(glm::cross(sun, glm::dvec3(0, 1, 0)));
+  std::vector<double> fractions = {0.0, 0.3, 0.6, 0.9, 0.99};
+  std::vector<glm::dvec3> dirs;
+  for (double f : fractions) {
+    double angle = f * atmosphere.sun_angular_radius_rad;
+    dirs.push_back(sun * std::cos(angle) + glm::cross(axis, sun) * std::sin(angle));
+  }
+  std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
+  for (size_t i = 0; i < dirs.size(); ++i) {
+    glm::dvec3 ref = reference.Radiance(glm::dvec3(glm::vec3(dirs[i])), sun);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(gpu[4 * i + c] / ref[c], 1.0, 1e-3) << i << " " << c;
+    if (i > 0) {
+      EXPECT_LT(gpu[4 * i + 1], gpu[4 * (i - 1) + 1]) << "limb darkening at " << fractions[i];
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SkyRendererTest, CubeSeamsAreAsSmoothAsFaceInteriors) {
+  // Across every face edge, neighbouring texels (found through the Vulkan
+  // face-selection table) differ no more than neighbours inside a face.
+  const int n = 32;
+  EffectSettings effects;
+  effects.sun_disc = false;  // the disc is a deliberate discontinuity
+  SkyRenderer renderer(testing::Vulkan(), AtmosphereParams{}, QualitySettings{}, effects, {1, 1, 1});
+  std::vector<ViewRequest> views;
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+  for (double elevation : {45.0, 3.0}) {
+    glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 30.0);
+    std::vector<std::vector<float>> faces = renderer.Render(sun, views);
+    auto value = [&](int face, int x, int y) {
+      const float* p = &faces[face][(size_t(y) * n + x) * 4];
+      return glm::dvec3(p[0], p[1], p[2]);
+    };
+    auto relative = [](glm::dvec3 a, glm::dvec3 b) {
+      glm::dvec3 d = glm::abs(a - b) / glm::max(glm::max(a, b), glm::dvec3(1e-30));
+      return std::max({d.x, d.y, d.z});
+    };
+    double interior = 0.0, seam = 0.0;
+    int seam_pairs = 0;
+    for (int face = 0; face < 6; ++face) {
+      for (int y = 0; y < n; ++y) {
+        for (int x = 0; x < n; ++x) {
+          if (x + 1 < n) interior = std::max(interior, relative(value(face, x, y), value(face, x + 1, y)));
+          if (y + 1 < n) interior = std::max(interior, relative(value(face, x, y), value(face, x, y + 1)));
+          // Step one texel beyond each edge and find the texel on the neighbour face.
+          const int steps[4][2] = {{-1, 0}, {1, 0}, {0, -1}, {0, 1}};
+          for (const auto& s : steps) {
+            int xs = x + s[0], ys = y + s[1];
+            if (xs >= 0 && xs < n && ys >= 0 && ys < n) continue;
+            double sc = 2.0 * (xs + 0.5) / n - 1.0, tc = 2.0 * (ys + 0.5) / n - 1.0;
+            // Face basis from the table: direction = major + sc * S + tc * T.
+            static const double kBasis[6][3][3] = {
+                {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+                {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+                {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}}};
+            glm::dvec3 major(kBasis[face][0][0], kBasis[face][0][1], kBasis[face][0][2]);
+            glm::dvec3 S(kBasis[face][1][0], kBasis[face][1][1], kBasis[face][1][2]);
+            glm::dvec3 T(kBasis[face][2][0], kBasis[face][2][1], kBasis[face][2][2]);
+            glm::dvec3 d = glm::normalize(major + sc * S + tc * T);
+            // The neighbour: the texel of another face whose direction is closest.
+            int best_face = -1, bx = 0, by = 0;
+            double best = 1e9;
+            for (int f = 0; f < 6; ++f) {
+              if (f == face) continue;
+              for (int yy = 0; yy < n; ++yy)
+                for (int xx = 0; xx < n; ++xx) {
+                  double dist = glm::length(VulkanCubeTexelDirection(f, xx, yy, n) - d);
+                  if (dist < best) {
+                    best = dist;
+                    best_face = f;
+                    bx = xx;
+                    by = yy;
+                  }
+                }
+            }
+            seam = std::max(seam, relative(value(face, x, y), value(best_face, bx, by)));
+            ++seam_pairs;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(seam_pairs, 6 * 4 * n);
+    EXPECT_LE(seam, interior) << "sun elevation " << elevation;
+    EXPECT_GT(interior, 0.0);
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SkyRendererTest, ValuesAreFiniteForEveryEffectCombination) {
+  for (int mask = 0; mask < 8; ++mask) {
+    EffectSettings effects;
+    effects.multiple_scattering = mask & 1;
+    effects.sun_disc = mask & 2;
+    effects.ground = mask & 4;
+    SkyRenderer renderer(testing::Vulkan(), AtmosphereParams{}, QualitySettings{}, effects, {1, 1, 1});
+    for (double elevation : {90.0, 0.0, -18.0}) {
+      auto images = renderer.Render(SunDirectionFromElevationAzimuth(elevation, 0.0), TestViews());
+      for (const auto& image : images) ExpectFiniteNonNegative(image, "effects " + std::to_string(mask));
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+}  // namespace
+}  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// The per-frame sky-view LUT path and every integrator, GPU against the
+// double reference running the same algorithm.
+TEST(SkyRendererTest, IntegratorsAndSkyViewPathMatchReference) {
+  const AtmosphereParams atmosphere;
+  std::vector<QualitySettings> variants;
+  for (int integrator : {INTEGRATOR_ANALYTIC, INTEGRATOR_MIDPOINT, INTEGRATOR_TRAPEZOID, INTEGRATOR_SIMPSON}) {
+    QualitySettings q;
+    q.integrator = integrator;
+    q.view_steps = 24;
+    q.light_steps = integrator == INTEGRATOR_ANALYTIC ? 0 : 8;
+    variants.push_back(q);
+  }
+  QualitySettings sky_view;
+  sky_view.sky_view_lut = true;
+  sky_view.sky_view_width = 96;
+  sky_view.sky_view_height = 54;
+  variants.push_back(sky_view);
+  const ViewRequest view{MAPPING_LATLONG, 32, 16, 0};
+  for (const QualitySettings& q : variants) {
+    SkyRenderer renderer(testing::Vulkan(), atmosphere, q, EffectSettings{}, {1, 1, 1});
+    ReferenceModel reference(atmosphere, q, EffectSettings{}, {1, 1, 1});
+    reference.PrecomputeLuts();
+    for (double elevation : {30.0, 2.0}) {
+      glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 135.0);
+      reference.PrepareSun(sun);
+      std::vector<float> gpu = renderer.Render(sun, {view})[0];
+      ExpectFiniteNonNegative(gpu, "variant");
+      Comparison c = Compare(gpu, reference.RenderView(sun, view), 1e-4);
+      EXPECT_LE(c.max_relative_error, 1e-3) << "integrator " << q.integrator << " sky-view " << q.sky_view_lut
+                                            << " elevation " << elevation;
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+}  // namespace
+}  // namespace skybake

@@ -9,6 +9,8 @@
 #pragma once
 
 #include <array>
+#include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 
@@ -55,7 +57,21 @@ struct QualitySettings {
   int transmittance_height = 64;
   int multiscattering_size = 32;      // Hillaire 2020: 32 x 32
   int integrator = INTEGRATOR_ANALYTIC;
+  // Sun transmittance at each view sample: 0 reads the transmittance LUT,
+  // N > 0 marches N midpoint steps towards the Sun (Galaj 2019's light samples).
+  int light_steps = 0;
+  int step_distribution = STEPS_QUADRATIC;  // STEPS_UNIFORM is the paper's
+  // In-scattering per output texel: ray-marched (false), or read from a
+  // per-frame sky-view LUT of this size (Hillaire 2020 section 5.3).
+  bool sky_view_lut = false;
+  int sky_view_width = 384;
+  int sky_view_height = 216;
 };
+
+// The named presets, chosen from the accuracy study (docs/accuracy.md):
+// "draft", "production" (the defaults of QualitySettings), "reference".
+QualitySettings QualityPreset(const std::string& name);
+std::vector<std::string> QualityPresetNames();
 
 // Optional physical effects; each off effect is compiled out of the shaders.
 struct EffectSettings {

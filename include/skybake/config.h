@@ -55,6 +55,7 @@ struct PreviewSettings {
 
 struct SkyStyle {
   AtmosphereParams atmosphere;
+  std::string quality_preset = "production";  // see QualityPreset()
   QualitySettings quality;
   EffectSettings effects;
   SunSettings sun;

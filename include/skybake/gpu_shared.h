@@ -23,7 +23,8 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_TRANSMITTANCE 1    // storage vec4[], transmittance LUT
 #define BINDING_MULTISCATTERING 2  // storage vec4[], multiple-scattering LUT
 #define BINDING_OUTPUT 3           // storage vec4[], rendered texels
-#define BINDING_AOAS 4             // uniform GpuAoas, the style's aesthetic principles
+#define BINDING_SKYVIEW 4          // storage vec4[], sky-view LUT
+#define BINDING_AOAS 5             // uniform GpuAoas, the style's aesthetic principles
 
 // Output mappings (SkyPush.view.x).
 #define MAPPING_LATLONG 0      // OpenEXR latlong, 2N x N, Imf::LatLongMap
@@ -32,7 +33,16 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define MAPPING_DIRECTIONS 3   // explicit directions read from the output buffer
 
 // Integrators for the in-scattering integral (GpuAtmosphere.samples.w).
-#define INTEGRATOR_ANALYTIC 0  // Hillaire 2020: exact transmittance over each step
+// Galaj & Wojciechowski 2019 study the midpoint, trapezoidal and Simpson
+// rules; the analytic step of Hillaire 2020 is the default.
+#define INTEGRATOR_ANALYTIC 0   // Hillaire 2020: source constant per step, exact transmittance
+#define INTEGRATOR_MIDPOINT 1   // composite midpoint rule (Galaj 2019 eq. 4)
+#define INTEGRATOR_TRAPEZOID 2  // composite trapezoidal rule (Galaj 2019 eq. 6)
+#define INTEGRATOR_SIMPSON 3    // composite Simpson rule (Galaj 2019 eq. 8)
+
+// Placement of the view-ray samples (GpuAtmosphere.render.w).
+#define STEPS_UNIFORM 0    // t = t_max u (Galaj 2019)
+#define STEPS_QUADRATIC 1  // t = t_max u^2, denser near the observer
 
 // Workgroup size of every 2D compute shader.
 #define SKYBAKE_LOCAL_SIZE_X 8
@@ -50,6 +60,7 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 lut_sizes;             // x,y: transmittance LUT; z,w: multiple-scattering LUT
   ivec4 samples;               // x: view steps; y: transmittance LUT steps; z: multi-scattering steps; w: integrator
   ivec4 effects;               // x: multiple scattering on; y: sun disc on; z: ground on; w: ms sqrt(directions)
+  ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
 };
 
 // Most cloud-shape segments a style can have (GpuAoas.shape_segments). A
@@ -104,7 +115,7 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuAtmosphere) == 11 * 16, "GpuAtmosphere must be vec4-packed");
+static_assert(sizeof(GpuAtmosphere) == 12 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 3 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
               "GpuAoas must be vec4-packed");

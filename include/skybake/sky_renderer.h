@@ -32,6 +32,7 @@ struct PassTiming {
 struct RenderCounters {
   int transmittance_lut_builds = 0;
   int multiscattering_lut_builds = 0;
+  int skyview_lut_builds = 0;
   int frames = 0;
 };
 
@@ -87,14 +88,17 @@ class SkyRenderer {
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
   void UpdateDescriptors();
-  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool specialize_effects);
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes);
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
   // later one reads (`barrier_after`).
   void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
 
+  static constexpr uint32_t kBindingCount = 6;  // bindings 0..5 of gpu_shared.h
+
   VulkanContext& context_;
   gpu::GpuAtmosphere gpu_atmosphere_{};
+  QualitySettings quality_;
   EffectSettings effects_;
   AoasSwitches aoas_switches_;
   bool output_directions_ = false;
@@ -105,6 +109,7 @@ class SkyRenderer {
   Buffer transmittance_buffer_;
   Buffer multiscattering_buffer_;
   Buffer output_buffer_;
+  Buffer skyview_buffer_;
 
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
@@ -113,6 +118,7 @@ class SkyRenderer {
   VkPipeline transmittance_pipeline_ = VK_NULL_HANDLE;
   VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
