@@ -37,7 +37,8 @@ std::string DescribePrinciples(const SkyStyle& style) {
   if (a.hue.enabled) parts.push_back(a.hue.color.empty() ? "hue vector" : "hue " + a.hue.color);
   if (a.ambiguity.enabled) parts.push_back(fmt::format("ambiguity l_pt {:g}", a.ambiguity.l_pt));
   if (a.clouds.enabled) parts.push_back(fmt::format("clouds s_noise {:g}", a.clouds.s_noise));
-  if (a.shapes.enabled) parts.push_back(fmt::format("{} shapes", a.shapes.shapes.size()));
+  if (a.shapes.enabled)
+    parts.push_back(fmt::format("{} shape{}", a.shapes.shapes.size(), a.shapes.shapes.size() == 1 ? "" : "s"));
   parts.push_back(fmt::format("sun {:g} deg", style.sun.elevation_deg));
   std::string out;
   for (size_t i = 0; i < parts.size(); ++i) out += (i ? ", " : "") + parts[i];

@@ -6,11 +6,14 @@
 // bakes of every shipped style.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <random>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
+#include <sys/wait.h>
 #include <type_traits>
 
 #include <glm/glm.hpp>
@@ -737,6 +740,50 @@ TEST(AoasStylesTest, GalleryWritesOneLabelledSheet) {
   EXPECT_EQ(result.entries.size(), styles.size());
   EXPECT_TRUE(std::filesystem::exists(result.contact_sheet));
   EXPECT_EQ(result.validation_messages, 0);
+}
+
+// `skybake gallery` end to end: exit codes and the sheet's layout.
+int RunSkybake(const std::string& args, std::string* output) {
+  std::string command = std::string(SKYBAKE_BINARY) + " " + args + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return -1;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) output->append(buffer, n);
+  int status = pclose(pipe);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(AoasStylesTest, GalleryCommandExitCodesAndSheet) {
+  const std::string root = ::testing::TempDir() + "/skybake_gallery_cli";
+  std::filesystem::remove_all(root);
+  std::filesystem::create_directories(root + "/empty");
+  std::filesystem::create_directories(root + "/bad");
+  {
+    std::ofstream bad(root + "/bad/broken.toml");
+    bad << "[clouds]\nenabled = true\ns_noise = 0.0\n";
+  }
+  std::string output;
+  EXPECT_EQ(RunSkybake("gallery " + root + "/empty --out " + root + "/o", &output), 2) << output;
+  output.clear();
+  EXPECT_EQ(RunSkybake("gallery " + root + "/bad --out " + root + "/o", &output), 3) << output;
+  EXPECT_NE(output.find("broken.toml:3:11: clouds.s_noise"), std::string::npos) << output;
+  output.clear();
+  const std::string styles = testing::SourceDir() + "/configs/styles";
+  ASSERT_EQ(RunSkybake("gallery " + styles + " --size 16 --columns 3 --vulkan-validation -q --out " + root +
+                           "/o --set quality.view_steps=8",
+                       &output),
+            0)
+      << output;
+  auto in = OIIO::ImageInput::open(root + "/o/gallery.png");
+  ASSERT_TRUE(in);
+  // 10 styles in 3 columns: 4 rows of 32 x 8 tiles under 40-pixel labels,
+  // 8-pixel margins.
+  size_t count = StyleFilesIn(styles).size();
+  int rows = int((count + 2) / 3);
+  EXPECT_EQ(in->spec().width, 3 * (32 + 8) + 8);
+  EXPECT_EQ(in->spec().height, rows * (8 + 40 + 8) + 8);
+  EXPECT_NE(output.find("smiley_clouds"), std::string::npos);
 }
 
 }  // namespace
