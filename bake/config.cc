@@ -50,6 +50,7 @@ constexpr Range kDomeRadius{1e-6, 1e6, false, false};
 constexpr Range kDomeFraction{0.0, 1.0, true, false};
 constexpr Range kNoiseOffset{-1e4, 1e4, false, false};
 constexpr int kMaxOctaves = 8;
+constexpr Range kFlattening{0.0, 1.0, false, true};
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -187,6 +188,13 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("shapes.enabled", x.shapes.enabled);
   v.Real("shapes.strength", x.shapes.strength, kUnit);
   v.Shapes("shapes.shape", x.shapes.shapes);
+
+  GltfSettings& g = s.gltf;
+  v.Bool("gltf.enabled", g.enabled);
+  v.Choice("gltf.dome", g.dome, {{"sphere", DomeShape::kSphere}, {"hemisphere", DomeShape::kHemisphere}});
+  v.Real("gltf.radius_m", g.radius_m, kPositive);
+  v.Real("gltf.flattening", g.flattening, kFlattening);
+  v.Int("gltf.segments", g.segments, 8, 1024);
 }
 
 // --------------------------------------------------------------- reading
@@ -464,8 +472,13 @@ class StyleReader {
     out = std::move(shapes);
   }
 
-  // Reports every key of the file that no Visit call asked for.
-  void ReportUnknownKeys() { WalkUnknown(root_, ""); }
+  // Reports every key of the file that no Visit call asked for. Tables named
+  // in `opaque` belong to another reader (a style's inline [schedule]).
+  void ReportUnknownKeys(const std::set<std::string>& opaque = {}) {
+    opaque_ = opaque;
+    for (const std::string& name : opaque) known_.insert(name);
+    WalkUnknown(root_, "");
+  }
 
  private:
   const toml::node* Find(const char* path) {
@@ -490,6 +503,7 @@ class StyleReader {
         ErrorAt(key.source(), path, fmt::format("unknown key '{}'{}", key.str(), Suggest(path)));
         continue;
       }
+      if (opaque_.count(path)) continue;
       if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
     }
   }
@@ -544,6 +558,7 @@ class StyleReader {
   std::string file_;
   std::vector<ConfigError>& errors_;
   std::set<std::string> known_;
+  std::set<std::string> opaque_;
 };
 
 // --------------------------------------------------------------- writing
@@ -693,7 +708,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
 
   StyleReader reader(root, name, result.errors);
   VisitStyle(result.style, reader);
-  reader.ReportUnknownKeys();
+  reader.ReportUnknownKeys({"schedule"});  // read by LoadSchedule (schedule.h)
 
   // Cross-field checks, located at the second key.
   const AtmosphereParams& a = result.style.atmosphere;

@@ -49,7 +49,7 @@ uint64_t FileSize(const std::string& path) {
 
 std::string TemporaryPathFor(const std::string& path) {
   std::filesystem::path p(path);
-  // One fmt call: GCC 12's -Wrestrict misfires on `"." + std::string&&`.
+  // One fmt::format call: GCC 12's -Wrestrict misfires on `"." + std::string`.
   std::string name = fmt::format(".{}.tmp{}", p.filename().string(), ::getpid());
   return (p.parent_path() / name).string();
 }

@@ -56,13 +56,14 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
     for (const std::string& o :
          {std::string("output.faces=false"), std::string("output.cube_strip=false"),
           std::string("output.latlong=false"), std::string("output.preview=true"),
+          std::string("gltf.enabled=false"),
           fmt::format("output.basename=\"{}\"", name),
           fmt::format("render.latlong_height={}", options.latlong_height)})
       overrides.push_back(o);
     ConfigResult config = LoadSkyStyle(path, overrides);
     if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
     BakeOptions bake = options.bake;
-    bake.out_dir = options.out_dir;
+    bake.out_dir = (std::filesystem::path(options.out_dir) / name).string();  // preview + manifest
     BakeResult baked = BakeStyle(config.style, bake);
     result.validation_messages += baked.validation_messages;
     GalleryEntry entry{name, path, DescribePrinciples(config.style), ""};

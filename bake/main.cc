@@ -1,7 +1,7 @@
 // skybake: bakes physical, art-directable skies into HDR environment maps.
 //
-//   skybake bake <style.toml> [--out DIR] [--size N] [--set key=value ...]
-//   skybake check <style.toml> [--set key=value ...]
+//   skybake bake <style.toml> [--schedule day.toml] [--out DIR] [--size N] [--set key=value ...]
+//   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
 //   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
 //
@@ -9,6 +9,7 @@
 // LUTs, render, files, preview), report.
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "skybake/exr_io.h"
 #include "skybake/gallery.h"
 #include "skybake/pipeline.h"
+#include "skybake/schedule.h"
 #include "skybake/vulkan_context.h"
 
 namespace {
@@ -55,6 +57,7 @@ int RunDevices() {
 struct BakeArgs {
   std::string style_path;
   std::string out_dir = "out";
+  std::string schedule_path;  // empty: the style's inline [schedule], if any
   int size = 0;
   int device = -1;
   std::vector<std::string> overrides;
@@ -74,8 +77,32 @@ int RunBake(const BakeArgs& args, bool check_only) {
     PrintErrors(config.errors);
     return kExitConfig;
   }
+  // A schedule (its own file, or inline in the style) makes a sequence: every
+  // frame's style is resolved and checked before any GPU work.
+  std::string schedule_path = args.schedule_path;
+  if (schedule_path.empty() && FileHasSchedule(args.style_path)) schedule_path = args.style_path;
+  std::optional<Schedule> schedule;
+  std::vector<SkyStyle> frame_styles;
+  if (!schedule_path.empty()) {
+    ScheduleResult loaded = LoadSchedule(schedule_path);
+    if (!loaded.ok()) {
+      PrintErrors(loaded.errors);
+      return kExitConfig;
+    }
+    FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
+    if (!styles.ok()) {
+      PrintErrors(styles.errors);
+      return kExitConfig;
+    }
+    schedule = std::move(loaded.schedule);
+    frame_styles = std::move(styles.styles);
+  }
   if (check_only) {
-    std::printf("%s: ok\n", args.style_path.c_str());
+    if (schedule)
+      std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), schedule_path.c_str(),
+                  schedule->frames.size());
+    else
+      std::printf("%s: ok\n", args.style_path.c_str());
     return kExitOk;
   }
 
@@ -89,7 +116,7 @@ int RunBake(const BakeArgs& args, bool check_only) {
       std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
     };
   }
-  BakeResult result = BakeStyle(config.style, options);
+  BakeResult result = schedule ? BakeSequence(frame_styles, *schedule, options) : BakeStyle(config.style, options);
 
   // Report: the files, then anything the validation layer said.
   for (const BakedFile& f : result.files)
@@ -178,9 +205,13 @@ int main(int argc, char** argv) {
         ->required();
     cmd->add_option("--set", args.overrides,
                     "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
+    cmd->add_option("--schedule", args.schedule_path,
+                    "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
+                    "[schedule], if it has one)");
   };
 
-  CLI::App* bake = app.add_subcommand("bake", "Bake a style into EXR cube faces, cube strip, latlong and a PNG preview");
+  CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
+      "preview, a glTF scene and manifest.json");
   add_style_options(bake);
   bake->add_option("--out", args.out_dir, "Output folder")->capture_default_str();
   bake->add_option("--size", args.size,

@@ -1,16 +1,31 @@
 #include "skybake/pipeline.h"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <memory>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <openssl/evp.h>
 
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
+#include "skybake/gltf_scene.h"
 #include "skybake/tonemap.h"
 
 namespace skybake {
 namespace {
+
+using Clock = std::chrono::steady_clock;
+using nlohmann::json;
+
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 class StageTimer {
  public:
@@ -25,7 +40,6 @@ class StageTimer {
   }
 
  private:
-  using Clock = std::chrono::steady_clock;
   BakeResult& result_;
   const ProgressCallback& progress_;
   Clock::time_point start_;
@@ -33,7 +47,470 @@ class StageTimer {
 
 std::string FormatVector(const glm::dvec3& v) { return fmt::format("{:.9g} {:.9g} {:.9g}", v.x, v.y, v.z); }
 
+double Luminance(const Rgb& rgb) { return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]; }
+
+// One frame to bake: its style, sun and place in the sequence.
+struct FramePlan {
+  const SkyStyle* style = nullptr;
+  int number = 0;  // 0: a single bake, no number in file names
+  std::optional<CivilTime> time;
+  double hours_from_start = 0.0;
+  double elevation_deg = 0.0, azimuth_deg = 0.0;
+  glm::dvec3 sun{0, 1, 0};
+};
+
+// What the shaders of one style see: the atmosphere with the hue principle
+// applied (its Rayleigh constants), and the per-texel AOAS principles, whose
+// saturation is judged in Rec.709 luminance RGB.
+struct StyledInputs {
+  AtmosphereParams atmosphere;
+  AoasInputs aoas;
+};
+StyledInputs StyledInputsOf(const SkyStyle& style) {
+  return {StyledAtmosphere(style.atmosphere, style.aoas),
+          ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance))};
+}
+
+// The renderers for one atmosphere: as styled, and without the sun disc (for
+// the sky-only SH and, by difference, the disc itself). Rebuilt only when a
+// frame changes what the shaders see.
+class RendererCache {
+ public:
+  RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
+
+  SkyRenderer& Main(const SkyStyle& style) {
+    Update(style);
+    return *main_;
+  }
+  // The renderer of the last frame.
+  SkyRenderer& Current() { return *main_; }
+  // Without the disc; the main renderer when the style has none.
+  SkyRenderer& NoDisc(const SkyStyle& style) {
+    Update(style);
+    if (!style.effects.sun_disc) return *main_;
+    if (!no_disc_) {
+      EffectSettings effects = style.effects;
+      effects.sun_disc = false;
+      StyledInputs in = StyledInputsOf(style);
+      no_disc_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, effects,
+                                               OutputScale(style.output.units), false, in.aoas);
+      ++result_.renderer_builds;
+    }
+    return *no_disc_;
+  }
+
+ private:
+  void Update(const SkyStyle& style) {
+    StyledInputs in = StyledInputsOf(style);
+    gpu::GpuAtmosphere key =
+        ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+    const AoasSwitches& s = in.aoas.switches;
+    const AoasSwitches& k = aoas_key_.switches;
+    bool same_aoas = s.skydome == k.skydome && s.ambiguity == k.ambiguity &&
+                     s.cloud_noise == k.cloud_noise && s.cloud_shapes == k.cloud_shapes &&
+                     std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0;
+    if (main_ && same_aoas && std::memcmp(&key, &key_, sizeof key) == 0) return;
+    no_disc_.reset();
+    main_.reset();
+    main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
+                                          OutputScale(style.output.units), false, in.aoas);
+    ++result_.renderer_builds;
+    key_ = key;
+    aoas_key_ = in.aoas;
+  }
+
+  VulkanContext& context_;
+  BakeResult& result_;
+  std::unique_ptr<SkyRenderer> main_, no_disc_;
+  gpu::GpuAtmosphere key_{};
+  AoasInputs aoas_key_;
+};
+
+// Converts spectral output to luminance for exposure; a copy.
+std::vector<float> DisplayLuminance(const std::vector<float>& rgba, OutputUnits units) {
+  std::vector<float> display = rgba;
+  if (units == OutputUnits::kLuminance) return display;
+  Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
+  for (size_t i = 0; i < display.size(); ++i)
+    if (i % 4 != 3) display[i] *= float(to_luminance[i % 4]);
+  return display;
+}
+
+json ShJson(const ShRgb& c) {
+  json rows = json::array();
+  for (const Rgb& rgb : c) rows.push_back({rgb[0], rgb[1], rgb[2]});
+  return rows;
+}
+
+json VectorJson(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+
+// The views one frame renders for its SH: six small faces.
+std::vector<ViewRequest> ShViews(const SkyStyle& style) {
+  const int n = std::min(style.render.cube_size, 64);
+  std::vector<ViewRequest> views;
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+  return views;
+}
+
+void WriteTextAtomically(const std::string& path, const std::string& text) {
+  std::string temporary = TemporaryPathFor(path);
+  {
+    std::ofstream out(temporary, std::ios::binary);
+    out << text;
+    if (!out) {
+      std::remove(temporary.c_str());
+      throw OutputError(fmt::format("cannot write {}", path));
+    }
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    std::remove(temporary.c_str());
+    throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(errno)));
+  }
+}
+
+BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* schedule, const BakeOptions& options) {
+  BakeResult result;
+  StageTimer timer(result, options.progress);
+  const Clock::time_point bake_start = Clock::now();
+  const bool sequence = schedule != nullptr;
+  const SkyStyle& first = *plans.front().style;
+
+  // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
+  VulkanContext context(options.vulkan);
+  timer.Finish("device", fmt::format("{} ({})", context.device_info().name, context.device_info().type));
+
+  // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
+  RendererCache renderers(context, result);
+  renderers.Main(first);
+  timer.Finish("pipelines");
+  renderers.Main(first).PrecomputeLuts();
+  for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
+  timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}",
+                                   first.quality.transmittance_width, first.quality.transmittance_height,
+                                   first.quality.multiscattering_size, first.quality.multiscattering_size));
+
+  // The reference frame (highest sun) sets the sequence's exposure and lights the glTF scene.
+  size_t reference = 0;
+  for (size_t i = 1; i < plans.size(); ++i)
+    if (plans[i].elevation_deg > plans[reference].elevation_deg) reference = i;
+
+  // Sequence-wide exposure and half-float scale, decided before any file is
+  // written, never per frame.
+  std::optional<double> ev100;
+  std::string exposure_source;
+  double half_scale = 1.0;
+  if (sequence) {
+    const FramePlan& ref = plans[reference];
+    if (ref.style->preview.auto_exposure) {
+      const int h = ref.style->render.latlong_height;
+      std::vector<float> latlong =
+          renderers.Main(*ref.style).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
+      ev100 = AutoEv100(DisplayLuminance(latlong, ref.style->output.units), 2 * h, h);
+      exposure_source = fmt::format("auto exposure of frame {} (highest sun), applied to every frame", ref.number);
+    } else {
+      ev100 = ref.style->preview.ev100;
+      exposure_source = "preview.ev100";
+    }
+    if (first.output.pixel_type == PixelType::kHalf) {
+      // The brightest texel of a frame is the sun disc's centre, or else the
+      // sky near it: a coarse latlong plus the disc centre, with a factor 2
+      // of margin, bound every frame; writing checks the bound.
+      double max_value = 0.0;
+      for (const FramePlan& plan : plans) {
+        SkyRenderer& r = renderers.Main(*plan.style);
+        std::vector<float> coarse = r.Render(plan.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];
+        std::vector<float> centre = r.RenderDirections(plan.sun, {plan.sun});
+        RgbaImage a{128, 64, coarse}, b{1, 1, centre};
+        max_value = std::max(max_value, CheckedMaxValue({&a, &b}));
+      }
+      half_scale = HalfRangeScale(2.0 * max_value, first.output.overflow);
+    }
+    timer.Finish("exposure", fmt::format("EV100 {:.2f} ({}), half scale {:.9g}", *ev100, exposure_source, half_scale));
+  }
+  result.half_scale = half_scale;
+
+  std::filesystem::create_directories(options.out_dir);
+  auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
+  auto add_file = [&](FrameResult& frame, const std::string& path, const std::string& kind, uint64_t bytes) {
+    frame.files.push_back({path, kind, bytes, Sha256OfFile(path)});
+  };
+
+  std::string reference_png;
+  int texture_width = 0, texture_height = 0;
+  for (size_t index = 0; index < plans.size(); ++index) {
+    const FramePlan& plan = plans[index];
+    const SkyStyle& style = *plan.style;
+    FrameResult frame;
+    frame.number = plan.number;
+    frame.time = plan.time;
+    frame.sun_direction = plan.sun;
+    frame.sun_elevation_deg = plan.elevation_deg;
+    frame.sun_azimuth_deg = plan.azimuth_deg;
+    const std::string number = plan.number > 0 ? fmt::format(".{:04d}", plan.number) : "";
+    const std::string label = plan.number > 0 ? fmt::format("frame {}", plan.number) : "render";
+
+    // Render: every view of the frame in one submission, then the SH views.
+    Clock::time_point render_start = Clock::now();
+    SkyRenderer& renderer = renderers.Main(style);
+    std::vector<ViewRequest> views = PlanViews(style);
+    if (style.gltf.enabled && !style.output.latlong && !style.output.preview) {
+      const int h = style.render.latlong_height;
+      views.push_back({MAPPING_LATLONG, 2 * h, h, 0});  // the glTF texture needs the latlong
+    }
+    std::vector<std::vector<float>> pixels = renderer.Render(plan.sun, views);
+    for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+    // SH: the sky without the disc from small faces; the disc added as the
+    // irradiance it delivers (centre radiance times its limb-darkened solid
+    // angle), which point-sampled texels would alias.
+    const std::vector<float> with_disc = renderer.RenderDirections(plan.sun, {plan.sun});
+    SkyRenderer& sky_only = renderers.NoDisc(style);
+    const std::vector<float> without_disc = sky_only.RenderDirections(plan.sun, {plan.sun});
+    std::vector<ViewRequest> sh_views = ShViews(style);
+    std::vector<std::vector<float>> sh_faces = sky_only.Render(plan.sun, sh_views);
+    for (const PassTiming& t : sky_only.last_timings()) frame.gpu_passes.push_back(t);
+    const double alpha = style.atmosphere.sun_angular_radius_rad;
+    const double disc_solid_angle = M_PI * alpha * alpha * (1.0 - style.atmosphere.limb_darkening_u / 3.0);
+    for (int c = 0; c < 3; ++c)
+      frame.sun_irradiance[c] = std::max(0.0, double(with_disc[c]) - double(without_disc[c])) * disc_solid_angle;
+    if (!style.effects.sun_disc) frame.sun_irradiance = {0.0, 0.0, 0.0};
+    Rgb sun_luminance = frame.sun_irradiance;
+    if (style.output.units == OutputUnits::kSpectral) {
+      Rgb k = OutputScale(OutputUnits::kLuminance);
+      for (int c = 0; c < 3; ++c) sun_luminance[c] *= k[c];
+    }
+    frame.sun_illuminance_lux = Luminance(sun_luminance);
+    ShRgb sky = ProjectCubeFaces({sh_faces[0].data(), sh_faces[1].data(), sh_faces[2].data(), sh_faces[3].data(),
+                                  sh_faces[4].data(), sh_faces[5].data()},
+                                 sh_views[0].width);
+    frame.sh_irradiance_without_sun = RadianceToIrradiance(sky);
+    AddDirectionalSource(sky, plan.sun, frame.sun_irradiance);
+    frame.sh_irradiance_with_sun = RadianceToIrradiance(sky);
+    frame.render_seconds = SecondsSince(render_start);
+    size_t texels = 0;
+    for (const ViewRequest& v : views) texels += size_t(v.width) * v.height;
+    timer.Finish(label, fmt::format("{} views, {:.2f} Mtexels, sun elevation {:.2f} azimuth {:.2f}{}", views.size(),
+                                    texels * 1e-6, plan.elevation_deg, plan.azimuth_deg,
+                                    plan.time ? ", " + plan.time->Iso8601() : ""));
+
+    // Files: one scale for every file (of the frame, or of the sequence).
+    Clock::time_point write_start = Clock::now();
+    std::vector<RgbaImage> images;
+    for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, std::move(pixels[i])});
+    std::vector<const RgbaImage*> all;
+    for (const RgbaImage& image : images) all.push_back(&image);
+    const double max_value = CheckedMaxValue(all);
+    if (style.output.pixel_type == PixelType::kHalf) {
+      if (!sequence) {
+        half_scale = HalfRangeScale(max_value, style.output.overflow);
+        result.half_scale = half_scale;
+      } else if (max_value * half_scale > kHalfMax) {
+        throw OutputError(fmt::format(
+            "frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
+            "output.pixel_type = \"float\"", plan.number, max_value, half_scale));
+      }
+    }
+    ExrWriteOptions exr;
+    exr.pixel_type = style.output.pixel_type;
+    exr.compression = style.output.compression;
+    exr.scale = half_scale;
+    const bool luminance = style.output.units == OutputUnits::kLuminance;
+    if (luminance) exr.white_luminance = 1.0 / half_scale;
+    exr.attributes = {
+        {"skybake:version", SKYBAKE_VERSION},
+        {"skybake:config", style.resolved_toml},
+        {"skybake:source", style.source_path},
+        {"skybake:units", luminance ? "linear Rec.709 luminance, cd/m^2 per 1.0 divided by skybake:scale"
+                                    : "spectral radiance W m^-2 sr^-1 nm^-1 at 680/550/440 nm (R/G/B), "
+                                      "divided by skybake:scale"},
+        {"skybake:scale", fmt::format("{:.9g}", half_scale)},
+        {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
+        {"skybake:sun_direction", FormatVector(plan.sun)},
+    };
+    if (plan.number > 0) exr.attributes["skybake:frame_number"] = std::to_string(plan.number);
+    if (plan.time) exr.attributes["skybake:time"] = plan.time->Iso8601();
+    size_t view_index = 0;
+    if (style.output.faces) {
+      for (int face = 0; face < 6; ++face, ++view_index) {
+        ExrWriteOptions face_exr = exr;
+        face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
+        face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
+        std::string path = path_of(style.output.basename + "_" + style.output.face_names[face] + number + ".exr");
+        add_file(frame, path, "face", WriteExr(path, images[view_index], face_exr));
+      }
+    }
+    if (style.output.cube_strip) {
+      ExrWriteOptions cube_exr = exr;
+      cube_exr.envmap = 1;  // ENVMAP_CUBE
+      std::string path = path_of(style.output.basename + "_cube" + number + ".exr");
+      add_file(frame, path, "cube", WriteExr(path, images[view_index], cube_exr));
+      ++view_index;
+    }
+    const RgbaImage* latlong = view_index < images.size() ? &images[view_index] : nullptr;
+    if (style.output.latlong) {
+      ExrWriteOptions latlong_exr = exr;
+      latlong_exr.envmap = 0;  // ENVMAP_LATLONG
+      std::string path = path_of(style.output.basename + "_latlong" + number + ".exr");
+      add_file(frame, path, "latlong", WriteExr(path, *latlong, latlong_exr));
+    }
+    timer.Finish("write EXR", fmt::format("{} files, {} compression, {}", frame.files.size(),
+                                          style.output.compression,
+                                          style.output.pixel_type == PixelType::kHalf ? "half" : "float"));
+
+    // Preview (and glTF texture): exposure, ACES, sRGB; one exposure for a sequence.
+    if (latlong && (style.output.preview || style.gltf.enabled)) {
+      std::vector<float> display = DisplayLuminance(latlong->rgba, style.output.units);
+      if (!ev100) {
+        ev100 = style.preview.auto_exposure ? AutoEv100(display, latlong->width, latlong->height) : style.preview.ev100;
+        exposure_source = style.preview.auto_exposure ? "auto exposure" : "preview.ev100";
+      }
+      result.preview_ev100 = *ev100;
+      std::vector<uint8_t> srgb =
+          TonemapToSrgb8(display, latlong->width, latlong->height, ExposureFromEv100(*ev100));
+      std::string path = path_of(style.output.basename + "_latlong" + number + ".png");
+      add_file(frame, path, style.output.preview ? "preview" : "gltf_texture",
+               WritePng(path, latlong->width, latlong->height, srgb));
+      if (index == reference) {
+        reference_png = std::filesystem::path(path).filename().string();
+        texture_width = latlong->width;
+        texture_height = latlong->height;
+      }
+    }
+    frame.write_seconds = SecondsSince(write_start);
+    if (ev100) timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
+    for (const BakedFile& f : frame.files) result.files.push_back(f);
+    result.frames.push_back(std::move(frame));
+  }
+
+  // Scene: the dome textured with the reference frame, the sun (animated for a sequence).
+  json provenance = {
+      {"version", SKYBAKE_VERSION},
+      {"style", first.source_path},
+      {"schedule", schedule ? schedule->source_path : ""},
+      {"units", first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
+                                                              : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm"},
+      {"exposure_ev100", ev100.value_or(0.0)},
+      {"texture_frame", plans[reference].number},
+      {"sh_basis", "real SH l<=2, order (0,0)(1,-1)(1,0)(1,1)(2,-2)(2,-1)(2,0)(2,1)(2,2), Ramamoorthi-Hanrahan "
+                   "2001 constants on world x,y,z (+Y up); irradiance E(n) = sum E_lm Y_lm(n)"},
+  };
+  json frame_extras = json::array();
+  std::vector<SceneSun> suns;
+  for (size_t i = 0; i < result.frames.size(); ++i) {
+    const FrameResult& f = result.frames[i];
+    SceneSun sun;
+    sun.time_s = schedule && schedule->clock_times ? plans[i].hours_from_start : double(i);
+    sun.direction = f.sun_direction;
+    sun.illuminance_lux = f.sun_illuminance_lux;
+    double peak = std::max({f.sun_irradiance[0], f.sun_irradiance[1], f.sun_irradiance[2]});
+    if (peak > 0.0) sun.color = {f.sun_irradiance[0] / peak, f.sun_irradiance[1] / peak, f.sun_irradiance[2] / peak};
+    suns.push_back(sun);
+    frame_extras.push_back({{"frame", f.number},
+                            {"time", f.time ? f.time->Iso8601() : ""},
+                            {"animation_time_s", sun.time_s},
+                            {"sun_direction", VectorJson(f.sun_direction)},
+                            {"sun_illuminance_lux", f.sun_illuminance_lux},
+                            {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                            {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}});
+  }
+  provenance["frames"] = frame_extras;
+  std::vector<BakedFile> scene_files;
+  if (first.gltf.enabled && !reference_png.empty()) {
+    SceneDescription scene;
+    scene.name = first.output.basename;
+    scene.out_dir = options.out_dir;
+    scene.texture_file = reference_png;
+    scene.texture_width = texture_width;
+    scene.texture_height = texture_height;
+    scene.dome = first.gltf;
+    scene.suns = suns;
+    scene.light_frame = int(reference);
+    scene.extras_json = provenance.dump();
+    WrittenScene written = WriteGltfScene(scene);
+    for (auto [path, kind] : {std::pair{written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"},
+                              {written.glb_path, "glb"}}) {
+      uint64_t bytes = std::filesystem::file_size(path);
+      scene_files.push_back({path, kind, bytes, Sha256OfFile(path)});
+      result.files.push_back(scene_files.back());
+    }
+    timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", written.gltf_path, suns.size(),
+                                     suns.size() == 1 ? "" : "s"));
+  }
+
+  // Manifest: every file with its size and SHA-256, per frame; written last, atomically.
+  auto file_json = [&](const BakedFile& f) {
+    return json{{"file", std::filesystem::path(f.path).filename().string()},
+                {"kind", f.kind},
+                {"bytes", f.bytes},
+                {"sha256", f.sha256}};
+  };
+  json manifest = provenance;
+  manifest.erase("frames");
+  manifest["out_dir"] = options.out_dir;
+  manifest["half_scale"] = half_scale;
+  manifest["exposure_source"] = exposure_source;
+  manifest["frame_convention"] = "+Y up, right-handed, North -Z, East +X; sun_direction points towards the Sun; "
+                                 "azimuth clockwise from North";
+  if (schedule && schedule->place) {
+    manifest["place"] = {{"latitude_deg", schedule->place->latitude_deg},
+                         {"longitude_deg", schedule->place->longitude_deg}};
+  }
+  json frames = json::array();
+  for (size_t i = 0; i < result.frames.size(); ++i) {
+    const FrameResult& f = result.frames[i];
+    json files = json::array();
+    for (const BakedFile& file : f.files) files.push_back(file_json(file));
+    json passes = json::array();
+    for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
+    frames.push_back({{"frame", f.number},
+                      {"time", f.time ? json(f.time->Iso8601()) : json(nullptr)},
+                      {"hours_from_start", plans[i].hours_from_start},
+                      {"sun", {{"elevation_deg", f.sun_elevation_deg},
+                               {"azimuth_deg", f.sun_azimuth_deg},
+                               {"direction", VectorJson(f.sun_direction)},
+                               {"illuminance_lux", f.sun_illuminance_lux}}},
+                      {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                      {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
+                      {"files", files},
+                      {"timings", {{"render_s", f.render_seconds}, {"write_s", f.write_seconds}, {"gpu_passes", passes}}}});
+  }
+  manifest["frames"] = frames;
+  json scene_json = json::array();
+  for (const BakedFile& f : scene_files) scene_json.push_back(file_json(f));
+  manifest["scene"] = scene_json;
+  manifest["renderer_builds"] = result.renderer_builds;
+  json stages = json::array();
+  for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
+  manifest["timings"] = {{"total_s", SecondsSince(bake_start)}, {"stages", stages}};
+  result.manifest_path = path_of("manifest.json");
+  WriteTextAtomically(result.manifest_path, manifest.dump(2) + "\n");
+  result.files.push_back({result.manifest_path, "manifest", std::filesystem::file_size(result.manifest_path), ""});
+  timer.Finish("manifest", result.manifest_path);
+
+  result.counters = renderers.Current().counters();
+  result.validation_messages = context.validation_message_count();
+  return result;
+}
+
 }  // namespace
+
+std::string Sha256OfFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw OutputError(fmt::format("cannot read {} to checksum it", path));
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
+  if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1)
+    throw OutputError("OpenSSL: cannot start SHA-256");
+  std::vector<char> chunk(1 << 16);
+  while (in) {
+    in.read(chunk.data(), std::streamsize(chunk.size()));
+    if (in.gcount() > 0) EVP_DigestUpdate(ctx.get(), chunk.data(), size_t(in.gcount()));
+  }
+  unsigned char digest[EVP_MAX_MD_SIZE];
+  unsigned int length = 0;
+  EVP_DigestFinal_ex(ctx.get(), digest, &length);
+  std::string hex;
+  for (unsigned int i = 0; i < length; ++i) hex += fmt::format("{:02x}", digest[i]);
+  return hex;
+}
 
 std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
   std::vector<ViewRequest> views;
@@ -49,119 +526,32 @@ std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
 }
 
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options) {
-  BakeResult result;
-  StageTimer timer(result, options.progress);
+  FramePlan plan;
+  plan.style = &style;
+  plan.elevation_deg = style.sun.elevation_deg;
+  plan.azimuth_deg = style.sun.azimuth_deg;
+  plan.sun = SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg);
+  return BakeFrames({plan}, nullptr, options);
+}
 
-  // Device: headless Vulkan, best device or the one asked for.
-  VulkanContext context(options.vulkan);
-  timer.Finish("device", fmt::format("{} ({})", context.device_info().name, context.device_info().type));
-
-  // Pipelines: compiled once, with the effects as specialization constants.
-  // The hue principle acts on the atmosphere (its Rayleigh constants), the
-  // other AOAS principles per texel; saturation is judged in Rec.709 luminance RGB.
-  const Rgb output_scale = OutputScale(style.output.units);
-  const AtmosphereParams atmosphere = StyledAtmosphere(style.atmosphere, style.aoas);
-  const AoasInputs aoas = ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance));
-  SkyRenderer renderer(context, atmosphere, style.quality, style.effects, output_scale, false, aoas);
-  timer.Finish("pipelines");
-
-  // LUTs: transmittance, then multiple scattering.
-  renderer.PrecomputeLuts();
-  for (const PassTiming& t : renderer.last_timings()) result.gpu_passes.push_back(t);
-  timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}",
-                                   style.quality.transmittance_width, style.quality.transmittance_height,
-                                   style.quality.multiscattering_size, style.quality.multiscattering_size));
-
-  // Render: every view of the frame in one submission.
-  const glm::dvec3 sun = SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg);
-  std::vector<ViewRequest> views = PlanViews(style);
-  std::vector<std::vector<float>> pixels = renderer.Render(sun, views);
-  for (const PassTiming& t : renderer.last_timings()) result.gpu_passes.push_back(t);
-  size_t texels = 0;
-  for (const ViewRequest& v : views) texels += size_t(v.width) * v.height;
-  timer.Finish("render", fmt::format("{} views, {:.2f} Mtexels, {} steps per texel", views.size(),
-                                     texels * 1e-6, style.quality.view_steps));
-
-  std::vector<RgbaImage> images;
-  for (size_t i = 0; i < views.size(); ++i)
-    images.push_back({views[i].width, views[i].height, std::move(pixels[i])});
-  std::vector<const RgbaImage*> all;
-  for (const RgbaImage& image : images) all.push_back(&image);
-
-  // Files: one scale for the whole bake, so faces, strip and latlong agree.
-  std::filesystem::create_directories(options.out_dir);
-  const double max_value = CheckedMaxValue(all);
-  if (style.output.pixel_type == PixelType::kHalf)
-    result.half_scale = HalfRangeScale(max_value, style.output.overflow);
-  ExrWriteOptions exr;
-  exr.pixel_type = style.output.pixel_type;
-  exr.compression = style.output.compression;
-  exr.scale = result.half_scale;
-  const bool luminance = style.output.units == OutputUnits::kLuminance;
-  if (luminance) exr.white_luminance = 1.0 / result.half_scale;
-  exr.attributes = {
-      {"skybake:version", SKYBAKE_VERSION},
-      {"skybake:config", style.resolved_toml},
-      {"skybake:source", style.source_path},
-      {"skybake:units", luminance ? "linear Rec.709 luminance, cd/m^2 per 1.0 divided by skybake:scale"
-                                  : "spectral radiance W m^-2 sr^-1 nm^-1 at 680/550/440 nm (R/G/B), "
-                                    "divided by skybake:scale"},
-      {"skybake:scale", fmt::format("{:.9g}", result.half_scale)},
-      {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
-      {"skybake:sun_direction", FormatVector(sun)},
-  };
-  auto path_of = [&](const std::string& suffix) {
-    return (std::filesystem::path(options.out_dir) / (style.output.basename + suffix)).string();
-  };
-  size_t index = 0;
-  if (style.output.faces) {
-    for (int face = 0; face < 6; ++face, ++index) {
-      ExrWriteOptions face_exr = exr;
-      face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
-      face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
-      std::string path = path_of("_" + style.output.face_names[face] + ".exr");
-      result.files.push_back({path, "face", WriteExr(path, images[index], face_exr)});
-    }
+BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& schedule, const BakeOptions& options) {
+  if (styles.size() != schedule.frames.size() || styles.empty())
+    throw std::invalid_argument(fmt::format("BakeSequence: {} styles for {} frames", styles.size(),
+                                            schedule.frames.size()));
+  std::vector<FramePlan> plans;
+  for (size_t i = 0; i < styles.size(); ++i) {
+    const ScheduleFrame& f = schedule.frames[i];
+    FramePlan plan;
+    plan.style = &styles[i];
+    plan.number = f.number;
+    plan.time = f.time;
+    plan.hours_from_start = f.hours_from_start;
+    plan.elevation_deg = f.elevation_deg;
+    plan.azimuth_deg = f.azimuth_deg;
+    plan.sun = f.sun_direction;
+    plans.push_back(plan);
   }
-  if (style.output.cube_strip) {
-    ExrWriteOptions cube_exr = exr;
-    cube_exr.envmap = 1;  // ENVMAP_CUBE
-    std::string path = path_of("_cube.exr");
-    result.files.push_back({path, "cube", WriteExr(path, images[index], cube_exr)});
-    ++index;
-  }
-  const RgbaImage* latlong = (style.output.latlong || style.output.preview) ? &images[index] : nullptr;
-  if (style.output.latlong) {
-    ExrWriteOptions latlong_exr = exr;
-    latlong_exr.envmap = 0;  // ENVMAP_LATLONG
-    std::string path = path_of("_latlong.exr");
-    result.files.push_back({path, "latlong", WriteExr(path, *latlong, latlong_exr)});
-  }
-  timer.Finish("write EXR", fmt::format("{} files, {} compression, {}", result.files.size(),
-                                        style.output.compression,
-                                        style.output.pixel_type == PixelType::kHalf ? "half" : "float"));
-
-  // Preview: exposure, ACES, sRGB. Exposure works in cd/m^2, so spectral
-  // output is converted to luminance for the preview only.
-  if (style.output.preview) {
-    std::vector<float> display = latlong->rgba;
-    if (!luminance) {
-      Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
-      for (size_t i = 0; i < display.size(); ++i)
-        if (i % 4 != 3) display[i] *= float(to_luminance[i % 4]);
-    }
-    result.preview_ev100 = style.preview.auto_exposure
-                               ? AutoEv100(display, latlong->width, latlong->height)
-                               : style.preview.ev100;
-    std::vector<uint8_t> srgb = TonemapToSrgb8(display, latlong->width, latlong->height,
-                                               ExposureFromEv100(result.preview_ev100));
-    std::string path = path_of("_latlong.png");
-    result.files.push_back({path, "preview", WritePng(path, latlong->width, latlong->height, srgb)});
-    timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", result.preview_ev100));
-  }
-  result.counters = renderer.counters();
-  result.validation_messages = context.validation_message_count();
-  return result;
+  return BakeFrames(plans, &schedule, options);
 }
 
 }  // namespace skybake

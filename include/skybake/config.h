@@ -53,6 +53,16 @@ struct PreviewSettings {
   double ev100 = 14.0;        // used when auto_exposure is false
 };
 
+// The glTF 2.0 scene written beside the maps (see gltf_scene.h).
+enum class DomeShape { kSphere, kHemisphere };
+struct GltfSettings {
+  bool enabled = true;              // write name.gltf (+ .bin) and name.glb
+  DomeShape dome = DomeShape::kSphere;
+  double radius_m = 1000.0;         // horizontal radius of the dome
+  double flattening = 0.0;          // 0: round; f: vertical radius = (1 - f) * radius_m
+  int segments = 64;                // around the horizon; half as many rings pole to pole
+};
+
 struct SkyStyle {
   AtmosphereParams atmosphere;
   std::string quality_preset = "production";  // see QualityPreset()
@@ -63,6 +73,7 @@ struct SkyStyle {
   OutputSettings output;
   PreviewSettings preview;
   AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
+  GltfSettings gltf;
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance
 };

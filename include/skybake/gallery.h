@@ -43,8 +43,8 @@ std::vector<std::string> StyleFilesIn(const std::string& dir);
 // The AOAS principles a style turns on, as a short list ("physical" if none).
 std::string DescribePrinciples(const SkyStyle& style);
 
-// Bakes every style (each must be valid: the caller checks them first) and
-// writes out_dir/gallery.png. Throws ConfigFailure for an invalid style, and
+// Bakes every style into out_dir/<style>/ (its latlong preview and its
+// manifest) and writes out_dir/gallery.png. Throws ConfigFailure for an invalid style, and
 // what BakeStyle throws.
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options);
 

@@ -5,10 +5,13 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "skybake/config.h"
+#include "skybake/schedule.h"
+#include "skybake/sh.h"
 #include "skybake/sky_renderer.h"
 #include "skybake/vulkan_context.h"
 
@@ -39,23 +42,57 @@ struct BakeOptions {
 
 struct BakedFile {
   std::string path;
-  std::string kind;  // "face", "cube", "latlong", "preview"
+  std::string kind;  // "face", "cube", "latlong", "preview", "gltf", "gltf_bin", "glb", "manifest"
   uint64_t bytes = 0;
+  std::string sha256;  // hex; empty for the manifest itself
+};
+
+// What one frame of a bake produced.
+struct FrameResult {
+  int number = 1;                    // in file names; 0 for a single bake (no number)
+  std::optional<CivilTime> time;
+  glm::dvec3 sun_direction{0, 1, 0};
+  double sun_elevation_deg = 0.0;
+  double sun_azimuth_deg = 0.0;
+  std::vector<BakedFile> files;
+  ShRgb sh_irradiance_with_sun{};     // E_lm, sun disc included as its transmitted irradiance
+  ShRgb sh_irradiance_without_sun{};  // E_lm of the sky alone
+  Rgb sun_irradiance{0, 0, 0};        // transmitted sun at the observer, output units x sr
+  double sun_illuminance_lux = 0.0;
+  double render_seconds = 0.0;
+  double write_seconds = 0.0;
+  std::vector<PassTiming> gpu_passes;
 };
 
 struct BakeResult {
-  std::vector<BakedFile> files;
+  std::vector<BakedFile> files;  // every file, frames then scene then manifest
+  std::vector<FrameResult> frames;
   std::vector<StageReport> stages;
   std::vector<PassTiming> gpu_passes;  // LUT and render passes, GPU timestamps
   RenderCounters counters;
   double half_scale = 1.0;   // power-of-two factor applied to fit half range
   double preview_ev100 = 0.0;
   int validation_messages = 0;
+  std::string manifest_path;
+  int renderer_builds = 0;  // SkyRenderer constructions (atmosphere changes)
 };
 
 // Bakes one style (one sun position) into options.out_dir, which is created
-// if needed. Throws VulkanUnavailable, VulkanError or OutputError.
+// if needed: EXR maps, preview, glTF scene, manifest.json. Throws
+// VulkanUnavailable, VulkanError or OutputError.
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
+
+// Bakes a sequence: frame k of `schedule` with `styles[k]` (see
+// ResolveFrameStyles), files numbered name.####.ext. One Vulkan context
+// throughout; the renderer and its LUTs are rebuilt only when a frame
+// changes the atmosphere, quality, effects or units. One exposure and one
+// half-float scale for the whole sequence. Writes one glTF scene with the
+// sun animated across the frames, and manifest.json.
+BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& schedule,
+                        const BakeOptions& options);
+
+// SHA-256 of a file, lowercase hex. Throws OutputError.
+std::string Sha256OfFile(const std::string& path);
 
 // The views one bake renders, in order: six Vulkan faces, the cube strip,
 // the latlong (each only when enabled in `output`).

@@ -1,0 +1,253 @@
+// Sequence bakes end to end on lavapipe under the validation layer: a
+// 24-frame schedule, its manifest checked file by file against sha256sum,
+// and the glTF scenes checked by the Khronos glTF-Validator and rendered by
+// three.js in headless Chromium (node scripts in tests/viewer/).
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <set>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <glm/geometric.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <nlohmann/json.hpp>
+#include <OpenImageIO/imageio.h>
+
+#include "skybake/pipeline.h"
+#include "skybake/schedule.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* kDay24 = R"(
+[schedule]
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+times = { start = 06:00:00, end = 11:45:00, step_minutes = 15 }
+)";
+
+// Small and quick: 16^3 cube faces, a 32 x 16 latlong.
+const std::vector<std::string> kSmall = {"render.cube_size=16", "render.latlong_height=16", "gltf.segments=32"};
+
+// Runs a shell command; returns its exit status and stdout.
+std::pair<int, std::string> RunCommand(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
+  int status = pclose(pipe);
+  return {WEXITSTATUS(status), output};
+}
+
+std::string ViewerDir() { return testing::SourceDir() + "/tests/viewer"; }
+
+class Sequence : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // Per process: ctest runs each test case in its own process, maybe in parallel.
+    out_dir_ = (fs::temp_directory_path() / fmt::format("skybake-sequence-test-{}", ::getpid())).string();
+    fs::remove_all(out_dir_);
+    ScheduleResult schedule = ParseSchedule(kDay24, "day24.toml");
+    ASSERT_TRUE(schedule.ok());
+    schedule_ = std::make_unique<Schedule>(schedule.schedule);
+    FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", kSmall, *schedule_);
+    ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
+    BakeOptions options;
+    options.out_dir = out_dir_ + "/sequence";
+    options.vulkan.validation = true;
+    try {
+      result_ = std::make_unique<BakeResult>(BakeSequence(styles.styles, *schedule_, options));
+      ConfigResult single = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml", kSmall);
+      ASSERT_TRUE(single.ok());
+      options.out_dir = out_dir_ + "/single";
+      single_ = std::make_unique<BakeResult>(BakeStyle(single.style, options));
+    } catch (const std::exception& e) {
+      FAIL() << "bake failed: " << e.what()
+             << "\nVulkan is required: apt-get install libvulkan1 mesa-vulkan-drivers vulkan-validationlayers";
+    }
+  }
+  static void TearDownTestSuite() { fs::remove_all(out_dir_); }
+  void SetUp() override {
+    ASSERT_TRUE(result_) << "the sequence bake failed";
+    ASSERT_TRUE(single_) << "the single bake failed";
+  }
+
+  static std::string out_dir_;
+  static std::unique_ptr<Schedule> schedule_;
+  static std::unique_ptr<BakeResult> result_, single_;
+};
+std::string Sequence::out_dir_;
+std::unique_ptr<Schedule> Sequence::schedule_;
+std::unique_ptr<BakeResult> Sequence::result_, Sequence::single_;
+
+TEST_F(Sequence, TwentyFourFramesOneRendererNoValidationMessages) {
+  EXPECT_EQ(result_->validation_messages, 0);
+  EXPECT_EQ(single_->validation_messages, 0);
+  ASSERT_EQ(result_->frames.size(), 24u);
+  // One renderer with the sun disc and one without, for the whole sequence:
+  // the atmosphere never changes, so the LUTs are built once each.
+  EXPECT_EQ(result_->renderer_builds, 2);
+  EXPECT_EQ(result_->counters.transmittance_lut_builds, 1);
+  for (int frame = 1; frame <= 24; ++frame)
+    for (const char* name : {"sky_px", "sky_nz", "sky_cube", "sky_latlong"})
+      EXPECT_TRUE(fs::exists(fmt::format("{}/sequence/{}.{:04d}.exr", out_dir_, name, frame))) << name << " " << frame;
+  EXPECT_TRUE(fs::exists(out_dir_ + "/sequence/sky_latlong.0024.png"));
+  EXPECT_FALSE(fs::exists(out_dir_ + "/sequence/sky_latlong.0025.png"));
+}
+
+TEST_F(Sequence, ManifestListsEveryFileWithMatchingChecksum) {
+  std::ifstream in(result_->manifest_path);
+  ASSERT_TRUE(in) << result_->manifest_path;
+  json manifest = json::parse(in);
+  ASSERT_EQ(manifest["frames"].size(), 24u);
+  std::set<std::string> listed;
+  int checked = 0;
+  auto check = [&](const json& file) {
+    std::string path = out_dir_ + "/sequence/" + file["file"].get<std::string>();
+    ASSERT_TRUE(fs::exists(path)) << path;
+    EXPECT_EQ(fs::file_size(path), file["bytes"].get<uint64_t>()) << path;
+    auto [status, output] = RunCommand("sha256sum '" + path + "'");
+    ASSERT_EQ(status, 0) << output;
+    EXPECT_EQ(output.substr(0, 64), file["sha256"].get<std::string>()) << path;
+    listed.insert(file["file"].get<std::string>());
+    ++checked;
+  };
+  for (size_t i = 0; i < 24; ++i) {
+    const json& frame = manifest["frames"][i];
+    const ScheduleFrame& expected = schedule_->frames[i];
+    EXPECT_EQ(frame["frame"].get<int>(), expected.number);
+    EXPECT_EQ(frame["time"].get<std::string>(), expected.time->Iso8601());
+    for (int c = 0; c < 3; ++c)
+      EXPECT_DOUBLE_EQ(frame["sun"]["direction"][c].get<double>(), expected.sun_direction[c]);
+    EXPECT_EQ(frame["sh_irradiance_with_sun"].size(), 9u);
+    EXPECT_EQ(frame["sh_irradiance_without_sun"][0].size(), 3u);
+    EXPECT_GT(frame["timings"]["render_s"].get<double>(), 0.0);
+    for (const json& file : frame["files"]) check(file);
+  }
+  for (const json& file : manifest["scene"]) check(file);
+  // 6 faces + strip + latlong + PNG per frame, then .gltf, .bin, .glb.
+  EXPECT_EQ(checked, 24 * 9 + 3);
+  // Every file of the folder is listed, apart from the manifest itself.
+  for (const auto& entry : fs::directory_iterator(out_dir_ + "/sequence")) {
+    std::string name = entry.path().filename().string();
+    if (name == "manifest.json" || name.find("screenshot") != std::string::npos) continue;
+    EXPECT_TRUE(listed.count(name)) << name << " is not in the manifest";
+  }
+  // One exposure for the sequence.
+  EXPECT_TRUE(manifest["exposure_ev100"].is_number());
+  EXPECT_NE(manifest["exposure_source"].get<std::string>().find("every frame"), std::string::npos);
+}
+
+TEST_F(Sequence, ShOfTheSkyIsBrighterWithTheSun) {
+  for (const FrameResult& f : result_->frames) {
+    // Irradiance on an upward surface; the sun adds only when it is up.
+    double with = EvaluateSh(f.sh_irradiance_with_sun, {0, 1, 0})[1];
+    double without = EvaluateSh(f.sh_irradiance_without_sun, {0, 1, 0})[1];
+    EXPECT_GT(without, 0.0) << f.number;
+    if (f.sun_elevation_deg > 1.0) {
+      EXPECT_GT(with, without) << f.number;
+    }
+  }
+}
+
+TEST_F(Sequence, GltfValidatorReportsNoErrorsOrWarnings) {
+  std::string files;
+  for (const char* dir : {"sequence", "single"})
+    for (const char* name : {"sky.gltf", "sky.glb"}) files += " '" + out_dir_ + "/" + dir + "/" + name + "'";
+  auto [status, output] = RunCommand("cd '" + ViewerDir() + "' && node validate.mjs" + files);
+  std::printf("%s", output.c_str());
+  EXPECT_EQ(status, 0) << output << "\n(install with: bash .ci/setup)";
+  EXPECT_EQ(output.find("0 errors, 0 warnings"), output.find("0 errors, 0 warnings"));
+  size_t count = 0;
+  for (size_t p = output.find("0 errors, 0 warnings"); p != std::string::npos;
+       p = output.find("0 errors, 0 warnings", p + 1))
+    ++count;
+  EXPECT_EQ(count, 4u);
+}
+
+// Rotates v by the glTF quaternion [x, y, z, w].
+glm::dvec3 Rotate(const json& q, const glm::dvec3& v) {
+  glm::dquat quat(q[3].get<double>(), q[0].get<double>(), q[1].get<double>(), q[2].get<double>());
+  return quat * v;
+}
+
+TEST_F(Sequence, GltfSunShinesAwayFromTheBakedSun) {
+  std::ifstream in(out_dir_ + "/sequence/sky.gltf");
+  json gltf = json::parse(in);
+  ASSERT_EQ(gltf["extensionsUsed"].size(), 2u);
+  for (const json& name : gltf["extensionsUsed"]) EXPECT_NE(name.get<std::string>(), "KHR_materials_emissive_strength");
+  const json& sun_node = gltf["nodes"][1];
+  ASSERT_EQ(sun_node["extensions"]["KHR_lights_punctual"]["light"].get<int>(), 0);
+  EXPECT_EQ(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["type"].get<std::string>(), "directional");
+  // The light (the highest-sun frame, the last) shines along the node's -Z.
+  const FrameResult& last = result_->frames.back();
+  EXPECT_LT(glm::length(Rotate(sun_node["rotation"], {0, 0, -1}) + last.sun_direction), 1e-6);
+  EXPECT_NEAR(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(),
+              last.sun_illuminance_lux, 1e-6 * last.sun_illuminance_lux);
+  // Every animation key points the light away from its frame's sun.
+  const json& sampler = gltf["animations"][0]["samplers"][0];
+  const json& output = gltf["accessors"][sampler["output"].get<int>()];
+  const json& view = gltf["bufferViews"][output["bufferView"].get<int>()];
+  ASSERT_EQ(output["count"].get<int>(), 24);
+  std::ifstream bin(out_dir_ + "/sequence/sky.bin", std::ios::binary);
+  std::vector<char> bytes((std::istreambuf_iterator<char>(bin)), std::istreambuf_iterator<char>());
+  const float* keys = reinterpret_cast<const float*>(bytes.data() + view["byteOffset"].get<size_t>());
+  for (int k = 0; k < 24; ++k) {
+    json q = {keys[4 * k], keys[4 * k + 1], keys[4 * k + 2], keys[4 * k + 3]};
+    EXPECT_LT(glm::length(Rotate(q, {0, 0, -1}) + result_->frames[k].sun_direction), 1e-5) << "key " << k;
+  }
+}
+
+// Mean sRGB colour of the top tenth of a screenshot.
+std::array<double, 3> TopMean(const std::string& png) {
+  auto in = OIIO::ImageInput::open(png);
+  if (!in) return {-1, -1, -1};
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<uint8_t> pixels(size_t(spec.width) * spec.height * spec.nchannels);
+  in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::UINT8, pixels.data());
+  std::array<double, 3> sum{0, 0, 0};
+  const int rows = std::max(1, spec.height / 10);
+  for (int y = 0; y < rows; ++y)
+    for (int x = 0; x < spec.width; ++x)
+      for (int c = 0; c < 3; ++c) sum[c] += pixels[(size_t(y) * spec.width + x) * spec.nchannels + c];
+  for (double& s : sum) s /= double(rows) * spec.width;
+  return sum;
+}
+
+TEST_F(Sequence, ThreeJsRendersTheDomeInHeadlessChromium) {
+  for (std::string scene : {out_dir_ + "/sequence/sky.glb", out_dir_ + "/single/sky.gltf"}) {
+    std::string shot = scene + ".screenshot.png";
+    fs::remove(shot);
+    auto [status, output] = RunCommand("cd '" + ViewerDir() + "' && node view.mjs '" + scene + "' '" + shot + "'");
+    std::printf("%s", output.c_str());
+    ASSERT_EQ(status, 0) << output << "\n(install with: bash .ci/setup)";
+    EXPECT_NE(output.find("\"ok\":\"1\""), std::string::npos) << output;
+    EXPECT_NE(output.find("\"lights\":\"1\""), std::string::npos) << "the sun light did not load: " << output;
+    std::array<double, 3> top = TopMean(shot);
+    std::printf("%s: top of frame mean sRGB %.1f %.1f %.1f\n", shot.c_str(), top[0], top[1], top[2]);
+    // A daytime sky: bright enough not to be black, and blue.
+    EXPECT_GT(top[0] + top[1] + top[2], 3 * 40.0) << "the top of the frame is black";
+    EXPECT_GT(top[2], top[0] + 20.0) << "the top of the frame is not sky blue";
+  }
+  // The sequence's scene animates the sun.
+  auto [status, output] = RunCommand("cd '" + ViewerDir() + "' && node view.mjs '" + out_dir_ + "/sequence/sky.gltf' '" +
+                              out_dir_ + "/sequence/sky.gltf.screenshot.png'");
+  EXPECT_EQ(status, 0) << output;
+  EXPECT_NE(output.find("\"animations\":\"1\""), std::string::npos) << output;
+}
+
+}  // namespace
+}  // namespace skybake
