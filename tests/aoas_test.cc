@@ -24,6 +24,7 @@
 #include "skybake/gallery.h"
 #include "skybake/pipeline.h"
 #include "skybake/reference_model.h"
+#include "skybake/schedule.h"
 #include "skybake/sky_renderer.h"
 #include "test_support.h"
 
@@ -740,6 +741,50 @@ TEST(AoasStylesTest, GalleryWritesOneLabelledSheet) {
   EXPECT_EQ(result.entries.size(), styles.size());
   EXPECT_TRUE(std::filesystem::exists(result.contact_sheet));
   EXPECT_EQ(result.validation_messages, 0);
+}
+
+// Day cycle from clock time, and drifting clouds, through a schedule.
+TEST(AoasScheduleTest, SunFollowsTheClockAndCloudsDrift) {
+  const std::string path = ::testing::TempDir() + "/skybake_aoas_schedule.toml";
+  {
+    std::ofstream out(path);
+    out << kFastQuality << R"(
+[hue]
+enabled = true
+color = "#ffcc33"
+[clouds]
+enabled = true
+s_noise = 0.2
+drift = [0.0, 0.0, 0.0]
+[schedule]
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+times = [09:00:00, 11:00:00, 13:00:00]
+[schedule.per_hour]
+"clouds.drift" = [0.5, 0.0, 0.25]
+)";
+  }
+  ScheduleResult schedule = LoadSchedule(path);
+  ASSERT_TRUE(schedule.ok());
+  FrameStyles frames = ResolveFrameStyles(path, {"render.latlong_height=16"}, schedule.schedule);
+  ASSERT_TRUE(frames.ok()) << frames.errors[0].Format();
+  ASSERT_EQ(frames.styles.size(), 3u);
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_NEAR(frames.styles[i].aoas.clouds.drift.x, 1.0 * i, 1e-9);
+    EXPECT_NEAR(frames.styles[i].aoas.clouds.drift.z, 0.5 * i, 1e-9);
+  }
+  // The morning sun climbs.
+  EXPECT_LT(frames.styles[0].sun.elevation_deg, frames.styles[1].sun.elevation_deg);
+  EXPECT_LT(frames.styles[1].sun.elevation_deg, frames.styles[2].sun.elevation_deg);
+  // Same sun, drift alone: the clouds move, the sky stays finite.
+  SkyStyle still = frames.styles[0], drifted = frames.styles[1];
+  drifted.sun = still.sun;
+  ViewRequest view{MAPPING_LATLONG, 32, 16, 0};
+  std::vector<float> a = RenderGpu(still, {view})[0], b = RenderGpu(drifted, {view})[0];
+  for (float v : b) ASSERT_TRUE(std::isfinite(v));
+  EXPECT_GT(MaxRelativeDifference(b, a), 0.01);
 }
 
 // `skybake gallery` end to end: exit codes and the sheet's layout.
