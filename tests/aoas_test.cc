@@ -444,7 +444,7 @@ TEST(AoasDeterminismTest, SeedDeterminesTheSkyOnGpuAndCpu) {
   RecordProperty("gpu_cpu_max_relative_difference", std::to_string(worst));
   RecordProperty("gpu_cpu_mean_relative_difference", std::to_string(mean));
   std::printf("GPU vs CPU: max %.3g, mean %.3g relative\n", worst, mean);
-  // Measured on lavapipe: max 3.7e-5, mean 1.0e-6.
+  // Measured on lavapipe: max 3.3e-5 to 3.7e-5, mean 1.0e-6 to 1.3e-6.
   EXPECT_LT(worst, 2e-4);
   EXPECT_LT(mean, 1e-5);
 }
@@ -729,20 +729,6 @@ TEST(AoasStylesTest, EveryShippedStyleBakesWithoutNanOrInf) {
   }
 }
 
-TEST(AoasStylesTest, GalleryWritesOneLabelledSheet) {
-  std::string out = ::testing::TempDir() + "/skybake_gallery_test";
-  std::filesystem::remove_all(out);
-  GalleryOptions options;
-  options.out_dir = out;
-  options.latlong_height = 32;
-  options.overrides = {"quality.view_steps=8"};
-  std::vector<std::string> styles = StyleFilesIn(testing::SourceDir() + "/configs/styles");
-  GalleryResult result = BakeGallery(styles, options);
-  EXPECT_EQ(result.entries.size(), styles.size());
-  EXPECT_TRUE(std::filesystem::exists(result.contact_sheet));
-  EXPECT_EQ(result.validation_messages, 0);
-}
-
 // Day cycle from clock time, and drifting clouds, through a schedule.
 TEST(AoasScheduleTest, SunFollowsTheClockAndCloudsDrift) {
   const std::string path = ::testing::TempDir() + "/skybake_aoas_schedule.toml";
@@ -787,7 +773,8 @@ times = [09:00:00, 11:00:00, 13:00:00]
   EXPECT_GT(MaxRelativeDifference(b, a), 0.01);
 }
 
-// `skybake gallery` end to end: exit codes and the sheet's layout.
+// `skybake gallery` end to end, under the validation layer (any message
+// fails the command): exit codes, every style listed, the sheet's layout.
 int RunSkybake(const std::string& args, std::string* output) {
   std::string command = std::string(SKYBAKE_BINARY) + " " + args + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
@@ -816,7 +803,8 @@ TEST(AoasStylesTest, GalleryCommandExitCodesAndSheet) {
   output.clear();
   const std::string styles = testing::SourceDir() + "/configs/styles";
   ASSERT_EQ(RunSkybake("gallery " + styles + " --size 16 --columns 3 --vulkan-validation -q --out " + root +
-                           "/o --set quality.view_steps=8",
+                           "/o --set quality.view_steps=8 --set quality.transmittance_steps=32 "
+                           "--set quality.multiscattering_sqrt_directions=2 --set quality.multiscattering_lut_size=8",
                        &output),
             0)
       << output;
@@ -828,7 +816,8 @@ TEST(AoasStylesTest, GalleryCommandExitCodesAndSheet) {
   int rows = int((count + 2) / 3);
   EXPECT_EQ(in->spec().width, 3 * (32 + 8) + 8);
   EXPECT_EQ(in->spec().height, rows * (8 + 40 + 8) + 8);
-  EXPECT_NE(output.find("smiley_clouds"), std::string::npos);
+  for (const std::string& style : StyleFilesIn(styles))
+    EXPECT_NE(output.find(std::filesystem::path(style).stem().string()), std::string::npos) << style;
 }
 
 }  // namespace
