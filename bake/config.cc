@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <glm/glm.hpp>
 #include <toml++/toml.h>
 
 namespace skybake {
@@ -42,6 +43,13 @@ constexpr Range kUnit{0.0, 1.0, false, false};
 constexpr Range kOpenUnitSymmetric{-1.0, 1.0, true, true};
 constexpr Range kElevation{-90.0, 90.0, false, false};
 constexpr Range kSunRadius{0.0, 0.5, true, false};
+constexpr Range kNoiseThreshold{-1.0, 1.0, false, true};
+constexpr Range kShapeRadius{0.0, 90.0, true, false};
+constexpr Range kAzimuth{-360.0, 360.0, false, false};
+constexpr Range kDomeRadius{1e-6, 1e6, false, false};
+constexpr Range kDomeFraction{0.0, 1.0, true, false};
+constexpr Range kNoiseOffset{-1e4, 1e4, false, false};
+constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
 
 // Documented limits (README "Limits"): beyond these a bake would need more
@@ -161,6 +169,29 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
   v.Bool("preview.auto_exposure", s.preview.auto_exposure);
   v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
+
+  // AOAS (Shen, Mallett, Shkurko 2019): the aesthetic principles.
+  AoasSettings& x = s.aoas;
+  v.Uint("aoas.seed", x.seed);
+  v.Bool("skydome.enabled", x.skydome.enabled);
+  v.Real("skydome.radius", x.skydome.radius, kDomeRadius);
+  v.Vector("skydome.viewer_position", x.skydome.viewer_position, kAnyFinite);
+  v.Bool("hue.enabled", x.hue.enabled);
+  v.Color("hue.color", x.hue.color);
+  v.Triple("hue.rayleigh_per_km", x.hue.rayleigh_per_km, kNonNegative);
+  v.Real("hue.strength", x.hue.strength, kUnit);
+  v.Bool("ambiguity.enabled", x.ambiguity.enabled);
+  v.Real("ambiguity.l_pt", x.ambiguity.l_pt, kDomeFraction);
+  v.Real("ambiguity.grain", x.ambiguity.grain, kDomeFraction);
+  v.Bool("clouds.enabled", x.clouds.enabled);
+  v.Real("clouds.s_noise", x.clouds.s_noise, kDomeFraction);
+  v.Int("clouds.octaves", x.clouds.octaves, 1, kMaxOctaves);
+  v.Real("clouds.threshold", x.clouds.threshold, kNoiseThreshold);
+  v.Real("clouds.strength", x.clouds.strength, kUnit);
+  v.Vector("clouds.drift", x.clouds.drift, kNoiseOffset);
+  v.Bool("shapes.enabled", x.shapes.enabled);
+  v.Real("shapes.strength", x.shapes.strength, kUnit);
+  v.Shapes("shapes.shape", x.shapes.shapes);
 
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
@@ -333,6 +364,118 @@ class StyleReader {
     out = result;
   }
 
+  void Uint(const char* path, uint32_t& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_integer() || node->as_integer()->get() < 0 ||
+        node->as_integer()->get() > int64_t(UINT32_MAX)) {
+      Error(node, path, fmt::format("expected an integer in [0, {}]", UINT32_MAX));
+      return;
+    }
+    out = uint32_t(node->as_integer()->get());
+  }
+
+  void Vector(const char* path, glm::dvec3& out, const Range& range) {
+    Rgb triple = {out.x, out.y, out.z};
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_array()) {
+      Error(node, path, "expected an array of 3 numbers [x, y, z]");
+      return;
+    }
+    Triple(path, triple, range);
+    out = {triple[0], triple[1], triple[2]};
+  }
+
+  void Color(const char* path, std::string& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    Rgb unused;
+    if (!node->is_string() || !ParseHexColor(node->as_string()->get(), unused)) {
+      Error(node, path, "expected a colour \"#rrggbb\" (sRGB, hexadecimal), e.g. \"#ffcc33\"");
+      return;
+    }
+    out = node->as_string()->get();
+  }
+
+  // [[shapes.shape]] tables: kind, points, closed, radius_deg, strength.
+  void Shapes(const char* path, std::vector<CloudShape>& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || !array->is_array_of_tables()) {
+      Error(node, path, "expected [[shapes.shape]] tables");
+      return;
+    }
+    std::vector<CloudShape> shapes;
+    for (size_t i = 0; i < array->size(); ++i) {
+      const toml::table& t = *array->get(i)->as_table();
+      std::string where = fmt::format("{}[{}]", path, i);
+      CloudShape shape;
+      bool ok = true;
+      for (const auto& [key, value] : t) {
+        std::string k(key.str());
+        std::string key_path = where + "." + k;
+        if (k == "kind") {
+          std::string kind = value.value_or(std::string());
+          if (kind == "point") shape.kind = ShapeKind::kPoint;
+          else if (kind == "polyline") shape.kind = ShapeKind::kPolyline;
+          else if (kind == "spline") shape.kind = ShapeKind::kSpline;
+          else ok = false, Error(&value, key_path, "expected 'point', 'polyline' or 'spline'");
+        } else if (k == "closed") {
+          if (!value.is_boolean()) ok = false, Error(&value, key_path, "expected true or false");
+          else shape.closed = value.as_boolean()->get();
+        } else if (k == "radius_deg" || k == "strength") {
+          std::optional<double> v = value.value<double>();
+          const Range& range = k == "radius_deg" ? kShapeRadius : kUnit;
+          if (!v || value.is_boolean() || !std::isfinite(*v) || !range.Contains(*v)) {
+            ok = false;
+            Error(&value, key_path, fmt::format("expected a number in {}", range.Describe()));
+          } else {
+            (k == "radius_deg" ? shape.radius_deg : shape.strength) = *v;
+          }
+        } else if (k == "points") {
+          const toml::array* points = value.as_array();
+          if (!points || points->empty()) {
+            ok = false;
+            Error(&value, key_path, "expected [[elevation_deg, azimuth_deg], ...]");
+            continue;
+          }
+          for (size_t j = 0; j < points->size(); ++j) {
+            const toml::array* pair = points->get(j)->as_array();
+            std::optional<double> el, az;
+            if (pair && pair->size() == 2) {
+              el = pair->get(0)->value<double>();
+              az = pair->get(1)->value<double>();
+            }
+            if (!el || !az || !kElevation.Contains(*el) || !kAzimuth.Contains(*az)) {
+              ok = false;
+              Error(points->get(j), fmt::format("{}[{}]", key_path, j),
+                    "expected [elevation_deg in [-90, 90], azimuth_deg in [-360, 360]]");
+              continue;
+            }
+            shape.points.push_back({*el, *az});
+          }
+        } else {
+          ok = false;
+          Error(&value, key_path,
+                fmt::format("unknown key '{}' (a shape has kind, points, closed, radius_deg, "
+                            "strength)", k));
+        }
+      }
+      if (ok && shape.points.empty()) {
+        ok = false;
+        Error(array->get(i), where, "a shape needs points = [[elevation_deg, azimuth_deg], ...]");
+      }
+      if (ok && shape.kind != ShapeKind::kPoint && shape.points.size() < 2) {
+        ok = false;
+        Error(array->get(i), where, "a polyline or spline needs at least 2 points");
+      }
+      if (ok) shapes.push_back(std::move(shape));
+    }
+    out = std::move(shapes);
+  }
+
   // Reports every key of the file that no Visit call asked for. Tables named
   // in `opaque` belong to another reader (a style's inline [schedule]).
   void ReportUnknownKeys(const std::set<std::string>& opaque = {}) {
@@ -437,6 +580,28 @@ class StyleWriter {
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
   void Preset(const char* path, std::string& name, QualitySettings&) { Put(path, name); }
+  void Uint(const char* path, uint32_t& v) { Put(path, int64_t(v)); }
+  void Vector(const char* path, glm::dvec3& v, const Range&) { Put(path, toml::array{v.x, v.y, v.z}); }
+  void Color(const char* path, std::string& v) {
+    if (!v.empty()) Put(path, v);
+  }
+  void Shapes(const char* path, std::vector<CloudShape>& shapes) {
+    toml::array array;
+    for (const CloudShape& shape : shapes) {
+      toml::table t;
+      t.insert("kind", shape.kind == ShapeKind::kPoint      ? "point"
+                       : shape.kind == ShapeKind::kPolyline ? "polyline"
+                                                            : "spline");
+      toml::array points;
+      for (const auto& p : shape.points) points.push_back(toml::array{p[0], p[1]});
+      t.insert("points", std::move(points));
+      t.insert("closed", shape.closed);
+      t.insert("radius_deg", shape.radius_deg);
+      t.insert("strength", shape.strength);
+      array.push_back(std::move(t));
+    }
+    if (!array.empty()) Put(path, std::move(array));
+  }
   void FileNames(const char* path, std::vector<std::string>& v, size_t) {
     toml::array array;
     for (const std::string& s : v) array.push_back(s);
@@ -577,7 +742,44 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       break;
     }
   }
+  const AoasSettings& x = result.style.aoas;
+  if (x.skydome.enabled) {
+    const glm::dvec3& p = x.skydome.viewer_position;
+    if (!(glm::length(p) < 0.99 * x.skydome.radius)) {
+      ConfigError e = locate("skydome.viewer_position");
+      e.message = fmt::format("the viewer must be inside the dome: |position| = {} must be below "
+                              "0.99 x radius = {}",
+                              glm::length(p), 0.99 * x.skydome.radius);
+      result.errors.push_back(e);
+    }
+    if (p.y < 0.0) {
+      ConfigError e = locate("skydome.viewer_position");
+      e.message = fmt::format("the viewer must be on or above the ground plane (y = {} < 0)", p.y);
+      result.errors.push_back(e);
+    }
+  }
+  if (x.shapes.enabled) {
+    size_t arcs = ShapeArcs(x.shapes).size();
+    if (arcs == 0) {
+      ConfigError e = locate("shapes.enabled");
+      e.message = "shapes are enabled but there is no [[shapes.shape]]";
+      result.errors.push_back(e);
+    } else if (arcs > AOAS_MAX_SHAPE_SEGMENTS) {
+      ConfigError e = locate("shapes.shape");
+      e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
+                              arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
+      result.errors.push_back(e);
+    }
+  }
   if (!result.ok()) return result;
+
+  // A target colour decides the hue vector (README "Styles").
+  if (!x.hue.color.empty()) {
+    Rgb target;
+    ParseHexColor(x.hue.color, target);
+    result.style.aoas.hue.rayleigh_per_km =
+        RayleighForTargetColor(target, result.style.atmosphere, OutputScale(OutputUnits::kLuminance));
+  }
 
   StyleWriter writer;
   VisitStyle(result.style, writer);

@@ -20,6 +20,8 @@ using ivec2 = glm::ivec2;
 using glm::abs;
 using glm::acos;
 using glm::asin;
+using glm::atan;
+using glm::cross;
 using glm::clamp;
 using glm::cos;
 using glm::dot;

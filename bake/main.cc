@@ -2,6 +2,7 @@
 //
 //   skybake bake <style.toml> [--schedule day.toml] [--out DIR] [--size N] [--set key=value ...]
 //   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
+//   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
 //
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
@@ -18,6 +19,7 @@
 #include "skybake/accuracy.h"
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
+#include "skybake/gallery.h"
 #include "skybake/pipeline.h"
 #include "skybake/schedule.h"
 #include "skybake/vulkan_context.h"
@@ -132,6 +134,61 @@ int RunBake(const BakeArgs& args, bool check_only) {
   return kExitOk;
 }
 
+struct GalleryArgs {
+  std::string styles_dir = "configs/styles";
+  std::string out_dir = "out/gallery";
+  int size = 192;
+  int columns = 2;
+};
+
+int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
+  // Parse and validate every style first: nothing is baked if one is wrong.
+  std::vector<std::string> styles = StyleFilesIn(gallery.styles_dir);
+  if (styles.empty()) {
+    std::fprintf(stderr, "skybake: error: no .toml styles in %s\n", gallery.styles_dir.c_str());
+    return kExitUsage;
+  }
+  std::vector<ConfigError> errors;
+  for (const std::string& path : styles) {
+    ConfigResult config = LoadSkyStyle(path, args.overrides);
+    errors.insert(errors.end(), config.errors.begin(), config.errors.end());
+  }
+  if (!errors.empty()) {
+    PrintErrors(errors);
+    return kExitConfig;
+  }
+
+  // Bake each style's preview, then lay out the labelled contact sheet.
+  GalleryOptions options;
+  options.out_dir = gallery.out_dir;
+  options.latlong_height = gallery.size;
+  options.columns = gallery.columns;
+  options.overrides = args.overrides;
+  options.bake.vulkan.device_index = args.device;
+  options.bake.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  size_t done = 0;
+  if (!args.quiet) {
+    options.bake.progress = [&done, &styles](const StageReport& s) {
+      if (s.name != "preview") return;
+      std::fprintf(stderr, "skybake: gallery %zu/%zu %s (%s)\n", done + 1, styles.size(),
+                   styles[done].c_str(), s.detail.c_str());
+      ++done;
+    };
+  }
+  GalleryResult result = BakeGallery(styles, options);
+
+  // Report: every style with its principles, then the sheet.
+  for (const GalleryEntry& e : result.entries)
+    std::printf("style    %-24s %s\n", e.name.c_str(), e.principles.c_str());
+  std::printf("gallery  %s\n", result.contact_sheet.c_str());
+  if (result.validation_messages > 0) {
+    std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d messages\n",
+                 result.validation_messages);
+    return kExitVulkan;
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -169,6 +226,23 @@ int main(int argc, char** argv) {
   CLI::App* check = app.add_subcommand("check", "Validate a style without baking");
   add_style_options(check);
 
+  GalleryArgs gallery_args;
+  CLI::App* gallery = app.add_subcommand(
+      "gallery", "Bake every style of a folder and write one labelled contact sheet (gallery.png)");
+  gallery->add_option("styles", gallery_args.styles_dir, "Folder of style TOML files")
+      ->capture_default_str();
+  gallery->add_option("--out", gallery_args.out_dir, "Output folder")->capture_default_str();
+  gallery->add_option("--size", gallery_args.size, "Latlong height H of each style (2H x H)")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 2048));
+  gallery->add_option("--columns", gallery_args.columns, "Tiles per row")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  gallery->add_option("--set", args.overrides, "Override a key in every style (repeatable)");
+  gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
+  gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
+  gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
+
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
 
   AccuracyStudyOptions study;
@@ -195,7 +269,11 @@ int main(int argc, char** argv) {
       return kExitOk;
     }
     if (check->parsed()) return RunBake(args, true);
+    if (gallery->parsed()) return RunGallery(gallery_args, args);
     return RunBake(args, false);
+  } catch (const ConfigFailure& e) {
+    PrintErrors(e.errors);
+    return kExitConfig;
   } catch (const VulkanUnavailable& e) {
     std::fprintf(stderr, "skybake: error: %s\n", e.what());
     return kExitVulkan;

@@ -59,9 +59,21 @@ struct FramePlan {
   glm::dvec3 sun{0, 1, 0};
 };
 
-// The renderer for one atmosphere (it also renders without the disc, for the
-// sky-only SH, from the same LUTs). Rebuilt only when a frame changes what
-// the shaders see.
+// What the shaders of one style see: the atmosphere with the hue principle
+// applied (its Rayleigh constants), and the per-texel AOAS principles, whose
+// saturation is judged in Rec.709 luminance RGB.
+struct StyledInputs {
+  AtmosphereParams atmosphere;
+  AoasInputs aoas;
+};
+StyledInputs StyledInputsOf(const SkyStyle& style) {
+  return {StyledAtmosphere(style.atmosphere, style.aoas),
+          ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance))};
+}
+
+// The renderer for one styled atmosphere (it also renders without the disc,
+// for the sky-only SH, from the same LUTs). Rebuilt only when a frame changes
+// what the shaders see.
 class RendererCache {
  public:
   RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
@@ -74,20 +86,28 @@ class RendererCache {
   SkyRenderer& Current() { return *main_; }
  private:
   void Update(const SkyStyle& style) {
+    StyledInputs in = StyledInputsOf(style);
     gpu::GpuAtmosphere key =
-        ToGpuAtmosphere(style.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
-    if (main_ && std::memcmp(&key, &key_, sizeof key) == 0) return;
+        ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+    const AoasSwitches& s = in.aoas.switches;
+    const AoasSwitches& k = aoas_key_.switches;
+    bool same_aoas = s.skydome == k.skydome && s.ambiguity == k.ambiguity &&
+                     s.cloud_noise == k.cloud_noise && s.cloud_shapes == k.cloud_shapes &&
+                     std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0;
+    if (main_ && same_aoas && std::memcmp(&key, &key_, sizeof key) == 0) return;
     main_.reset();
-    main_ = std::make_unique<SkyRenderer>(context_, style.atmosphere, style.quality, style.effects,
-                                          OutputScale(style.output.units));
+    main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
+                                          OutputScale(style.output.units), false, in.aoas);
     ++result_.renderer_builds;
     key_ = key;
+    aoas_key_ = in.aoas;
   }
 
   VulkanContext& context_;
   BakeResult& result_;
   std::unique_ptr<SkyRenderer> main_;
   gpu::GpuAtmosphere key_{};
+  AoasInputs aoas_key_;
 };
 
 // Converts spectral output to luminance for exposure; a copy.

@@ -35,13 +35,31 @@ vec3 SkyViewLutTexel(int x, int y) {
   return (*g_luts.skyview)[size_t(y) * g_luts.skyview_width + x];
 }
 
+// The shape arcs the shared code reads through its hooks (as the GPU reads
+// them from the AOAS uniform block).
+thread_local const gpu::GpuAoas* g_aoas = nullptr;
+vec4 ShapeSegmentStart(int i) {
+  const gpu::vec4& v = g_aoas->shape_segments[2 * i];
+  return vec4(v.x, v.y, v.z, v.w);
+}
+vec4 ShapeSegmentEnd(int i) {
+  const gpu::vec4& v = g_aoas->shape_segments[2 * i + 1];
+  return vec4(v.x, v.y, v.z, v.w);
+}
+
+constexpr int kPerlinPermutation[256] = {SKYBAKE_PERLIN_PERMUTATION};
+int PerlinPermutation(int i) { return kPerlinPermutation[i]; }
+
 #include "atmosphere.glsl"
+#include "aoas.glsl"
 #include "envmap.glsl"
 
 }  // namespace reference
 
 struct ReferenceModel::Impl {
   reference::AtmosphereParameters atm;
+  reference::AoasParameters aoas;
+  gpu::GpuAoas gpu_aoas;
   glm::dvec3 output_scale;
   std::vector<glm::dvec3> transmittance;
   std::vector<glm::dvec3> multiscattering;
@@ -55,6 +73,7 @@ struct ReferenceModel::Impl {
     reference::g_luts.skyview_width = atm.sky_view_width;
     reference::g_luts.transmittance_width = atm.transmittance_width;
     reference::g_luts.multiscattering_width = atm.multiscattering_width;
+    reference::g_aoas = &gpu_aoas;
   }
 };
 
@@ -75,12 +94,39 @@ void ParallelFor(size_t n, const ReferenceModel::Impl* impl, Fn fn) {
 }
 
 glm::dvec3 ToVec(const Rgb& rgb) { return {rgb[0], rgb[1], rgb[2]}; }
+glm::dvec3 ToVec(const gpu::vec4& v) { return {v.x, v.y, v.z}; }
+
+// The same unpacking as AoasFromUniform() in shaders/common.glsl.
+reference::AoasParameters AoasFromUniform(const gpu::GpuAoas& g, const AoasSwitches& switches) {
+  reference::AoasParameters aoas;
+  aoas.dome_radius = g.dome.x;
+  aoas.viewer_position = ToVec(g.viewer);
+  aoas.l_pt = g.dome.y;
+  aoas.perturbation_grain = g.dome.z;
+  aoas.perturbation_offset = ToVec(g.perturbation_offset);
+  aoas.s_noise = g.noise.x;
+  aoas.noise_octaves = g.counts.y;
+  aoas.noise_threshold = g.noise.y;
+  aoas.noise_strength = g.noise.z;
+  aoas.noise_offset = ToVec(g.noise_offset);
+  aoas.shape_strength = g.noise.w;
+  aoas.shape_segment_count = std::min(g.counts.x, AOAS_MAX_SHAPE_SEGMENTS);
+  aoas.color_scale = ToVec(g.color_scale);
+  aoas.skydome = switches.skydome;
+  aoas.ambiguity = switches.ambiguity;
+  aoas.cloud_noise = switches.cloud_noise;
+  aoas.cloud_shapes = switches.cloud_shapes;
+  return aoas;
+}
 
 }  // namespace
 
 ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings& q,
-                               const EffectSettings& effects, const Rgb& output_scale)
+                               const EffectSettings& effects, const Rgb& output_scale,
+                               const AoasInputs& aoas_inputs)
     : impl_(new Impl) {
+  impl_->gpu_aoas = aoas_inputs.uniform;
+  impl_->aoas = AoasFromUniform(aoas_inputs.uniform, aoas_inputs.switches);
   reference::AtmosphereParameters& atm = impl_->atm;
   atm.bottom_radius = a.bottom_radius_km;
   atm.top_radius = a.top_radius_km;
@@ -161,6 +207,12 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
   return reference::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
 }
 
+glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
+  impl_->Bind();
+  return reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
+         impl_->output_scale;
+}
+
 std::vector<glm::dvec3> ViewDirections(const ViewRequest& v) {
   std::vector<glm::dvec3> dirs(size_t(v.width) * v.height);
   for (int y = 0; y < v.height; ++y) {
@@ -182,10 +234,9 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
   std::vector<glm::dvec3> dirs = ViewDirections(view);
   std::vector<double> image(dirs.size() * 4);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {
-    glm::dvec3 l = impl_->use_skyview
-                       ? reference::ComputeSkyRadianceFromSkyView(impl_->atm, dirs[i], sun)
-                       : reference::ComputeSkyRadiance(impl_->atm, dirs[i], sun);
-    l *= impl_->output_scale;
+    glm::dvec3 l = reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun,
+                                                       impl_->use_skyview) *
+                   impl_->output_scale;
     image[4 * i + 0] = l.x;
     image[4 * i + 1] = l.y;
     image[4 * i + 2] = l.z;

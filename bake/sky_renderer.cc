@@ -11,6 +11,11 @@
 namespace skybake {
 namespace {
 
+// Of the bindings of gpu_shared.h, the atmosphere and AOAS blocks are uniform.
+bool IsUniformBinding(uint32_t binding) {
+  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS;
+}
+
 uint32_t GroupCount(int texels, int local_size) {
   return uint32_t((texels + local_size - 1) / local_size);
 }
@@ -19,14 +24,21 @@ uint32_t GroupCount(int texels, int local_size) {
 
 SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
                          const QualitySettings& quality, const EffectSettings& effects,
-                         const Rgb& output_scale, bool output_directions)
-    : context_(context), quality_(quality), effects_(effects), output_directions_(output_directions) {
+                         const Rgb& output_scale, bool output_directions,
+                         const AoasInputs& aoas)
+    : context_(context),
+      quality_(quality),
+      effects_(effects),
+      aoas_switches_(aoas.switches),
+      output_directions_(output_directions) {
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
   VkDevice device = context_.device();
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
   atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
   transmittance_buffer_ = CreateBuffer(
       VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
   multiscattering_buffer_ = CreateBuffer(
@@ -38,8 +50,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i].binding = i;
-    bindings[i].descriptorType =
-        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
@@ -56,8 +68,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   layout_info.pPushConstantRanges = &push_range;
   VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
 
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 1}};
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = 2;
@@ -115,6 +127,7 @@ SkyRenderer::~SkyRenderer() {
   DestroyBuffer(output_buffer_);
   DestroyBuffer(multiscattering_buffer_);
   DestroyBuffer(transmittance_buffer_);
+  DestroyBuffer(aoas_buffer_);
   DestroyBuffer(atmosphere_buffer_);
 }
 
@@ -171,6 +184,7 @@ void SkyRenderer::UpdateDescriptors() {
       {multiscattering_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {skyview_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {aoas_buffer_.buffer, 0, VK_WHOLE_SIZE},
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -178,8 +192,8 @@ void SkyRenderer::UpdateDescriptors() {
     writes[i].dstSet = descriptor_set_;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType =
-        i == BINDING_ATMOSPHERE ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     writes[i].pBufferInfo = &infos[i];
   }
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
@@ -194,17 +208,22 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
 
   // Specialization constants of common.glsl: ids 0..3 the optional effects,
-  // 10..11 the quality settings. Every pipeline gets them all; a shader
-  // that does not use one ignores it.
+  // 4..7 the AOAS principles that act per texel, 10..11 the quality
+  // settings, 12..13 the Mie and ozone constituents. Every pipeline gets them all; a shader that does not use one
+  // ignores it.
   struct {
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
+    VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
     int32_t integrator;
     VkBool32 sky_view, mie, ozone;
-  } values = {effects_.multiple_scattering, sun_disc, effects_.ground, output_directions_,
-              quality_.integrator, quality_.sky_view_lut, effects_.mie, effects_.ozone};
-  const VkSpecializationMapEntry entries[8] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
-                                               {10, 16, 4}, {11, 20, 4}, {12, 24, 4}, {13, 28, 4}};
-  VkSpecializationInfo specialization{8, entries, sizeof(values), &values};
+  } values = {effects_.multiple_scattering, sun_disc,      effects_.ground,
+              output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
+              aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
+              quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone};
+  const VkSpecializationMapEntry entries[12] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+                                                {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
+                                                {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4}};
+  VkSpecializationInfo specialization{12, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;

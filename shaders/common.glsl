@@ -24,6 +24,9 @@ layout(std430, set = 0, binding = BINDING_OUTPUT) buffer OutputBuffer {
 layout(std430, set = 0, binding = BINDING_SKYVIEW) buffer SkyViewBuffer {
   vec4 skyview_texels[];
 };
+layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
+  GpuAoas gpu_aoas;
+};
 layout(push_constant) uniform PushBlock {
   SkyPush push;
 };
@@ -36,6 +39,12 @@ layout(constant_id = 12) const bool kMie = true;
 layout(constant_id = 13) const bool kOzone = true;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
+// The AOAS principles (AoasSwitches); a style that does not use one compiles
+// it out. The sky hue needs no switch: it is the Rayleigh vector itself.
+layout(constant_id = 4) const bool kSkydome = false;
+layout(constant_id = 5) const bool kAmbiguity = false;
+layout(constant_id = 6) const bool kCloudNoise = false;
+layout(constant_id = 7) const bool kCloudShapes = false;
 // Quadrature rule (INTEGRATOR_*) and whether output texels read the sky-view
 // LUT instead of ray-marching; ids from 10 on are the quality settings.
 layout(constant_id = 10) const int kIntegrator = INTEGRATOR_ANALYTIC;
@@ -53,7 +62,12 @@ vec3 SkyViewLutTexel(int x, int y) {
   return skyview_texels[y * gpu_atmosphere.render.y + x].xyz;
 }
 
+vec4 ShapeSegmentStart(int i) { return gpu_aoas.shape_segments[2 * i]; }
+vec4 ShapeSegmentEnd(int i) { return gpu_aoas.shape_segments[2 * i + 1]; }
+int PerlinPermutation(int i) { return gpu_aoas.perlin_permutation[i >> 2][i & 3]; }
+
 #include "atmosphere.glsl"
+#include "aoas.glsl"
 #include "envmap.glsl"
 
 AtmosphereParameters AtmosphereFromUniform() {
@@ -95,6 +109,28 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.multiple_scattering_strength = gpu_atmosphere.strengths.x;
   atm.sun_disc_strength = gpu_atmosphere.strengths.y;
   return atm;
+}
+
+AoasParameters AoasFromUniform() {
+  AoasParameters aoas;
+  aoas.dome_radius = gpu_aoas.dome.x;
+  aoas.viewer_position = gpu_aoas.viewer.xyz;
+  aoas.l_pt = gpu_aoas.dome.y;
+  aoas.perturbation_grain = gpu_aoas.dome.z;
+  aoas.perturbation_offset = gpu_aoas.perturbation_offset.xyz;
+  aoas.s_noise = gpu_aoas.noise.x;
+  aoas.noise_octaves = gpu_aoas.counts.y;
+  aoas.noise_threshold = gpu_aoas.noise.y;
+  aoas.noise_strength = gpu_aoas.noise.z;
+  aoas.noise_offset = gpu_aoas.noise_offset.xyz;
+  aoas.shape_strength = gpu_aoas.noise.w;
+  aoas.shape_segment_count = min(gpu_aoas.counts.x, AOAS_MAX_SHAPE_SEGMENTS);
+  aoas.color_scale = gpu_aoas.color_scale.xyz;
+  aoas.skydome = kSkydome;
+  aoas.ambiguity = kAmbiguity;
+  aoas.cloud_noise = kCloudNoise;
+  aoas.cloud_shapes = kCloudShapes;
+  return aoas;
 }
 
 #endif  // SKYBAKE_COMMON_GLSL

@@ -24,7 +24,7 @@ void main() {
     return;
   }
   AtmosphereParameters atm = AtmosphereFromUniform();
-  vec3 radiance = kUseSkyView ? ComputeSkyRadianceFromSkyView(atm, view, push.sun_direction.xyz)
-                              : ComputeSkyRadiance(atm, view, push.sun_direction.xyz);
+  AoasParameters aoas = AoasFromUniform();
+  vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz, kUseSkyView);
   output_texels[index] = vec4(radiance * gpu_atmosphere.output_scale.xyz, 1.0);
 }

@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
 
 namespace skybake {
@@ -71,6 +72,7 @@ struct SkyStyle {
   RenderSettings render;
   OutputSettings output;
   PreviewSettings preview;
+  AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
   GltfSettings gltf;
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance

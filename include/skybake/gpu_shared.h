@@ -24,6 +24,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_MULTISCATTERING 2  // storage vec4[], multiple-scattering LUT
 #define BINDING_OUTPUT 3           // storage vec4[], rendered texels
 #define BINDING_SKYVIEW 4          // storage vec4[], sky-view LUT
+#define BINDING_AOAS 5             // uniform GpuAoas, the style's aesthetic principles
 
 // Output mappings (SkyPush.view.x).
 #define MAPPING_LATLONG 0      // OpenEXR latlong, 2N x N, Imf::LatLongMap
@@ -63,6 +64,51 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   vec4 strengths;              // x: multiple-scattering strength; y: sun-disc strength; zw: unused
 };
 
+// Most cloud-shape segments a style can have (GpuAoas.shape_segments). A
+// point is one segment; a spline is sampled into kAoasSplineSubdivisions
+// segments per span on the host.
+#define AOAS_MAX_SHAPE_SEGMENTS 192
+
+// Perlin 2002, "Improving Noise": the reference permutation of 0..255, the
+// one table of Improved Perlin noise (shaders/aoas.glsl). The GPU reads it
+// from GpuAoas.perlin_permutation rather than from a constant array: Mesa's
+// lavapipe spends minutes compiling dynamic indexing into a 256-entry
+// constant array.
+#define SKYBAKE_PERLIN_PERMUTATION                                                       \
+  151, 160, 137, 91, 90, 15, 131, 13, 201, 95, 96, 53, 194, 233, 7, 225, 140, 36, 103,  \
+  30, 69, 142, 8, 99, 37, 240, 21, 10, 23, 190, 6, 148, 247, 120, 234, 75, 0, 26, 197,  \
+  62, 94, 252, 219, 203, 117, 35, 11, 32, 57, 177, 33, 88, 237, 149, 56, 87, 174, 20,   \
+  125, 136, 171, 168, 68, 175, 74, 165, 71, 134, 139, 48, 27, 166, 77, 146, 158, 231,   \
+  83, 111, 229, 122, 60, 211, 133, 230, 220, 105, 92, 41, 55, 46, 245, 40, 244, 102,    \
+  143, 54, 65, 25, 63, 161, 1, 216, 80, 73, 209, 76, 132, 187, 208, 89, 18, 169, 200,   \
+  196, 135, 130, 116, 188, 159, 86, 164, 100, 109, 198, 173, 186, 3, 64, 52, 217, 226,  \
+  250, 124, 123, 5, 202, 38, 147, 118, 126, 255, 82, 85, 212, 207, 206, 59, 227, 47,    \
+  16, 58, 17, 182, 189, 28, 42, 223, 183, 170, 213, 119, 248, 152, 2, 44, 154, 163,     \
+  70, 221, 153, 101, 155, 167, 43, 172, 9, 129, 22, 39, 253, 19, 98, 108, 110, 79, 113, \
+  224, 232, 178, 185, 112, 104, 218, 246, 97, 228, 251, 34, 242, 193, 238, 210, 144,    \
+  12, 191, 179, 162, 241, 81, 51, 145, 235, 249, 14, 239, 107, 49, 192, 214, 31, 181,   \
+  199, 106, 157, 184, 84, 204, 176, 115, 121, 50, 45, 127, 4, 150, 254, 138, 236, 205,  \
+  93, 222, 114, 67, 29, 24, 72, 243, 141, 128, 195, 78, 66, 215, 61, 156, 180
+
+// The aesthetic principles of AOAS (Shen, Mallett, Shkurko 2019), see
+// shaders/aoas.glsl. Lengths in skydome space are in the scene's units
+// (dome.x is the dome radius); noise and perturbation sizes in dome radii.
+SKYBAKE_GPU_STRUCT(GpuAoas) {
+  vec4 dome;                // x: dome radius, scene units; y: l_pt, dome radii; z: perturbation grain, dome radii; w: unused
+  vec4 viewer;              // xyz: viewer position P^s_v in skydome space, scene units; w: unused
+  vec4 perturbation_offset; // xyz: seed offset of the perturbation field (noise space); w: unused
+  vec4 noise;               // x: s_noise, dome radii; y: threshold; z: strength; w: shape strength
+  vec4 noise_offset;        // xyz: drift + seed offset (noise space); w: unused
+  vec4 color_scale;         // xyz: radiance -> Rec.709 RGB in which saturation is judged; w: unused
+  ivec4 counts;             // x: shape segments; y: noise octaves; zw: unused
+  // Segment i runs from shape_segments[2i] to shape_segments[2i+1] on the
+  // unit sphere: xyz unit direction; w of the first: fade radius, rad;
+  // w of the second: strength in [0, 1].
+  vec4 shape_segments[2 * AOAS_MAX_SHAPE_SEGMENTS];
+  // SKYBAKE_PERLIN_PERMUTATION, four entries per ivec4.
+  ivec4 perlin_permutation[64];
+};
+
 SKYBAKE_GPU_STRUCT(SkyPush) {
   vec4 sun_direction;  // xyz: unit vector towards the Sun; w: unused
   ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE)
@@ -72,6 +118,8 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 #ifdef __cplusplus
 static_assert(sizeof(GpuAtmosphere) == 13 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 3 * 16, "SkyPush must be vec4-packed");
+static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
+              "GpuAoas must be vec4-packed");
 }  // namespace skybake::gpu
 #endif
 

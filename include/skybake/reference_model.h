@@ -1,6 +1,6 @@
 // The double-precision CPU reference of the sky renderer. It compiles the
 // same shared source as the shaders (shaders/atmosphere.glsl and
-// shaders/envmap.glsl) with Real = double, so every function has the same
+// shaders/aoas.glsl, shaders/envmap.glsl) with Real = double, so every function has the same
 // name and structure on both sides and tests can put them side by side.
 // Tests use it; bakes do not.
 #pragma once
@@ -9,6 +9,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
 #include "skybake/sky_renderer.h"
 
@@ -16,8 +17,11 @@ namespace skybake {
 
 class ReferenceModel {
  public:
+  // `aoas`: the per-texel aesthetic principles, read from the same packed
+  // uniform the GPU gets (so both sides use the same float parameters).
   ReferenceModel(const AtmosphereParams& atmosphere, const QualitySettings& quality,
-                 const EffectSettings& effects, const Rgb& output_scale);
+                 const EffectSettings& effects, const Rgb& output_scale,
+                 const AoasInputs& aoas = AoasInputs());
   ~ReferenceModel();
   ReferenceModel(ReferenceModel&&) noexcept;
 
@@ -31,7 +35,11 @@ class ReferenceModel {
   // Radiance times output_scale along unit `view` with the Sun along unit `sun`.
   glm::dvec3 Radiance(const glm::dvec3& view, const glm::dvec3& sun) const;
 
-  // RGBA image of one view, as SkyRenderer::Render returns it.
+  // The styled sky (ComputeStyledSkyRadiance) times output_scale for texel
+  // direction `w`.
+  glm::dvec3 StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const;
+
+  // RGBA image of one view, as SkyRenderer::Render returns it (styled).
   std::vector<double> RenderView(const glm::dvec3& sun, const ViewRequest& view) const;
 
   // Transmittance from altitude (km) to the top along mu, read from the LUT,

@@ -9,6 +9,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
 #include "skybake/vulkan_context.h"
 
@@ -39,10 +40,13 @@ struct RenderCounters {
 class SkyRenderer {
  public:
   // With `output_directions`, views contain the unit direction of each texel
-  // (xyz) instead of radiance: the shader-side mapping, for tests.
+  // (xyz) instead of radiance: the shader-side mapping, for tests. `aoas`
+  // holds the per-texel aesthetic principles (none by default); the hue
+  // principle is already in `atmosphere` (StyledAtmosphere).
   SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
               const QualitySettings& quality, const EffectSettings& effects,
-              const Rgb& output_scale, bool output_directions = false);
+              const Rgb& output_scale, bool output_directions = false,
+              const AoasInputs& aoas = AoasInputs());
   ~SkyRenderer();
   SkyRenderer(const SkyRenderer&) = delete;
   SkyRenderer& operator=(const SkyRenderer&) = delete;
@@ -93,18 +97,20 @@ class SkyRenderer {
   // later one reads (`barrier_after`).
   void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
 
-  static constexpr uint32_t kBindingCount = 5;
+  static constexpr uint32_t kBindingCount = 6;  // bindings 0..5 of gpu_shared.h
 
   VulkanContext& context_;
   gpu::GpuAtmosphere gpu_atmosphere_{};
   QualitySettings quality_;
   EffectSettings effects_;
+  AoasSwitches aoas_switches_;
   bool output_directions_ = false;
   bool luts_ready_ = false;
   bool skyview_ready_ = false;
   glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
 
   Buffer atmosphere_buffer_;
+  Buffer aoas_buffer_;
   Buffer transmittance_buffer_;
   Buffer multiscattering_buffer_;
   Buffer output_buffer_;
