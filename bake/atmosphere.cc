@@ -13,12 +13,20 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
           -std::cos(azimuth) * std::cos(elevation)};
 }
 
+// Each preset is the cheapest case of the accuracy study's Pareto front that
+// meets its bound (docs/accuracy.md, `skybake accuracy`):
+//   draft       analytic 48 quadratic steps, sky-view LUT 192 x 108   1.06e-2
+//   production  analytic 48 quadratic steps, sky-view LUT 384 x 216   3.95e-3
+//   reference   Simpson 64 quadratic steps per texel, transmittance
+//               LUT 1024 x 256 (1024 points)                          1.77e-4
 QualitySettings QualityPreset(const std::string& name) {
   QualitySettings q;  // production
   if (name == "draft") {
-    q.view_steps = 16;
+    q.sky_view_width = 192;
+    q.sky_view_height = 108;
   } else if (name == "reference") {
-    q.view_steps = 256;
+    q.sky_view_lut = false;
+    q.view_steps = 64;
     q.integrator = INTEGRATOR_SIMPSON;
     q.transmittance_width = 1024;
     q.transmittance_height = 256;

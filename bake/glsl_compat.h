@@ -21,6 +21,7 @@ using glm::abs;
 using glm::acos;
 using glm::asin;
 using glm::atan;
+using glm::atan;
 using glm::cross;
 using glm::clamp;
 using glm::cos;

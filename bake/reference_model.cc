@@ -65,6 +65,8 @@ struct ReferenceModel::Impl {
   std::vector<glm::dvec3> multiscattering;
   std::vector<glm::dvec3> skyview;
   bool use_skyview = false;
+  bool skyview_ready = false;
+  glm::dvec3 skyview_sun{0.0};
 
   void Bind() const {
     reference::g_luts.transmittance = &transmittance;
@@ -190,8 +192,11 @@ void ReferenceModel::PrecomputeLuts() {
   }
 }
 
-void ReferenceModel::PrepareSun(const glm::dvec3& sun) {
+void ReferenceModel::PrepareSun(const glm::dvec3& sun) const {
   if (!impl_->use_skyview) return;
+  if (impl_->skyview_ready && impl_->skyview_sun == sun) return;
+  impl_->skyview_ready = true;
+  impl_->skyview_sun = sun;
   const reference::AtmosphereParameters& atm = impl_->atm;
   impl_->skyview.assign(size_t(atm.sky_view_width) * atm.sky_view_height, glm::dvec3(0.0));
   int w = atm.sky_view_width;
@@ -201,6 +206,7 @@ void ReferenceModel::PrepareSun(const glm::dvec3& sun) {
 }
 
 glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& sun) const {
+  PrepareSun(sun);  // the sky-view LUT, as the GPU builds it
   impl_->Bind();
   if (impl_->use_skyview)
     return reference::ComputeSkyRadianceFromSkyView(impl_->atm, view, sun) * impl_->output_scale;
@@ -208,6 +214,7 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
 }
 
 glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
+  PrepareSun(sun);
   impl_->Bind();
   return reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
          impl_->output_scale;
@@ -231,6 +238,7 @@ std::vector<glm::dvec3> ViewDirections(const ViewRequest& v) {
 }
 
 std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const ViewRequest& view) const {
+  PrepareSun(sun);
   std::vector<glm::dvec3> dirs = ViewDirections(view);
   std::vector<double> image(dirs.size() * 4);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {

@@ -656,7 +656,10 @@ Real HorizonZenithAngle(IN(AtmosphereParameters) atm) {
     // From space the "horizon" is the limb of the atmosphere's top.
     return kPi - asin(min(atm.top_radius / r, 1.0));
   }
-  return kPi - asin(min(atm.bottom_radius / r, 1.0));
+  // pi/2 + asin(sqrt(r^2 - R_b^2) / r): the small angle below the horizontal
+  // formed from the altitude, not from R_b / r ~ 1 (which rounds to 1 in
+  // float32 for observers below a few metres).
+  return 0.5 * kPi + asin(min(sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r, 1.0));
 }
 
 vec2 SkyViewUvFromDirection(IN(AtmosphereParameters) atm, Real zenith_angle, Real azimuth) {
@@ -715,10 +718,12 @@ vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_
   if (y < atm.sky_view_height / 2) {
     // The horizon row must stay on the sky side: cos(horizon) rounds below
     // the exact horizon cosine in float32, so clamp to the latter, formed
-    // without cancellation (0 exactly for an observer on the ground).
+    // without cancellation (0 exactly for an observer on the ground), moved
+    // up by 1e-5 of itself so that the ground test of the exactly tangent ray
+    // is not left to rounding.
     Real h = atm.observer_altitude;
     Real r = atm.bottom_radius + h;
-    Real mu_horizon = -sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r;
+    Real mu_horizon = -sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r * (1.0 - 1e-5);
     if (h <= atm.top_radius - atm.bottom_radius && view.y < mu_horizon) {
       Real horizontal = length(vec2(view.x, view.z));
       Real scale = horizontal > 0.0 ? sqrt(max(1.0 - mu_horizon * mu_horizon, 0.0)) / horizontal : 0.0;
@@ -768,13 +773,15 @@ vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azim
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
 // the solar disc seen through the transmittance LUT.
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  Real zenith_angle = acos(ClampCosine(view.y));
+  // Angles from atan2 of sine and cosine parts: acos loses half the digits
+  // near 0 and pi (at the zenith, and next to the sun's vertical plane).
+  Real horizontal = length(vec2(view.x, view.z));
+  Real zenith_angle = atan(horizontal, view.y);
   // Azimuth between the horizontal projections of view and sun.
-  Real vx = length(vec2(view.x, view.z));
-  Real sx = length(vec2(sun.x, sun.z));
+  Real cos_part = view.x * sun.x + view.z * sun.z;
+  Real sin_part = abs(view.x * sun.z - view.z * sun.x);
   Real azimuth = 0.0;
-  if (vx > 0.0 && sx > 0.0)
-    azimuth = acos(ClampCosine((view.x * sun.x + view.z * sun.z) / (vx * sx)));
+  if (sin_part > 0.0 || cos_part != 0.0) azimuth = atan(sin_part, cos_part);
   SkyRay ray = SetUpSkyRay(atm, view, sun);
   vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ray.in_atmosphere && ray.hits_ground);
   if (atm.sun_disc) {

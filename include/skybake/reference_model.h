@@ -30,7 +30,7 @@ class ReferenceModel {
 
   // With quality.sky_view_lut: builds the sky-view LUT for this Sun (the
   // other calls then read it, as the GPU does). No-op otherwise.
-  void PrepareSun(const glm::dvec3& sun);
+  void PrepareSun(const glm::dvec3& sun) const;
 
   // Radiance times output_scale along unit `view` with the Sun along unit `sun`.
   glm::dvec3 Radiance(const glm::dvec3& view, const glm::dvec3& sun) const;
