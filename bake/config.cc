@@ -573,6 +573,21 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       break;
     }
   }
+  // Every file of a bake has its own name: face names differ from each other
+  // and from the cube strip's and latlong's suffixes.
+  const std::vector<std::string>& faces = result.style.output.face_names;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    bool reserved = faces[i] == "cube" || faces[i] == "latlong";
+    bool repeated = std::find(faces.begin(), faces.begin() + i, faces[i]) != faces.begin() + i;
+    if (reserved || repeated) {
+      ConfigError e = locate("output.face_names");
+      e.key = fmt::format("output.face_names[{}]", i);
+      e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
+                           : fmt::format("'{}' is given twice: each face is its own file", faces[i]);
+      result.errors.push_back(e);
+      break;
+    }
+  }
   if (!result.ok()) return result;
 
   StyleWriter writer;
