@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -254,6 +255,10 @@ int main(int argc, char** argv) {
   } catch (const OutputError& e) {
     std::fprintf(stderr, "skybake: error: %s\n", e.what());
     return kExitOutput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
+                         "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
+    return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
     std::fprintf(stderr, "skybake: error: %s\n", e.what());
     return kExitOutput;
