@@ -155,6 +155,18 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
                                 "cd '" + root + "/killed' &&");
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_EQ(again.output.find(" 8 views"), std::string::npos) << again.output;
+
+  // Another style: no frame matches its recorded style_sha256, so --resume
+  // bakes all twenty again.
+  CommandRun changed = RunSkybake("bake '" + Style() + "' --schedule '" + schedule +
+                                      "' --size 16 --out out --resume --set atmosphere.mie.g=0.7",
+                                  "cd '" + root + "/killed' &&");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  size_t rendered = 0;
+  for (size_t at = changed.output.find(" 8 views"); at != std::string::npos; at = changed.output.find(" 8 views", at + 1))
+    ++rendered;
+  EXPECT_EQ(rendered, 20u) << changed.output;
+  EXPECT_NE(ReadBytes(killed + "/sky_px.0001.exr"), ReadBytes(root + "/whole/out/sky_px.0001.exr"));
   fs::remove_all(root);
 }
 
