@@ -467,6 +467,7 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
     ConfigError e;
     e.file = "--set";
     e.key = eq == std::string::npos ? text : text.substr(0, eq);
+    if (e.key.empty()) e.key = "(key)";
     e.message = message;
     errors.push_back(e);
   };

@@ -338,6 +338,23 @@ sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
      "MISSING", "", 3,
          "skybake: error: schedule.toml: (file): cannot open the schedule file: check the path\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampKeyWithEqualsSign", R"toml()toml",
+     R"toml([schedule]
+sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
+[schedule.ramp]
+"atmosphere.mie.g=0.1" = [0.7, 0.8]
+)toml", "", 3,
+         "skybake: error: schedule.toml:4:26: schedule.ramp.atmosphere.mie.g=0.1: 'atmosphere.mie.g=0.1' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetKeyWithSpace", R"toml()toml",
+     R"toml([schedule]
+[[schedule.frames]]
+elevation_deg = 10
+azimuth_deg = 135
+set = { "sun.elevation_deg " = 5 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:5:32: schedule.frames[0].set.sun.elevation_deg : 'sun.elevation_deg ' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
 };
 // clang-format on
 
