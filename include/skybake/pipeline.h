@@ -114,8 +114,11 @@ struct BakeResult {
 };
 
 // Bakes one style (one sun position) into options.out_dir, which is created
-// if needed: EXR maps, preview, glTF scene, manifest.json. Throws
-// VulkanUnavailable, VulkanError or OutputError.
+// if needed: EXR maps, preview, glTF scene, manifest.json. Before any GPU
+// work: BudgetError over the budget, OutputExistsError when a file it would
+// write exists (unless options.force or options.resume); stale temporaries of
+// its file names are removed. Later: VulkanUnavailable, VulkanError or
+// OutputError. manifest.json is rewritten after every frame.
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
 
 // Bakes a sequence: frame k of `schedule` with `styles[k]` (see
