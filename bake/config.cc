@@ -406,7 +406,7 @@ class StyleReader {
       e.column = int(where.begin.column);
       if (where.path) e.file = *where.path;
     }
-    e.key = path;
+    e.key = path.empty() ? "\"\"" : path;  // a TOML key may be the empty string
     e.message = message;
     errors_.push_back(std::move(e));
   }

@@ -355,6 +355,11 @@ set = { "sun.elevation_deg " = 5 }
 )toml", "", 3,
          "skybake: error: schedule.toml:5:32: schedule.frames[0].set.sun.elevation_deg : 'sun.elevation_deg ' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"EmptyKey", R"toml("" = 0.007
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:1:1: \"\": unknown key ''\n"
+         "skybake: 1 error; nothing was baked\n"},
 };
 // clang-format on
 
