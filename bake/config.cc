@@ -553,7 +553,7 @@ class StyleReader {
       e.column = int(where.begin.column);
       if (where.path) e.file = *where.path;
     }
-    e.key = path;
+    e.key = path.empty() ? "\"\"" : path;  // a TOML key may be the empty string
     e.message = message;
     errors_.push_back(std::move(e));
   }
@@ -636,6 +636,7 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
     ConfigError e;
     e.file = "--set";
     e.key = eq == std::string::npos ? text : text.substr(0, eq);
+    if (e.key.empty()) e.key = "(key)";
     e.message = message;
     errors.push_back(e);
   };
@@ -769,6 +770,21 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
                               arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
       result.errors.push_back(e);
+    }
+  }
+  // Every file of a bake has its own name: face names differ from each other
+  // and from the cube strip's and latlong's suffixes.
+  const std::vector<std::string>& faces = result.style.output.face_names;
+  for (size_t i = 0; i < faces.size(); ++i) {
+    bool reserved = faces[i] == "cube" || faces[i] == "latlong";
+    bool repeated = std::find(faces.begin(), faces.begin() + i, faces[i]) != faces.begin() + i;
+    if (reserved || repeated) {
+      ConfigError e = locate("output.face_names");
+      e.key = fmt::format("output.face_names[{}]", i);
+      e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
+                           : fmt::format("'{}' is given twice: each face is its own file", faces[i]);
+      result.errors.push_back(e);
+      break;
     }
   }
   if (!result.ok()) return result;

@@ -6,7 +6,11 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <set>
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <fmt/format.h>
@@ -14,9 +18,11 @@
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
 namespace skybake {
@@ -30,19 +36,32 @@ Imf::Compression CompressionFromName(const std::string& name) {
   return Imf::ZIP_COMPRESSION;
 }
 
-// Renames the finished temporary file over `path`; removes it on failure.
-void CommitFile(const std::string& temporary, const std::string& path) {
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    int error = errno;
-    std::remove(temporary.c_str());
-    throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(error)));
+// An OpenEXR output stream into memory: the file is encoded whole, then
+// written by WriteFileAtomically, so every byte reaches the disk through one
+// checked path.
+class MemoryOStream : public Imf::OStream {
+ public:
+  explicit MemoryOStream(const std::string& name) : Imf::OStream(name.c_str()) {}
+  void write(const char c[], int n) override {
+    if (position_ + size_t(n) > bytes_.size()) bytes_.resize(position_ + size_t(n));
+    std::memcpy(bytes_.data() + position_, c, size_t(n));
+    position_ += size_t(n);
   }
-}
+  uint64_t tellp() override { return position_; }
+  void seekp(uint64_t pos) override { position_ = size_t(pos); }
+  const std::string& bytes() const { return bytes_; }
 
-uint64_t FileSize(const std::string& path) {
-  std::error_code ec;
-  uintmax_t size = std::filesystem::file_size(path, ec);
-  return ec ? 0 : uint64_t(size);
+ private:
+  std::string bytes_;
+  size_t position_ = 0;
+};
+
+// What to do about a failed write, by errno.
+std::string WriteFix(int error) {
+  if (error == ENOSPC || error == EDQUOT) return ": the disk is full; free space or choose another --out";
+  if (error == EFBIG) return ": the file is larger than the file-size limit (ulimit -f) or the file system allows";
+  if (error == EACCES || error == EPERM || error == EROFS) return ": choose a writable --out folder";
+  return "";
 }
 
 }  // namespace
@@ -52,6 +71,66 @@ std::string TemporaryPathFor(const std::string& path) {
   // One fmt::format call: GCC 12's -Wrestrict misfires on `"." + std::string`.
   std::string name = fmt::format(".{}.tmp{}", p.filename().string(), ::getpid());
   return (p.parent_path() / name).string();
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view bytes) {
+  const std::string temporary = TemporaryPathFor(path);
+  auto fail = [&](const char* what, int error, int fd) {
+    if (fd >= 0) ::close(fd);
+    ::unlink(temporary.c_str());
+    throw OutputError(fmt::format("cannot write {} ({} {}: {}){}", path, what, temporary, std::strerror(error),
+                                  WriteFix(error)));
+  };
+  int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) fail("creating", errno, -1);
+  for (size_t done = 0; done < bytes.size();) {
+    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) fail("writing", n < 0 ? errno : EIO, fd);
+    done += size_t(n);
+  }
+  // On disk before the rename, so that even a power cut leaves the old file
+  // or the whole new one.
+  if (::fsync(fd) != 0) fail("syncing", errno, fd);
+  if (::close(fd) != 0) fail("closing", errno, -1);
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    int error = errno;
+    ::unlink(temporary.c_str());
+    throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(error)));
+  }
+}
+
+bool IsTemporaryOf(const std::string& file_name, const std::string& output_name, int* pid) {
+  const std::string prefix = "." + output_name + ".tmp";
+  if (file_name.size() <= prefix.size() || file_name.compare(0, prefix.size(), prefix) != 0) return false;
+  int value = 0;
+  for (size_t i = prefix.size(); i < file_name.size(); ++i) {
+    char c = file_name[i];
+    if (c < '0' || c > '9' || value > 100000000) return false;
+    value = value * 10 + (c - '0');
+  }
+  if (pid) *pid = value;
+  return true;
+}
+
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir, const std::vector<std::string>& names) {
+  std::vector<std::string> removed;
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec)) return removed;
+  std::set<std::string> wanted(names.begin(), names.end());
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string file = entry.path().filename().string();
+    if (file.size() < 2 || file[0] != '.') continue;
+    const size_t tmp = file.rfind(".tmp");
+    if (tmp == std::string::npos) continue;
+    const std::string output = file.substr(1, tmp - 1);
+    int pid = 0;
+    if (!wanted.count(output) || !IsTemporaryOf(file, output, &pid)) continue;
+    // A live writer keeps its file; a dead one (killed) left it behind.
+    if (pid == ::getpid() || (pid > 0 && ::kill(pid, 0) == 0)) continue;
+    if (std::filesystem::remove(entry.path(), ec)) removed.push_back(entry.path().string());
+  }
+  return removed;
 }
 
 double CheckedMaxValue(const std::vector<const RgbaImage*>& images) {
@@ -122,35 +201,33 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
   frame.insert("G", Imf::Slice(type, base + 1 * element, xs, ys));
   frame.insert("B", Imf::Slice(type, base + 2 * element, xs, ys));
 
-  std::string temporary = TemporaryPathFor(path);
+  MemoryOStream encoded(path);
   try {
-    Imf::OutputFile file(temporary.c_str(), header);
+    Imf::OutputFile file(encoded, header);
     file.setFrameBuffer(frame);
     file.writePixels(h);
   } catch (const std::exception& e) {
-    std::remove(temporary.c_str());
-    throw OutputError(fmt::format("cannot write {}: {}", path, e.what()));
-  }
-  CommitFile(temporary, path);
-  return FileSize(path);
+    throw OutputError(fmt::format("cannot encode {}: {}", path, e.what()));
+  }  // the OutputFile destructor writes the line offsets: encoded is complete here
+  WriteFileAtomically(path, encoded.bytes());
+  return encoded.bytes().size();
 }
 
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  std::string temporary = TemporaryPathFor(path);
   auto out = OIIO::ImageOutput::create("png");
   if (!out) throw OutputError("OpenImageIO has no PNG writer: " + OIIO::geterror());
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("oiio:ColorSpace", "sRGB");
   spec.attribute("Software", "skybake " SKYBAKE_VERSION);
-  bool ok = out->open(temporary, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb.data());
+  // Encoded in memory, then written like every other file.
+  std::vector<unsigned char> encoded;
+  OIIO::Filesystem::IOVecOutput proxy(encoded);
+  out->set_ioproxy(&proxy);
+  bool ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb.data());
   ok = out->close() && ok;
-  if (!ok) {
-    std::string message = out->geterror();
-    std::remove(temporary.c_str());
-    throw OutputError(fmt::format("cannot write {}: {}", path, message));
-  }
-  CommitFile(temporary, path);
-  return FileSize(path);
+  if (!ok) throw OutputError(fmt::format("cannot encode {}: {}", path, out->geterror()));
+  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(encoded.data()), encoded.size()));
+  return encoded.size();
 }
 
 }  // namespace skybake

@@ -72,22 +72,6 @@ tinygltf::Value ToValue(const json& j) {
   return tinygltf::Value();
 }
 
-void WriteFileAtomically(const std::string& path, const std::string& bytes) {
-  std::string temporary = TemporaryPathFor(path);
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out.write(bytes.data(), std::streamsize(bytes.size()));
-    if (!out) {
-      std::remove(temporary.c_str());
-      throw OutputError(fmt::format("cannot write {}", path));
-    }
-  }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(errno)));
-  }
-}
-
 std::string ReadFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw OutputError(fmt::format("cannot read {} for the glTF scene", path));

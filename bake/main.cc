@@ -1,14 +1,17 @@
 // skybake: bakes physical, art-directable skies into HDR environment maps.
 //
 //   skybake bake <style.toml> [--schedule day.toml] [--out DIR] [--size N] [--set key=value ...]
+//                [--force | --resume] [--max-memory-mib M] [--max-frame-seconds S]
 //   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
 //   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
 //
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <new>
 #include <optional>
 #include <string>
 #include <vector>
@@ -63,6 +66,10 @@ struct BakeArgs {
   std::vector<std::string> overrides;
   bool quiet = false;
   bool validation = false;
+  bool force = false;
+  bool resume = false;
+  double max_memory_mib = 4096.0;
+  double max_frame_seconds = 3600.0;
 };
 
 int RunBake(const BakeArgs& args, bool check_only) {
@@ -97,7 +104,25 @@ int RunBake(const BakeArgs& args, bool check_only) {
     schedule = std::move(loaded.schedule);
     frame_styles = std::move(styles.styles);
   }
+  // Budget: every frame's memory and time estimate, before any GPU work.
+  BakeOptions options;
+  options.max_memory_mib = args.max_memory_mib;
+  options.max_frame_seconds = args.max_frame_seconds;
+  ResourceEstimate largest;
+  for (const SkyStyle& style : schedule ? frame_styles : std::vector<SkyStyle>{config.style}) {
+    CheckBudget(style, options);
+    ResourceEstimate e = EstimateResources(style);
+    if (e.memory_mib > largest.memory_mib) largest.memory_mib = e.memory_mib;
+    if (e.seconds > largest.seconds) largest.seconds = e.seconds;
+  }
+  if (args.resume && !schedule) {
+    std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
+                         "an inline [schedule]), or use --force to bake a single style again\n");
+    return kExitUsage;
+  }
   if (check_only) {
+    std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
+                largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
     if (schedule)
       std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), schedule_path.c_str(),
                   schedule->frames.size());
@@ -107,8 +132,9 @@ int RunBake(const BakeArgs& args, bool check_only) {
   }
 
   // Bake: device, pipelines, LUTs, render, files, preview.
-  BakeOptions options;
   options.out_dir = args.out_dir;
+  options.force = args.force;
+  options.resume = args.resume;
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
   if (!args.quiet) {
@@ -195,7 +221,8 @@ int main(int argc, char** argv) {
   CLI::App app{"skybake " SKYBAKE_VERSION
                ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
                "into OpenEXR environment maps with Vulkan compute.\n"
-               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style, 4 Vulkan, 5 output."};
+               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
+               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget."};
   app.require_subcommand(1);
   app.get_formatter()->column_width(34);
 
@@ -208,6 +235,14 @@ int main(int argc, char** argv) {
     cmd->add_option("--schedule", args.schedule_path,
                     "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
                     "[schedule], if it has one)");
+    cmd->add_option("--max-memory-mib", args.max_memory_mib,
+                    "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
+                    "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
+        ->capture_default_str()
+        ->check(CLI::PositiveNumber);
   };
 
   CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
@@ -218,6 +253,11 @@ int main(int argc, char** argv) {
                    "Cube face size N; also sets the latlong to 2N x N (default: the style's, 512)")
       ->check(CLI::Range(1, 8192));
   bake->add_option("--device", args.device, "Vulkan device index from 'skybake devices' (default: best)");
+  CLI::Option* force = bake->add_flag(
+      "--force", args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
+  bake->add_flag("--resume", args.resume,
+                 "Sequence: keep the frames whose files match their checksums in --out/manifest.json, bake the rest")
+      ->excludes(force);
   bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
   bake->add_flag("--vulkan-validation", args.validation,
                  "Load the Khronos validation layer; any message fails the bake (also "
@@ -253,6 +293,10 @@ int main(int argc, char** argv) {
   accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
   accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
 
+  // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
+  // like a full disk, instead of killing the process mid-file.
+  std::signal(SIGXFSZ, SIG_IGN);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -280,9 +324,19 @@ int main(int argc, char** argv) {
   } catch (const VulkanError& e) {
     std::fprintf(stderr, "skybake: error: Vulkan: %s\n", e.what());
     return kExitVulkan;
+  } catch (const BudgetError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitBudget;
+  } catch (const OutputExistsError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitExists;
   } catch (const OutputError& e) {
     std::fprintf(stderr, "skybake: error: %s\n", e.what());
     return kExitOutput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
+                         "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
+    return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
     std::fprintf(stderr, "skybake: error: %s\n", e.what());
     return kExitOutput;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include <fmt/format.h>
@@ -136,20 +137,96 @@ std::vector<ViewRequest> ShViews(const SkyStyle& style) {
   return views;
 }
 
-void WriteTextAtomically(const std::string& path, const std::string& text) {
-  std::string temporary = TemporaryPathFor(path);
-  {
-    std::ofstream out(temporary, std::ios::binary);
-    out << text;
-    if (!out) {
-      std::remove(temporary.c_str());
-      throw OutputError(fmt::format("cannot write {}", path));
-    }
+// The file names one frame writes (in out_dir), in the order they are written.
+struct FrameNames {
+  std::vector<std::string> faces;  // six, when output.faces
+  std::string cube, latlong, png;  // empty when not written
+  std::vector<std::string> All() const {
+    std::vector<std::string> all = faces;
+    for (const std::string* n : {&cube, &latlong, &png})
+      if (!n->empty()) all.push_back(*n);
+    return all;
   }
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    std::remove(temporary.c_str());
-    throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(errno)));
+};
+
+FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
+  const OutputSettings& o = style.output;
+  const std::string number = number_in_name > 0 ? fmt::format(".{:04d}", number_in_name) : "";
+  FrameNames names;
+  if (o.faces)
+    for (int face = 0; face < 6; ++face) names.faces.push_back(o.basename + "_" + o.face_names[face] + number + ".exr");
+  if (o.cube_strip) names.cube = o.basename + "_cube" + number + ".exr";
+  if (o.latlong) names.latlong = o.basename + "_latlong" + number + ".exr";
+  if (o.preview || style.gltf.enabled) names.png = o.basename + "_latlong" + number + ".png";
+  return names;
+}
+
+std::vector<std::string> PlannedFileNames(const std::vector<FramePlan>& plans) {
+  std::vector<std::string> names;
+  for (const FramePlan& plan : plans)
+    for (const std::string& n : FrameFileNames(*plan.style, plan.number).All()) names.push_back(n);
+  const SkyStyle& first = *plans.front().style;
+  if (first.gltf.enabled)
+    for (const char* ext : {".gltf", ".bin", ".glb"}) names.push_back(first.output.basename + ext);
+  names.push_back("manifest.json");
+  return names;
+}
+
+// What a resumed bake may skip: the frames of the previous manifest.
+struct PreviousBake {
+  bool loaded = false;
+  double half_scale = 0.0;
+  double exposure_ev100 = 0.0;
+  std::map<int, json> frames;  // by frame number
+};
+
+PreviousBake ReadPreviousManifest(const std::string& path) {
+  PreviousBake previous;
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return previous;
+  std::ifstream in(path, std::ios::binary);
+  json manifest = json::parse(in, nullptr, false);
+  if (manifest.is_discarded() || !manifest.is_object())
+    throw OutputError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
+                                  "--force instead to bake every frame again", path));
+  previous.loaded = true;
+  previous.half_scale = manifest.value("half_scale", 0.0);
+  previous.exposure_ev100 = manifest.value("exposure_ev100", 0.0);
+  if (manifest.contains("frames") && manifest["frames"].is_array())
+    for (const json& f : manifest["frames"])
+      if (f.is_object() && f.contains("frame") && f["frame"].is_number_integer())
+        previous.frames[f["frame"].get<int>()] = f;
+  return previous;
+}
+
+// The files of `frame` from the previous manifest when every one of them is
+// on disk with its recorded SHA-256 and the frame was baked with the same
+// style, exposure and half scale; otherwise nothing.
+std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous, const FramePlan& plan,
+                                                    const std::string& out_dir, double half_scale,
+                                                    double ev100) {
+  if (!previous.loaded || previous.half_scale != half_scale || previous.exposure_ev100 != ev100)
+    return std::nullopt;
+  auto it = previous.frames.find(plan.number);
+  if (it == previous.frames.end()) return std::nullopt;
+  const json& f = it->second;
+  if (f.value("style_sha256", std::string()) != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
+  if (!f.contains("files") || !f["files"].is_array()) return std::nullopt;
+  std::vector<std::string> expected = FrameFileNames(*plan.style, plan.number).All();
+  std::vector<BakedFile> files;
+  for (const json& entry : f["files"]) {
+    if (!entry.is_object()) return std::nullopt;
+    std::string name = entry.value("file", std::string());
+    if (files.size() >= expected.size() || name != expected[files.size()]) return std::nullopt;
+    std::string path = (std::filesystem::path(out_dir) / name).string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
+    std::string sha = Sha256OfFile(path);
+    if (sha != entry.value("sha256", std::string())) return std::nullopt;
+    files.push_back({path, entry.value("kind", std::string()), uint64_t(std::filesystem::file_size(path)), sha});
   }
+  if (files.size() != expected.size()) return std::nullopt;
+  return files;
 }
 
 BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* schedule, const BakeOptions& options) {
@@ -159,9 +236,47 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   const bool sequence = schedule != nullptr;
   const SkyStyle& first = *plans.front().style;
 
+  // Outputs, before any GPU work: within budget, not overwriting a previous
+  // bake unless asked to, stale temporaries of a killed bake removed.
+  for (const FramePlan& plan : plans) CheckBudget(*plan.style, options);
+  const std::vector<std::string> planned = PlannedFileNames(plans);
+  auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
+  if (!options.force && !options.resume) {
+    for (const std::string& name : planned) {
+      std::error_code ec;
+      if (std::filesystem::exists(path_of(name), ec))
+        throw OutputExistsError(fmt::format(
+            "{} already exists: pass --force to overwrite the bake's files{}, or choose another --out",
+            path_of(name), sequence ? ", --resume to finish an interrupted sequence" : ""));
+    }
+  }
+  PreviousBake previous;
+  if (options.resume) previous = ReadPreviousManifest(path_of("manifest.json"));
+  result.removed_temporaries = RemoveStaleTemporaries(options.out_dir, planned);
+  timer.Finish("outputs", fmt::format("{} files planned{}{}", planned.size(),
+                                      result.removed_temporaries.empty()
+                                          ? ""
+                                          : fmt::format(", {} stale temporary file(s) removed",
+                                                        result.removed_temporaries.size()),
+                                      previous.loaded ? fmt::format(", resuming from {} frame(s) in manifest.json",
+                                                                    previous.frames.size())
+                                                      : ""));
+
   // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
   VulkanContext context(options.vulkan);
   timer.Finish("device", fmt::format("{} ({})", context.device_info().name, context.device_info().type));
+  // Each render's output is one storage buffer: refuse views the device cannot bind.
+  const uint64_t max_range = context.properties().limits.maxStorageBufferRange;
+  for (const FramePlan& plan : plans) {
+    for (const ViewRequest& v : PlanViews(*plan.style)) {
+      uint64_t bytes = uint64_t(v.width) * uint64_t(v.height) * 16;
+      if (bytes > max_range)
+        throw VulkanError(fmt::format("a {}x{} view needs {} MiB in one storage buffer; {} allows {} MiB "
+                                      "(maxStorageBufferRange): lower render.cube_size or render.latlong_height",
+                                      v.width, v.height, bytes >> 20, context.device_info().name, max_range >> 20),
+                          VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    }
+  }
 
   // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
   RendererCache renderers(context, result);
@@ -214,9 +329,73 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   result.half_scale = half_scale;
 
   std::filesystem::create_directories(options.out_dir);
-  auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
   auto add_file = [&](FrameResult& frame, const std::string& path, const std::string& kind, uint64_t bytes) {
     frame.files.push_back({path, kind, bytes, Sha256OfFile(path)});
+  };
+
+  // Manifest: every file with its size and SHA-256, per frame and for the
+  // scene; rewritten atomically after every frame, `complete` once the bake is.
+  auto provenance_of = [&]() {
+    return json{
+        {"version", SKYBAKE_VERSION},
+        {"style", first.source_path},
+        {"schedule", schedule ? schedule->source_path : ""},
+        {"units", first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
+                                                                : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm"},
+        {"exposure_ev100", ev100.value_or(0.0)},
+        {"texture_frame", plans[reference].number},
+        {"sh_basis", "real SH l<=2, order (0,0)(1,-1)(1,0)(1,1)(2,-2)(2,-1)(2,0)(2,1)(2,2), Ramamoorthi-Hanrahan "
+                     "2001 constants on world x,y,z (+Y up); irradiance E(n) = sum E_lm Y_lm(n)"},
+    };
+  };
+  auto write_manifest = [&](const std::vector<BakedFile>& scene, bool complete) {
+    auto file_json = [&](const BakedFile& f) {
+      return json{{"file", std::filesystem::path(f.path).filename().string()},
+                  {"kind", f.kind},
+                  {"bytes", f.bytes},
+                  {"sha256", f.sha256}};
+    };
+    json manifest = provenance_of();
+    manifest["out_dir"] = options.out_dir;
+    manifest["half_scale"] = half_scale;
+    manifest["exposure_source"] = exposure_source;
+    manifest["frame_convention"] = "+Y up, right-handed, North -Z, East +X; sun_direction points towards the Sun; "
+                                   "azimuth clockwise from North";
+    if (schedule && schedule->place) {
+      manifest["place"] = {{"latitude_deg", schedule->place->latitude_deg},
+                           {"longitude_deg", schedule->place->longitude_deg}};
+    }
+    json frames = json::array();
+    for (size_t i = 0; i < result.frames.size(); ++i) {
+      const FrameResult& f = result.frames[i];
+      json files = json::array();
+      for (const BakedFile& file : f.files) files.push_back(file_json(file));
+      json passes = json::array();
+      for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
+      frames.push_back({{"frame", f.number},
+                        {"style_sha256", Sha256OfText(plans[i].style->resolved_toml)},
+                        {"time", f.time ? json(f.time->Iso8601()) : json(nullptr)},
+                        {"hours_from_start", plans[i].hours_from_start},
+                        {"sun", {{"elevation_deg", f.sun_elevation_deg},
+                                 {"azimuth_deg", f.sun_azimuth_deg},
+                                 {"direction", VectorJson(f.sun_direction)},
+                                 {"illuminance_lux", f.sun_illuminance_lux}}},
+                        {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                        {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
+                        {"files", files},
+                        {"timings", {{"render_s", f.render_seconds}, {"write_s", f.write_seconds}, {"gpu_passes", passes}}}});
+    }
+    manifest["frames"] = frames;
+    manifest["complete"] = complete;
+    json scene_json = json::array();
+    for (const BakedFile& f : scene) scene_json.push_back(file_json(f));
+    manifest["scene"] = scene_json;
+    manifest["renderer_builds"] = result.renderer_builds;
+    json stages = json::array();
+    for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
+    manifest["timings"] = {{"total_s", SecondsSince(bake_start)}, {"stages", stages}};
+    result.manifest_path = path_of("manifest.json");
+    WriteFileAtomically(result.manifest_path, manifest.dump(2) + "\n");
   };
 
   std::string reference_png;
@@ -230,8 +409,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.sun_direction = plan.sun;
     frame.sun_elevation_deg = plan.elevation_deg;
     frame.sun_azimuth_deg = plan.azimuth_deg;
-    const std::string number = plan.number > 0 ? fmt::format(".{:04d}", plan.number) : "";
     const std::string label = plan.number > 0 ? fmt::format("frame {}", plan.number) : "render";
+    const FrameNames names = FrameFileNames(style, plan.number);
+    // A resumed sequence skips frames whose files are verified against the manifest.
+    std::optional<std::vector<BakedFile>> verified;
+    if (sequence && options.resume) verified = VerifiedFrame(previous, plan, options.out_dir, half_scale, *ev100);
 
     // Render: every view of the frame in one submission, then the SH views.
     Clock::time_point render_start = Clock::now();
@@ -241,8 +423,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       const int h = style.render.latlong_height;
       views.push_back({MAPPING_LATLONG, 2 * h, h, 0});  // the glTF texture needs the latlong
     }
-    std::vector<std::vector<float>> pixels = renderer.Render(plan.sun, views);
-    for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+    std::vector<std::vector<float>> pixels;
+    if (!verified) {
+      pixels = renderer.Render(plan.sun, views);
+      for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+    }
     // SH: the sky without the disc from small faces; the disc added as the
     // irradiance it delivers (centre radiance times its limb-darkened solid
     // angle), which point-sampled texels would alias.
@@ -271,9 +456,24 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.render_seconds = SecondsSince(render_start);
     size_t texels = 0;
     for (const ViewRequest& v : views) texels += size_t(v.width) * v.height;
-    timer.Finish(label, fmt::format("{} views, {:.2f} Mtexels, sun elevation {:.2f} azimuth {:.2f}{}", views.size(),
-                                    texels * 1e-6, plan.elevation_deg, plan.azimuth_deg,
-                                    plan.time ? ", " + plan.time->Iso8601() : ""));
+    if (verified) texels = 0;
+    timer.Finish(label, fmt::format("{} views, {:.2f} Mtexels, sun elevation {:.2f} azimuth {:.2f}{}{}",
+                                    verified ? 0 : views.size(), texels * 1e-6, plan.elevation_deg, plan.azimuth_deg,
+                                    plan.time ? ", " + plan.time->Iso8601() : "",
+                                    verified ? ", files verified by checksum: not rendered again" : ""));
+    if (verified) {
+      frame.files = *verified;
+      if (index == reference && !names.png.empty()) {
+        reference_png = names.png;
+        texture_width = 2 * style.render.latlong_height;
+        texture_height = style.render.latlong_height;
+      }
+      result.preview_ev100 = *ev100;
+      for (const BakedFile& f : frame.files) result.files.push_back(f);
+      result.frames.push_back(std::move(frame));
+      write_manifest({}, false);
+      continue;
+    }
 
     // Files: one scale for every file (of the frame, or of the sequence).
     Clock::time_point write_start = Clock::now();
@@ -317,14 +517,14 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
         ExrWriteOptions face_exr = exr;
         face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
         face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
-        std::string path = path_of(style.output.basename + "_" + style.output.face_names[face] + number + ".exr");
+        std::string path = path_of(names.faces[face]);
         add_file(frame, path, "face", WriteExr(path, images[view_index], face_exr));
       }
     }
     if (style.output.cube_strip) {
       ExrWriteOptions cube_exr = exr;
       cube_exr.envmap = 1;  // ENVMAP_CUBE
-      std::string path = path_of(style.output.basename + "_cube" + number + ".exr");
+      std::string path = path_of(names.cube);
       add_file(frame, path, "cube", WriteExr(path, images[view_index], cube_exr));
       ++view_index;
     }
@@ -332,7 +532,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     if (style.output.latlong) {
       ExrWriteOptions latlong_exr = exr;
       latlong_exr.envmap = 0;  // ENVMAP_LATLONG
-      std::string path = path_of(style.output.basename + "_latlong" + number + ".exr");
+      std::string path = path_of(names.latlong);
       add_file(frame, path, "latlong", WriteExr(path, *latlong, latlong_exr));
     }
     timer.Finish("write EXR", fmt::format("{} files, {} compression, {}", frame.files.size(),
@@ -349,7 +549,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       result.preview_ev100 = *ev100;
       std::vector<uint8_t> srgb =
           TonemapToSrgb8(display, latlong->width, latlong->height, ExposureFromEv100(*ev100));
-      std::string path = path_of(style.output.basename + "_latlong" + number + ".png");
+      std::string path = path_of(names.png);
       add_file(frame, path, style.output.preview ? "preview" : "gltf_texture",
                WritePng(path, latlong->width, latlong->height, srgb));
       if (index == reference) {
@@ -362,20 +562,12 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     if (ev100) timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
     for (const BakedFile& f : frame.files) result.files.push_back(f);
     result.frames.push_back(std::move(frame));
+    // The manifest after every frame: a killed bake leaves a valid record of the frames done.
+    write_manifest({}, false);
   }
 
   // Scene: the dome textured with the reference frame, the sun (animated for a sequence).
-  json provenance = {
-      {"version", SKYBAKE_VERSION},
-      {"style", first.source_path},
-      {"schedule", schedule ? schedule->source_path : ""},
-      {"units", first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
-                                                              : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm"},
-      {"exposure_ev100", ev100.value_or(0.0)},
-      {"texture_frame", plans[reference].number},
-      {"sh_basis", "real SH l<=2, order (0,0)(1,-1)(1,0)(1,1)(2,-2)(2,-1)(2,0)(2,1)(2,2), Ramamoorthi-Hanrahan "
-                   "2001 constants on world x,y,z (+Y up); irradiance E(n) = sum E_lm Y_lm(n)"},
-  };
+  json provenance = provenance_of();
   json frame_extras = json::array();
   std::vector<SceneSun> suns;
   for (size_t i = 0; i < result.frames.size(); ++i) {
@@ -420,52 +612,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   }
 
   // Manifest: every file with its size and SHA-256, per frame; written last, atomically.
-  auto file_json = [&](const BakedFile& f) {
-    return json{{"file", std::filesystem::path(f.path).filename().string()},
-                {"kind", f.kind},
-                {"bytes", f.bytes},
-                {"sha256", f.sha256}};
-  };
-  json manifest = provenance;
-  manifest.erase("frames");
-  manifest["out_dir"] = options.out_dir;
-  manifest["half_scale"] = half_scale;
-  manifest["exposure_source"] = exposure_source;
-  manifest["frame_convention"] = "+Y up, right-handed, North -Z, East +X; sun_direction points towards the Sun; "
-                                 "azimuth clockwise from North";
-  if (schedule && schedule->place) {
-    manifest["place"] = {{"latitude_deg", schedule->place->latitude_deg},
-                         {"longitude_deg", schedule->place->longitude_deg}};
-  }
-  json frames = json::array();
-  for (size_t i = 0; i < result.frames.size(); ++i) {
-    const FrameResult& f = result.frames[i];
-    json files = json::array();
-    for (const BakedFile& file : f.files) files.push_back(file_json(file));
-    json passes = json::array();
-    for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
-    frames.push_back({{"frame", f.number},
-                      {"time", f.time ? json(f.time->Iso8601()) : json(nullptr)},
-                      {"hours_from_start", plans[i].hours_from_start},
-                      {"sun", {{"elevation_deg", f.sun_elevation_deg},
-                               {"azimuth_deg", f.sun_azimuth_deg},
-                               {"direction", VectorJson(f.sun_direction)},
-                               {"illuminance_lux", f.sun_illuminance_lux}}},
-                      {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
-                      {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
-                      {"files", files},
-                      {"timings", {{"render_s", f.render_seconds}, {"write_s", f.write_seconds}, {"gpu_passes", passes}}}});
-  }
-  manifest["frames"] = frames;
-  json scene_json = json::array();
-  for (const BakedFile& f : scene_files) scene_json.push_back(file_json(f));
-  manifest["scene"] = scene_json;
-  manifest["renderer_builds"] = result.renderer_builds;
-  json stages = json::array();
-  for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
-  manifest["timings"] = {{"total_s", SecondsSince(bake_start)}, {"stages", stages}};
-  result.manifest_path = path_of("manifest.json");
-  WriteTextAtomically(result.manifest_path, manifest.dump(2) + "\n");
+  write_manifest(scene_files, true);
   result.files.push_back({result.manifest_path, "manifest", std::filesystem::file_size(result.manifest_path), ""});
   timer.Finish("manifest", result.manifest_path);
 
@@ -476,23 +623,100 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
 }  // namespace
 
+namespace {
+
+class Sha256 {
+ public:
+  Sha256() : ctx_(EVP_MD_CTX_new(), EVP_MD_CTX_free) {
+    if (!ctx_ || EVP_DigestInit_ex(ctx_.get(), EVP_sha256(), nullptr) != 1)
+      throw OutputError("OpenSSL: cannot start SHA-256");
+  }
+  void Update(const void* data, size_t size) { EVP_DigestUpdate(ctx_.get(), data, size); }
+  std::string HexDigest() {
+    unsigned char digest[EVP_MAX_MD_SIZE];
+    unsigned int length = 0;
+    EVP_DigestFinal_ex(ctx_.get(), digest, &length);
+    std::string hex;
+    for (unsigned int i = 0; i < length; ++i) hex += fmt::format("{:02x}", digest[i]);
+    return hex;
+  }
+
+ private:
+  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx_;
+};
+
+}  // namespace
+
 std::string Sha256OfFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw OutputError(fmt::format("cannot read {} to checksum it", path));
-  std::unique_ptr<EVP_MD_CTX, decltype(&EVP_MD_CTX_free)> ctx(EVP_MD_CTX_new(), EVP_MD_CTX_free);
-  if (!ctx || EVP_DigestInit_ex(ctx.get(), EVP_sha256(), nullptr) != 1)
-    throw OutputError("OpenSSL: cannot start SHA-256");
+  Sha256 sha;
   std::vector<char> chunk(1 << 16);
   while (in) {
     in.read(chunk.data(), std::streamsize(chunk.size()));
-    if (in.gcount() > 0) EVP_DigestUpdate(ctx.get(), chunk.data(), size_t(in.gcount()));
+    if (in.gcount() > 0) sha.Update(chunk.data(), size_t(in.gcount()));
   }
-  unsigned char digest[EVP_MAX_MD_SIZE];
-  unsigned int length = 0;
-  EVP_DigestFinal_ex(ctx.get(), digest, &length);
-  std::string hex;
-  for (unsigned int i = 0; i < length; ++i) hex += fmt::format("{:02x}", digest[i]);
-  return hex;
+  return sha.HexDigest();
+}
+
+std::string Sha256OfText(std::string_view text) {
+  Sha256 sha;
+  sha.Update(text.data(), text.size());
+  return sha.HexDigest();
+}
+
+// Ray-march samples per second of lavapipe on the 2-core CI machine, measured
+// on the default style's production bake (3.67 Mtexels x 48 steps in 14.5 s;
+// README "Limits"). A slower or faster machine scales every estimate alike.
+constexpr double kLavapipeSamplesPerSecond = 1.2e7;
+
+ResourceEstimate EstimateResources(const SkyStyle& style) {
+  std::vector<ViewRequest> views = PlanViews(style);
+  const double latlong = 2.0 * style.render.latlong_height * double(style.render.latlong_height);
+  if (style.gltf.enabled && !style.output.latlong && !style.output.preview)
+    views.push_back({MAPPING_LATLONG, 2 * style.render.latlong_height, style.render.latlong_height, 0});
+  double texels = 0.0, largest = 0.0;
+  for (const ViewRequest& v : views) {
+    texels += double(v.width) * v.height;
+    largest = std::max(largest, double(v.width) * v.height);
+  }
+  const QualitySettings& q = style.quality;
+  const double luts = 16.0 * (double(q.transmittance_width) * q.transmittance_height +
+                              double(q.multiscattering_size) * q.multiscattering_size +
+                              (q.sky_view_lut ? double(q.sky_view_width) * q.sky_view_height : 0.0));
+  const double channel = style.output.pixel_type == PixelType::kHalf ? 2.0 : 4.0;
+  ResourceEstimate e;
+  // Device output buffer and its host copy (RGBA float each), the largest
+  // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG.
+  const bool preview = style.output.preview || style.gltf.enabled;
+  const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
+  e.memory_mib = bytes / (1024.0 * 1024.0);
+  // Samples: every texel marches view_steps (times light_steps when the Sun's
+  // transmittance is marched too), plus the LUTs (small at any setting).
+  const double per_texel = double(q.view_steps) * (q.light_steps > 0 ? 1.0 + q.light_steps : 1.0);
+  const double lut_samples = double(q.transmittance_width) * q.transmittance_height * q.transmittance_steps +
+                             double(q.multiscattering_size) * q.multiscattering_size * q.multiscattering_sqrt_dirs *
+                                 q.multiscattering_sqrt_dirs * q.multiscattering_steps;
+  e.samples = texels * per_texel + lut_samples;
+  e.seconds = e.samples / kLavapipeSamplesPerSecond;
+  return e;
+}
+
+void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
+  const ResourceEstimate e = EstimateResources(style);
+  if (e.memory_mib > options.max_memory_mib)
+    throw BudgetError(fmt::format(
+        "the bake needs an estimated {:.0f} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
+        "of {:.0f} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
+        "--max-memory-mib (README \"Limits\")",
+        e.memory_mib, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height,
+        options.max_memory_mib));
+  if (e.seconds > options.max_frame_seconds)
+    throw BudgetError(fmt::format(
+        "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "
+        "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
+        "--max-frame-seconds (README \"Limits\")",
+        e.samples, e.seconds, options.max_frame_seconds));
 }
 
 std::vector<ViewRequest> PlanViews(const SkyStyle& style) {

@@ -132,13 +132,27 @@ class ScheduleReader {
     return std::nullopt;
   }
 
+  // Whether `key` (dotted) can name a style key: non-empty parts of letters,
+  // digits and '_'. Anything else (an '=' or a space) would be misread as an
+  // assignment, so it is reported here, at its place in the schedule.
+  bool StyleKeyName(const toml::node& node, const std::string& where, const std::string& key) {
+    bool ok = !key.empty() && key.front() != '.' && key.back() != '.' && key.find("..") == std::string::npos;
+    for (char c : key)
+      ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.');
+    if (!ok)
+      Error(&node, where, fmt::format("'{}' is not a style key: use a dotted key such as \"atmosphere.mie.g\"", key));
+    return ok;
+  }
+
   // Flattens a table of style keys (quoted "a.b.c" or nested a.b.c) into
   // dotted keys with their TOML text.
-  void Flatten(const toml::table& table, const std::string& prefix, std::vector<FrameOverride>& out) {
+  void Flatten(const toml::table& table, const std::string& prefix, std::vector<FrameOverride>& out,
+               const std::string& where) {
     for (const auto& [k, node] : table) {
       std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (!StyleKeyName(node, where + "." + key, key)) continue;
       if (const toml::table* sub = node.as_table()) {
-        Flatten(*sub, key, out);
+        Flatten(*sub, key, out, where);
         continue;
       }
       FrameOverride o;
@@ -151,11 +165,12 @@ class ScheduleReader {
 
   // Flattens a table of numbers or RGB triples (ramps, rates).
   template <class F>
-  void FlattenNumbers(const toml::table& table, const std::string& prefix, F each) {
+  void FlattenNumbers(const toml::table& table, const std::string& prefix, F each, const std::string& where) {
     for (const auto& [k, node] : table) {
       std::string key = prefix.empty() ? std::string(k.str()) : prefix + "." + std::string(k.str());
+      if (!StyleKeyName(node, where + "." + key, key)) continue;
       if (const toml::table* sub = node.as_table()) {
-        FlattenNumbers(*sub, key, each);
+        FlattenNumbers(*sub, key, each, where);
         continue;
       }
       each(key, node);
@@ -417,7 +432,7 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
       }
       if (const toml::node* set = t->get("set")) {
         if (const toml::table* st = set->as_table())
-          r.Flatten(*st, "", f.overrides);
+          r.Flatten(*st, "", f.overrides, fkey + ".set");
         else
           r.Error(set, fkey + ".set", "expected a table of style keys, e.g. set = { \"atmosphere.mie.g\" = 0.7 }");
       }
@@ -477,7 +492,7 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
           return;
         }
         schedule.ramps.push_back({key, *from, *to, r.Origin(&node, key)});
-      });
+      }, "schedule.ramp");
     } else {
       r.Error(ramp, "schedule.ramp", "expected a table: \"style.key\" = [from, to]");
     }
@@ -489,7 +504,7 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
       r.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
         std::optional<std::vector<double>> rate = r.Values(node, "schedule.per_hour." + key);
         if (rate) schedule.rates.push_back({key, *rate, r.Origin(&node, key)});
-      });
+      }, "schedule.per_hour");
     } else {
       r.Error(per_hour, "schedule.per_hour", "expected a table: \"style.key\" = rate");
     }

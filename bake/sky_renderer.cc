@@ -1,5 +1,7 @@
 #include "skybake/sky_renderer.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cstring>
 
@@ -343,6 +345,26 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
   for (const ViewRequest& v : views) {
     offsets.push_back(total);
     total += size_t(v.width) * v.height;
+  }
+  // The views share one storage buffer; when they do not fit in the largest
+  // range the device can bind, they are rendered in groups that do.
+  const VkDeviceSize max_range = context_.properties().limits.maxStorageBufferRange;
+  if (VkDeviceSize(total) * 16 > max_range) {
+    if (views.size() == 1)
+      throw VulkanError(fmt::format("a {}x{} view needs {} MiB in one storage buffer; {} allows {} MiB "
+                                    "(maxStorageBufferRange): lower render.cube_size or render.latlong_height",
+                                    views[0].width, views[0].height, (VkDeviceSize(total) * 16) >> 20,
+                                    context_.device_info().name, max_range >> 20),
+                        VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    const size_t half = views.size() / 2;
+    std::vector<std::vector<float>> images =
+        Render(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half));
+    std::vector<PassTiming> timings = last_timings();
+    for (std::vector<float>& image : Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end())))
+      images.push_back(std::move(image));
+    timings.insert(timings.end(), last_timings().begin(), last_timings().end());
+    timings_ = timings;
+    return images;
   }
   EnsureOutputCapacity(std::max<size_t>(total, 1) * 16);
 

@@ -2,7 +2,11 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <array>
 #include <filesystem>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace skybake::testing {
 namespace {
@@ -41,6 +45,32 @@ std::string SourceDir() { return SKYBAKE_SOURCE_DIR; }
 std::string SharedDir() {
   if (const char* env = std::getenv("SKYBAKE_SHARED_DIR")) return env;
   return (std::filesystem::path(SKYBAKE_SOURCE_DIR).parent_path() / "shared").string();
+}
+
+CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix) {
+  std::string script = shell_prefix + " '" + SKYBAKE_BINARY + "' " + args + " 2>&1";
+  std::string command = "bash -c \"" ;
+  for (char c : script) {
+    if (c == '"' || c == '\\' || c == '$' || c == '`') command += '\\';
+    command += c;
+  }
+  command += "\"";
+  CommandRun run;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (!pipe) return run;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
+  int status = pclose(pipe);
+  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return run;
+}
+
+std::string FreshTempDir(const std::string& name) {
+  auto dir = std::filesystem::temp_directory_path() / ("skybake_" + name + "_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir.string();
 }
 
 }  // namespace skybake::testing

@@ -23,4 +23,15 @@ void ExpectNoValidationMessages();
 std::string SourceDir();
 std::string SharedDir();
 
+// The skybake binary run through a shell: `shell_prefix` goes before it
+// (environment, `cd dir &&`, `ulimit -f N;`), `args` after it.
+struct CommandRun {
+  int exit_code = -1;  // -1 when killed by a signal
+  std::string output;  // stdout and stderr together
+};
+CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix = "");
+
+// A new, empty folder under the temporary directory, unique to this process.
+std::string FreshTempDir(const std::string& name);
+
 }  // namespace skybake::testing

@@ -7,6 +7,7 @@
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "skybake/config.h"
@@ -50,6 +51,15 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
 
 // Writes an 8-bit sRGB PNG through OpenImageIO.
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
+
+// Writes `bytes` to a temporary file beside `path`, syncs it and renames it
+// over `path`. On any failure the temporary is removed and OutputError names
+// the file, the system error and the fix (a full disk, a file-size limit).
+void WriteFileAtomically(const std::string& path, std::string_view bytes);
+
+// Removes hidden temporaries (TemporaryPathFor) of the given file names in
+// `dir` left by processes that no longer run (a killed bake); returns them.
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir, const std::vector<std::string>& names);
 
 // Temporary name beside `path` for a write in progress (hidden, pid-tagged).
 std::string TemporaryPathFor(const std::string& path);

@@ -6,10 +6,13 @@
 #include <cstdint>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "skybake/config.h"
+#include "skybake/exr_io.h"
 #include "skybake/schedule.h"
 #include "skybake/sh.h"
 #include "skybake/sky_renderer.h"
@@ -24,7 +27,23 @@ enum ExitCode : int {
   kExitUsage = 2,     // bad command line
   kExitConfig = 3,    // the style or schedule is invalid
   kExitVulkan = 4,    // no usable Vulkan driver or device, or a Vulkan failure
-  kExitOutput = 5,    // an output file could not be written
+  kExitOutput = 5,    // an output file could not be written (disk full, no permission)
+  kExitExists = 6,    // the bake's files already exist: pass --force or --resume
+  kExitBudget = 7,    // the bake would exceed the memory or time budget (README "Limits")
+};
+
+// The bake's files are already in the output folder and neither --force nor
+// --resume was given. Thrown before any GPU work.
+class OutputExistsError : public OutputError {
+ public:
+  using OutputError::OutputError;
+};
+
+// The bake would need more memory or time than the budget. Thrown before any
+// GPU work; the message gives the estimate.
+class BudgetError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 struct StageReport {
@@ -38,7 +57,23 @@ struct BakeOptions {
   std::string out_dir = "out";
   VulkanOptions vulkan;
   ProgressCallback progress;  // may be empty
+  bool force = false;   // overwrite files of a previous bake in out_dir
+  bool resume = false;  // sequence: keep frames verified against out_dir/manifest.json, bake the rest
+  double max_memory_mib = 4096.0;       // budget for one frame's host + device memory (README "Limits")
+  double max_frame_seconds = 3600.0;    // budget for one frame's estimated lavapipe render time
 };
+
+// Estimated peak memory and lavapipe time of one frame of `style`.
+struct ResourceEstimate {
+  double memory_mib = 0.0;      // device output buffer, host copies, LUTs, encoded files
+  double samples = 0.0;         // ray-march samples (texels x steps, LUTs included)
+  double seconds = 0.0;         // samples / kLavapipeSamplesPerSecond
+};
+ResourceEstimate EstimateResources(const SkyStyle& style);
+
+// Throws BudgetError when `style` is over the budget of `options`, naming the
+// estimate, the budget and the keys to lower.
+void CheckBudget(const SkyStyle& style, const BakeOptions& options);
 
 struct BakedFile {
   std::string path;
@@ -75,11 +110,15 @@ struct BakeResult {
   int validation_messages = 0;
   std::string manifest_path;
   int renderer_builds = 0;  // SkyRenderer constructions (atmosphere changes)
+  std::vector<std::string> removed_temporaries;  // left by a killed bake, removed before baking
 };
 
 // Bakes one style (one sun position) into options.out_dir, which is created
-// if needed: EXR maps, preview, glTF scene, manifest.json. Throws
-// VulkanUnavailable, VulkanError or OutputError.
+// if needed: EXR maps, preview, glTF scene, manifest.json. Before any GPU
+// work: BudgetError over the budget, OutputExistsError when a file it would
+// write exists (unless options.force or options.resume); stale temporaries of
+// its file names are removed. Later: VulkanUnavailable, VulkanError or
+// OutputError. manifest.json is rewritten after every frame.
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
 
 // Bakes a sequence: frame k of `schedule` with `styles[k]` (see
@@ -93,6 +132,7 @@ BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& sch
 
 // SHA-256 of a file, lowercase hex. Throws OutputError.
 std::string Sha256OfFile(const std::string& path);
+std::string Sha256OfText(std::string_view text);
 
 // The views one bake renders, in order: six Vulkan faces, the cube strip,
 // the latlong (each only when enabled in `output`).

@@ -1,0 +1,255 @@
+// Nothing is lost: existing outputs need --force, a killed sequence resumes
+// to the same bytes, a full disk is reported and leaves no partial file,
+// names cannot leave the output folder, and bakes over the budget or the
+// device's limits are refused with the estimate. Runs the binary.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CommandRun;
+using testing::FreshTempDir;
+using testing::RunSkybake;
+
+std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
+
+// Twenty frames, the Sun rising from the horizon to 38 degrees.
+constexpr const char* kTwentyFrames = R"([schedule]
+sun = { elevation_deg = { start = 0, end = 38, step = 2 }, azimuth_deg = 135 }
+)";
+
+std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text) {
+  std::string path = dir + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::set<std::string> Names(const std::string& dir) {
+  std::set<std::string> names;
+  if (fs::exists(dir))
+    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+// The manifest without what differs between any two runs: wall-clock timings.
+nlohmann::json ManifestWithoutTimings(const std::string& path) {
+  std::ifstream in(path);
+  nlohmann::json m = nlohmann::json::parse(in);
+  m.erase("timings");
+  for (nlohmann::json& f : m["frames"]) f.erase("timings");
+  return m;
+}
+
+TEST(SafeOutputs, ExistingOutputsNeedForce) {
+  std::string out = FreshTempDir("exists") + "/out";
+  const std::string bake = "bake '" + Style() + "' --size 8 -q --out '" + out + "'";
+  CommandRun first = RunSkybake(bake);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  std::string before = ReadBytes(out + "/sky_px.exr");
+  CommandRun again = RunSkybake(bake);
+  EXPECT_EQ(again.exit_code, 6) << again.output;
+  EXPECT_EQ(again.output, "skybake: error: " + out +
+                              "/sky_px.exr already exists: pass --force to overwrite the bake's files, or choose "
+                              "another --out\n");
+  EXPECT_EQ(ReadBytes(out + "/sky_px.exr"), before);
+  CommandRun forced = RunSkybake(bake + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_EQ(ReadBytes(out + "/sky_px.exr"), before) << "the same bake gives the same bytes";
+  CommandRun resume_single = RunSkybake(bake + " --resume");
+  EXPECT_EQ(resume_single.exit_code, 2) << resume_single.output;
+  EXPECT_NE(resume_single.output.find("--resume continues a sequence bake"), std::string::npos);
+  CommandRun both = RunSkybake(bake + " --resume --force");
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  fs::remove_all(fs::path(out).parent_path());
+}
+
+// kill -9 in the middle of a 20-frame bake, then --resume: every file is
+// byte-identical to an uninterrupted bake's (the manifest apart from its
+// wall-clock timings).
+TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
+  const std::string root = FreshTempDir("resume");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  fs::create_directories(root + "/whole");
+  fs::create_directories(root + "/killed");
+  // The same relative --out for both, so that manifest.json's out_dir matches.
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 16 -q --out out";
+  CommandRun whole = RunSkybake(bake, "cd '" + root + "/whole' &&");
+  ASSERT_EQ(whole.exit_code, 0) << whole.output;
+
+  const std::string killed = root + "/killed/out";
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    if (chdir((root + "/killed").c_str()) != 0) _exit(127);
+    execl(SKYBAKE_BINARY, "skybake", "bake", Style().c_str(), "--schedule", schedule.c_str(), "--size", "16",
+          "-q", "--out", "out", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Kill once the fifth frame's first file is in place (frames 1-4 done).
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!fs::exists(killed + "/sky_px.0005.exr") && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_EQ(kill(pid, SIGKILL), 0);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "the bake finished before the kill: it was not interrupted";
+
+  // After the kill: every file under a real output name is complete (the
+  // manifest lists the frames done; any other output file has the bytes of
+  // the uninterrupted bake, since it was renamed into place only once whole).
+  const std::set<std::string> after_kill = Names(killed);
+  nlohmann::json partial = nlohmann::json::parse(std::ifstream(killed + "/manifest.json"));
+  EXPECT_FALSE(partial["complete"].get<bool>());
+  EXPECT_GE(partial["frames"].size(), 4u);
+  EXPECT_LT(partial["frames"].size(), 20u);
+  size_t temporaries = 0;
+  for (const std::string& name : after_kill) {
+    if (name[0] == '.') {
+      ++temporaries;  // a hidden temporary of the killed process: never a real output name
+      EXPECT_NE(name.find(".tmp"), std::string::npos) << name;
+      continue;
+    }
+    if (name == "manifest.json") continue;
+    EXPECT_EQ(ReadBytes(killed + "/" + name), ReadBytes(root + "/whole/out/" + name)) << name << " is partial";
+  }
+
+  CommandRun resumed = RunSkybake(bake + " --resume", "cd '" + root + "/killed' &&");
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
+  const std::set<std::string> whole_names = Names(root + "/whole/out");
+  EXPECT_EQ(Names(killed), whole_names) << "no temporary left, no file missing";
+  for (const std::string& name : whole_names) {
+    if (name == "manifest.json") continue;
+    EXPECT_EQ(ReadBytes(killed + "/" + name), ReadBytes(root + "/whole/out/" + name)) << name;
+  }
+  EXPECT_EQ(ManifestWithoutTimings(killed + "/manifest.json"), ManifestWithoutTimings(root + "/whole/out/manifest.json"));
+  std::printf("killed after %zu of 20 frames, %zu temporary file(s) left by the kill and removed by --resume\n",
+              partial["frames"].size(), temporaries);
+
+  // Resuming a finished bake renders nothing and changes no file.
+  CommandRun again = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 16 --out out --resume",
+                                "cd '" + root + "/killed' &&");
+  ASSERT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_EQ(again.output.find(" 8 views"), std::string::npos) << again.output;
+
+  // Another style: no frame matches its recorded style_sha256, so --resume
+  // bakes all twenty again.
+  CommandRun changed = RunSkybake("bake '" + Style() + "' --schedule '" + schedule +
+                                      "' --size 16 --out out --resume --set atmosphere.mie.g=0.7",
+                                  "cd '" + root + "/killed' &&");
+  ASSERT_EQ(changed.exit_code, 0) << changed.output;
+  size_t rendered = 0;
+  for (size_t at = changed.output.find(" 8 views"); at != std::string::npos; at = changed.output.find(" 8 views", at + 1))
+    ++rendered;
+  EXPECT_EQ(rendered, 20u) << changed.output;
+  EXPECT_NE(ReadBytes(killed + "/sky_px.0001.exr"), ReadBytes(root + "/whole/out/sky_px.0001.exr"));
+  fs::remove_all(root);
+}
+
+// A file-size limit (ulimit -f, in KiB) stands in for a full disk: write()
+// fails with EFBIG, as with ENOSPC.
+TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
+  const std::string root = FreshTempDir("full");
+  const std::string out = root + "/out";
+  CommandRun run = RunSkybake("bake '" + Style() + "' --size 64 -q --set output.compression=none --out '" + out + "'",
+                              "ulimit -f 16;");
+  EXPECT_EQ(run.exit_code, 5) << run.output;
+  EXPECT_EQ(run.output, "skybake: error: cannot write " + out + "/sky_px.exr (writing " + out + "/.sky_px.exr.tmp" +
+                            run.output.substr(run.output.find(".tmp") + 4, run.output.find(": File") -
+                                                                               run.output.find(".tmp") - 4) +
+                            ": File too large): the file is larger than the file-size limit (ulimit -f) or the "
+                            "file system allows\n");
+  EXPECT_TRUE(Names(out).empty()) << "left: " << *Names(out).begin();
+  fs::remove_all(root);
+}
+
+// Cube 4096 with latlong 8192x4096: 235 Mtexels x 32 bytes (device buffer
+// and host copy), the 101 Mtexel cube strip's RGB half copy and encoding
+// (x 12 bytes), the preview (34 Mtexels x 22 bytes): 9024 MiB.
+TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
+  CommandRun run = RunSkybake("check '" + Style() + "' --set render.cube_size=4096 --set render.latlong_height=4096");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_EQ(run.output,
+            "skybake: error: the bake needs an estimated 9024 MiB of memory per frame (cube 4096, latlong "
+            "8192x4096), above the budget of 4096 MiB: lower render.cube_size or render.latlong_height, turn off "
+            "outputs, or raise --max-memory-mib (README \"Limits\")\n");
+  CommandRun small_budget = RunSkybake("bake '" + Style() + "' --size 64 --max-memory-mib 1 --out /nonexistent/x");
+  EXPECT_EQ(small_budget.exit_code, 7) << small_budget.output;
+  EXPECT_NE(small_budget.output.find("estimated 2 MiB of memory per frame"), std::string::npos) << small_budget.output;
+  EXPECT_EQ(small_budget.output.find("skybake: device"), std::string::npos) << "no GPU work";
+}
+
+// Cube 2048 and latlong 4096x2048 (58.7 Mtexels) x 4096 steps = 2.41e11
+// samples, at lavapipe's measured 1.2e7 samples/s.
+TEST(SafeOutputs, TimeBudgetRefusesWithTheEstimate) {
+  CommandRun run = RunSkybake("check '" + Style() + "' --set render.cube_size=2048 --set render.latlong_height=2048 "
+                              "--set quality.view_steps=4096");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_EQ(run.output,
+            "skybake: error: the bake needs an estimated 2.41e+11 ray-march samples per frame, about 20044 s of "
+            "lavapipe time, above the budget of 3600 s per frame: lower quality.view_steps, quality.light_steps or "
+            "the sizes, or raise --max-frame-seconds (README \"Limits\")\n");
+  CommandRun ok = RunSkybake("check '" + Style() + "'");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("estimate per frame: 141 MiB of memory (budget 4096), 15.1 s of lavapipe time"),
+            std::string::npos)
+      << ok.output;
+}
+
+// A view larger than the device can bind as one storage buffer (lavapipe:
+// 128 MiB) is refused with the sizes, not a crash or a validation error.
+TEST(SafeOutputs, ViewBeyondTheDeviceLimitIsAClearVulkanError) {
+  const std::string root = FreshTempDir("devicelimit");
+  CommandRun run = RunSkybake("bake '" + Style() + "' --size 2048 --set output.faces=false --set output.latlong=false "
+                              "--set output.preview=false --set gltf.enabled=false --out '" + root + "/out'");
+  EXPECT_EQ(run.exit_code, 4) << run.output;
+  EXPECT_NE(run.output.find("skybake: error: Vulkan: a 2048x12288 view needs 384 MiB in one storage buffer; "),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("allows 128 MiB (maxStorageBufferRange): lower render.cube_size or "
+                            "render.latlong_height\n"),
+            std::string::npos)
+      << run.output;
+  EXPECT_TRUE(Names(root + "/out").empty());
+  fs::remove_all(root);
+}
+
+// Views that fit one by one but not together are rendered in groups: 1024
+// faces and cube strip (192 MiB of views, above lavapipe's 128 MiB) under
+// the validation layer.
+TEST(SafeOutputs, ViewsAboveTheDeviceLimitTogetherAreRenderedInGroups) {
+  const std::string root = FreshTempDir("groups");
+  CommandRun run = RunSkybake("bake '" + Style() + "' --size 1024 --set quality.view_steps=4 --set output.latlong=false "
+                              "--set gltf.enabled=false --set output.preview=false --vulkan-validation -q --out '" +
+                              root + "/out'");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_TRUE(fs::exists(root + "/out/sky_cube.exr"));
+  fs::remove_all(root);
+}
+
+}  // namespace
+}  // namespace skybake

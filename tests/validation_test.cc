@@ -1,0 +1,409 @@
+// The table of bad inputs: each style or schedule below is refused before
+// any GPU work with exactly the message shown (file:line:column, key path,
+// the problem and how to fix it) and the exit code for its kind. Each case
+// runs the binary twice, as `skybake check` and as `skybake bake`, which must
+// say the same and create nothing.
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct BadInput {
+  const char* name;
+  const char* style;     // style.toml; nullptr: no such file
+  const char* schedule;  // schedule.toml given with --schedule; nullptr: none; "MISSING": given, absent
+  const char* args;      // more arguments
+  int exit_code;
+  const char* message;   // the whole output
+};
+
+void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
+
+// clang-format off
+const BadInput kBadInputs[] = {
+    {"UnknownKeyWithSuggestion", R"toml([sun]
+elevaton_deg = 10
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:1: sun.elevaton_deg: unknown key 'elevaton_deg' (did you mean 'sun.elevation_deg'?)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"UnknownTableWithSuggestion", R"toml([atmosphre]
+bottom_radius_km = 6360.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:1:2: atmosphre: unknown key 'atmosphre' (did you mean 'atmosphere'?)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"StringForNumber", R"toml([sun]
+elevation_deg = "high"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:17: sun.elevation_deg: expected a number, got a string\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"IntegerForBoolean", R"toml([effects]
+sun_disc = 1
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:12: effects.sun_disc: expected true or false, got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"RealForInteger", R"toml([render]
+cube_size = 16.5
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:13: render.cube_size: expected an integer, got a number\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"NegativeBottomRadius", R"toml([atmosphere]
+bottom_radius_km = -6360.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:20: atmosphere.bottom_radius_km: -6360 is out of range (0, inf)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"NegativeScaleHeight", R"toml([atmosphere.rayleigh]
+scale_height_km = -8.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:19: atmosphere.rayleigh.scale_height_km: -8 is out of range (0, inf)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"TopRadiusNotAboveBottom", R"toml([atmosphere]
+bottom_radius_km = 6360.0
+top_radius_km = 6360.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:3:17: atmosphere.top_radius_km: top radius 6360 km must be above the bottom radius 6360 km\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"MieGOne", R"toml([atmosphere.mie]
+g = 1.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:5: atmosphere.mie.g: 1 is out of range (-1, 1)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"MieGMinusOne", R"toml([atmosphere.mie]
+g = -1.0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:5: atmosphere.mie.g: -1 is out of range (-1, 1)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"MieGNan", R"toml([atmosphere.mie]
+g = nan
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:5: atmosphere.mie.g: must be a finite number (got nan)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ElevationInfinite", R"toml([sun]
+elevation_deg = inf
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:17: sun.elevation_deg: must be a finite number (got inf)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"TripleWithNan", R"toml([atmosphere]
+ground_albedo = [0.1, nan, 0.1]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:23: atmosphere.ground_albedo[1]: must be a finite number (got nan)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"TripleOfTwo", R"toml([sun]
+irradiance = [1.0, 2.0]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: sun.irradiance: expected a number or an array of 3 numbers [680 nm, 550 nm, 440 nm]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"CubeSizeZero", R"toml([render]
+cube_size = 0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:13: render.cube_size: 0 is out of range [1, 8192]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"CubeSizeAboveLimit", R"toml([render]
+cube_size = 8193
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:13: render.cube_size: 8193 is out of range [1, 8192]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"LatlongHeightNegative", R"toml([render]
+latlong_height = -1
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:18: render.latlong_height: -1 is out of range [1, 8192]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"UnknownPreset", R"toml([quality]
+preset = "ultra"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:10: quality.preset: 'ultra' is not one of 'draft', 'production' or 'reference'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"UnknownIntegrator", R"toml([quality]
+integrator = "euler"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: quality.integrator: 'euler' is not one of 'analytic', 'midpoint', 'trapezoid' or 'simpson'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ViewStepsZero", R"toml([quality]
+view_steps = 0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: quality.view_steps: 0 is out of range [1, 4096]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameParentTraversal", R"toml([output]
+basename = "../evil"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: '../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameAbsolute", R"toml([output]
+basename = "/tmp/evil"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: '/tmp/evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameSubfolder", R"toml([output]
+basename = "a/b"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: 'a/b' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameHidden", R"toml([output]
+basename = ".sky"
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: '.sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNameTraversal", R"toml([output]
+face_names = ["px", "nx", "py", "ny", "pz", "../../nz"]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:45: output.face_names[5]: expected a plain file name (letters, digits, '_', '-', '.', '+')\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNamesFive", R"toml([output]
+face_names = ["px", "nx", "py", "ny", "pz"]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: output.face_names: expected an array of 6 file names\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNamesRepeated", R"toml([output]
+face_names = ["px", "px", "py", "ny", "pz", "nz"]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: output.face_names[1]: 'px' is given twice: each face is its own file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNameClashesWithCubeStrip", R"toml([output]
+face_names = ["cube", "nx", "py", "ny", "pz", "nz"]
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:2:14: output.face_names[0]: 'cube' is the name of another output file: choose another face name\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"MieExtinctionBelowScattering", R"toml([atmosphere.mie]
+scattering_per_km = 0.005
+extinction_per_km = 0.004
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:3:21: atmosphere.mie.extinction_per_km: extinction 0.004 must be at least the scattering 0.005 (channel 0)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SyntaxErrorUnclosedTable", R"toml([sun
+elevation_deg = 10
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:1:5: (syntax): Error while parsing table header: expected ']', saw '\\n'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"DuplicateKey", R"toml([sun]
+elevation_deg = 10
+elevation_deg = 20
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:3:17: (syntax): Error while parsing key-value pair: cannot redefine existing integer 'elevation_deg'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"AllErrorsAtOnce", R"toml([sun]
+elevation_deg = 91
+[atmosphere.mie]
+g = 2
+[render]
+cube_size = 0
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:4:5: atmosphere.mie.g: 2 is out of range (-1, 1)\n"
+         "skybake: error: style.toml:2:17: sun.elevation_deg: 91 is out of range [-90, 90]\n"
+         "skybake: error: style.toml:6:13: render.cube_size: 0 is out of range [1, 8192]\n"
+         "skybake: 3 errors; nothing was baked\n"},
+    {"SetWithoutValue", R"toml()toml",
+     nullptr, "--set render.cube_size", 3,
+         "skybake: error: --set: render.cube_size: expected key.path=value, e.g. --set sun.elevation_deg=10\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetTraversal", R"toml()toml",
+     nullptr, "--set output.basename=../../etc/sky", 3,
+         "skybake: error: --set output.basename=../../etc/sky:1:5: output.basename: '../../etc/sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"MissingStyleFile", nullptr,
+     nullptr, "", 3,
+         "skybake: error: style.toml: (file): cannot open the style file: check the path\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleEmptyTimes", R"toml()toml",
+     R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = []
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:9: schedule.times: the list is empty\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleQuotedTime", R"toml()toml",
+     R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = ["09:30"]
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:10: schedule.times[0]: expected a local time such as 09:30:00 (TOML time, no quotes)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleTimeOutOfRange", R"toml()toml",
+     R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = [25:00:00]
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:12: (syntax): Error while parsing time: expected hour between 0 to 59 (inclusive), saw 25\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleQuotedDate", R"toml()toml",
+     R"toml([schedule]
+date = "2013-05-27"
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = [09:30:00]
+)toml", "", 3,
+         "skybake: error: schedule.toml:2:8: schedule.date: expected a date such as 2013-05-27 (TOML date, no quotes)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleNoFrames", R"toml()toml",
+     R"toml([schedule]
+first_frame = 1
+)toml", "", 3,
+         "skybake: error: schedule.toml:1:1: schedule: no frames: give `times`, `sun` or [[schedule.frames]]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleEmptyElevationList", R"toml()toml",
+     R"toml([schedule]
+sun = { elevation_deg = [], azimuth_deg = 135 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:2:25: schedule.sun.elevation_deg: the list is empty\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleZeroStep", R"toml()toml",
+     R"toml([schedule]
+sun = { elevation_deg = { start = 0, end = 10, step = 0 }, azimuth_deg = 135 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:2:25: schedule.sun.elevation_deg: step 0 cannot go from 0 to 10: use a non-zero step with the sign of end - start\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleUnknownKey", R"toml()toml",
+     R"toml([schedule]
+tiems = [09:30:00]
+sun = { elevation_deg = 10, azimuth_deg = 135 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:2:9: schedule.tiems: unknown key 'tiems' (expected 'first_frame', 'date', 'latitude_deg', 'longitude_deg', 'utc_offset_hours', 'times', 'sun', 'frames', 'ramp', 'per_hour')\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleLatitudeOutOfRange", R"toml()toml",
+     R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 95.0
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = [09:30:00]
+)toml", "", 3,
+         "skybake: error: schedule.toml:3:16: schedule.latitude_deg: latitude must be within [-90, 90]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetsTraversalBasename", R"toml()toml",
+     R"toml([schedule]
+[[schedule.frames]]
+elevation_deg = 10
+azimuth_deg = 135
+set = { "output.basename" = "../../evil" }
+)toml", "", 3,
+         "skybake: error: schedule.toml:5:29: output.basename: frame 1: '../../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampPushesGOutOfRange", R"toml()toml",
+     R"toml([schedule]
+sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
+[schedule.ramp]
+"atmosphere.mie.g" = [0.8, 1.2]
+)toml", "", 3,
+         "skybake: error: schedule.toml:4:22: atmosphere.mie.g: frame 2: 1.2 is out of range (-1, 1)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleMissingFile", R"toml()toml",
+     "MISSING", "", 3,
+         "skybake: error: schedule.toml: (file): cannot open the schedule file: check the path\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampKeyWithEqualsSign", R"toml()toml",
+     R"toml([schedule]
+sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
+[schedule.ramp]
+"atmosphere.mie.g=0.1" = [0.7, 0.8]
+)toml", "", 3,
+         "skybake: error: schedule.toml:4:26: schedule.ramp.atmosphere.mie.g=0.1: 'atmosphere.mie.g=0.1' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetKeyWithSpace", R"toml()toml",
+     R"toml([schedule]
+[[schedule.frames]]
+elevation_deg = 10
+azimuth_deg = 135
+set = { "sun.elevation_deg " = 5 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:5:32: schedule.frames[0].set.sun.elevation_deg : 'sun.elevation_deg ' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"EmptyKey", R"toml("" = 0.007
+)toml",
+     nullptr, "", 3,
+         "skybake: error: style.toml:1:1: \"\": unknown key ''\n"
+         "skybake: 1 error; nothing was baked\n"},
+};
+// clang-format on
+
+class BadInputs : public ::testing::TestWithParam<BadInput> {};
+
+TEST_P(BadInputs, RefusedWithTheExactMessageAndExitCode) {
+  const BadInput& c = GetParam();
+  const std::string dir = testing::FreshTempDir(std::string("bad_") + c.name);
+  if (c.style) std::ofstream(dir + "/style.toml") << c.style;
+  std::string args = "style.toml";
+  if (c.schedule) {
+    if (std::string(c.schedule) != "MISSING") std::ofstream(dir + "/schedule.toml") << c.schedule;
+    args += " --schedule schedule.toml";
+  }
+  args += std::string(" ") + c.args;
+  const std::string cd = "cd '" + dir + "' &&";
+
+  testing::CommandRun check = testing::RunSkybake("check " + args, cd);
+  EXPECT_EQ(check.exit_code, c.exit_code) << check.output;
+  EXPECT_EQ(check.output, c.message);
+
+  testing::CommandRun bake = testing::RunSkybake("bake " + args + " -q --out out", cd);
+  EXPECT_EQ(bake.exit_code, c.exit_code) << bake.output;
+  EXPECT_EQ(bake.output, c.message);
+  EXPECT_FALSE(fs::exists(dir + "/out")) << "nothing is created";
+  // Nothing escaped the folder either (the traversal cases aim at ../evil).
+  EXPECT_FALSE(fs::exists(fs::path(dir).parent_path() / "evil_px.exr"));
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Table, BadInputs, ::testing::ValuesIn(kBadInputs),
+                         [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+
+TEST(BadInputs, TableHasAtLeastThirtyCases) { EXPECT_GE(std::size(kBadInputs), 30u); }
+
+// Usage errors (exit 2) come from the command line itself.
+TEST(BadInputs, SizeOutsideTheCommandLineRangeIsAUsageError) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  for (const char* size : {"0", "8193", "-4"}) {
+    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size " + size + " --out /nonexistent/x");
+    EXPECT_EQ(run.exit_code, 2) << size << ": " << run.output;
+    EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
+  }
+}
+
+}  // namespace
+}  // namespace skybake
