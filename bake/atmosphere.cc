@@ -37,6 +37,10 @@ QualitySettings QualityPreset(const std::string& name) {
 
 std::vector<std::string> QualityPresetNames() { return {"draft", "production", "reference"}; }
 
+bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
+  return q.light_steps <= 0 || e.multiple_scattering || e.ground || e.sun_disc;
+}
+
 gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySettings& q,
                                    const EffectSettings& effects, const Rgb& output_scale) {
   auto v4 = [](const Rgb& rgb, double w) {

@@ -181,7 +181,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Triple("hue.rayleigh_per_km", x.hue.rayleigh_per_km, kNonNegative);
   v.Real("hue.strength", x.hue.strength, kUnit);
   v.Bool("ambiguity.enabled", x.ambiguity.enabled);
-  v.Real("ambiguity.l_pt", x.ambiguity.l_pt, kDomeFraction);
+  v.Real("ambiguity.l_pt", x.ambiguity.l_pt, kUnit);  // 0: no perturbation (pruned)
   v.Real("ambiguity.grain", x.ambiguity.grain, kDomeFraction);
   v.Bool("clouds.enabled", x.clouds.enabled);
   v.Real("clouds.s_noise", x.clouds.s_noise, kDomeFraction);

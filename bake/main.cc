@@ -24,6 +24,7 @@
 #include "skybake/exr_io.h"
 #include "skybake/gallery.h"
 #include "skybake/pipeline.h"
+#include "skybake/pass_plan.h"
 #include "skybake/schedule.h"
 #include "skybake/vulkan_context.h"
 
@@ -70,9 +71,13 @@ struct BakeArgs {
   bool resume = false;
   double max_memory_mib = 4096.0;
   double max_frame_seconds = 3600.0;
+  bool dry_run = false;  // print the plan instead of baking
 };
 
-int RunBake(const BakeArgs& args, bool check_only) {
+enum class Mode { kBake, kCheck, kPlan };
+
+int RunBake(const BakeArgs& args, Mode mode) {
+  const bool check_only = mode == Mode::kCheck;
   // Parse and validate: every error at once, before any GPU work.
   std::vector<std::string> overrides = args.overrides;
   if (args.size > 0) {
@@ -119,6 +124,12 @@ int RunBake(const BakeArgs& args, bool check_only) {
     std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
                          "an inline [schedule]), or use --force to bake a single style again\n");
     return kExitUsage;
+  }
+  if (mode == Mode::kPlan || args.dry_run) {
+    // The passes, LUTs and shader variant the bake would run, and why.
+    PassPlan plan = PlanPasses(schedule ? frame_styles : std::vector<SkyStyle>{config.style});
+    std::printf("%s", FormatPlan(plan, args.style_path + (schedule ? " with " + schedule_path : "")).c_str());
+    return kExitOk;
   }
   if (check_only) {
     std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
@@ -258,6 +269,7 @@ int main(int argc, char** argv) {
   bake->add_flag("--resume", args.resume,
                  "Sequence: keep the frames whose files match their checksums in --out/manifest.json, bake the rest")
       ->excludes(force);
+  bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
   bake->add_flag("--vulkan-validation", args.validation,
                  "Load the Khronos validation layer; any message fails the bake (also "
@@ -265,6 +277,11 @@ int main(int argc, char** argv) {
 
   CLI::App* check = app.add_subcommand("check", "Validate a style without baking");
   add_style_options(check);
+
+  CLI::App* plan = app.add_subcommand(
+      "plan", "Print the passes, LUT sizes, shader variant, estimated work and reuse of a bake, and why each "
+              "effect is on (also: bake --dry-run)");
+  add_style_options(plan);
 
   GalleryArgs gallery_args;
   CLI::App* gallery = app.add_subcommand(
@@ -312,9 +329,10 @@ int main(int argc, char** argv) {
       std::printf("%s", report.c_str());
       return kExitOk;
     }
-    if (check->parsed()) return RunBake(args, true);
+    if (check->parsed()) return RunBake(args, Mode::kCheck);
+    if (plan->parsed()) return RunBake(args, Mode::kPlan);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
-    return RunBake(args, false);
+    return RunBake(args, Mode::kBake);
   } catch (const ConfigFailure& e) {
     PrintErrors(e.errors);
     return kExitConfig;

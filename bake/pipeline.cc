@@ -1,5 +1,7 @@
 #include "skybake/pipeline.h"
 
+#include "skybake/pass_plan.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -86,16 +88,26 @@ class RendererCache {
   // The renderer of the last frame.
   SkyRenderer& Current() { return *main_; }
  private:
-  void Update(const SkyStyle& style) {
+  void Update(const SkyStyle& unpruned) {
+    // The pass plan's pruning: zero-strength and unused effects compiled out.
+    const SkyStyle style = PrunedStyle(unpruned);
     StyledInputs in = StyledInputsOf(style);
     gpu::GpuAtmosphere key =
         ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
-    const AoasSwitches& s = in.aoas.switches;
-    const AoasSwitches& k = aoas_key_.switches;
-    bool same_aoas = s.skydome == k.skydome && s.ambiguity == k.ambiguity &&
-                     s.cloud_noise == k.cloud_noise && s.cloud_shapes == k.cloud_shapes &&
-                     std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0;
-    if (main_ && same_aoas && std::memcmp(&key, &key_, sizeof key) == 0) return;
+    if (main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
+      // Same atmosphere: the LUTs stay; per-texel AOAS parameters (a cloud
+      // drift, say) change in place when the shader variant is the same.
+      if (std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0 &&
+          in.aoas.switches.skydome == aoas_key_.switches.skydome &&
+          in.aoas.switches.ambiguity == aoas_key_.switches.ambiguity &&
+          in.aoas.switches.cloud_noise == aoas_key_.switches.cloud_noise &&
+          in.aoas.switches.cloud_shapes == aoas_key_.switches.cloud_shapes)
+        return;
+      if (main_->UpdateAoas(in.aoas)) {
+        aoas_key_ = in.aoas;
+        return;
+      }
+    }
     main_.reset();
     main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
                                           OutputScale(style.output.units), false, in.aoas);
@@ -691,13 +703,10 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   const bool preview = style.output.preview || style.gltf.enabled;
   const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
   e.memory_mib = bytes / (1024.0 * 1024.0);
-  // Samples: every texel marches view_steps (times light_steps when the Sun's
-  // transmittance is marched too), plus the LUTs (small at any setting).
-  const double per_texel = double(q.view_steps) * (q.light_steps > 0 ? 1.0 + q.light_steps : 1.0);
-  const double lut_samples = double(q.transmittance_width) * q.transmittance_height * q.transmittance_steps +
-                             double(q.multiscattering_size) * q.multiscattering_size * q.multiscattering_sqrt_dirs *
-                                 q.multiscattering_sqrt_dirs * q.multiscattering_steps;
-  e.samples = texels * per_texel + lut_samples;
+  // Samples: the pass plan's count for one frame (each ray-marched texel
+  // marches view_steps, times light_steps when the Sun's transmittance is
+  // marched too; a sky-view texel is one LUT read; plus the LUTs).
+  e.samples = PlanPasses({style}).total_samples;
   e.seconds = e.samples / kLavapipeSamplesPerSecond;
   return e;
 }

@@ -316,18 +316,22 @@ void SkyRenderer::PrecomputeLuts() {
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
   gpu::SkyPush push{};
-  dispatches.push_back({"transmittance LUT", transmittance_pipeline_, push,
-                        GroupCount(gpu_atmosphere_.lut_sizes.x, SKYBAKE_LOCAL_SIZE_X),
-                        GroupCount(gpu_atmosphere_.lut_sizes.y, SKYBAKE_LOCAL_SIZE_Y)});
-  barriers.push_back(true);
+  // A LUT that nothing reads is not computed (pass_plan.h).
+  const bool transmittance = NeedsTransmittanceLut(quality_, effects_);
+  if (transmittance) {
+    dispatches.push_back({"transmittance LUT", transmittance_pipeline_, push,
+                          GroupCount(gpu_atmosphere_.lut_sizes.x, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(gpu_atmosphere_.lut_sizes.y, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+  }
   if (effects_.multiple_scattering) {
     dispatches.push_back({"multiple-scattering LUT", multiscattering_pipeline_, push,
                           GroupCount(gpu_atmosphere_.lut_sizes.z, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(gpu_atmosphere_.lut_sizes.w, SKYBAKE_LOCAL_SIZE_Y)});
     barriers.push_back(true);
   }
-  Submit(dispatches, barriers);
-  ++counters_.transmittance_lut_builds;
+  if (!dispatches.empty()) Submit(dispatches, barriers);
+  if (transmittance) ++counters_.transmittance_lut_builds;
   if (effects_.multiple_scattering) ++counters_.multiscattering_lut_builds;
   luts_ready_ = true;
 }
@@ -371,7 +375,9 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
-  if (quality_.sky_view_lut && !output_directions_ && !(skyview_ready_ && skyview_sun_ == sun)) {
+  // The skydome moves the observer, so its texels ray-march: no sky-view LUT.
+  if (quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ &&
+      !(skyview_ready_ && skyview_sun_ == sun)) {
     // The sky-view LUT depends on the sun only: built once per sun position.
     skyview_ready_ = true;
     skyview_sun_ = sun;
@@ -427,6 +433,16 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
   view.width = int(directions.size());
   view.height = 1;
   return Render(sun, {view}, sun_disc)[0];
+}
+
+bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {
+  const AoasSwitches& s = aoas.switches;
+  if (s.skydome != aoas_switches_.skydome || s.ambiguity != aoas_switches_.ambiguity ||
+      s.cloud_noise != aoas_switches_.cloud_noise || s.cloud_shapes != aoas_switches_.cloud_shapes)
+    return false;
+  // Every submission waits for its fence, so no dispatch reads the buffer now.
+  std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
+  return true;
 }
 
 std::vector<float> SkyRenderer::ReadTransmittanceLut() const {

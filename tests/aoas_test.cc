@@ -235,6 +235,7 @@ SkyStyle Style(const std::string& toml) {
 // A short march keeps the tests fast; every comparison uses the same settings.
 const char* kFastQuality = R"(
 [quality]
+sky_view_lut = false
 view_steps = 16
 transmittance_steps = 64
 multiscattering_steps = 10

@@ -86,6 +86,10 @@ struct EffectSettings {
   double sun_disc_strength = 1.0;             // artistic multiplier of the disc radiance
 };
 
+// Whether the transmittance LUT is read: by the sun transmittance unless
+// marched (light_steps > 0), by multiple scattering, the ground and the disc.
+bool NeedsTransmittanceLut(const QualitySettings& quality, const EffectSettings& effects);
+
 // Unit vector towards the Sun from its elevation above the horizon and its
 // azimuth clockwise from North (compass bearing), in degrees.
 glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth_deg);

@@ -66,6 +66,11 @@ class SkyRenderer {
   std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
                                       const std::vector<glm::dvec3>& directions, bool sun_disc = true);
 
+  // Replaces the per-texel AOAS parameters (drift, strengths, shapes) without
+  // touching the LUTs or pipelines; false when the switches differ (a new
+  // shader variant is needed).
+  bool UpdateAoas(const AoasInputs& aoas);
+
   // LUT contents (RGBA float per texel, row-major), for tests.
   std::vector<float> ReadTransmittanceLut() const;
   std::vector<float> ReadMultipleScatteringLut() const;

@@ -1,0 +1,164 @@
+#include "skybake/pass_plan.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "skybake/aoas.h"
+#include "skybake/pipeline.h"
+
+namespace skybake {
+namespace {
+
+bool AnyPositive(const Rgb& v) { return v[0] > 0.0 || v[1] > 0.0 || v[2] > 0.0; }
+
+// A rough cost per medium sample (3 exponentials, two bilinear LUT reads,
+// phase functions): for the "estimated work" line only.
+constexpr double kFlopPerSample = 60.0;
+
+std::string Size(int w, int h) { return fmt::format("{} x {}", w, h); }
+
+}  // namespace
+
+SkyStyle PrunedStyle(const SkyStyle& style) {
+  SkyStyle s = style;
+  EffectSettings& e = s.effects;
+  const AtmosphereParams& a = style.atmosphere;
+  e.mie = e.mie && (AnyPositive(a.mie_scattering_per_km) || AnyPositive(a.mie_extinction_per_km));
+  e.ozone = e.ozone && AnyPositive(a.ozone_absorption_per_km);
+  e.ground = e.ground && AnyPositive(a.ground_albedo);
+  e.sun_disc = e.sun_disc && e.sun_disc_strength > 0.0 && AnyPositive(a.solar_irradiance);
+  const bool scatters = AnyPositive(style.aoas.hue.enabled ? StyledAtmosphere(a, style.aoas).rayleigh_scattering_per_km
+                                                           : a.rayleigh_scattering_per_km) ||
+                        (e.mie && AnyPositive(a.mie_scattering_per_km));
+  e.multiple_scattering = e.multiple_scattering && e.multiple_scattering_strength > 0.0 && scatters;
+  AoasSettings& x = s.aoas;
+  x.hue.enabled = x.hue.enabled && x.hue.strength > 0.0;
+  x.ambiguity.enabled = x.ambiguity.enabled && x.ambiguity.l_pt > 0.0;
+  x.clouds.enabled = x.clouds.enabled && x.clouds.strength > 0.0;
+  x.shapes.enabled = x.shapes.enabled && x.shapes.strength > 0.0 && !x.shapes.shapes.empty();
+  return s;
+}
+
+bool NeedsSkyViewLut(const SkyStyle& style) {
+  return style.quality.sky_view_lut && !style.aoas.skydome.enabled;
+}
+
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
+  PassPlan plan;
+  plan.frames = int(frames.size());
+  if (frames.empty()) return plan;
+  const SkyStyle& first = frames.front();
+  const SkyStyle pruned = PrunedStyle(first);
+  const EffectSettings& r = first.effects;
+  const EffectSettings& p = pruned.effects;
+  const AtmosphereParams& a = first.atmosphere;
+
+  // Effects, with the keys that decided them.
+  auto decide = [&](const std::string& name, bool requested, bool on, const std::string& why_off,
+                    const std::string& why_on) {
+    plan.effects.push_back({name, requested, on, on ? why_on : (requested ? why_off : "switched off in the style")});
+  };
+  decide("multiple scattering", r.multiple_scattering, p.multiple_scattering,
+         "effects.multiple_scattering_strength = 0 or nothing scatters",
+         fmt::format("effects.multiple_scattering = true, strength {}", r.multiple_scattering_strength));
+  decide("Mie (aerosols)", r.mie, p.mie, "atmosphere.mie coefficients are all 0",
+         "atmosphere.mie.scattering_per_km / extinction_per_km > 0");
+  decide("ozone", r.ozone, p.ozone, "atmosphere.ozone.absorption_per_km is 0",
+         "atmosphere.ozone.absorption_per_km > 0");
+  decide("ground bounce", r.ground, p.ground, "atmosphere.ground_albedo is 0",
+         fmt::format("atmosphere.ground_albedo = [{}, {}, {}]", a.ground_albedo[0], a.ground_albedo[1],
+                     a.ground_albedo[2]));
+  decide("sun disc", r.sun_disc, p.sun_disc, "effects.sun_disc_strength = 0 or no irradiance",
+         fmt::format("effects.sun_disc = true, strength {}", r.sun_disc_strength));
+  const AoasSettings& xr = first.aoas;
+  const AoasSettings& xp = pruned.aoas;
+  decide("skydome (AOAS 3.2)", xr.skydome.enabled, xp.skydome.enabled, "", "[skydome] enabled = true");
+  decide("hue override", xr.hue.enabled, xp.hue.enabled, "hue.strength = 0",
+         fmt::format("[hue] enabled, strength {}", xr.hue.strength));
+  decide("ambiguity (eq. 5-6)", xr.ambiguity.enabled, xp.ambiguity.enabled, "ambiguity.l_pt = 0",
+         fmt::format("[ambiguity] enabled, l_pt {}", xr.ambiguity.l_pt));
+  decide("cloud noise (eq. 7-8)", xr.clouds.enabled, xp.clouds.enabled, "clouds.strength = 0",
+         fmt::format("[clouds] enabled, strength {}", xr.clouds.strength));
+  decide("cloud shapes", xr.shapes.enabled, xp.shapes.enabled, "shapes.strength = 0 or no shape",
+         fmt::format("[shapes] enabled, {} shapes", xr.shapes.shapes.size()));
+  plan.effects.push_back({"twilight and night dimming", false, false, "not implemented"});
+
+  // Distinct atmospheres over the frames: each one rebuilds the LUTs.
+  std::vector<gpu::GpuAtmosphere> keys;
+  for (const SkyStyle& f : frames) {
+    SkyStyle fp = PrunedStyle(f);
+    gpu::GpuAtmosphere key = ToGpuAtmosphere(StyledAtmosphere(fp.atmosphere, fp.aoas), fp.quality, fp.effects,
+                                             OutputScale(fp.output.units));
+    bool seen = std::any_of(keys.begin(), keys.end(), [&](const gpu::GpuAtmosphere& k) {
+      return std::memcmp(&k, &key, sizeof key) == 0;
+    });
+    if (!seen) keys.push_back(key);
+  }
+  plan.atmospheres = int(keys.size());
+
+  const QualitySettings& q = first.quality;
+  const int light = std::max(q.light_steps, 1);
+  if (NeedsTransmittanceLut(q, p))
+    plan.passes.push_back({"transmittance LUT", Size(q.transmittance_width, q.transmittance_height),
+                           "once per atmosphere", plan.atmospheres,
+                           double(q.transmittance_width) * q.transmittance_height * q.transmittance_steps});
+  if (p.multiple_scattering)
+    plan.passes.push_back({"multiple-scattering LUT", Size(q.multiscattering_size, q.multiscattering_size),
+                           "once per atmosphere", plan.atmospheres,
+                           double(q.multiscattering_size) * q.multiscattering_size * q.multiscattering_sqrt_dirs *
+                               q.multiscattering_sqrt_dirs * q.multiscattering_steps});
+  const bool sky_view = NeedsSkyViewLut(pruned);
+  if (sky_view)
+    plan.passes.push_back({"sky-view LUT", Size(q.sky_view_width, q.sky_view_height), "once per frame",
+                           plan.frames, double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
+  const double per_texel = sky_view ? 1.0 : double(q.view_steps) * light;
+  for (const ViewRequest& v : PlanViews(first)) {
+    std::string name = v.mapping == MAPPING_LATLONG      ? "render latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP ? "render cube strip"
+                                                         : fmt::format("render face {}", v.face);
+    plan.passes.push_back({name, Size(v.width, v.height), sky_view ? "once per frame (LUT reads)" : "once per frame",
+                           plan.frames, double(v.width) * v.height * per_texel});
+  }
+  for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+
+  static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
+  plan.variant = fmt::format(
+      "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} skydome={} ambiguity={} "
+      "cloud_noise={} cloud_shapes={} integrator={} sky_view={}",
+      p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, xp.skydome.enabled, xp.ambiguity.enabled,
+      xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
+  if (plan.frames > 1) {
+    if (plan.atmospheres == 1)
+      plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +
+                            std::to_string(plan.frames) + " frames (the atmosphere does not change)");
+    else
+      plan.reused.push_back(fmt::format("transmittance and multiple-scattering LUTs: built {} times, once per "
+                                        "distinct atmosphere of the schedule",
+                                        plan.atmospheres));
+    plan.reused.push_back("pipelines: compiled once per atmosphere, never per frame");
+  }
+  return plan;
+}
+
+std::string FormatPlan(const PassPlan& plan, const std::string& source) {
+  std::string out = fmt::format("plan for {}: {} frame{}, {} atmosphere{}\n\neffects:\n", source, plan.frames,
+                                plan.frames == 1 ? "" : "s", plan.atmospheres, plan.atmospheres == 1 ? "" : "s");
+  for (const EffectDecision& e : plan.effects)
+    out += fmt::format("  {:<28} {:<4} {}\n", e.name, e.on ? "on" : "off", e.reason);
+  out += "\npasses:\n";
+  for (const PlannedPass& p : plan.passes)
+    out += fmt::format("  {:<26} {:>12}  {:<28} x{:<5} {:>10.3g} samples/run\n", p.name, p.size, p.frequency,
+                       p.runs, p.samples);
+  out += fmt::format("\nshader variant:\n  {}\n", plan.variant);
+  out += fmt::format("\nestimated work: {:.3g} medium samples, about {:.3g} GFLOP at ~{} FLOP per sample\n",
+                     plan.total_samples, plan.total_samples * kFlopPerSample * 1e-9, int(kFlopPerSample));
+  if (!plan.reused.empty()) {
+    out += "\nreused across frames:\n";
+    for (const std::string& r : plan.reused) out += "  " + r + "\n";
+  }
+  return out;
+}
+
+}  // namespace skybake

@@ -1,0 +1,181 @@
+// The pass planner: plans contain exactly the expected passes, LUTs are built
+// once per atmosphere, and pruning never changes the image (an effect at
+// zero strength compiled in equals the effect compiled out).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include <gtest/gtest.h>
+#include <glm/glm.hpp>
+
+#include "skybake/aoas.h"
+#include "skybake/pass_plan.h"
+#include "skybake/sky_renderer.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+SkyStyle Style(const std::string& toml, const std::vector<std::string>& overrides = {}) {
+  ConfigResult r = ParseSkyStyle(toml, "plan_test.toml", overrides);
+  EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].Format());
+  return r.style;
+}
+
+std::vector<std::string> PassNames(const PassPlan& plan) {
+  std::vector<std::string> names;
+  for (const PlannedPass& p : plan.passes) names.push_back(p.name);
+  return names;
+}
+
+const EffectDecision& Effect(const PassPlan& plan, const std::string& name) {
+  for (const EffectDecision& e : plan.effects)
+    if (e.name == name) return e;
+  static EffectDecision missing{"missing", false, false, ""};
+  return missing;
+}
+
+const std::vector<std::string> kRenderPasses = {"render face 0", "render face 1", "render face 2",
+                                                "render face 3", "render face 4", "render face 5",
+                                                "render cube strip", "render latlong"};
+
+std::vector<std::string> With(std::vector<std::string> head, const std::vector<std::string>& tail) {
+  head.insert(head.end(), tail.begin(), tail.end());
+  return head;
+}
+
+TEST(PassPlanTest, DefaultStyleRunsEveryPhysicalPass) {
+  PassPlan plan = PlanPasses({Style("[atmosphere]\nground_albedo = 0.1\n")});
+  EXPECT_EQ(PassNames(plan),
+            With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"}, kRenderPasses));
+  for (const char* e : {"multiple scattering", "Mie (aerosols)", "ozone", "ground bounce", "sun disc"})
+    EXPECT_TRUE(Effect(plan, e).on) << e;
+  for (const char* e : {"skydome (AOAS 3.2)", "hue override", "ambiguity (eq. 5-6)", "cloud noise (eq. 7-8)",
+                        "cloud shapes"})
+    EXPECT_FALSE(Effect(plan, e).on) << e;
+  EXPECT_NE(plan.variant.find("multiple_scattering=true"), std::string::npos) << plan.variant;
+}
+
+TEST(PassPlanTest, UnreadLutsAreNotComputed) {
+  // No multiple scattering: no multiple-scattering LUT.
+  PassPlan no_ms = PlanPasses({Style("[effects]\nmultiple_scattering = false\n")});
+  EXPECT_EQ(PassNames(no_ms), With({"transmittance LUT", "sky-view LUT"}, kRenderPasses));
+  // Ray-marching every texel: no sky-view LUT.
+  PassPlan march = PlanPasses({Style("[quality]\nsky_view_lut = false\n")});
+  EXPECT_EQ(PassNames(march), With({"transmittance LUT", "multiple-scattering LUT"}, kRenderPasses));
+  // Sun transmittance marched and nothing else reading the transmittance LUT.
+  PassPlan marched = PlanPasses({Style(
+      "[quality]\nsky_view_lut = false\nlight_steps = 8\n[effects]\nmultiple_scattering = false\n"
+      "sun_disc = false\nground = false\n")});
+  EXPECT_EQ(PassNames(marched), kRenderPasses);
+  // The skydome moves the observer: its texels ray-march, no sky-view LUT.
+  PassPlan dome = PlanPasses({Style("[skydome]\nenabled = true\nviewer_position = [0.0, 0.3, 0.0]\n")});
+  EXPECT_EQ(PassNames(dome), With({"transmittance LUT", "multiple-scattering LUT"}, kRenderPasses));
+  // Only a latlong requested: one render pass.
+  PassPlan latlong = PlanPasses({Style("[output]\nfaces = false\ncube_strip = false\n")});
+  EXPECT_EQ(PassNames(latlong), With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"},
+                                     {"render latlong"}));
+}
+
+TEST(PassPlanTest, ZeroStrengthEffectsArePrunedWithTheirReason) {
+  PassPlan plan = PlanPasses({Style(
+      "[atmosphere]\nground_albedo = 0.0\n[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0\n"
+      "[atmosphere.ozone]\nabsorption_per_km = 0.0\n[effects]\nmultiple_scattering_strength = 0.0\n"
+      "sun_disc_strength = 0.0\n[clouds]\nenabled = true\nstrength = 0.0\n")});
+  for (const char* e : {"multiple scattering", "Mie (aerosols)", "ozone", "ground bounce", "sun disc",
+                        "cloud noise (eq. 7-8)"}) {
+    EXPECT_TRUE(Effect(plan, e).requested) << e;
+    EXPECT_FALSE(Effect(plan, e).on) << e;
+  }
+  EXPECT_EQ(Effect(plan, "ozone").reason, "atmosphere.ozone.absorption_per_km is 0");
+  EXPECT_EQ(PassNames(plan), With({"transmittance LUT", "sky-view LUT"}, kRenderPasses));
+  EXPECT_NE(plan.variant.find("mie=false ozone=false"), std::string::npos) << plan.variant;
+}
+
+TEST(PassPlanTest, LutsAreBuiltOncePerAtmosphereOfASchedule) {
+  std::vector<SkyStyle> same, changing;
+  for (int i = 0; i < 12; ++i) {
+    same.push_back(Style("", {"sun.elevation_deg=" + std::to_string(5 * i)}));
+    changing.push_back(Style("", {"atmosphere.mie.g=" + std::to_string(0.5 + 0.01 * i)}));
+  }
+  PassPlan a = PlanPasses(same);
+  EXPECT_EQ(a.atmospheres, 1);
+  EXPECT_EQ(a.passes[0].runs, 1);   // transmittance LUT
+  EXPECT_EQ(a.passes[2].runs, 12);  // sky-view LUT, per frame
+  EXPECT_FALSE(a.reused.empty());
+  EXPECT_EQ(PlanPasses(changing).atmospheres, 12);
+}
+
+// Pruning never changes the output: for every effect, the effect compiled in
+// at zero strength renders what the pruned style (effect compiled out)
+// renders, to float rounding.
+struct Equivalence {
+  std::string effect;
+  std::string zero_strength_toml;
+};
+
+class PruningEquivalenceTest : public ::testing::TestWithParam<Equivalence> {};
+
+TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
+  const Equivalence& eq = GetParam();
+  const bool sets_atmosphere = eq.zero_strength_toml.find("[atmosphere]") != std::string::npos;
+  SkyStyle zero = Style(eq.zero_strength_toml + (sets_atmosphere ? "" : "\n[atmosphere]\nground_albedo = 0.1\n"));
+  SkyStyle pruned = PrunedStyle(zero);
+  const Rgb scale = OutputScale(zero.output.units);
+  auto make = [&](const SkyStyle& s) {
+    return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(s.atmosphere, s.aoas), s.quality,
+                                         s.effects, scale, false,
+                                         ToAoasInputs(s.aoas, OutputScale(OutputUnits::kLuminance)));
+  };
+  auto compiled_in = make(zero);
+  auto compiled_out = make(pruned);
+  const std::vector<ViewRequest> views = {{MAPPING_LATLONG, 64, 32, 0}, {MAPPING_VULKAN_FACE, 16, 16, 2}};
+  for (double elevation : {35.0, 3.0}) {
+    glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 160.0);
+    auto a = compiled_in->Render(sun, views);
+    auto b = compiled_out->Render(sun, views);
+    double worst = 0.0, max_value = 0.0;
+    for (size_t v = 0; v < views.size(); ++v)
+      for (size_t i = 0; i < a[v].size(); ++i) max_value = std::max(max_value, double(b[v][i]));
+    for (size_t v = 0; v < views.size(); ++v)
+      for (size_t i = 0; i < a[v].size(); ++i) {
+        if (i % 4 == 3) continue;
+        double diff = std::abs(double(a[v][i]) - double(b[v][i]));
+        worst = std::max(worst, diff / std::max(double(b[v][i]), 1e-6 * max_value));
+      }
+    // Float rounding: a handful of ulps of float32.
+    EXPECT_LE(worst, 1e-5) << eq.effect << " at sun " << elevation;
+    std::printf("%-22s sun %4.1f: pruned vs zero strength max relative difference %.2e\n", eq.effect.c_str(),
+                elevation, worst);
+  }
+  const EffectSettings& z = zero.effects;
+  const EffectSettings& p = pruned.effects;
+  const bool differs = z.multiple_scattering != p.multiple_scattering || z.mie != p.mie || z.ozone != p.ozone ||
+                       z.ground != p.ground || z.sun_disc != p.sun_disc ||
+                       zero.aoas.clouds.enabled != pruned.aoas.clouds.enabled ||
+                       zero.aoas.shapes.enabled != pruned.aoas.shapes.enabled ||
+                       zero.aoas.ambiguity.enabled != pruned.aoas.ambiguity.enabled ||
+                       zero.aoas.hue.enabled != pruned.aoas.hue.enabled;
+  EXPECT_TRUE(differs) << eq.effect << ": the pruned style must compile the effect out";
+  testing::ExpectNoValidationMessages();
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Effects, PruningEquivalenceTest,
+    ::testing::Values(
+        Equivalence{"multiple_scattering", "[effects]\nmultiple_scattering_strength = 0.0"},
+        Equivalence{"mie", "[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0"},
+        Equivalence{"ozone", "[atmosphere.ozone]\nabsorption_per_km = 0.0"},
+        Equivalence{"ground", "[effects]\nground = true\n[atmosphere]\nground_albedo = 0.0"},
+        Equivalence{"sun_disc", "[effects]\nsun_disc_strength = 0.0"},
+        Equivalence{"hue", "[hue]\nenabled = true\ncolor = \"#ff3300\"\nstrength = 0.0"},
+        Equivalence{"ambiguity", "[ambiguity]\nenabled = true\nl_pt = 0.0"},
+        Equivalence{"cloud_noise", "[clouds]\nenabled = true\nstrength = 0.0"},
+        Equivalence{"cloud_shapes",
+                    "[shapes]\nenabled = true\nstrength = 0.0\n[[shapes.shape]]\nkind = \"point\"\n"
+                    "points = [[30.0, 160.0]]"}),
+    [](const ::testing::TestParamInfo<Equivalence>& info) { return info.param.effect; });
+
+}  // namespace
+}  // namespace skybake
