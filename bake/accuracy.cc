@@ -54,6 +54,7 @@ AtmosphereParameters FromParams(const AtmosphereParams& a) {
   atm.limb_darkening = a.limb_darkening_u;
   atm.mie = true;
   atm.ozone = true;
+  atm.night = false;
   return atm;
 }
 

@@ -37,6 +37,13 @@ QualitySettings QualityPreset(const std::string& name) {
 
 std::vector<std::string> QualityPresetNames() { return {"draft", "production", "reference"}; }
 
+Rgb NightSkyRadiance(const EffectSettings& e) {
+  // Bruneton 2017's SKY_SPECTRAL_RADIANCE_TO_LUMINANCE (lm/W) per channel:
+  // radiance L / K_c gives Rec.709 (L, L, L), neutral of luminance L.
+  const Rgb k = {114974.916437, 71305.954816, 65310.548555};
+  return {e.night_sky_luminance_cd_m2 / k[0], e.night_sky_luminance_cd_m2 / k[1], e.night_sky_luminance_cd_m2 / k[2]};
+}
+
 bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
   return q.light_steps <= 0 || e.multiple_scattering || e.ground || e.sun_disc;
 }
@@ -63,6 +70,7 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
                q.multiscattering_sqrt_dirs};
   g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, q.step_distribution};
   g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
+  g.night = v4(NightSkyRadiance(effects), effects.night_dimming_strength);
   return g;
 }
 

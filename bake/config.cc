@@ -128,6 +128,9 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("effects.ozone", s.effects.ozone);
   v.Real("effects.multiple_scattering_strength", s.effects.multiple_scattering_strength, kNonNegative);
   v.Real("effects.sun_disc_strength", s.effects.sun_disc_strength, kNonNegative);
+  v.Bool("effects.night_dimming", s.effects.night_dimming);
+  v.Real("effects.night_dimming_strength", s.effects.night_dimming_strength, kUnit);
+  v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
 
   QualitySettings& q = s.quality;
   v.Preset("quality.preset", s.quality_preset, q);  // first: the keys below refine it

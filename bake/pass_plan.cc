@@ -33,6 +33,7 @@ SkyStyle PrunedStyle(const SkyStyle& style) {
                                                            : a.rayleigh_scattering_per_km) ||
                         (e.mie && AnyPositive(a.mie_scattering_per_km));
   e.multiple_scattering = e.multiple_scattering && e.multiple_scattering_strength > 0.0 && scatters;
+  e.night_dimming = e.night_dimming && e.night_dimming_strength > 0.0;
   AoasSettings& x = s.aoas;
   x.hue.enabled = x.hue.enabled && x.hue.strength > 0.0;
   x.ambiguity.enabled = x.ambiguity.enabled && x.ambiguity.l_pt > 0.0;
@@ -83,7 +84,9 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
          fmt::format("[clouds] enabled, strength {}", xr.clouds.strength));
   decide("cloud shapes", xr.shapes.enabled, xp.shapes.enabled, "shapes.strength = 0 or no shape",
          fmt::format("[shapes] enabled, {} shapes", xr.shapes.shapes.size()));
-  plan.effects.push_back({"twilight and night dimming", false, false, "not implemented"});
+  decide("twilight and night dimming", r.night_dimming, p.night_dimming, "effects.night_dimming_strength = 0",
+         fmt::format("effects.night_dimming = true, strength {}, night sky {} cd/m^2", r.night_dimming_strength,
+                     r.night_sky_luminance_cd_m2));
 
   // Distinct atmospheres over the frames: each one rebuilds the LUTs.
   std::vector<gpu::GpuAtmosphere> keys;
@@ -125,9 +128,10 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
 
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
   plan.variant = fmt::format(
-      "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} skydome={} ambiguity={} "
+      "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} night={} skydome={} ambiguity={} "
       "cloud_noise={} cloud_shapes={} integrator={} sky_view={}",
-      p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, xp.skydome.enabled, xp.ambiguity.enabled,
+      p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
+      xp.ambiguity.enabled,
       xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
   if (plan.frames > 1) {
     if (plan.atmospheres == 1)

@@ -167,6 +167,10 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
   atm.ozone = effects.ozone;
   atm.multiple_scattering_strength = effects.multiple_scattering_strength;
   atm.sun_disc_strength = effects.sun_disc_strength;
+  atm.night = effects.night_dimming;
+  Rgb night = NightSkyRadiance(effects);
+  atm.night_radiance = ToVec(night);
+  atm.night_strength = effects.night_dimming_strength;
   impl_->output_scale = ToVec(output_scale);
   impl_->transmittance.assign(size_t(q.transmittance_width) * q.transmittance_height, glm::dvec3(1.0));
   impl_->multiscattering.assign(size_t(q.multiscattering_size) * q.multiscattering_size, glm::dvec3(0.0));

@@ -217,15 +217,17 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
     VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
     int32_t integrator;
-    VkBool32 sky_view, mie, ozone;
+    VkBool32 sky_view, mie, ozone, night;
   } values = {effects_.multiple_scattering, sun_disc,      effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
-              quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone};
-  const VkSpecializationMapEntry entries[12] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+              quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
+              effects_.night_dimming};
+  const VkSpecializationMapEntry entries[13] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
                                                 {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
-                                                {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4}};
-  VkSpecializationInfo specialization{12, entries, sizeof(values), &values};
+                                                {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4},
+                                                {14, 48, 4}};
+  VkSpecializationInfo specialization{13, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;

@@ -331,6 +331,7 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
     vec3 color = radiance * aoas.color_scale;
     radiance = ScaleSaturation(color, keep) / aoas.color_scale;
   }
+  if (atm.night) radiance = ApplyNightDimming(atm, radiance, w, sun);
   return radiance;
 }
 

@@ -70,6 +70,9 @@ struct AtmosphereParameters {
   bool ozone;                   // ozone absorption present
   Real multiple_scattering_strength;  // multiplies Psi_ms
   Real sun_disc_strength;       // multiplies the disc radiance
+  bool night;                   // twilight and night dimming
+  vec3 night_radiance;          // night-sky floor, units of solar_irradiance per sr
+  Real night_strength;          // 0: off .. 1: the full night look
 };
 
 // ---------------------------------------------------------------- medium
@@ -634,6 +637,18 @@ vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   vec3 radiance = sky.radiance;
   if (atm.sun_disc) radiance += SunDiscContribution(atm, view, sun, sky.transmittance);
   return radiance * atm.solar_irradiance;
+}
+
+// Twilight and night dimming (an artistic effect): between the end of civil
+// twilight (sun at -6 deg) and astronomical night (-18 deg) the sky blends,
+// by night_strength, from the physical sky to a night-sky floor (airglow and
+// starlight) above the horizon and to black below it.
+vec3 ApplyNightDimming(IN(AtmosphereParameters) atm, vec3 radiance, vec3 view, vec3 sun) {
+  // 1 - smoothstep(sin(-18 deg), sin(-6 deg), sun.y): 0 by day, 1 at night.
+  Real night = 1.0 - smoothstep(-0.30901699437494740, -0.10452846326765347, sun.y);
+  Real k = atm.night_strength * night;
+  vec3 floor_radiance = view.y > 0.0 ? atm.night_radiance : vec3(0.0);
+  return radiance * (1.0 - k) + floor_radiance * k;
 }
 
 // ---------------------------------------------------------------- sky-view LUT

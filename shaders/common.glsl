@@ -37,6 +37,7 @@ layout(constant_id = 1) const bool kSunDisc = true;
 layout(constant_id = 2) const bool kGround = true;
 layout(constant_id = 12) const bool kMie = true;
 layout(constant_id = 13) const bool kOzone = true;
+layout(constant_id = 14) const bool kNight = false;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
 // The AOAS principles (AoasSwitches); a style that does not use one compiles
@@ -108,6 +109,9 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.ozone = kOzone;
   atm.multiple_scattering_strength = gpu_atmosphere.strengths.x;
   atm.sun_disc_strength = gpu_atmosphere.strengths.y;
+  atm.night = kNight;
+  atm.night_radiance = gpu_atmosphere.night.xyz;
+  atm.night_strength = gpu_atmosphere.night.w;
   return atm;
 }
 

@@ -93,6 +93,34 @@ TEST(PassPlanTest, ZeroStrengthEffectsArePrunedWithTheirReason) {
   EXPECT_NE(plan.variant.find("mie=false ozone=false"), std::string::npos) << plan.variant;
 }
 
+TEST(NightDimmingTest, NightSkyIsTheFloorAndDayIsUntouched) {
+  // Sun at -25 deg, full strength: the sky above the horizon is the neutral
+  // night floor of 1.7e-4 cd/m^2 (luminance output), the ground black; by day
+  // the effect changes nothing.
+  SkyStyle night = Style("[effects]\nnight_dimming = true\n");
+  SkyStyle plain = Style("");
+  auto render = [](const SkyStyle& s, double elevation) {
+    SkyRenderer r(testing::Vulkan(), s.atmosphere, s.quality, s.effects, OutputScale(s.output.units), false,
+                  ToAoasInputs(s.aoas, OutputScale(OutputUnits::kLuminance)));
+    return r.Render(SunDirectionFromElevationAzimuth(elevation, 90.0), {{MAPPING_LATLONG, 32, 16, 0}})[0];
+  };
+  std::vector<float> dark = render(night, -25.0);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 32; ++x) {
+      const float* p = &dark[(size_t(y) * 32 + x) * 4];
+      for (int c = 0; c < 3; ++c) {
+        if (y < 7) {
+          EXPECT_NEAR(p[c], 1.7e-4, 1e-9) << x << " " << y;  // rows above the horizon
+        } else if (y > 8) {
+          EXPECT_EQ(p[c], 0.0f) << x << " " << y;  // rows below it
+        }
+      }
+    }
+  std::vector<float> day_a = render(night, 20.0), day_b = render(plain, 20.0);
+  for (size_t i = 0; i < day_a.size(); ++i) EXPECT_EQ(day_a[i], day_b[i]);
+  testing::ExpectNoValidationMessages();
+}
+
 TEST(PassPlanTest, LutsAreBuiltOncePerAtmosphereOfASchedule) {
   std::vector<SkyStyle> same, changing;
   for (int i = 0; i < 12; ++i) {
@@ -131,7 +159,7 @@ TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
   auto compiled_in = make(zero);
   auto compiled_out = make(pruned);
   const std::vector<ViewRequest> views = {{MAPPING_LATLONG, 64, 32, 0}, {MAPPING_VULKAN_FACE, 16, 16, 2}};
-  for (double elevation : {35.0, 3.0}) {
+  for (double elevation : {35.0, 3.0, -12.0}) {
     glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 160.0);
     auto a = compiled_in->Render(sun, views);
     auto b = compiled_out->Render(sun, views);
@@ -152,7 +180,7 @@ TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
   const EffectSettings& z = zero.effects;
   const EffectSettings& p = pruned.effects;
   const bool differs = z.multiple_scattering != p.multiple_scattering || z.mie != p.mie || z.ozone != p.ozone ||
-                       z.ground != p.ground || z.sun_disc != p.sun_disc ||
+                       z.ground != p.ground || z.sun_disc != p.sun_disc || z.night_dimming != p.night_dimming ||
                        zero.aoas.clouds.enabled != pruned.aoas.clouds.enabled ||
                        zero.aoas.shapes.enabled != pruned.aoas.shapes.enabled ||
                        zero.aoas.ambiguity.enabled != pruned.aoas.ambiguity.enabled ||
@@ -169,6 +197,7 @@ INSTANTIATE_TEST_SUITE_P(
         Equivalence{"ozone", "[atmosphere.ozone]\nabsorption_per_km = 0.0"},
         Equivalence{"ground", "[effects]\nground = true\n[atmosphere]\nground_albedo = 0.0"},
         Equivalence{"sun_disc", "[effects]\nsun_disc_strength = 0.0"},
+        Equivalence{"night_dimming", "[effects]\nnight_dimming = true\nnight_dimming_strength = 0.0"},
         Equivalence{"hue", "[hue]\nenabled = true\ncolor = \"#ff3300\"\nstrength = 0.0"},
         Equivalence{"ambiguity", "[ambiguity]\nenabled = true\nl_pt = 0.0"},
         Equivalence{"cloud_noise", "[clouds]\nenabled = true\nstrength = 0.0"},

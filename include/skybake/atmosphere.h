@@ -84,7 +84,17 @@ struct EffectSettings {
   bool ozone = true;             // ozone absorption
   double multiple_scattering_strength = 1.0;  // artistic multiplier of Hillaire's Psi_ms
   double sun_disc_strength = 1.0;             // artistic multiplier of the disc radiance
+  // Twilight and night dimming: from sun -6 deg to -18 deg the sky blends to a
+  // night-sky floor of this luminance (cd/m^2; 1.7e-4 is a dark natural sky,
+  // 22 mag/arcsec^2 by L = 10.8e4 x 10^(-0.4 m) cd/m^2).
+  bool night_dimming = false;
+  double night_dimming_strength = 1.0;
+  double night_sky_luminance_cd_m2 = 1.7e-4;
 };
+
+// The night-sky floor as radiance in the renderer's spectral units (W m^-2
+// sr^-1 nm^-1 at 680/550/440 nm), neutral in Rec.709, from its luminance.
+Rgb NightSkyRadiance(const EffectSettings& effects);
 
 // Whether the transmittance LUT is read: by the sun transmittance unless
 // marched (light_steps > 0), by multiple scattering, the ground and the disc.

@@ -62,6 +62,7 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 effects;               // x: multiple scattering on; y: sun disc on; z: ground on; w: ms sqrt(directions)
   ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
   vec4 strengths;              // x: multiple-scattering strength; y: sun-disc strength; zw: unused
+  vec4 night;                  // xyz: night-sky radiance (output units before output_scale); w: strength
 };
 
 // Most cloud-shape segments a style can have (GpuAoas.shape_segments). A
@@ -116,7 +117,7 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuAtmosphere) == 13 * 16, "GpuAtmosphere must be vec4-packed");
+static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 3 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
               "GpuAoas must be vec4-packed");
