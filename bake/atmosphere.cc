@@ -15,8 +15,8 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 
 // Each preset is the cheapest case of the accuracy study's Pareto front that
 // meets its bound (docs/accuracy.md, `skybake accuracy`):
-//   draft       analytic 48 quadratic steps, sky-view LUT 192 x 108   1.06e-2
-//   production  analytic 48 quadratic steps, sky-view LUT 384 x 216   3.95e-3
+//   draft       analytic 48 quadratic steps, sky-view LUT 192 x 108   1.05e-2
+//   production  analytic 48 quadratic steps, sky-view LUT 384 x 216   3.65e-3
 //   reference   Simpson 64 quadratic steps per texel, transmittance
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
 QualitySettings QualityPreset(const std::string& name) {

@@ -48,8 +48,8 @@ struct AtmosphereParams {
 };
 
 // Integration settings. The defaults are the `production` preset, chosen
-// from the accuracy study (docs/accuracy.md): max relative error 3.95e-3 of
-// single scattering over the upper hemisphere, sun 3..90 deg.
+// from the accuracy study (docs/accuracy.md): max relative error of
+// single scattering over the upper hemisphere, sun 3..90 deg (3.65e-3).
 struct QualitySettings {
   int view_steps = 48;                // ray-march steps per output texel (or sky-view texel)
   int transmittance_steps = 256;      // quadrature points per transmittance texel
