@@ -20,6 +20,7 @@
 #include "skybake/sky_renderer.h"
 #include "skybake/tonemap.h"
 #include "skybake/vulkan_context.h"
+#include "shared_params.h"
 
 namespace skybake {
 namespace converged {
@@ -34,24 +35,8 @@ vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #include "atmosphere.glsl"
 
 AtmosphereParameters FromParams(const AtmosphereParams& a) {
-  auto v = [](const Rgb& c) { return vec3(c[0], c[1], c[2]); };
   AtmosphereParameters atm{};
-  atm.bottom_radius = a.bottom_radius_km;
-  atm.top_radius = a.top_radius_km;
-  atm.observer_altitude = a.observer_altitude_m * 1e-3;
-  atm.rayleigh_scattering = v(a.rayleigh_scattering_per_km);
-  atm.rayleigh_scale_height = a.rayleigh_scale_height_km;
-  atm.mie_scattering = v(a.mie_scattering_per_km);
-  atm.mie_extinction = v(a.mie_extinction_per_km);
-  atm.mie_scale_height = a.mie_scale_height_km;
-  atm.mie_g = a.mie_g;
-  atm.absorption_extinction = v(a.ozone_absorption_per_km);
-  atm.ozone_peak_altitude = a.ozone_peak_altitude_km;
-  atm.ozone_half_width = a.ozone_half_width_km;
-  atm.ground_albedo = v(a.ground_albedo);
-  atm.solar_irradiance = v(a.solar_irradiance);
-  atm.sun_angular_radius = a.sun_angular_radius_rad;
-  atm.limb_darkening = a.limb_darkening_u;
+  FillPhysicalParameters(a, atm);
   atm.mie = true;
   atm.ozone = true;
   atm.night = false;

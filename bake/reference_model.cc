@@ -1,5 +1,7 @@
 #include "skybake/reference_model.h"
 
+#include "shared_params.h"
+
 #include <algorithm>
 #include <thread>
 
@@ -130,22 +132,7 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
   impl_->gpu_aoas = aoas_inputs.uniform;
   impl_->aoas = AoasFromUniform(aoas_inputs.uniform, aoas_inputs.switches);
   reference::AtmosphereParameters& atm = impl_->atm;
-  atm.bottom_radius = a.bottom_radius_km;
-  atm.top_radius = a.top_radius_km;
-  atm.observer_altitude = a.observer_altitude_m * 1e-3;
-  atm.rayleigh_scattering = ToVec(a.rayleigh_scattering_per_km);
-  atm.rayleigh_scale_height = a.rayleigh_scale_height_km;
-  atm.mie_scattering = ToVec(a.mie_scattering_per_km);
-  atm.mie_extinction = ToVec(a.mie_extinction_per_km);
-  atm.mie_scale_height = a.mie_scale_height_km;
-  atm.mie_g = a.mie_g;
-  atm.absorption_extinction = ToVec(a.ozone_absorption_per_km);
-  atm.ozone_peak_altitude = a.ozone_peak_altitude_km;
-  atm.ozone_half_width = a.ozone_half_width_km;
-  atm.ground_albedo = ToVec(a.ground_albedo);
-  atm.solar_irradiance = ToVec(a.solar_irradiance);
-  atm.sun_angular_radius = a.sun_angular_radius_rad;
-  atm.limb_darkening = a.limb_darkening_u;
+  FillPhysicalParameters(a, atm);
   atm.transmittance_width = q.transmittance_width;
   atm.transmittance_height = q.transmittance_height;
   atm.multiscattering_width = q.multiscattering_size;

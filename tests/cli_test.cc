@@ -15,23 +15,10 @@
 namespace skybake {
 namespace {
 
-struct CommandRun {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using testing::CommandRun;
 
-CommandRun Skybake(const std::string& args, const std::string& env = "") {
-  std::string command = env + " " + SKYBAKE_BINARY + " " + args + " 2>&1";
-  CommandRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (!pipe) return run;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.output.append(buffer.data(), n);
-  int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
-}
+// The binary with `env` assignments before it (run through bash).
+CommandRun Skybake(const std::string& args, const std::string& env = "") { return testing::RunSkybake(args, env); }
 
 std::string FreshDir(const std::string& name) {
   auto dir = std::filesystem::temp_directory_path() / ("skybake_cli_" + name + std::to_string(::getpid()));
