@@ -94,6 +94,13 @@ class RendererCache {
     StyledInputs in = StyledInputsOf(style);
     gpu::GpuAtmosphere key =
         ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+    // A new atmosphere with the same shader variant (a scheduled drift of
+    // its constants): new uniforms and LUTs, the same pipelines.
+    if (main_ && std::memcmp(&key, &key_, sizeof key) != 0 &&
+        main_->UpdateAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units))) {
+      key_ = key;
+      ++result_.atmosphere_updates;
+    }
     if (main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
       // Same atmosphere: the LUTs stay; per-texel AOAS parameters (a cloud
       // drift, say) change in place when the shader variant is the same.

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <exception>
+#include <future>
 
 #include "shaders/multiscattering_lut.spv.h"
 #include "shaders/sky_render.spv.h"
@@ -84,12 +86,38 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VK_CHECK(vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
   UpdateDescriptors();
 
-  // Pipelines are built once per renderer, never per frame.
-  transmittance_pipeline_ = CreatePipeline(kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv), false);
-  multiscattering_pipeline_ =
-      CreatePipeline(kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv), false);
-  if (quality.sky_view_lut) skyview_pipeline_ = CreatePipeline(kSkyviewLutSpv, sizeof(kSkyviewLutSpv), false);
-  sky_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), effects.sun_disc);
+  // Pipelines are built once per renderer, never per frame, and only those
+  // the effects need. Compiling is most of a short bake's start-up on
+  // lavapipe (LLVM), and pipeline creation may run on several threads at once
+  // (the device is not externally synchronized for it): one thread each.
+  struct PipelineJob {
+    VkPipeline* pipeline;
+    const uint32_t* code;
+    size_t bytes;
+  };
+  std::vector<PipelineJob> jobs;
+  if (NeedsTransmittanceLut(quality, effects))
+    jobs.push_back({&transmittance_pipeline_, kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv)});
+  if (effects.multiple_scattering)
+    jobs.push_back({&multiscattering_pipeline_, kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv)});
+  if (quality.sky_view_lut && !aoas.switches.skydome) jobs.push_back({&skyview_pipeline_, kSkyviewLutSpv, sizeof(kSkyviewLutSpv)});
+  jobs.push_back({&sky_pipeline_, kSkyRenderSpv, sizeof(kSkyRenderSpv)});
+  std::vector<std::future<VkPipeline>> compiled;
+  for (const PipelineJob& job : jobs)
+    compiled.push_back(std::async(std::launch::async, [this, job] { return CreatePipeline(job.code, job.bytes); }));
+  std::exception_ptr failure;
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    try {
+      *jobs[i].pipeline = compiled[i].get();
+      ++counters_.pipelines;
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) {
+    DestroyAll();
+    std::rethrow_exception(failure);
+  }
 
   VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
@@ -112,19 +140,28 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
 }
 
 SkyRenderer::~SkyRenderer() {
+  vkDeviceWaitIdle(context_.device());
+  DestroyAll();
+}
+
+void SkyRenderer::DestroyAll() {
   VkDevice device = context_.device();
-  vkDeviceWaitIdle(device);
   if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
-  vkDestroyFence(device, fence_, nullptr);
-  vkDestroyCommandPool(device, command_pool_, nullptr);
-  vkDestroyPipeline(device, sky_pipeline_, nullptr);
-  if (skyview_pipeline_) vkDestroyPipeline(device, skyview_pipeline_, nullptr);
-  if (sky_no_disc_pipeline_) vkDestroyPipeline(device, sky_no_disc_pipeline_, nullptr);
-  vkDestroyPipeline(device, multiscattering_pipeline_, nullptr);
-  vkDestroyPipeline(device, transmittance_pipeline_, nullptr);
+  if (fence_) vkDestroyFence(device, fence_, nullptr);
+  if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
+  for (VkPipeline* p : {&sky_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_, &transmittance_pipeline_}) {
+    if (*p) vkDestroyPipeline(device, *p, nullptr);
+    *p = VK_NULL_HANDLE;
+  }
+  query_pool_ = VK_NULL_HANDLE;
+  fence_ = VK_NULL_HANDLE;
+  command_pool_ = VK_NULL_HANDLE;
   vkDestroyDescriptorPool(device, descriptor_pool_, nullptr);
   vkDestroyPipelineLayout(device, pipeline_layout_, nullptr);
   vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
+  descriptor_pool_ = VK_NULL_HANDLE;
+  pipeline_layout_ = VK_NULL_HANDLE;
+  set_layout_ = VK_NULL_HANDLE;
   DestroyBuffer(skyview_buffer_);
   DestroyBuffer(output_buffer_);
   DestroyBuffer(multiscattering_buffer_);
@@ -201,7 +238,7 @@ void SkyRenderer::UpdateDescriptors() {
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
 }
 
-VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc) {
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
   VkDevice device = context_.device();
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = bytes;
@@ -218,7 +255,7 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night;
-  } values = {effects_.multiple_scattering, sun_disc,      effects_.ground,
+  } values = {effects_.multiple_scattering, effects_.sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
@@ -240,7 +277,6 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(device, module, nullptr);
   VK_CHECK(result);
-  ++counters_.pipelines;
   return pipeline;
 }
 
@@ -340,11 +376,7 @@ void SkyRenderer::PrecomputeLuts() {
 
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                                                     const std::vector<ViewRequest>& views, bool sun_disc) {
-  VkPipeline sky_pipeline = sky_pipeline_;
-  if (!sun_disc && effects_.sun_disc) {
-    if (!sky_no_disc_pipeline_) sky_no_disc_pipeline_ = CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), false);
-    sky_pipeline = sky_no_disc_pipeline_;
-  }
+  const VkPipeline sky_pipeline = sky_pipeline_;
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
   std::vector<size_t> offsets;
   size_t total = 0;
@@ -364,9 +396,10 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                         VK_ERROR_OUT_OF_DEVICE_MEMORY);
     const size_t half = views.size() / 2;
     std::vector<std::vector<float>> images =
-        Render(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half));
+        Render(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half), sun_disc);
     std::vector<PassTiming> timings = last_timings();
-    for (std::vector<float>& image : Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end())))
+    for (std::vector<float>& image :
+         Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), sun_disc))
       images.push_back(std::move(image));
     timings.insert(timings.end(), last_timings().begin(), last_timings().end());
     timings_ = timings;
@@ -397,7 +430,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     gpu::SkyPush push{};
     push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
     push.view = {v.mapping, v.width, v.height, v.face};
-    push.offsets = {int32_t(offsets[i]), 0, 0, 0};
+    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, 0, 0};
     std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
                        : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
                        : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
@@ -435,6 +468,27 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
   view.width = int(directions.size());
   view.height = 1;
   return Render(sun, {view}, sun_disc)[0];
+}
+
+bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                                   const EffectSettings& effects, const Rgb& output_scale) {
+  const gpu::GpuAtmosphere g = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
+  // The shader variant (specialization constants) and the buffer sizes must
+  // stay; every other value is uniform data.
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  if (!same(g.lut_sizes, gpu_atmosphere_.lut_sizes) || !same(g.samples, gpu_atmosphere_.samples) ||
+      !same(g.effects, gpu_atmosphere_.effects) || !same(g.render, gpu_atmosphere_.render) ||
+      quality.sky_view_lut != quality_.sky_view_lut || effects.mie != effects_.mie ||
+      effects.ozone != effects_.ozone || effects.night_dimming != effects_.night_dimming)
+    return false;
+  if (same(g, gpu_atmosphere_)) return true;
+  // Every submission waits for its fence, so no dispatch reads the buffer now.
+  gpu_atmosphere_ = g;
+  effects_ = effects;
+  std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  luts_ready_ = false;
+  skyview_ready_ = false;
+  return true;
 }
 
 bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {

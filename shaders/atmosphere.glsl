@@ -625,6 +625,13 @@ InScattering ComputeSkyRadianceWithoutSun(IN(AtmosphereParameters) atm, vec3 vie
   return result;
 }
 
+// Whether `view` may see the disc: a cheap test that keeps the disc's
+// arcsine and transmittance read off every texel but the few near the Sun.
+// The margin of twice the radius leaves the exact test to SunDiscRadiance.
+bool NearSunDisc(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  return dot(view, sun) > cos(min(2.0 * atm.sun_angular_radius, kPi));
+}
+
 vec3 SunDiscContribution(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, vec3 transmittance) {
   vec3 d = view - sun;
   Real theta = 2.0 * asin(min(0.5 * length(d), 1.0));
@@ -635,7 +642,8 @@ vec3 SunDiscContribution(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, vec3
 vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   InScattering sky = ComputeSkyRadianceWithoutSun(atm, view, sun);
   vec3 radiance = sky.radiance;
-  if (atm.sun_disc) radiance += SunDiscContribution(atm, view, sun, sky.transmittance);
+  if (atm.sun_disc && NearSunDisc(atm, view, sun))
+    radiance += SunDiscContribution(atm, view, sun, sky.transmittance);
   return radiance * atm.solar_irradiance;
 }
 
@@ -799,7 +807,7 @@ vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3
   if (sin_part > 0.0 || cos_part != 0.0) azimuth = atan(sin_part, cos_part);
   SkyRay ray = SetUpSkyRay(atm, view, sun);
   vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ray.in_atmosphere && ray.hits_ground);
-  if (atm.sun_disc) {
+  if (atm.sun_disc && NearSunDisc(atm, view, sun)) {
     if (ray.in_atmosphere && !ray.hits_ground) {
       radiance += SunDiscContribution(atm, view, sun,
                                       GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));

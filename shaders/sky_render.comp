@@ -24,6 +24,9 @@ void main() {
     return;
   }
   AtmosphereParameters atm = AtmosphereFromUniform();
+  // The sky alone (for the SH of the sky without the Sun): the disc switched
+  // off per dispatch, so one pipeline serves both.
+  if (push.offsets.y != 0) atm.sun_disc = false;
   AoasParameters aoas = AoasFromUniform();
   vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz, kUseSkyView);
   output_texels[index] = vec4(radiance * gpu_atmosphere.output_scale.xyz, 1.0);

@@ -113,7 +113,7 @@ SKYBAKE_GPU_STRUCT(GpuAoas) {
 SKYBAKE_GPU_STRUCT(SkyPush) {
   vec4 sun_direction;  // xyz: unit vector towards the Sun; w: unused
   ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE)
-  ivec4 offsets;       // x: first output texel of this view in the output buffer
+  ivec4 offsets;       // x: first output texel of this view in the output buffer; y: 1 = no sun disc
 };
 
 #ifdef __cplusplus

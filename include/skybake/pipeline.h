@@ -109,7 +109,8 @@ struct BakeResult {
   double preview_ev100 = 0.0;
   int validation_messages = 0;
   std::string manifest_path;
-  int renderer_builds = 0;  // SkyRenderer constructions (atmosphere changes)
+  int renderer_builds = 0;  // SkyRenderer constructions (new shader variants or LUT sizes)
+  int atmosphere_updates = 0;  // atmosphere changes served by the same pipelines (new uniforms and LUTs)
   std::vector<std::string> removed_temporaries;  // left by a killed bake, removed before baking
 };
 

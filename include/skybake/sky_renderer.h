@@ -57,14 +57,21 @@ class SkyRenderer {
 
   // Renders every view for the sun direction (unit, towards the Sun) and
   // returns one RGBA float image per view, rows from the top.
-  // With `sun_disc` false, a variant without the disc (compiled once, on
-  // first use) renders from the same LUTs.
+  // With `sun_disc` false, the same pipeline renders without the disc (a
+  // push constant), from the same LUTs.
   std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
                                          const std::vector<ViewRequest>& views, bool sun_disc = true);
 
   // Radiance (RGBA) along each unit direction.
   std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
                                       const std::vector<glm::dvec3>& directions, bool sun_disc = true);
+
+  // Replaces the atmosphere (a scheduled drift of its constants, say)
+  // without new pipelines: the LUTs are rebuilt by the next Render. False
+  // when the shader variant or a LUT size would change (a new renderer is
+  // needed).
+  bool UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                        const EffectSettings& effects, const Rgb& output_scale);
 
   // Replaces the per-texel AOAS parameters (drift, strengths, shapes) without
   // touching the LUTs or pipelines; false when the switches differ (a new
@@ -96,7 +103,8 @@ class SkyRenderer {
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
   void UpdateDescriptors();
-  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc);
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes);
+  void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
   // later one reads (`barrier_after`).
@@ -129,7 +137,6 @@ class SkyRenderer {
   VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
   VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
-  VkPipeline sky_no_disc_pipeline_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
