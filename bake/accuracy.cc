@@ -340,9 +340,13 @@ std::vector<StudyCase> StudyCases(bool quick) {
     cases.push_back(fine_lut(MakeCase(INTEGRATOR_SIMPSON, 128, 0, true, 768, 432, STEPS_QUADRATIC)));
     cases.push_back(fine_lut(MakeCase(INTEGRATOR_SIMPSON, 128, 0, true, 1536, 864, STEPS_QUADRATIC)));
   }
+  // The sky-view LUT: its resolution against its steps per texel (a frame
+  // of a time-lapse pays for one LUT, whatever its output size).
   for (auto [w, h] : quick ? std::vector<std::pair<int, int>>{{192, 108}}
-                           : std::vector<std::pair<int, int>>{{192, 108}, {384, 216}, {768, 432}})
-    cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, w, h, STEPS_QUADRATIC));
+                           : std::vector<std::pair<int, int>>{{192, 108}, {256, 144}, {320, 180}, {384, 216}})
+    for (int v : quick ? std::vector<int>{48} : std::vector<int>{24, 32, 48})
+      cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0, true, w, h, STEPS_QUADRATIC));
+  if (!quick) cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, 768, 432, STEPS_QUADRATIC));
   return cases;
 }
 
@@ -447,7 +451,9 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   single.ground = false;
   const std::vector<double> elevations = {90.0, 45.0, 10.0, 3.0, 0.0, -6.0};
   const std::vector<glm::dvec3> dirs = StudyDirections(options.quick);
-  const std::vector<StudyCase> cases = StudyCases(options.quick);
+  std::vector<StudyCase> cases = StudyCases(options.quick);
+  if (!options.only.empty())
+    std::erase_if(cases, [&](const StudyCase& c) { return c.name.find(options.only) == std::string::npos; });
   const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
 
   VulkanOptions vulkan_options;

@@ -15,8 +15,8 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 
 // Each preset is the cheapest case of the accuracy study's Pareto front that
 // meets its bound (docs/accuracy.md, `skybake accuracy`):
-//   draft       analytic 48 quadratic steps, sky-view LUT 192 x 108   1.05e-2
-//   production  analytic 48 quadratic steps, sky-view LUT 384 x 216   3.65e-3
+//   draft       analytic 24 quadratic steps, sky-view LUT 192 x 108   1.57e-2
+//   production  analytic 32 quadratic steps, sky-view LUT 320 x 180   7.07e-3
 //   reference   Simpson 64 quadratic steps per texel, transmittance
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
 QualitySettings QualityPreset(const std::string& name) {
@@ -24,6 +24,7 @@ QualitySettings QualityPreset(const std::string& name) {
   if (name == "draft") {
     q.sky_view_width = 192;
     q.sky_view_height = 108;
+    q.view_steps = 24;
   } else if (name == "reference") {
     q.sky_view_lut = false;
     q.view_steps = 64;

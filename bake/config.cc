@@ -160,6 +160,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Choice("output.compression", o.compression,
            {{"none", std::string("none")}, {"rle", std::string("rle")}, {"zips", std::string("zips")},
             {"zip", std::string("zip")}, {"piz", std::string("piz")}});
+  v.Int("output.zip_level", o.zip_level, 1, 9);
   v.Choice("output.overflow", o.overflow,
            {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
   v.Choice("output.units", o.units,

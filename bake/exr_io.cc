@@ -22,6 +22,7 @@
 #include <OpenEXR/ImfOutputFile.h>
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
+#include <OpenEXR/ImfThreading.h>
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
@@ -49,7 +50,7 @@ class MemoryOStream : public Imf::OStream {
   }
   uint64_t tellp() override { return position_; }
   void seekp(uint64_t pos) override { position_ = size_t(pos); }
-  const std::string& bytes() const { return bytes_; }
+  std::string TakeBytes() { return std::move(bytes_); }
 
  private:
   std::string bytes_;
@@ -158,12 +159,23 @@ double HalfRangeScale(double max_value, OverflowPolicy policy) {
   return std::exp2(-std::ceil(std::log2(max_value / kHalfMax)));
 }
 
+void SetExrThreads(int threads) {
+  if (Imf::globalThreadCount() != threads) Imf::setGlobalThreadCount(threads);
+}
+
 uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
+  const std::string bytes = EncodeExr(path, image, options);
+  WriteFileAtomically(path, bytes);
+  return bytes.size();
+}
+
+std::string EncodeExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
   const int w = image.width;
   const int h = image.height;
   Imf::PixelType type = options.pixel_type == PixelType::kHalf ? Imf::HALF : Imf::FLOAT;
   Imf::Header header(w, h);
   header.compression() = CompressionFromName(options.compression);
+  header.zipCompressionLevel() = options.zip_level;
   header.channels().insert("R", Imf::Channel(type));
   header.channels().insert("G", Imf::Channel(type));
   header.channels().insert("B", Imf::Channel(type));
@@ -209,8 +221,7 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
   } catch (const std::exception& e) {
     throw OutputError(fmt::format("cannot encode {}: {}", path, e.what()));
   }  // the OutputFile destructor writes the line offsets: encoded is complete here
-  WriteFileAtomically(path, encoded.bytes());
-  return encoded.bytes().size();
+  return encoded.TakeBytes();
 }
 
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {

@@ -309,6 +309,7 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
   accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
+  accuracy->add_option("--only", study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
 
   // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
   // like a full disk, instead of killing the process mid-file.

@@ -514,6 +514,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     ExrWriteOptions exr;
     exr.pixel_type = style.output.pixel_type;
     exr.compression = style.output.compression;
+    exr.zip_level = style.output.zip_level;
     exr.scale = half_scale;
     const bool luminance = style.output.units == OutputUnits::kLuminance;
     if (luminance) exr.white_luminance = 1.0 / half_scale;

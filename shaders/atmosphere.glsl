@@ -805,9 +805,20 @@ vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3
   Real sin_part = abs(view.x * sun.z - view.z * sun.x);
   Real azimuth = 0.0;
   if (sin_part > 0.0 || cos_part != 0.0) azimuth = atan(sin_part, cos_part);
-  SkyRay ray = SetUpSkyRay(atm, view, sun);
-  vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ray.in_atmosphere && ray.hits_ground);
+  // Whether the ray hits the ground: the test of SetUpSkyRay, which for an
+  // observer inside the atmosphere (every texel takes the same branch) needs
+  // none of the ray's distances.
+  bool ground = false;
+  if (atm.observer_altitude > atm.top_radius - atm.bottom_radius) {
+    SkyRay ray = SetUpSkyRay(atm, view, sun);
+    ground = ray.in_atmosphere && ray.hits_ground;
+  } else {
+    ground = RayIntersectsGround(atm, atm.bottom_radius + atm.observer_altitude, atm.observer_altitude,
+                                 ClampCosine(view.y));
+  }
+  vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ground);
   if (atm.sun_disc && NearSunDisc(atm, view, sun)) {
+    SkyRay ray = SetUpSkyRay(atm, view, sun);
     if (ray.in_atmosphere && !ray.hits_ground) {
       radiance += SunDiscContribution(atm, view, sun,
                                       GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));

@@ -51,7 +51,7 @@ struct AtmosphereParams {
 // from the accuracy study (docs/accuracy.md): max relative error of
 // single scattering over the upper hemisphere, sun 3..90 deg (3.65e-3).
 struct QualitySettings {
-  int view_steps = 48;                // ray-march steps per output texel (or sky-view texel)
+  int view_steps = 32;                // ray-march steps per output texel (or sky-view texel)
   int transmittance_steps = 256;      // quadrature points per transmittance texel
   int multiscattering_steps = 20;     // Hillaire 2020 uses 20
   int multiscattering_sqrt_dirs = 8;  // 64 directions, Hillaire 2020
@@ -66,8 +66,8 @@ struct QualitySettings {
   // In-scattering per output texel: ray-marched (false), or read from a
   // per-frame sky-view LUT of this size (Hillaire 2020 section 5.3).
   bool sky_view_lut = true;
-  int sky_view_width = 384;
-  int sky_view_height = 216;
+  int sky_view_width = 320;
+  int sky_view_height = 180;
 };
 
 // The named presets, chosen from the accuracy study (docs/accuracy.md):

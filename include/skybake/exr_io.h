@@ -32,6 +32,7 @@ constexpr double kHalfMax = 65504.0;
 struct ExrWriteOptions {
   PixelType pixel_type = PixelType::kHalf;
   std::string compression = "zip";
+  int zip_level = kDefaultZipLevel;  // zlib level 1..9 of zip and zips (docs/performance.md)
   int envmap = -1;               // -1: none; 0: ENVMAP_LATLONG; 1: ENVMAP_CUBE
   double scale = 1.0;            // multiplies every value before writing
   double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
@@ -46,8 +47,16 @@ double CheckedMaxValue(const std::vector<const RgbaImage*>& images);
 // already fits; with OverflowPolicy::kRefuse, throws OutputError instead.
 double HalfRangeScale(double max_value, OverflowPolicy policy);
 
-// Writes R, G, B channels; returns the size of the written file in bytes.
+// Encodes R, G, B channels into the bytes of an EXR file (`name` is for
+// messages). Line blocks are compressed on OpenEXR's global thread pool.
+std::string EncodeExr(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options);
+
+// Encodes and writes atomically; returns the size of the written file in bytes.
 uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options);
+
+// Sizes OpenEXR's global thread pool, which compresses line blocks in
+// parallel (0: no pool). Idempotent and cheap when the size is unchanged.
+void SetExrThreads(int threads);
 
 // Writes an 8-bit sRGB PNG through OpenImageIO.
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
