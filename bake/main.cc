@@ -2,6 +2,8 @@
 //
 //   skybake bake <style.toml> [--schedule day.toml] [--out DIR] [--size N] [--set key=value ...]
 //                [--force | --resume] [--max-memory-mib M] [--max-frame-seconds S]
+//                [--frames FIRST:LAST] [--shard I/N]
+//   skybake merge-manifest DIR [--force] [--sizes-only]
 //   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
 //   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
@@ -23,9 +25,11 @@
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
 #include "skybake/gallery.h"
+#include "skybake/manifest.h"
 #include "skybake/pipeline.h"
 #include "skybake/pass_plan.h"
 #include "skybake/schedule.h"
+#include "skybake/shard.h"
 #include "skybake/vulkan_context.h"
 
 namespace {
@@ -72,6 +76,8 @@ struct BakeArgs {
   double max_memory_mib = 4096.0;
   double max_frame_seconds = 3600.0;
   bool dry_run = false;  // print the plan instead of baking
+  std::string frames;    // --frames FIRST:LAST, empty: every frame
+  std::string shard;     // --shard I/N, empty: no split
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -79,6 +85,10 @@ enum class Mode { kBake, kCheck, kPlan };
 int RunBake(const BakeArgs& args, Mode mode) {
   const bool check_only = mode == Mode::kCheck;
   // Parse and validate: every error at once, before any GPU work.
+  std::optional<FrameRange> frames;
+  std::optional<ShardSpec> shard;
+  if (!args.frames.empty()) frames = ParseFrameRange(args.frames);
+  if (!args.shard.empty()) shard = ParseShard(args.shard);
   std::vector<std::string> overrides = args.overrides;
   if (args.size > 0) {
     overrides.push_back(fmt::format("render.cube_size={}", args.size));
@@ -120,6 +130,14 @@ int RunBake(const BakeArgs& args, Mode mode) {
     if (e.memory_mib > largest.memory_mib) largest.memory_mib = e.memory_mib;
     if (e.seconds > largest.seconds) largest.seconds = e.seconds;
   }
+  // Shard: the part of the sequence this run bakes (README "Scale-out").
+  std::optional<FrameRange> part;
+  if (frames || shard) {
+    if (!schedule)
+      throw UsageError("--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
+                       "[schedule])");
+    part = SelectFrames(*schedule, frames, shard);
+  }
   if (args.resume && !schedule) {
     std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
                          "an inline [schedule]), or use --force to bake a single style again\n");
@@ -146,6 +164,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
   options.out_dir = args.out_dir;
   options.force = args.force;
   options.resume = args.resume;
+  options.frames = part;
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
   if (!args.quiet) {
@@ -168,6 +187,17 @@ int RunBake(const BakeArgs& args, Mode mode) {
                  result.validation_messages, result.validation_messages == 1 ? "" : "s");
     return kExitVulkan;
   }
+  return kExitOk;
+}
+
+int RunMergeManifest(const MergeOptions& options) {
+  // Check every part, then write the scene and manifest.json.
+  MergeResult result = MergeShardManifests(options);
+  for (const std::string& part : result.parts) std::printf("part      %s\n", part.c_str());
+  for (const BakedFile& f : result.scene_files)
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+  std::printf("manifest  %s  %d frames from %zu part%s\n", result.manifest_path.c_str(), result.frames,
+              result.parts.size(), result.parts.size() == 1 ? "" : "s");
   return kExitOk;
 }
 
@@ -233,7 +263,8 @@ int main(int argc, char** argv) {
                ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
                "into OpenEXR environment maps with Vulkan compute.\n"
                "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
-               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget."};
+               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
+               "manifests that do not merge."};
   app.require_subcommand(1);
   app.get_formatter()->column_width(34);
 
@@ -267,8 +298,17 @@ int main(int argc, char** argv) {
   CLI::Option* force = bake->add_flag(
       "--force", args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
   bake->add_flag("--resume", args.resume,
-                 "Sequence: keep the frames whose files match their checksums in --out/manifest.json, bake the rest")
+                 "Sequence: keep the frames whose files match their checksums in the manifest in --out (manifest.json, or "
+                 "the shard's), bake the rest")
       ->excludes(force);
+  bake->add_option("--frames", args.frames,
+                   "Sequence: bake only frames FIRST to LAST (inclusive), numbered as in file names (from "
+                   "schedule.first_frame); writes manifest.shard-FIRST-LAST.json, no scene")
+      ->type_name("FIRST:LAST");
+  bake->add_option("--shard", args.shard,
+                   "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
+                   "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
+      ->type_name("I/N");
   bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
   bake->add_flag("--vulkan-validation", args.validation,
@@ -299,6 +339,17 @@ int main(int argc, char** argv) {
   gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
   gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
   gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
+
+  MergeOptions merge_options;
+  bool sizes_only = false;
+  CLI::App* merge = app.add_subcommand(
+      "merge-manifest",
+      "Join the shard manifests (manifest.shard-FIRST-LAST.json, from bake --shard or --frames) of a folder into "
+      "manifest.json and write the glTF scene, equal to an unsharded bake's; checks that the parts are of one "
+      "bake, cover every frame once, and that every listed file is there with its SHA-256");
+  merge->add_option("dir", merge_options.dir, "Folder holding every part's files and shard manifest")->required();
+  merge->add_flag("--force", merge_options.force, "Replace an existing manifest.json and glTF scene");
+  merge->add_flag("--sizes-only", sizes_only, "Check listed files by size only, without reading them for SHA-256");
 
   CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
 
@@ -333,7 +384,17 @@ int main(int argc, char** argv) {
     if (check->parsed()) return RunBake(args, Mode::kCheck);
     if (plan->parsed()) return RunBake(args, Mode::kPlan);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
+    if (merge->parsed()) {
+      merge_options.verify_checksums = !sizes_only;
+      return RunMergeManifest(merge_options);
+    }
     return RunBake(args, Mode::kBake);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitUsage;
+  } catch (const ManifestError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    return kExitMerge;
   } catch (const ConfigFailure& e) {
     PrintErrors(e.errors);
     return kExitConfig;

@@ -18,6 +18,7 @@
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
+#include "skybake/manifest.h"
 #include "skybake/tonemap.h"
 
 namespace skybake {
@@ -140,14 +141,6 @@ std::vector<float> DisplayLuminance(const std::vector<float>& rgba, OutputUnits 
   return display;
 }
 
-json ShJson(const ShRgb& c) {
-  json rows = json::array();
-  for (const Rgb& rgb : c) rows.push_back({rgb[0], rgb[1], rgb[2]});
-  return rows;
-}
-
-json VectorJson(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
-
 // The views one frame renders for its SH: six small faces.
 std::vector<ViewRequest> ShViews(const SkyStyle& style) {
   const int n = std::min(style.render.cube_size, 64);
@@ -180,14 +173,18 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
   return names;
 }
 
-std::vector<std::string> PlannedFileNames(const std::vector<FramePlan>& plans) {
+// The files of the frames in `part` (every frame when unset); a part writes
+// its own manifest and no scene (merge-manifest writes it).
+std::vector<std::string> PlannedFileNames(const std::vector<FramePlan>& plans, const std::optional<FrameRange>& part) {
   std::vector<std::string> names;
   for (const FramePlan& plan : plans)
-    for (const std::string& n : FrameFileNames(*plan.style, plan.number).All()) names.push_back(n);
+    if (!part || part->Contains(plan.number))
+      for (const std::string& n : FrameFileNames(*plan.style, plan.number).All()) names.push_back(n);
   const SkyStyle& first = *plans.front().style;
-  if (first.gltf.enabled)
+  if (first.gltf.enabled && !part)
     for (const char* ext : {".gltf", ".bin", ".glb"}) names.push_back(first.output.basename + ext);
-  names.push_back("manifest.json");
+  names.push_back(ManifestFileName(part));
+  names.push_back(TimingsFileName(part));
   return names;
 }
 
@@ -254,11 +251,15 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   const Clock::time_point bake_start = Clock::now();
   const bool sequence = schedule != nullptr;
   const SkyStyle& first = *plans.front().style;
+  // A part of the sequence (--frames, --shard) bakes only its frames; every
+  // sequence-wide value below still comes from every frame in `plans`.
+  const std::optional<FrameRange>& part = options.frames;
+  const std::string manifest_name = ManifestFileName(part);
 
   // Outputs, before any GPU work: within budget, not overwriting a previous
   // bake unless asked to, stale temporaries of a killed bake removed.
   for (const FramePlan& plan : plans) CheckBudget(*plan.style, options);
-  const std::vector<std::string> planned = PlannedFileNames(plans);
+  const std::vector<std::string> planned = PlannedFileNames(plans, part);
   auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
   if (!options.force && !options.resume) {
     for (const std::string& name : planned) {
@@ -270,15 +271,15 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     }
   }
   PreviousBake previous;
-  if (options.resume) previous = ReadPreviousManifest(path_of("manifest.json"));
+  if (options.resume) previous = ReadPreviousManifest(path_of(manifest_name));
   result.removed_temporaries = RemoveStaleTemporaries(options.out_dir, planned);
   timer.Finish("outputs", fmt::format("{} files planned{}{}", planned.size(),
                                       result.removed_temporaries.empty()
                                           ? ""
                                           : fmt::format(", {} stale temporary file(s) removed",
                                                         result.removed_temporaries.size()),
-                                      previous.loaded ? fmt::format(", resuming from {} frame(s) in manifest.json",
-                                                                    previous.frames.size())
+                                      previous.loaded ? fmt::format(", resuming from {} frame(s) in {}",
+                                                                    previous.frames.size(), manifest_name)
                                                       : ""));
 
   // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
@@ -352,75 +353,64 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.files.push_back({path, kind, bytes, Sha256OfFile(path)});
   };
 
-  // Manifest: every file with its size and SHA-256, per frame and for the
-  // scene; rewritten atomically after every frame, `complete` once the bake is.
-  auto provenance_of = [&]() {
-    return json{
-        {"version", SKYBAKE_VERSION},
-        {"style", first.source_path},
-        {"schedule", schedule ? schedule->source_path : ""},
-        {"units", first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
-                                                                : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm"},
-        {"exposure_ev100", ev100.value_or(0.0)},
-        {"texture_frame", plans[reference].number},
-        {"sh_basis", "real SH l<=2, order (0,0)(1,-1)(1,0)(1,1)(2,-2)(2,-1)(2,0)(2,1)(2,2), Ramamoorthi-Hanrahan "
-                     "2001 constants on world x,y,z (+Y up); irradiance E(n) = sum E_lm Y_lm(n)"},
-    };
+  // Manifest: every file with its size and SHA-256, per frame; rewritten
+  // atomically after every frame, `complete` once the bake (or part) is. Its
+  // sequence-wide entries come from every frame of `plans`, so the parts of
+  // a sequence agree on them and merge-manifest can check that they do.
+  std::vector<std::string> style_sha256;  // per plan
+  std::string sequence_identity;          // every frame's number, time, sun and style
+  std::map<int, size_t> plan_of_frame;    // frame number -> index in plans
+  for (size_t i = 0; i < plans.size(); ++i) {
+    const FramePlan& plan = plans[i];
+    style_sha256.push_back(Sha256OfText(plan.style->resolved_toml));
+    sequence_identity += fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", plan.number,
+                                     plan.time ? plan.time->Iso8601() : "", plan.sun.x, plan.sun.y, plan.sun.z,
+                                     style_sha256.back());
+    plan_of_frame[plan.number] = i;
+  }
+  auto manifest_of = [&]() {
+    Manifest m;
+    m.version = SKYBAKE_VERSION;
+    m.style = first.source_path;
+    m.schedule = schedule ? schedule->source_path : "";
+    m.sequence_sha256 = Sha256OfText(sequence_identity);
+    m.units = first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
+                                                            : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm";
+    m.exposure_ev100 = ev100.value_or(0.0);
+    m.exposure_source = exposure_source;
+    m.texture_frame = plans[reference].number;
+    m.half_scale = half_scale;
+    if (schedule) {
+      m.place = schedule->place;
+      m.sequence = FrameRange{plans.front().number, plans.back().number};
+    }
+    m.part = part;
+    // The scene's texture: the reference frame's PNG, a 2h x h latlong.
+    const SkyStyle& ref = *plans[reference].style;
+    m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, FrameFileNames(ref, plans[reference].number).png,
+              2 * ref.render.latlong_height, ref.render.latlong_height};
+    for (const FrameResult& f : result.frames) {
+      const size_t i = plan_of_frame.at(f.number);
+      ManifestFrame frame = ManifestFrameOf(f);
+      frame.style_sha256 = style_sha256[i];
+      frame.hours_from_start = plans[i].hours_from_start;
+      frame.animation_time_s = schedule && schedule->clock_times ? plans[i].hours_from_start : double(i);
+      m.frames.push_back(std::move(frame));
+    }
+    return m;
   };
   auto write_manifest = [&](const std::vector<BakedFile>& scene, bool complete) {
-    auto file_json = [&](const BakedFile& f) {
-      return json{{"file", std::filesystem::path(f.path).filename().string()},
-                  {"kind", f.kind},
-                  {"bytes", f.bytes},
-                  {"sha256", f.sha256}};
-    };
-    json manifest = provenance_of();
-    manifest["out_dir"] = options.out_dir;
-    manifest["half_scale"] = half_scale;
-    manifest["exposure_source"] = exposure_source;
-    manifest["frame_convention"] = "+Y up, right-handed, North -Z, East +X; sun_direction points towards the Sun; "
-                                   "azimuth clockwise from North";
-    if (schedule && schedule->place) {
-      manifest["place"] = {{"latitude_deg", schedule->place->latitude_deg},
-                           {"longitude_deg", schedule->place->longitude_deg}};
-    }
-    json frames = json::array();
-    for (size_t i = 0; i < result.frames.size(); ++i) {
-      const FrameResult& f = result.frames[i];
-      json files = json::array();
-      for (const BakedFile& file : f.files) files.push_back(file_json(file));
-      json passes = json::array();
-      for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
-      frames.push_back({{"frame", f.number},
-                        {"style_sha256", Sha256OfText(plans[i].style->resolved_toml)},
-                        {"time", f.time ? json(f.time->Iso8601()) : json(nullptr)},
-                        {"hours_from_start", plans[i].hours_from_start},
-                        {"sun", {{"elevation_deg", f.sun_elevation_deg},
-                                 {"azimuth_deg", f.sun_azimuth_deg},
-                                 {"direction", VectorJson(f.sun_direction)},
-                                 {"illuminance_lux", f.sun_illuminance_lux}}},
-                        {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
-                        {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
-                        {"files", files},
-                        {"timings", {{"render_s", f.render_seconds}, {"write_s", f.write_seconds}, {"gpu_passes", passes}}}});
-    }
-    manifest["frames"] = frames;
-    manifest["complete"] = complete;
-    json scene_json = json::array();
-    for (const BakedFile& f : scene) scene_json.push_back(file_json(f));
-    manifest["scene"] = scene_json;
-    manifest["renderer_builds"] = result.renderer_builds;
-    json stages = json::array();
-    for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
-    manifest["timings"] = {{"total_s", SecondsSince(bake_start)}, {"stages", stages}};
-    result.manifest_path = path_of("manifest.json");
-    WriteFileAtomically(result.manifest_path, manifest.dump(2) + "\n");
+    Manifest m = manifest_of();
+    for (const BakedFile& f : scene)
+      m.scene.push_back({std::filesystem::path(f.path).filename().string(), f.kind, f.bytes, f.sha256});
+    m.complete = complete;
+    result.manifest_path = path_of(manifest_name);
+    WriteManifest(m, result.manifest_path);
   };
 
-  std::string reference_png;
-  int texture_width = 0, texture_height = 0;
   for (size_t index = 0; index < plans.size(); ++index) {
     const FramePlan& plan = plans[index];
+    if (part && !part->Contains(plan.number)) continue;  // another part's frame
     const SkyStyle& style = *plan.style;
     FrameResult frame;
     frame.number = plan.number;
@@ -482,11 +472,6 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                     verified ? ", files verified by checksum: not rendered again" : ""));
     if (verified) {
       frame.files = *verified;
-      if (index == reference && !names.png.empty()) {
-        reference_png = names.png;
-        texture_width = 2 * style.render.latlong_height;
-        texture_height = style.render.latlong_height;
-      }
       result.preview_ev100 = *ev100;
       for (const BakedFile& f : frame.files) result.files.push_back(f);
       result.frames.push_back(std::move(frame));
@@ -572,11 +557,6 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       std::string path = path_of(names.png);
       add_file(frame, path, style.output.preview ? "preview" : "gltf_texture",
                WritePng(path, latlong->width, latlong->height, srgb));
-      if (index == reference) {
-        reference_png = std::filesystem::path(path).filename().string();
-        texture_width = latlong->width;
-        texture_height = latlong->height;
-      }
     }
     frame.write_seconds = SecondsSince(write_start);
     if (ev100) timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
@@ -586,55 +566,26 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     write_manifest({}, false);
   }
 
-  // Scene: the dome textured with the reference frame, the sun (animated for a sequence).
-  json provenance = provenance_of();
-  json frame_extras = json::array();
-  std::vector<SceneSun> suns;
-  for (size_t i = 0; i < result.frames.size(); ++i) {
-    const FrameResult& f = result.frames[i];
-    SceneSun sun;
-    sun.time_s = schedule && schedule->clock_times ? plans[i].hours_from_start : double(i);
-    sun.direction = f.sun_direction;
-    sun.illuminance_lux = f.sun_illuminance_lux;
-    double peak = std::max({f.sun_irradiance[0], f.sun_irradiance[1], f.sun_irradiance[2]});
-    if (peak > 0.0) sun.color = {f.sun_irradiance[0] / peak, f.sun_irradiance[1] / peak, f.sun_irradiance[2] / peak};
-    suns.push_back(sun);
-    frame_extras.push_back({{"frame", f.number},
-                            {"time", f.time ? f.time->Iso8601() : ""},
-                            {"animation_time_s", sun.time_s},
-                            {"sun_direction", VectorJson(f.sun_direction)},
-                            {"sun_illuminance_lux", f.sun_illuminance_lux},
-                            {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
-                            {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}});
+  // Scene and manifest: a whole bake ends as merge-manifest does, through
+  // WriteSceneAndManifest, so both give the same bytes; a part writes only
+  // its own manifest (merge-manifest writes the scene once all parts are in).
+  if (part) {
+    write_manifest({}, true);
+  } else {
+    Manifest manifest = manifest_of();
+    std::vector<BakedFile> scene_files = WriteSceneAndManifest(manifest, options.out_dir);
+    for (const BakedFile& f : scene_files) result.files.push_back(f);
+    if (!scene_files.empty())
+      timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", scene_files.front().path, manifest.frames.size(),
+                                       manifest.frames.size() == 1 ? "" : "s"));
+    result.manifest_path = path_of(manifest_name);
   }
-  provenance["frames"] = frame_extras;
-  std::vector<BakedFile> scene_files;
-  if (first.gltf.enabled && !reference_png.empty()) {
-    SceneDescription scene;
-    scene.name = first.output.basename;
-    scene.out_dir = options.out_dir;
-    scene.texture_file = reference_png;
-    scene.texture_width = texture_width;
-    scene.texture_height = texture_height;
-    scene.dome = first.gltf;
-    scene.suns = suns;
-    scene.light_frame = int(reference);
-    scene.extras_json = provenance.dump();
-    WrittenScene written = WriteGltfScene(scene);
-    for (auto [path, kind] : {std::pair{written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"},
-                              {written.glb_path, "glb"}}) {
-      uint64_t bytes = std::filesystem::file_size(path);
-      scene_files.push_back({path, kind, bytes, Sha256OfFile(path)});
-      result.files.push_back(scene_files.back());
-    }
-    timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", written.gltf_path, suns.size(),
-                                     suns.size() == 1 ? "" : "s"));
-  }
-
-  // Manifest: every file with its size and SHA-256, per frame; written last, atomically.
-  write_manifest(scene_files, true);
   result.files.push_back({result.manifest_path, "manifest", std::filesystem::file_size(result.manifest_path), ""});
   timer.Finish("manifest", result.manifest_path);
+  // Timings: what differs from run to run, beside the manifest.
+  const std::string timings_path = path_of(TimingsFileName(part));
+  WriteTimings(result, options.out_dir, SecondsSince(bake_start), timings_path);
+  result.files.push_back({timings_path, "timings", std::filesystem::file_size(timings_path), ""});
 
   result.counters = renderers.Current().counters();
   result.validation_messages = context.validation_message_count();
@@ -755,6 +706,7 @@ BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options) {
   plan.elevation_deg = style.sun.elevation_deg;
   plan.azimuth_deg = style.sun.azimuth_deg;
   plan.sun = SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg);
+  if (options.frames) throw std::invalid_argument("BakeStyle: a frame selection needs a schedule (BakeSequence)");
   return BakeFrames({plan}, nullptr, options);
 }
 
@@ -762,6 +714,12 @@ BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& sch
   if (styles.size() != schedule.frames.size() || styles.empty())
     throw std::invalid_argument(fmt::format("BakeSequence: {} styles for {} frames", styles.size(),
                                             schedule.frames.size()));
+  if (options.frames) {
+    const FrameRange all = ScheduleFrameRange(schedule);
+    if (!all.Contains(options.frames->first) || !all.Contains(options.frames->last) || options.frames->count() < 1)
+      throw std::invalid_argument(fmt::format("BakeSequence: frames {} to {} are not within the schedule's {} to {}",
+                                              options.frames->first, options.frames->last, all.first, all.last));
+  }
   std::vector<FramePlan> plans;
   for (size_t i = 0; i < styles.size(); ++i) {
     const ScheduleFrame& f = schedule.frames[i];

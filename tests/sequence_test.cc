@@ -123,6 +123,11 @@ TEST_F(Sequence, ManifestListsEveryFileWithMatchingChecksum) {
   ASSERT_TRUE(in) << result_->manifest_path;
   json manifest = json::parse(in);
   ASSERT_EQ(manifest["frames"].size(), 24u);
+  // Run-dependent facts are in timings.json, so the manifest is the same for every run of the bake.
+  for (const char* key : {"timings", "out_dir", "renderer_builds"}) EXPECT_FALSE(manifest.contains(key)) << key;
+  json timings = json::parse(std::ifstream(out_dir_ + "/sequence/timings.json"));
+  ASSERT_EQ(timings["frames"].size(), 24u);
+  EXPECT_EQ(timings["renderer_builds"].get<int>(), result_->renderer_builds);
   std::set<std::string> listed;
   int checked = 0;
   auto check = [&](const json& file) {
@@ -144,16 +149,17 @@ TEST_F(Sequence, ManifestListsEveryFileWithMatchingChecksum) {
       EXPECT_DOUBLE_EQ(frame["sun"]["direction"][c].get<double>(), expected.sun_direction[c]);
     EXPECT_EQ(frame["sh_irradiance_with_sun"].size(), 9u);
     EXPECT_EQ(frame["sh_irradiance_without_sun"][0].size(), 3u);
-    EXPECT_GT(frame["timings"]["render_s"].get<double>(), 0.0);
+    EXPECT_EQ(timings["frames"][i]["frame"].get<int>(), expected.number);
+    EXPECT_GT(timings["frames"][i]["render_s"].get<double>(), 0.0);
     for (const json& file : frame["files"]) check(file);
   }
   for (const json& file : manifest["scene"]) check(file);
   // 6 faces + strip + latlong + PNG per frame, then .gltf, .bin, .glb.
   EXPECT_EQ(checked, 24 * 9 + 3);
-  // Every file of the folder is listed, apart from the manifest itself.
+  // Every file of the folder is listed, apart from the manifest itself and the timings.
   for (const auto& entry : fs::directory_iterator(out_dir_ + "/sequence")) {
     std::string name = entry.path().filename().string();
-    if (name == "manifest.json" || name.find("screenshot") != std::string::npos) continue;
+    if (name == "manifest.json" || name == "timings.json" || name.find("screenshot") != std::string::npos) continue;
     EXPECT_TRUE(listed.count(name)) << name << " is not in the manifest";
   }
   // One exposure for the sequence.

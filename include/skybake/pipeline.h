@@ -14,6 +14,7 @@
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
 #include "skybake/schedule.h"
+#include "skybake/shard.h"
 #include "skybake/sh.h"
 #include "skybake/sky_renderer.h"
 #include "skybake/vulkan_context.h"
@@ -30,6 +31,7 @@ enum ExitCode : int {
   kExitOutput = 5,    // an output file could not be written (disk full, no permission)
   kExitExists = 6,    // the bake's files already exist: pass --force or --resume
   kExitBudget = 7,    // the bake would exceed the memory or time budget (README "Limits")
+  kExitMerge = 8,     // merge-manifest: shard manifests missing frames, overlapping, of different bakes
 };
 
 // The bake's files are already in the output folder and neither --force nor
@@ -58,7 +60,12 @@ struct BakeOptions {
   VulkanOptions vulkan;
   ProgressCallback progress;  // may be empty
   bool force = false;   // overwrite files of a previous bake in out_dir
-  bool resume = false;  // sequence: keep frames verified against out_dir/manifest.json, bake the rest
+  bool resume = false;  // sequence: keep frames verified against its manifest in out_dir, bake the rest
+  // Sequence: bake only these frames (a part, for a farm): their files,
+  // manifest.shard-FIRST-LAST.json and timings.shard-FIRST-LAST.json, no
+  // scene. Exposure, half scale and the scene's texture frame still come
+  // from every frame, so a part's files equal the same frames of a whole bake.
+  std::optional<FrameRange> frames;
   double max_memory_mib = 4096.0;       // budget for one frame's host + device memory (README "Limits")
   double max_frame_seconds = 3600.0;    // budget for one frame's estimated lavapipe render time
 };
@@ -115,9 +122,9 @@ struct BakeResult {
 };
 
 // Bakes one style (one sun position) into options.out_dir, which is created
-// if needed: EXR maps, preview, glTF scene, manifest.json. Before any GPU
-// work: BudgetError over the budget, OutputExistsError when a file it would
-// write exists (unless options.force or options.resume); stale temporaries of
+// if needed: EXR maps, preview, glTF scene, manifest.json, timings.json.
+// Before any GPU work: BudgetError over the budget, OutputExistsError when a
+// file it would write exists (unless options.force or options.resume); stale temporaries of
 // its file names are removed. Later: VulkanUnavailable, VulkanError or
 // OutputError. manifest.json is rewritten after every frame.
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
@@ -127,7 +134,8 @@ BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
 // throughout; the renderer and its LUTs are rebuilt only when a frame
 // changes the atmosphere, quality, effects or units. One exposure and one
 // half-float scale for the whole sequence. Writes one glTF scene with the
-// sun animated across the frames, and manifest.json.
+// sun animated across the frames, manifest.json and timings.json; with
+// options.frames, only those frames and their part's manifest (manifest.h).
 BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& schedule,
                         const BakeOptions& options);
 

@@ -1,0 +1,251 @@
+// Sequence bakes split for a farm, through the binary under the validation
+// layer: shards (--shard I/N) and frame ranges (--frames A:B) write the same
+// bytes as an unsharded bake of the same frames, merge-manifest joins their
+// manifests into the unsharded bake's manifest.json and glTF scene byte for
+// byte, and bad values or missing parts are refused with the fix.
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::CommandRun;
+using testing::FreshTempDir;
+using testing::RunSkybake;
+
+// Six clock times numbered from 11, so frame numbers and indices differ;
+// frame 13 changes the atmosphere, so the renderer is rebuilt mid-sequence
+// and a shard may start on a rebuilt one.
+constexpr const char* kSixFrames = R"([schedule]
+first_frame = 11
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+
+[[schedule.frames]]
+time = 07:00:00
+[[schedule.frames]]
+time = 08:00:00
+[[schedule.frames]]
+time = 09:00:00
+set = { "atmosphere.mie.g" = 0.7 }
+[[schedule.frames]]
+time = 10:00:00
+[[schedule.frames]]
+time = 11:00:00
+[[schedule.frames]]
+time = 12:00:00
+)";
+
+std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
+
+std::string ReadBytes(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::set<std::string> Names(const std::string& dir) {
+  std::set<std::string> names;
+  if (fs::exists(dir))
+    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
+  return names;
+}
+
+class Shard : public ::testing::Test {
+ protected:
+  // One folder per process (ctest runs each test in its own), with the
+  // schedule and, on first use, the unsharded bake to compare against.
+  static void SetUpTestSuite() {
+    root_ = FreshTempDir("shard");
+    schedule_ = root_ + "/six.toml";
+    std::ofstream(schedule_) << kSixFrames;
+  }
+  static void TearDownTestSuite() { fs::remove_all(root_); }
+
+  // `skybake bake` of the six frames at 16^3, validation on, plus `extra`.
+  static CommandRun Bake(const std::string& out, const std::string& extra) {
+    return RunSkybake("bake '" + Style() + "' --schedule '" + schedule_ + "' --size 16 -q --vulkan-validation --out '" +
+                      out + "' " + extra);
+  }
+  static const std::string& Whole() {
+    static const std::string whole = [] {
+      const std::string out = root_ + "/whole";
+      CommandRun run = Bake(out, "");
+      EXPECT_EQ(run.exit_code, 0) << run.output;
+      return out;
+    }();
+    return whole;
+  }
+  // Every file of the unsharded bake is in `dir` with the same bytes
+  // (manifest.json and the glTF scene included), timings.json apart.
+  static void ExpectSameAsWhole(const std::string& dir) {
+    const std::set<std::string> whole = Names(Whole());
+    ASSERT_EQ(whole.size(), 6u * 9 + 3 + 2) << "9 files per frame, the scene, manifest.json, timings.json";
+    for (const std::string& name : whole) {
+      if (name == "timings.json") continue;
+      ASSERT_TRUE(fs::exists(dir + "/" + name)) << name;
+      EXPECT_TRUE(ReadBytes(dir + "/" + name) == ReadBytes(Whole() + "/" + name)) << name << " differs";
+    }
+  }
+
+  static std::string root_, schedule_;
+};
+std::string Shard::root_, Shard::schedule_;
+
+TEST_F(Shard, ThreeShardsInOneFolderMergeToTheUnshardedBake) {
+  const std::string out = root_ + "/farm";
+  for (int i = 1; i <= 3; ++i) {
+    CommandRun run = Bake(out, fmt::format("--shard {}/3", i));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  // Contiguous blocks of two, each with its own manifest and no scene yet.
+  const std::set<std::string> names = Names(out);
+  for (const char* name : {"manifest.shard-0011-0012.json", "manifest.shard-0013-0014.json",
+                           "manifest.shard-0015-0016.json", "timings.shard-0013-0014.json"})
+    EXPECT_TRUE(names.count(name)) << name;
+  for (const char* name : {"manifest.json", "sky.gltf", "sky.glb", "timings.json"}) EXPECT_FALSE(names.count(name)) << name;
+  nlohmann::json part = nlohmann::json::parse(std::ifstream(out + "/manifest.shard-0013-0014.json"));
+  EXPECT_EQ(part["part"], nlohmann::json({{"first_frame", 13}, {"last_frame", 14}, {"frames", 2}, {"of_frames", 6}}));
+  ASSERT_EQ(part["frames"].size(), 2u);
+  EXPECT_EQ(part["frames"][0]["frame"].get<int>(), 13);
+  EXPECT_TRUE(part["complete"].get<bool>());
+  EXPECT_TRUE(part["scene"].empty());
+
+  CommandRun merge = RunSkybake("merge-manifest '" + out + "'");
+  ASSERT_EQ(merge.exit_code, 0) << merge.output;
+  EXPECT_NE(merge.output.find("6 frames from 3 parts"), std::string::npos) << merge.output;
+  ExpectSameAsWhole(out);
+
+  // --resume against the shard's own manifest: every frame verified, none
+  // rendered again, no byte changed.
+  CommandRun resume = RunSkybake("bake '" + Style() + "' --schedule '" + schedule_ +
+                                 "' --size 16 --vulkan-validation --out '" + out + "' --shard 2/3 --resume");
+  ASSERT_EQ(resume.exit_code, 0) << resume.output;
+  EXPECT_NE(resume.output.find("resuming from 2 frame(s) in manifest.shard-0013-0014.json"), std::string::npos)
+      << resume.output;
+  EXPECT_EQ(resume.output.find(" 8 views"), std::string::npos) << "a frame was rendered again: " << resume.output;
+  ExpectSameAsWhole(out);
+  // A merge is not repeated over its result without --force.
+  CommandRun again = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(again.exit_code, 6) << again.output;
+  EXPECT_EQ(RunSkybake("merge-manifest --force '" + out + "'").exit_code, 0);
+  ExpectSameAsWhole(out);
+}
+
+TEST_F(Shard, FrameRangesInSeparateFoldersCopiedTogetherMergeToTheUnshardedBake) {
+  // Three machines: frames 11-13, then 14-16 split in two shards (14, 15-16).
+  const std::string a = root_ + "/a", b = root_ + "/b", c = root_ + "/c";
+  CommandRun run = Bake(a, "--frames 11:13");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  run = Bake(b, "--frames 14:16 --shard 1/2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  run = Bake(c, "--frames 14:16 --shard 2/2");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+
+  // --frames 11:13 bakes exactly frames 11, 12 and 13.
+  std::set<std::string> expected = {"manifest.shard-0011-0013.json", "timings.shard-0011-0013.json"};
+  for (int frame = 11; frame <= 13; ++frame)
+    for (const char* kind : {"px", "nx", "py", "ny", "pz", "nz", "cube", "latlong"}) {
+      expected.insert(fmt::format("sky_{}.{:04d}.exr", kind, frame));
+      if (std::string(kind) == "latlong") expected.insert(fmt::format("sky_latlong.{:04d}.png", frame));
+    }
+  EXPECT_EQ(Names(a), expected);
+  EXPECT_TRUE(Names(b).count("manifest.shard-0014-0014.json"));
+  EXPECT_TRUE(Names(c).count("manifest.shard-0015-0016.json"));
+
+  const std::string together = root_ + "/together";
+  fs::create_directories(together);
+  for (const std::string& dir : {a, b, c})
+    for (const auto& e : fs::directory_iterator(dir)) fs::copy_file(e.path(), together + "/" + e.path().filename().string());
+  CommandRun merge = RunSkybake("merge-manifest '" + together + "'");
+  ASSERT_EQ(merge.exit_code, 0) << merge.output;
+  ExpectSameAsWhole(together);
+}
+
+TEST_F(Shard, MergeRefusesMissingFramesAndPartsOfAnotherBake) {
+  const std::string out = root_ + "/gap";
+  for (const char* shard : {"1/3", "3/3"}) {
+    CommandRun run = Bake(out, std::string("--shard ") + shard);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  CommandRun missing = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(missing.exit_code, 8) << missing.output;
+  EXPECT_NE(missing.output.find("skybake: error: frames 13-14 of 11-16 are missing"), std::string::npos)
+      << missing.output;
+  EXPECT_NE(missing.output.find("--frames 13:14"), std::string::npos) << "names the fix: " << missing.output;
+  EXPECT_FALSE(fs::exists(out + "/manifest.json"));
+  EXPECT_FALSE(fs::exists(out + "/sky.gltf"));
+
+  // The middle shard of another bake (another haze): its frames' files
+  // would not belong to the same sequence.
+  CommandRun other = Bake(out, "--shard 2/3 --set atmosphere.mie.g=0.75");
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  CommandRun mixed = RunSkybake("merge-manifest --sizes-only '" + out + "'");
+  EXPECT_EQ(mixed.exit_code, 8) << mixed.output;
+  EXPECT_NE(mixed.output.find("come from different bakes"), std::string::npos) << mixed.output;
+  EXPECT_NE(mixed.output.find("manifest.shard-0013-0014.json"), std::string::npos) << "names the file: " << mixed.output;
+  EXPECT_FALSE(fs::exists(out + "/manifest.json"));
+
+  // A listed file that is gone is named, with the part it belongs to.
+  CommandRun forced = Bake(out, "--shard 2/3 --force");
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  fs::remove(out + "/sky_nz.0015.exr");
+  CommandRun gone = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(gone.exit_code, 8) << gone.output;
+  EXPECT_NE(gone.output.find("sky_nz.0015.exr, listed in " + out + "/manifest.shard-0015-0016.json, is missing"),
+            std::string::npos)
+      << gone.output;
+}
+
+TEST_F(Shard, BadFramesAndShardsAreUsageErrorsBeforeAnyGpuWork) {
+  const std::string out = root_ + "/bad";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"--shard 0/3", "--shard 0/3: shards are counted from 1: use 1/3 to 3/3"},
+      {"--shard 4/3", "--shard 4/3: shard 4 does not exist among 3: use 1/3 to 3/3"},
+      {"--shard 1/0", "--shard 1/0: the number of shards must be at least 1"},
+      {"--shard two/3", "--shard two/3: expected I/N"},
+      {"--shard 3", "--shard 3: expected I/N"},
+      {"--shard 7/7", "--shard 7/7: 6 frames (11 to 16) cannot make 7 shards: use at most 6 shards"},
+      {"--frames 14:12", "--frames 14:12: the last frame comes before the first: use --frames 12:14"},
+      {"--frames 1:3", "--frames 1:3: " + schedule_ + " has frames 11 to 16"},
+      {"--frames 12:17", "--frames 12:17: " + schedule_ + " has frames 11 to 16"},
+      {"--frames a:b", "--frames a:b: expected FIRST:LAST"},
+      {"--frames 12", "--frames 12: expected FIRST:LAST"},
+      {"--frames 11:12 --shard 3/3", "--shard 3/3: 2 frames (11 to 12) cannot make 3 shards"},
+  };
+  for (const auto& [args, message] : cases) {
+    CommandRun run = Bake(out, args);
+    EXPECT_EQ(run.exit_code, 2) << args << ": " << run.output;
+    EXPECT_EQ(run.output.rfind("skybake: error: " + message, 0), 0u) << args << ": " << run.output;
+    EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
+  }
+  CommandRun single = RunSkybake("bake '" + Style() + "' --size 16 --shard 1/2 --out '" + out + "'");
+  EXPECT_EQ(single.exit_code, 2) << single.output;
+  EXPECT_NE(single.output.find("--frames and --shard split a sequence bake: give --schedule"), std::string::npos)
+      << single.output;
+  EXPECT_FALSE(fs::exists(out)) << "nothing written";
+
+  CommandRun help = RunSkybake("--help");
+  EXPECT_NE(help.output.find("merge-manifest"), std::string::npos) << help.output;
+  CommandRun bake_help = RunSkybake("bake --help");
+  EXPECT_NE(bake_help.output.find("--shard I/N"), std::string::npos) << bake_help.output;
+  EXPECT_NE(bake_help.output.find("--frames FIRST:LAST"), std::string::npos) << bake_help.output;
+}
+
+}  // namespace
+}  // namespace skybake
