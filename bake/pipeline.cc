@@ -8,6 +8,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <future>
+#include <thread>
 #include <map>
 #include <memory>
 
@@ -41,6 +43,13 @@ class StageTimer {
     result_.stages.push_back(report);
     if (progress_) progress_(report);
     start_ = now;
+  }
+  // A stage timed elsewhere (on the writer thread): reported, not counted
+  // against the time since the last Finish.
+  void Report(const std::string& name, double seconds, const std::string& detail = "") {
+    StageReport report{name, seconds, detail};
+    result_.stages.push_back(report);
+    if (progress_) progress_(report);
   }
 
  private:
@@ -245,12 +254,54 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   return files;
 }
 
+// What the writer thread needs of a rendered frame.
+struct FrameJob {
+  FramePlan plan;
+  FrameNames names;
+  std::vector<RgbaImage> images;  // the frame's views, in PlanViews order
+  double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
+  std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
+};
+
+// What it gives back.
+struct WrittenFrame {
+  std::vector<BakedFile> files;
+  double half_scale = 1.0;
+  std::optional<double> ev100;
+  std::string exposure_source;
+  double exr_seconds = 0.0, preview_seconds = 0.0, write_seconds = 0.0;
+  std::string exr_detail;
+};
+
+// The largest value the sun disc can give a frame, in output units: its
+// centre radiance unattenuated (transmittance <= 1), when the disc is on and
+// its top is above the observer's horizon; nothing otherwise, nor under the
+// AOAS skydome (which moves the observer and turns the Sun).
+std::optional<double> VisibleDiscBound(const SkyStyle& unpruned, double elevation_deg) {
+  const SkyStyle style = PrunedStyle(unpruned);
+  if (!style.effects.sun_disc || style.aoas.skydome.enabled) return std::nullopt;
+  const AtmosphereParams a = StyledAtmosphere(style.atmosphere, style.aoas);
+  const double r = a.bottom_radius_km + a.observer_altitude_m * 1e-3;
+  const double dip_deg = std::acos(std::min(a.bottom_radius_km / r, 1.0)) * 180.0 / M_PI;
+  const double alpha = a.sun_angular_radius_rad;
+  if (elevation_deg < -dip_deg - alpha * 180.0 / M_PI) return std::nullopt;
+  // SunDiscRadiance at the centre (atmosphere.glsl): 1 / (pi alpha^2 (1 - u/3)).
+  const double centre = 1.0 / (M_PI * alpha * alpha * (1.0 - a.limb_darkening_u / 3.0));
+  const Rgb scale = OutputScale(style.output.units);
+  double bound = 0.0;
+  for (int c = 0; c < 3; ++c)
+    bound = std::max(bound, a.solar_irradiance[c] * scale[c] * centre * style.effects.sun_disc_strength);
+  return bound;
+}
+
 BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* schedule, const BakeOptions& options) {
   BakeResult result;
   StageTimer timer(result, options.progress);
   const Clock::time_point bake_start = Clock::now();
   const bool sequence = schedule != nullptr;
   const SkyStyle& first = *plans.front().style;
+  // OpenEXR compresses line blocks on its own pool, one thread per core.
+  SetExrThreads(int(std::max(1u, std::thread::hardware_concurrency())));
   // A part of the sequence (--frames, --shard) bakes only its frames; every
   // sequence-wide value below still comes from every frame in `plans`.
   const std::optional<FrameRange>& part = options.frames;
@@ -318,9 +369,15 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   std::optional<double> ev100;
   std::string exposure_source;
   double half_scale = 1.0;
+  // Only previews and the glTF texture are exposed.
+  const bool exposed = std::any_of(plans.begin(), plans.end(), [](const FramePlan& p) {
+    return p.style->output.preview || p.style->gltf.enabled;
+  });
   if (sequence) {
     const FramePlan& ref = plans[reference];
-    if (ref.style->preview.auto_exposure) {
+    if (!exposed) {
+      exposure_source = "none (no preview or glTF texture)";
+    } else if (ref.style->preview.auto_exposure) {
       const int h = ref.style->render.latlong_height;
       std::vector<float> latlong =
           renderers.Main(*ref.style).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
@@ -332,10 +389,14 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     }
     if (first.output.pixel_type == PixelType::kHalf) {
       // The brightest texel of a frame is the sun disc's centre, or else the
-      // sky near it: a coarse latlong plus the disc centre, with a factor 2
-      // of margin, bound every frame; writing checks the bound.
+      // sky near it. While the disc is above the horizon of some frame, its
+      // unattenuated centre radiance bounds the sequence without rendering;
+      // otherwise a coarse latlong plus the disc centre of every frame does.
+      // A factor 2 of margin; writing checks the bound.
       double max_value = 0.0;
-      for (const FramePlan& plan : plans) {
+      for (const FramePlan& plan : plans)
+        if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) max_value = std::max(max_value, *bound);
+      for (const FramePlan& plan : max_value > 0.0 ? std::vector<FramePlan>{} : plans) {
         SkyRenderer& r = renderers.Main(*plan.style);
         std::vector<float> coarse = r.Render(plan.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];
         std::vector<float> centre = r.RenderDirections(plan.sun, {plan.sun});
@@ -344,14 +405,12 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       }
       half_scale = HalfRangeScale(2.0 * max_value, first.output.overflow);
     }
-    timer.Finish("exposure", fmt::format("EV100 {:.2f} ({}), half scale {:.9g}", *ev100, exposure_source, half_scale));
+    timer.Finish("exposure", fmt::format("EV100 {} ({}), half scale {:.9g}",
+                                         ev100 ? fmt::format("{:.2f}", *ev100) : "-", exposure_source, half_scale));
   }
   result.half_scale = half_scale;
 
   std::filesystem::create_directories(options.out_dir);
-  auto add_file = [&](FrameResult& frame, const std::string& path, const std::string& kind, uint64_t bytes) {
-    frame.files.push_back({path, kind, bytes, Sha256OfFile(path)});
-  };
 
   // Manifest: every file with its size and SHA-256, per frame; rewritten
   // atomically after every frame, `complete` once the bake (or part) is. Its
@@ -408,6 +467,138 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     WriteManifest(m, result.manifest_path);
   };
 
+  // One frame's files, from its rendered views: one scale for every file
+  // (of the frame, or of the sequence). Runs on the writer thread; reads
+  // only the job and constants of the bake.
+  auto write_frame = [&](FrameJob& job) {
+    WrittenFrame w;
+    const FramePlan& plan = job.plan;
+    const SkyStyle& style = *plan.style;
+    const FrameNames& names = job.names;
+    std::vector<RgbaImage>& images = job.images;
+    Clock::time_point write_start = Clock::now();
+    std::vector<const RgbaImage*> all;
+    for (const RgbaImage& image : images) all.push_back(&image);
+    const double max_value = CheckedMaxValue(all);
+    w.half_scale = job.half_scale;
+    if (style.output.pixel_type == PixelType::kHalf) {
+      if (!sequence) {
+        w.half_scale = HalfRangeScale(max_value, style.output.overflow);
+      } else if (max_value * job.half_scale > kHalfMax) {
+        throw OutputError(fmt::format(
+            "frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
+            "output.pixel_type = \"float\"", plan.number, max_value, job.half_scale));
+      }
+    }
+    ExrWriteOptions exr;
+    exr.pixel_type = style.output.pixel_type;
+    exr.compression = style.output.compression;
+    exr.zip_level = style.output.zip_level;
+    exr.scale = w.half_scale;
+    const bool luminance = style.output.units == OutputUnits::kLuminance;
+    if (luminance) exr.white_luminance = 1.0 / w.half_scale;
+    exr.attributes = {
+        {"skybake:version", SKYBAKE_VERSION},
+        {"skybake:config", style.resolved_toml},
+        {"skybake:source", style.source_path},
+        {"skybake:units", luminance ? "linear Rec.709 luminance, cd/m^2 per 1.0 divided by skybake:scale"
+                                    : "spectral radiance W m^-2 sr^-1 nm^-1 at 680/550/440 nm (R/G/B), "
+                                      "divided by skybake:scale"},
+        {"skybake:scale", fmt::format("{:.9g}", w.half_scale)},
+        {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
+        {"skybake:sun_direction", FormatVector(plan.sun)},
+    };
+    if (plan.number > 0) exr.attributes["skybake:frame_number"] = std::to_string(plan.number);
+    if (plan.time) exr.attributes["skybake:time"] = plan.time->Iso8601();
+    // Encoded in memory, written atomically, checksummed from the same bytes.
+    auto write_exr = [&](const std::string& name, const std::string& kind, const RgbaImage& image,
+                         const ExrWriteOptions& o) {
+      const std::string path = path_of(name);
+      const std::string bytes = EncodeExr(path, image, o);
+      WriteFileAtomically(path, bytes);
+      w.files.push_back({path, kind, bytes.size(), Sha256OfText(bytes)});
+    };
+    size_t view_index = 0;
+    if (style.output.faces) {
+      for (int face = 0; face < 6; ++face, ++view_index) {
+        ExrWriteOptions face_exr = exr;
+        face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
+        face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
+        write_exr(names.faces[face], "face", images[view_index], face_exr);
+      }
+    }
+    if (style.output.cube_strip) {
+      ExrWriteOptions cube_exr = exr;
+      cube_exr.envmap = 1;  // ENVMAP_CUBE
+      write_exr(names.cube, "cube", images[view_index], cube_exr);
+      ++view_index;
+    }
+    const RgbaImage* latlong = view_index < images.size() ? &images[view_index] : nullptr;
+    if (style.output.latlong) {
+      ExrWriteOptions latlong_exr = exr;
+      latlong_exr.envmap = 0;  // ENVMAP_LATLONG
+      write_exr(names.latlong, "latlong", *latlong, latlong_exr);
+    }
+    w.exr_seconds = SecondsSince(write_start);
+    w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
+                               style.output.compression == "zip" || style.output.compression == "zips"
+                                   ? fmt::format(" level {}", style.output.zip_level)
+                                   : "",
+                               style.output.pixel_type == PixelType::kHalf ? "half" : "float");
+
+    // Preview (and glTF texture): exposure, ACES, sRGB; one exposure for a sequence.
+    w.ev100 = job.ev100;
+    if (latlong && (style.output.preview || style.gltf.enabled)) {
+      Clock::time_point preview_start = Clock::now();
+      std::vector<float> display = DisplayLuminance(latlong->rgba, style.output.units);
+      if (!w.ev100) {
+        w.ev100 = style.preview.auto_exposure ? AutoEv100(display, latlong->width, latlong->height)
+                                              : style.preview.ev100;
+        w.exposure_source = style.preview.auto_exposure ? "auto exposure" : "preview.ev100";
+      }
+      std::vector<uint8_t> srgb = TonemapToSrgb8(display, latlong->width, latlong->height, ExposureFromEv100(*w.ev100));
+      std::string path = path_of(names.png);
+      uint64_t bytes = WritePng(path, latlong->width, latlong->height, srgb);
+      w.files.push_back({path, style.output.preview ? "preview" : "gltf_texture", bytes, Sha256OfFile(path)});
+      w.preview_seconds = SecondsSince(preview_start);
+    }
+    w.write_seconds = SecondsSince(write_start);
+    return w;
+  };
+  // The frame whose files are being written, and what the main thread does
+  // once they are: the frame's record, progress and the manifest.
+  std::optional<std::pair<FrameResult, std::future<WrittenFrame>>> pending;
+  auto collect_pending = [&]() {
+    if (!pending) return;
+    Clock::time_point wait_start = Clock::now();
+    WrittenFrame w = pending->second.get();
+    FrameResult frame = std::move(pending->first);
+    pending.reset();
+    if (!sequence) {
+      timer.Finish("write EXR", w.exr_detail);  // a single bake waits for its files: the same time
+    } else {
+      if (SecondsSince(wait_start) > 0.005) timer.Finish("waiting for files");
+      timer.Report("write EXR", w.exr_seconds,
+                   w.exr_detail + fmt::format(", frame {}, beside the next frame's render", frame.number));
+    }
+    if (w.ev100) {
+      if (!ev100) exposure_source = w.exposure_source;
+      ev100 = w.ev100;
+      result.preview_ev100 = *w.ev100;
+      if (w.preview_seconds > 0.0) timer.Report("preview", w.preview_seconds, fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
+    }
+    if (!sequence) {
+      half_scale = w.half_scale;
+      result.half_scale = half_scale;
+    }
+    frame.files = std::move(w.files);
+    frame.write_seconds = w.write_seconds;
+    for (const BakedFile& f : frame.files) result.files.push_back(f);
+    result.frames.push_back(std::move(frame));
+    // The manifest after every frame: a killed bake leaves a valid record of the frames done.
+    write_manifest({}, false);
+  };
+
   for (size_t index = 0; index < plans.size(); ++index) {
     const FramePlan& plan = plans[index];
     if (part && !part->Contains(plan.number)) continue;  // another part's frame
@@ -422,7 +613,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     const FrameNames names = FrameFileNames(style, plan.number);
     // A resumed sequence skips frames whose files are verified against the manifest.
     std::optional<std::vector<BakedFile>> verified;
-    if (sequence && options.resume) verified = VerifiedFrame(previous, plan, options.out_dir, half_scale, *ev100);
+    if (sequence && options.resume) verified = VerifiedFrame(previous, plan, options.out_dir, half_scale, ev100.value_or(0.0));
 
     // Render: every view of the frame in one submission, then the SH views.
     Clock::time_point render_start = Clock::now();
@@ -471,100 +662,29 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                     plan.time ? ", " + plan.time->Iso8601() : "",
                                     verified ? ", files verified by checksum: not rendered again" : ""));
     if (verified) {
+      collect_pending();
       frame.files = *verified;
-      result.preview_ev100 = *ev100;
+      result.preview_ev100 = ev100.value_or(0.0);
       for (const BakedFile& f : frame.files) result.files.push_back(f);
       result.frames.push_back(std::move(frame));
       write_manifest({}, false);
       continue;
     }
 
-    // Files: one scale for every file (of the frame, or of the sequence).
-    Clock::time_point write_start = Clock::now();
+    // Files: encoded, written and checksummed on the writer thread while
+    // the device renders the next frame (the last frame's, or a single
+    // bake's, are waited for at once).
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, std::move(pixels[i])});
-    std::vector<const RgbaImage*> all;
-    for (const RgbaImage& image : images) all.push_back(&image);
-    const double max_value = CheckedMaxValue(all);
-    if (style.output.pixel_type == PixelType::kHalf) {
-      if (!sequence) {
-        half_scale = HalfRangeScale(max_value, style.output.overflow);
-        result.half_scale = half_scale;
-      } else if (max_value * half_scale > kHalfMax) {
-        throw OutputError(fmt::format(
-            "frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
-            "output.pixel_type = \"float\"", plan.number, max_value, half_scale));
-      }
-    }
-    ExrWriteOptions exr;
-    exr.pixel_type = style.output.pixel_type;
-    exr.compression = style.output.compression;
-    exr.zip_level = style.output.zip_level;
-    exr.scale = half_scale;
-    const bool luminance = style.output.units == OutputUnits::kLuminance;
-    if (luminance) exr.white_luminance = 1.0 / half_scale;
-    exr.attributes = {
-        {"skybake:version", SKYBAKE_VERSION},
-        {"skybake:config", style.resolved_toml},
-        {"skybake:source", style.source_path},
-        {"skybake:units", luminance ? "linear Rec.709 luminance, cd/m^2 per 1.0 divided by skybake:scale"
-                                    : "spectral radiance W m^-2 sr^-1 nm^-1 at 680/550/440 nm (R/G/B), "
-                                      "divided by skybake:scale"},
-        {"skybake:scale", fmt::format("{:.9g}", half_scale)},
-        {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
-        {"skybake:sun_direction", FormatVector(plan.sun)},
-    };
-    if (plan.number > 0) exr.attributes["skybake:frame_number"] = std::to_string(plan.number);
-    if (plan.time) exr.attributes["skybake:time"] = plan.time->Iso8601();
-    size_t view_index = 0;
-    if (style.output.faces) {
-      for (int face = 0; face < 6; ++face, ++view_index) {
-        ExrWriteOptions face_exr = exr;
-        face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
-        face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
-        std::string path = path_of(names.faces[face]);
-        add_file(frame, path, "face", WriteExr(path, images[view_index], face_exr));
-      }
-    }
-    if (style.output.cube_strip) {
-      ExrWriteOptions cube_exr = exr;
-      cube_exr.envmap = 1;  // ENVMAP_CUBE
-      std::string path = path_of(names.cube);
-      add_file(frame, path, "cube", WriteExr(path, images[view_index], cube_exr));
-      ++view_index;
-    }
-    const RgbaImage* latlong = view_index < images.size() ? &images[view_index] : nullptr;
-    if (style.output.latlong) {
-      ExrWriteOptions latlong_exr = exr;
-      latlong_exr.envmap = 0;  // ENVMAP_LATLONG
-      std::string path = path_of(names.latlong);
-      add_file(frame, path, "latlong", WriteExr(path, *latlong, latlong_exr));
-    }
-    timer.Finish("write EXR", fmt::format("{} files, {} compression, {}", frame.files.size(),
-                                          style.output.compression,
-                                          style.output.pixel_type == PixelType::kHalf ? "half" : "float"));
-
-    // Preview (and glTF texture): exposure, ACES, sRGB; one exposure for a sequence.
-    if (latlong && (style.output.preview || style.gltf.enabled)) {
-      std::vector<float> display = DisplayLuminance(latlong->rgba, style.output.units);
-      if (!ev100) {
-        ev100 = style.preview.auto_exposure ? AutoEv100(display, latlong->width, latlong->height) : style.preview.ev100;
-        exposure_source = style.preview.auto_exposure ? "auto exposure" : "preview.ev100";
-      }
-      result.preview_ev100 = *ev100;
-      std::vector<uint8_t> srgb =
-          TonemapToSrgb8(display, latlong->width, latlong->height, ExposureFromEv100(*ev100));
-      std::string path = path_of(names.png);
-      add_file(frame, path, style.output.preview ? "preview" : "gltf_texture",
-               WritePng(path, latlong->width, latlong->height, srgb));
-    }
-    frame.write_seconds = SecondsSince(write_start);
-    if (ev100) timer.Finish("preview", fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
-    for (const BakedFile& f : frame.files) result.files.push_back(f);
-    result.frames.push_back(std::move(frame));
-    // The manifest after every frame: a killed bake leaves a valid record of the frames done.
-    write_manifest({}, false);
+    collect_pending();
+    FrameJob job{plan, names, std::move(images), half_scale, ev100};
+    pending.emplace(std::move(frame),
+                    std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
+                      return write_frame(job);
+                    }));
+    if (!sequence || index + 1 == plans.size()) collect_pending();
   }
+  collect_pending();
 
   // Scene and manifest: a whole bake ends as merge-manifest does, through
   // WriteSceneAndManifest, so both give the same bytes; a part writes only
