@@ -1,13 +1,17 @@
 #include "skybake/exr_io.h"
 
+#include "oiio_module.h"
+
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <mutex>
 #include <set>
 
+#include <dlfcn.h>
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/stat.h>
@@ -23,8 +27,6 @@
 #include <OpenEXR/ImfStandardAttributes.h>
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/ImfThreading.h>
-#include <OpenImageIO/filesystem.h>
-#include <OpenImageIO/imageio.h>
 
 namespace skybake {
 namespace {
@@ -225,20 +227,48 @@ std::string EncodeExr(const std::string& path, const RgbaImage& image, const Exr
 }
 
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) throw OutputError("OpenImageIO has no PNG writer: " + OIIO::geterror());
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  spec.attribute("Software", "skybake " SKYBAKE_VERSION);
-  // Encoded in memory, then written like every other file.
+  // Encoded in memory by the OpenImageIO module, then written like every other file.
   std::vector<unsigned char> encoded;
-  OIIO::Filesystem::IOVecOutput proxy(encoded);
-  out->set_ioproxy(&proxy);
-  bool ok = out->open(path, spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb.data());
-  ok = out->close() && ok;
-  if (!ok) throw OutputError(fmt::format("cannot encode {}: {}", path, out->geterror()));
+  std::string error;
+  if (!LoadOiioModule().encode_png(width, height, rgb.data(), encoded, error))
+    throw OutputError(fmt::format("cannot encode {}: {}", path, error));
   WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(encoded.data()), encoded.size()));
   return encoded.size();
+}
+
+const OiioModule& LoadOiioModule() {
+  static std::mutex mutex;
+  static const OiioModule* module = nullptr;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (module) return *module;
+  std::vector<std::filesystem::path> dirs;
+  if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) dirs.emplace_back(dir);
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    dirs.push_back(exe.parent_path());
+    dirs.push_back(exe.parent_path().parent_path());  // tests/ of the build tree
+  }
+  dirs.emplace_back(SKYBAKE_MODULE_BUILD_DIR);
+  std::string tried;
+  for (const std::filesystem::path& dir : dirs) {
+    const std::string path = (dir / "libskybake_oiio.so").string();
+    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      tried += fmt::format("\n  {}: {}", path, ::dlerror());
+      continue;
+    }
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module"));
+    if (!entry) {
+      tried += fmt::format("\n  {}: no skybake_oiio_module", path);
+      continue;
+    }
+    module = entry();
+    return *module;
+  }
+  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (PNG previews, glTF "
+                                "textures, galleries): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
+                                "holding it; tried:{}", tried));
 }
 
 }  // namespace skybake

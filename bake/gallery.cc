@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <filesystem>
 
-#include <OpenImageIO/imagebuf.h>
-#include <OpenImageIO/imagebufalgo.h>
 #include <fmt/format.h>
 
 #include "skybake/exr_io.h"
+#include "oiio_module.h"
 
 namespace skybake {
 namespace {
@@ -72,50 +71,25 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
     result.entries.push_back(entry);
   }
 
-  // Lay the upper halves out in a grid, each under its label.
-  const int tile_w = 2 * options.latlong_height;
-  const int tile_h = options.latlong_height / 2;
-  const int columns = std::max(1, std::min<int>(options.columns, int(result.entries.size())));
-  const int rows = (int(result.entries.size()) + columns - 1) / columns;
-  const int cell_w = tile_w + kMargin, cell_h = tile_h + kLabelHeight + kMargin;
-  OIIO::ImageSpec spec(columns * cell_w + kMargin, rows * cell_h + kMargin, 3, OIIO::TypeDesc::FLOAT);
-  OIIO::ImageBuf sheet(spec);
-  const float background[3] = {0.08f, 0.08f, 0.09f};
-  OIIO::ImageBufAlgo::fill(sheet, background);
-  for (size_t i = 0; i < result.entries.size(); ++i) {
-    const GalleryEntry& e = result.entries[i];
-    const int x0 = kMargin + int(i % columns) * cell_w;
-    const int y0 = kMargin + int(i / columns) * cell_h;
-    OIIO::ImageBuf preview(e.preview);
-    if (!preview.read(0, 0, true, OIIO::TypeDesc::FLOAT))
-      throw OutputError(fmt::format("cannot read {}: {}", e.preview, preview.geterror()));
-    OIIO::ImageBuf sky = OIIO::ImageBufAlgo::cut(preview, OIIO::ROI(0, tile_w, 0, tile_h, 0, 1, 0, 3));
-    if (!OIIO::ImageBufAlgo::paste(sheet, x0, y0 + kLabelHeight, 0, 0, sky))
-      throw OutputError("cannot compose the contact sheet: " + sheet.geterror());
-    // Two label lines, clipped to this cell.
-    const float name_color[3] = {0.95f, 0.95f, 0.95f};
-    const float detail_color[3] = {0.7f, 0.7f, 0.72f};
-    OIIO::ROI cell(x0, x0 + tile_w, y0, y0 + kLabelHeight, 0, 1, 0, 3);
-    bool ok = OIIO::ImageBufAlgo::render_text(sheet, x0 + 2, y0 + 17, e.name, kNameSize, kNameFont,
-                                              name_color, OIIO::ImageBufAlgo::TextAlignX::Left,
-                                              OIIO::ImageBufAlgo::TextAlignY::Baseline, 0, cell);
-    ok = ok && OIIO::ImageBufAlgo::render_text(sheet, x0 + 2, y0 + 34, e.principles, kDetailSize,
-                                               kDetailFont, detail_color,
-                                               OIIO::ImageBufAlgo::TextAlignX::Left,
-                                               OIIO::ImageBufAlgo::TextAlignY::Baseline, 0, cell);
-    if (!ok)
-      throw OutputError(
-          fmt::format("cannot draw the gallery labels ({}): install the DejaVu fonts "
-                      "(apt-get install fonts-dejavu-core)", sheet.geterror()));
-  }
-  // The previews are sRGB-encoded already: write the values as they are.
+  // Lay the upper halves out in a grid, each under its label (OpenImageIO module).
+  SheetLayout layout;
+  layout.tile_w = 2 * options.latlong_height;
+  layout.tile_h = options.latlong_height / 2;
+  layout.columns = options.columns;
+  layout.margin = kMargin;
+  layout.label_height = kLabelHeight;
+  layout.name_size = kNameSize;
+  layout.detail_size = kDetailSize;
+  layout.name_font = kNameFont;
+  layout.detail_font = kDetailFont;
+  std::vector<SheetCell> cells;
+  for (const GalleryEntry& e : result.entries) cells.push_back({e.preview, e.name, e.principles});
+  std::vector<uint8_t> rgb;
+  int width = 0, height = 0;
+  std::string error;
+  if (!LoadOiioModule().compose_sheet(cells, layout, rgb, width, height, error)) throw OutputError(error);
   std::string sheet_path = (std::filesystem::path(options.out_dir) / "gallery.png").string();
-  std::vector<uint8_t> rgb(size_t(spec.width) * spec.height * 3);
-  std::vector<float> pixels(rgb.size());
-  sheet.get_pixels(OIIO::ROI::All(), OIIO::TypeDesc::FLOAT, pixels.data());
-  for (size_t i = 0; i < rgb.size(); ++i)
-    rgb[i] = uint8_t(std::lround(std::clamp(pixels[i], 0.0f, 1.0f) * 255.0f));
-  WritePng(sheet_path, spec.width, spec.height, rgb);
+  WritePng(sheet_path, width, height, rgb);
   result.contact_sheet = sheet_path;
   return result;
 }

@@ -1,0 +1,43 @@
+// The OpenImageIO half of skybake, in a module loaded on first use.
+//
+// Linking OpenImageIO pulls in some 260 shared libraries whose start-up
+// costs about 0.3 s per process on the 2-core machine (docs/performance.md),
+// more than the whole W1 budget's share for it; a bake that writes no PNG
+// never loads them. The module is built beside the binaries
+// (libskybake_oiio.so) and found from SKYBAKE_MODULE_DIR or the directory of
+// the running executable.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace skybake {
+
+// One labelled tile of a contact sheet: the upper half of a preview PNG.
+struct SheetCell {
+  std::string preview_path, name, detail;
+};
+
+struct SheetLayout {
+  int tile_w = 0, tile_h = 0, columns = 1, margin = 8, label_height = 40;
+  int name_size = 17, detail_size = 12;
+  std::string name_font = "DejaVuSans-Bold", detail_font = "DejaVuSans";
+};
+
+// The module's entry points; each returns false with a message in `error`.
+struct OiioModule {
+  bool (*encode_png)(int width, int height, const uint8_t* rgb, std::vector<unsigned char>& png,
+                     std::string& error);
+  bool (*compose_sheet)(const std::vector<SheetCell>& cells, const SheetLayout& layout, std::vector<uint8_t>& rgb,
+                        int& width, int& height, std::string& error);
+};
+
+// Loads the module once (thread-safe); throws OutputError naming the file
+// and the fix when it cannot.
+const OiioModule& LoadOiioModule();
+
+}  // namespace skybake
+
+// The module's one exported symbol.
+extern "C" const skybake::OiioModule* skybake_oiio_module();

@@ -1,0 +1,187 @@
+#!/usr/bin/env python3
+"""The performance benchmark of docs/performance.md.
+
+W1: one frame of configs/benchmark/w1.toml (six 512^2 faces, the strip, a
+2048 x 1024 latlong; production preset; half-float ZIP EXRs), the whole
+`skybake bake` process. W2: the 96-frame time-lapse of W1
+(configs/benchmark/w2.toml). Both also with float32 EXRs, and W1 with the
+default outputs (PNG preview, glTF scene). Each is timed as a whole process
+(wall clock, peak resident memory from wait4), several times, medians
+reported. Blender (Cycles, Nishita sky, 1 sample; tests/benchmark/
+blender_sky.py) renders the same frames in the same run when it is installed.
+
+    python3 tests/benchmark/performance.py [--reps 3] [--no-blender]
+
+Prints a markdown report (stdout) with the stage times of skybake's own
+timings.json and how close each stage is to its limit.
+"""
+import argparse
+import json
+import os
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+
+def run(cmd, cwd=ROOT, log=None):
+    """Runs cmd; returns (wall seconds, peak RSS MiB). Fails loudly."""
+    start = time.monotonic()
+    proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
+    out = proc.stdout.read()
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.monotonic() - start
+    if os.waitstatus_to_exitcode(status) != 0:
+        sys.stderr.write(out.decode(errors="replace"))
+        raise SystemExit(f"failed: {' '.join(cmd)}")
+    if log:
+        with open(log, "wb") as f:
+            f.write(out)
+    return wall, usage.ru_maxrss / 1024.0
+
+
+def median_run(label, cmd, reps, before=None):
+    walls, peaks = [], []
+    for i in range(reps):
+        if before:
+            before()
+        wall, peak = run(cmd)
+        walls.append(wall)
+        peaks.append(peak)
+        sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, peak {peak:.0f} MiB\n")
+    return {"label": label, "wall": statistics.median(walls), "walls": walls, "peak": statistics.median(peaks),
+            "peak_max": max(peaks)}
+
+
+def cpu_peak_gflops():
+    """Peak FP32 rate of llvmpipe's 256-bit code: cores x clock x 8 lanes x 2 (FMA) x 2 FMA ports."""
+    cores, mhz = os.cpu_count(), 0.0
+    with open("/proc/cpuinfo") as f:
+        for line in f:
+            if line.startswith("cpu MHz"):
+                mhz = float(line.split(":")[1])
+                break
+    return cores * mhz * 1e-3 * 8 * 2 * 2, cores, mhz
+
+
+# FLOPs estimated by counting the operations of the shaders (shaders/
+# atmosphere.glsl), one per add, multiply or compare, a transcendental (exp,
+# sqrt, atan, sin, asin) as ~15, the length of llvmpipe's polynomial
+# expansions: a sky-view LUT sample (medium densities, two transmittance
+# and one multiple-scattering LUT reads, phases, the analytic step) ~250; an
+# output texel (mapping, two atan, the LUT read, the disc test) ~120.
+FLOPS_PER_SKYVIEW_SAMPLE = 250
+FLOPS_PER_TEXEL = 120
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--skybake", default=os.path.join(ROOT, "build", "skybake"))
+    parser.add_argument("--reps", type=int, default=3, help="runs of each case (medians reported)")
+    parser.add_argument("--reps-w1", type=int, default=5)
+    parser.add_argument("--reps-w2-float", type=int, default=1, help="runs of W2 with float32 files (slow)")
+    parser.add_argument("--no-blender", action="store_true")
+    parser.add_argument("--blender", default=shutil.which("blender"))
+    parser.add_argument("--work", default=None, help="scratch folder (default: a temporary one)")
+    args = parser.parse_args()
+    work = args.work or tempfile.mkdtemp(prefix="skybake-bench-")
+    os.makedirs(work, exist_ok=True)
+    w1 = ["configs/benchmark/w1.toml"]
+    w2 = w1 + ["--schedule", "configs/benchmark/w2.toml"]
+    floats = ["--set", 'output.pixel_type="float"']
+
+    def bake(extra, out):
+        return [args.skybake, "bake", *extra, "--out", os.path.join(work, out), "--force", "--quiet"]
+
+    results = {}
+    results["w1_half"] = median_run("W1 half", bake(w1, "w1"), args.reps_w1)
+    w1_timings = json.load(open(os.path.join(work, "w1", "timings.json")))
+    results["w1_float"] = median_run("W1 float", bake(w1 + floats, "w1f"), args.reps_w1)
+    results["w1_default"] = median_run("W1 + preview + glTF", bake(
+        w1 + ["--set", "output.preview=true", "--set", "gltf.enabled=true"], "w1d"), args.reps_w1)
+    results["w2_half"] = median_run("W2 half", bake(w2, "w2"), args.reps)
+    w2_manifest = os.path.join(work, "w2", "manifest.json")
+    w2_timings = json.load(open(os.path.join(work, "w2", "timings.json")))
+    w2_bytes = sum(f["bytes"] for fr in json.load(open(w2_manifest))["frames"] for f in fr["files"])
+    results["w2_float"] = median_run("W2 float", bake(w2 + floats, "w2f"), args.reps_w2_float)
+
+    blender = None
+    if args.blender and not args.no_blender:
+        script = os.path.join(ROOT, "tests", "benchmark", "blender_sky.py")
+        out = os.path.join(work, "blender")
+
+        def clean():
+            shutil.rmtree(out, ignore_errors=True)
+            os.makedirs(out)
+        base = [args.blender, "-b", "--factory-startup", "--python", script, "--", w2_manifest, out]
+        blender = {"w1": median_run("Blender W1", base + ["1"], args.reps, clean),
+                   "w2": median_run("Blender W2", base, 1, clean)}
+
+    # Stages of the last W2 run: medians over frames.
+    frames = w2_timings["frames"]
+    render_s = statistics.median(f["render_s"] for f in frames)
+    write_s = statistics.median(f["write_s"] for f in frames)
+    pass_ms = {}
+    for f in frames:
+        for p in f["gpu_passes"]:
+            pass_ms.setdefault(p["name"], []).append(p["gpu_ms"])
+    lut_ms = statistics.median(pass_ms.get("sky-view LUT", [0.0]))
+    view_names = ["face +X", "face -X", "face +Y", "face -Y", "face +Z", "face -Z", "cube strip", "latlong"]
+    # The first six "face" entries per frame are the output faces, the last six the 64^2 SH faces.
+    view_ms = 0.0
+    for f in frames:
+        per = {}
+        for p in f["gpu_passes"]:
+            per.setdefault(p["name"], []).append(p["gpu_ms"])
+        view_ms += sum(per[n][0] for n in view_names if n in per)
+    view_ms /= len(frames)
+    peak, cores, mhz = cpu_peak_gflops()
+    skyview_samples = 320 * 180 * 33
+    texels = 6 * 512 * 512 + 512 * 3072 + 2048 * 1024
+    lut_gflops = skyview_samples * FLOPS_PER_SKYVIEW_SAMPLE / (lut_ms * 1e-3) * 1e-9
+    view_gflops = texels * FLOPS_PER_TEXEL / (view_ms * 1e-3) * 1e-9
+    frame_mb = w2_bytes / len(frames) / 1e6
+    raw_mb = texels * 3 * 2 / 1e6
+
+    print("## Results\n")
+    print(f"Machine: {cores} cores at {mhz:.0f} MHz (/proc/cpuinfo), lavapipe; medians of {args.reps_w1} (W1) "
+          f"and {args.reps} (W2) runs in one run of this script.\n")
+    print("| case | target | wall (median) | runs | peak memory |")
+    print("| --- | --- | ---: | --- | ---: |")
+    targets = {"w1_half": "<= 0.5 s", "w2_half": "<= 30 s, <= 1 GiB"}
+    for key, r in results.items():
+        print(f"| {r['label']} | {targets.get(key, '')} | {r['wall']:.2f} s | "
+              f"{', '.join(f'{w:.2f}' for w in r['walls'])} | {r['peak_max']:.0f} MiB |")
+    if blender:
+        for key in ("w1", "w2"):
+            r = blender[key]
+            print(f"| {r['label']} (Cycles, 1 sample, half ZIP) | | {r['wall']:.2f} s | "
+                  f"{', '.join(f'{w:.2f}' for w in r['walls'])} | {r['peak_max']:.0f} MiB |")
+        print(f"\nskybake is {blender['w1']['wall'] / results['w1_half']['wall']:.1f}x faster than Blender on W1 "
+              f"and {blender['w2']['wall'] / results['w2_half']['wall']:.1f}x on W2 (target: 8x on W2).")
+    print("\n## Stages\n")
+    print("W1 (one process, stages of timings.json):\n")
+    print("| stage | seconds |")
+    print("| --- | ---: |")
+    for s in w1_timings["stages"]:
+        print(f"| {s['stage']} | {s['seconds']:.3f} |")
+    print(f"\nW2, medians over its {len(frames)} frames (files of a frame are written while the next renders):\n")
+    print("| stage | per frame | limit | how close |")
+    print("| --- | ---: | --- | --- |")
+    print(f"| sky-view LUT (GPU) | {lut_ms:.0f} ms | {skyview_samples / 1e6:.2f} M samples x ~{FLOPS_PER_SKYVIEW_SAMPLE} "
+          f"FLOP = {skyview_samples * FLOPS_PER_SKYVIEW_SAMPLE / 1e9:.2f} GFLOP; peak {peak:.0f} GFLOP/s | "
+          f"{lut_gflops:.1f} GFLOP/s, {100 * lut_gflops / peak:.0f}% of peak |")
+    print(f"| views (GPU, {texels / 1e6:.2f} Mtexels) | {view_ms:.0f} ms | ~{FLOPS_PER_TEXEL} FLOP per texel = "
+          f"{texels * FLOPS_PER_TEXEL / 1e9:.2f} GFLOP | {view_gflops:.1f} GFLOP/s, {100 * view_gflops / peak:.0f}% "
+          f"of peak |")
+    print(f"| render incl. SH and copies (wall) | {render_s * 1e3:.0f} ms | | |")
+    print(f"| encode + write + checksum 8 EXRs | {write_s * 1e3:.0f} ms | {raw_mb:.1f} MB of half RGB in, "
+          f"{frame_mb:.2f} MB written | {raw_mb / write_s:.0f} MB/s in, {frame_mb / write_s:.1f} MB/s out |")
+
+
+if __name__ == "__main__":
+    main()
