@@ -1,10 +1,12 @@
 #include "skybake/exr_io.h"
 
+#include "exr_deflate.h"
 #include "oiio_module.h"
 
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -161,7 +163,12 @@ double HalfRangeScale(double max_value, OverflowPolicy policy) {
   return std::exp2(-std::ceil(std::log2(max_value / kHalfMax)));
 }
 
+namespace {
+std::atomic<int> exr_threads{1};  // SetExrThreads
+}  // namespace
+
 void SetExrThreads(int threads) {
+  exr_threads = std::max(threads, 1);
   if (Imf::globalThreadCount() != threads) Imf::setGlobalThreadCount(threads);
 }
 
@@ -172,6 +179,8 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
 }
 
 std::string EncodeExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
+  if (!options.openexr_encoder && DeflateEncoderHandles(options.compression))
+    return EncodeExrDeflate(path, image, options, exr_threads);
   const int w = image.width;
   const int h = image.height;
   Imf::PixelType type = options.pixel_type == PixelType::kHalf ? Imf::HALF : Imf::FLOAT;

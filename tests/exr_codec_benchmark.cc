@@ -2,9 +2,11 @@
 // output.pixel_type: one W1 frame of the default style (six 512^2 faces, the
 // 512 x 3072 strip, a 2048 x 1024 latlong; docs/performance.md) is rendered
 // once on the Vulkan device, then encoded in memory by every lossless codec,
-// zip level and pixel type, on 1 and on 2 OpenEXR threads. Reports the median
-// encode time of the frame's eight files and their total size; writing to
-// disk is timed separately (`write+fsync` rows) since it depends on the disk.
+// zip level and pixel type, on 1 and on 2 threads: by skybake's libdeflate
+// encoder (none, zips, zip: the `encode/` rows) and by OpenEXR's own encoder
+// (every codec: the `openexr/` rows). Reports the median encode time of the
+// frame's eight files and their total size; writing to disk is timed
+// separately (`write+fsync` rows) since it depends on the disk.
 //
 //   build/tests/exr_codec_benchmark [--benchmark_repetitions=N]
 #include <cstdio>
@@ -53,13 +55,14 @@ double W1HalfScale() {
   return HalfRangeScale(CheckedMaxValue(all), OverflowPolicy::kScale);
 }
 
-void BM_Encode(benchmark::State& state, PixelType type, std::string compression, int level) {
+void BM_Encode(benchmark::State& state, PixelType type, std::string compression, int level, bool openexr) {
   const std::vector<RgbaImage>& images = W1Images();
   SetExrThreads(int(state.range(0)));
   ExrWriteOptions options;
   options.pixel_type = type;
   options.compression = compression;
   options.zip_level = level;
+  options.openexr_encoder = openexr;
   options.scale = type == PixelType::kHalf ? W1HalfScale() : 1.0;
   size_t bytes = 0, texels = 0;
   for (auto _ : state) {
@@ -102,17 +105,22 @@ void BM_WriteFsync(benchmark::State& state, PixelType type) {
 
 void Register() {
   struct Codec {
+    bool openexr;
     const char* name;
     int level;
   };
-  const Codec codecs[] = {{"none", 0}, {"rle", 0}, {"zips", 1}, {"zip", 1}, {"zip", 2}, {"zip", 4},
-                          {"zip", 6}, {"zip", 9}, {"piz", 0}};
+  const Codec codecs[] = {{false, "none", 0}, {false, "zips", 1}, {false, "zip", 1}, {false, "zip", 2},
+                          {false, "zip", 4},  {false, "zip", 6},  {false, "zip", 9}, {true, "none", 0},
+                          {true, "rle", 0},   {true, "zips", 1},  {true, "zip", 1},  {true, "zip", 4},
+                          {true, "piz", 0}};
   for (PixelType type : {PixelType::kHalf, PixelType::kFloat}) {
     const char* type_name = type == PixelType::kHalf ? "half" : "float";
     for (const Codec& c : codecs) {
-      std::string name = c.level > 0 ? fmt::format("encode/{}/{}/level{}", type_name, c.name, c.level)
-                                      : fmt::format("encode/{}/{}", type_name, c.name);
-      benchmark::RegisterBenchmark(name.c_str(), BM_Encode, type, std::string(c.name), std::max(c.level, 1))
+      const char* encoder = c.openexr ? "openexr" : "encode";
+      std::string name = c.level > 0 ? fmt::format("{}/{}/{}/level{}", encoder, type_name, c.name, c.level)
+                                      : fmt::format("{}/{}/{}", encoder, type_name, c.name);
+      benchmark::RegisterBenchmark(name.c_str(), BM_Encode, type, std::string(c.name), std::max(c.level, 1),
+                                   c.openexr)
           ->Arg(1)
           ->Arg(2)
           ->ArgName("threads")

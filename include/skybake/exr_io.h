@@ -37,6 +37,9 @@ struct ExrWriteOptions {
   double scale = 1.0;            // multiplies every value before writing
   double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
   std::map<std::string, std::string> attributes;  // provenance string attributes
+  // none, zip and zips are encoded by skybake's libdeflate encoder; true
+  // uses OpenEXR's own (zlib) encoder instead, for comparison.
+  bool openexr_encoder = false;
 };
 
 // Largest value over the RGB channels of the images; throws OutputError if
@@ -48,14 +51,15 @@ double CheckedMaxValue(const std::vector<const RgbaImage*>& images);
 double HalfRangeScale(double max_value, OverflowPolicy policy);
 
 // Encodes R, G, B channels into the bytes of an EXR file (`name` is for
-// messages). Line blocks are compressed on OpenEXR's global thread pool.
+// messages). Chunks are compressed on SetExrThreads threads.
 std::string EncodeExr(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options);
 
 // Encodes and writes atomically; returns the size of the written file in bytes.
 uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options);
 
-// Sizes OpenEXR's global thread pool, which compresses line blocks in
-// parallel (0: no pool). Idempotent and cheap when the size is unchanged.
+// Threads that compress the chunks of one file (OpenEXR's global thread pool
+// for its own encoder; 0 or 1: the calling thread only). Idempotent and cheap
+// when the size is unchanged.
 void SetExrThreads(int threads);
 
 // Writes an 8-bit sRGB PNG through OpenImageIO.

@@ -1,0 +1,213 @@
+#include "exr_deflate.h"
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include <fmt/format.h>
+#include <Imath/half.h>
+#include <OpenEXR/openexr.h>
+#include <libdeflate.h>
+
+namespace skybake {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "EXR pixel data is little-endian");
+
+// Scanlines per chunk, by the OpenEXR file format: 16 for ZIP, 1 for ZIPS and
+// for no compression.
+int LinesPerChunk(const std::string& compression) { return compression == "zip" ? 16 : 1; }
+
+exr_compression_t CoreCompression(const std::string& compression) {
+  if (compression == "zip") return EXR_COMPRESSION_ZIP;
+  if (compression == "zips") return EXR_COMPRESSION_ZIPS;
+  return EXR_COMPRESSION_NONE;
+}
+
+// Bytes of one chunk as the file stores them uncompressed: for each scanline,
+// the channels in name order (B, G, R), each a row of little-endian values.
+void LayOutChunk(const RgbaImage& image, int y0, int lines, bool half_pixels, float scale, uint8_t* out) {
+  const int w = image.width;
+  for (int y = y0; y < y0 + lines; ++y) {
+    const float* row = image.rgba.data() + size_t(y) * w * 4;
+    for (int channel : {2, 1, 0}) {  // B, G, R
+      if (half_pixels) {
+        for (int x = 0; x < w; ++x) {
+          const uint16_t bits = half(row[4 * x + channel] * scale).bits();
+          std::memcpy(out, &bits, 2);
+          out += 2;
+        }
+      } else {
+        for (int x = 0; x < w; ++x) {
+          const float v = row[4 * x + channel] * scale;
+          std::memcpy(out, &v, 4);
+          out += 4;
+        }
+      }
+    }
+  }
+}
+
+// The ZIP predictor of the EXR format: the even bytes, then the odd bytes,
+// each byte replaced by its difference from the previous one plus 128.
+void Predict(const uint8_t* raw, size_t n, uint8_t* out) {
+  const size_t half_n = (n + 1) / 2;
+  for (size_t i = 0; i < half_n; ++i) out[i] = raw[2 * i];
+  for (size_t i = 0; 2 * i + 1 < n; ++i) out[half_n + i] = raw[2 * i + 1];
+  uint8_t previous = out[0];
+  for (size_t i = 1; i < n; ++i) {
+    const uint8_t current = out[i];
+    out[i] = uint8_t(current - previous + 128);
+    previous = current;
+  }
+}
+
+struct CompressorDeleter {
+  void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
+};
+
+// One libdeflate compressor per thread and level (a compressor is not
+// shareable between threads; allocating one costs more than a small chunk).
+libdeflate_compressor* ThreadCompressor(int level) {
+  thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor;
+  thread_local int compressor_level = -1;
+  if (!compressor || compressor_level != level) {
+    compressor.reset(libdeflate_alloc_compressor(level));
+    if (!compressor) throw std::bad_alloc();
+    compressor_level = level;
+  }
+  return compressor.get();
+}
+
+struct Chunk {
+  int y = 0;
+  std::vector<uint8_t> bytes;  // as stored: deflated, or raw when that is not smaller
+};
+
+void EncodeChunks(const RgbaImage& image, const ExrWriteOptions& options, int lines_per_chunk, bool deflate,
+                  size_t first, size_t last, std::vector<Chunk>& chunks) {
+  const bool half_pixels = options.pixel_type == PixelType::kHalf;
+  const size_t line_bytes = size_t(image.width) * 3 * (half_pixels ? 2 : 4);
+  std::vector<uint8_t> raw(line_bytes * lines_per_chunk);
+  std::vector<uint8_t> predicted(raw.size());
+  libdeflate_compressor* compressor = deflate ? ThreadCompressor(options.zip_level) : nullptr;
+  for (size_t i = first; i < last; ++i) {
+    Chunk& chunk = chunks[i];
+    chunk.y = int(i) * lines_per_chunk;
+    const int lines = std::min(lines_per_chunk, image.height - chunk.y);
+    const size_t n = line_bytes * lines;
+    LayOutChunk(image, chunk.y, lines, half_pixels, float(options.scale), raw.data());
+    if (deflate) {
+      Predict(raw.data(), n, predicted.data());
+      chunk.bytes.resize(libdeflate_zlib_compress_bound(compressor, n));
+      const size_t packed = libdeflate_zlib_compress(compressor, predicted.data(), n, chunk.bytes.data(),
+                                                     chunk.bytes.size());
+      // A chunk that does not shrink is stored raw; readers tell the two
+      // apart by comparing its size with the uncompressed size.
+      if (packed > 0 && packed < n) {
+        chunk.bytes.resize(packed);
+        continue;
+      }
+    }
+    chunk.bytes.assign(raw.begin(), raw.begin() + n);
+  }
+}
+
+struct Sink {
+  std::string bytes;
+  std::string error;
+};
+
+int64_t WriteToSink(exr_const_context_t, void* user_data, const void* buffer, uint64_t size, uint64_t offset,
+                    exr_stream_error_func_ptr_t) {
+  auto* sink = static_cast<Sink*>(user_data);
+  if (offset + size > sink->bytes.size()) sink->bytes.resize(offset + size);
+  std::memcpy(sink->bytes.data() + offset, buffer, size);
+  return int64_t(size);
+}
+
+void RecordError(exr_const_context_t context, exr_result_t code, const char* message) {
+  void* user_data = nullptr;
+  if (exr_get_user_data(context, &user_data) == EXR_ERR_SUCCESS && user_data)
+    static_cast<Sink*>(user_data)->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
+}
+
+}  // namespace
+
+bool DeflateEncoderHandles(const std::string& compression) {
+  return compression == "none" || compression == "zip" || compression == "zips";
+}
+
+std::string EncodeExrDeflate(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options,
+                             int threads) {
+  if (!DeflateEncoderHandles(options.compression))
+    throw OutputError(fmt::format("cannot encode {}: compression {} is not ZIP, ZIPS or none", name,
+                                  options.compression));
+  const int lines_per_chunk = LinesPerChunk(options.compression);
+  const bool deflate = options.compression != "none";
+  const size_t count = size_t((image.height + lines_per_chunk - 1) / lines_per_chunk);
+  std::vector<Chunk> chunks(count);
+
+  // Chunks in contiguous blocks, one block per thread.
+  const size_t blocks = std::clamp<size_t>(size_t(std::max(threads, 1)), 1, std::max<size_t>(count, 1));
+  std::vector<std::thread> workers;
+  std::vector<std::exception_ptr> failures(blocks);
+  for (size_t b = 0; b < blocks; ++b) {
+    auto work = [&, b] {
+      try {
+        EncodeChunks(image, options, lines_per_chunk, deflate, count * b / blocks, count * (b + 1) / blocks, chunks);
+      } catch (...) {
+        failures[b] = std::current_exception();
+      }
+    };
+    if (b + 1 < blocks) workers.emplace_back(work);
+    else work();
+  }
+  for (std::thread& t : workers) t.join();
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+
+  Sink sink;
+  exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+  init.user_data = &sink;
+  init.write_fn = &WriteToSink;
+  init.error_handler_fn = &RecordError;
+  exr_context_t context = nullptr;
+  auto check = [&](exr_result_t result, const char* what) {
+    if (result == EXR_ERR_SUCCESS) return;
+    std::string message = sink.error.empty() ? exr_get_default_error_message(result) : sink.error;
+    if (context) exr_finish(&context);
+    throw OutputError(fmt::format("cannot encode {} ({}): {}", name, what, message));
+  };
+  check(exr_start_write(&context, name.c_str(), EXR_WRITE_FILE_DIRECTLY, &init), "starting");
+  int part = 0;
+  check(exr_add_part(context, nullptr, EXR_STORAGE_SCANLINE, &part), "adding the part");
+  check(exr_initialize_required_attr_simple(context, part, image.width, image.height,
+                                            CoreCompression(options.compression)),
+        "the required attributes");
+  const exr_pixel_type_t type = options.pixel_type == PixelType::kHalf ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
+  for (const char* channel : {"B", "G", "R"})
+    check(exr_result_t(exr_add_channel(context, part, channel, type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1)),
+          "a channel");
+  // Rec.709 primaries and D65 white, as Imf::Chromaticities() defines them.
+  const exr_attr_chromaticities_t rec709{0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
+  check(exr_attr_set_chromaticities(context, part, "chromaticities", &rec709), "chromaticities");
+  if (options.envmap >= 0)
+    check(exr_attr_set_envmap(context, part, "envmap", exr_envmap_t(options.envmap)), "envmap");
+  if (options.white_luminance > 0.0)
+    check(exr_attr_set_float(context, part, "whiteLuminance", float(options.white_luminance)), "whiteLuminance");
+  for (const auto& [key, value] : options.attributes)
+    check(exr_attr_set_string(context, part, key.c_str(), value.c_str()), key.c_str());
+  check(exr_write_header(context), "the header");
+  for (const Chunk& chunk : chunks)
+    check(exr_write_scanline_chunk(context, part, chunk.y, chunk.bytes.data(), chunk.bytes.size()), "a chunk");
+  const exr_result_t finished = exr_finish(&context);
+  context = nullptr;
+  check(finished, "the offset table");
+  return std::move(sink.bytes);
+}
+
+}  // namespace skybake
