@@ -12,6 +12,10 @@
 #include <OpenEXR/openexr.h>
 #include <libdeflate.h>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace skybake {
 namespace {
 
@@ -27,17 +31,46 @@ exr_compression_t CoreCompression(const std::string& compression) {
   return EXR_COMPRESSION_NONE;
 }
 
+// Half-float bits of `in` x `scale`, rounded to nearest even like
+// Imath::half(float).
+void ToHalfPortable(const float* in, size_t n, float scale, uint16_t* out) {
+  for (size_t i = 0; i < n; ++i) out[i] = half(in[i] * scale).bits();
+}
+
+#if defined(__x86_64__)
+// The same, eight at a time by the F16C instruction (the same rounding).
+__attribute__((target("avx,f16c"))) void ToHalfF16c(const float* in, size_t n, float scale, uint16_t* out) {
+  const __m256 s = _mm256_set1_ps(scale);
+  size_t i = 0;
+  for (; i + 8 <= n; i += 8) {
+    const __m256 v = _mm256_mul_ps(_mm256_loadu_ps(in + i), s);
+    _mm_storeu_si128(reinterpret_cast<__m128i*>(out + i), _mm256_cvtps_ph(v, _MM_FROUND_TO_NEAREST_INT));
+  }
+  ToHalfPortable(in + i, n - i, scale, out + i);
+}
+#endif
+
+void ToHalf(const float* in, size_t n, float scale, uint16_t* out) {
+#if defined(__x86_64__)
+  static const bool f16c = __builtin_cpu_supports("avx") && __builtin_cpu_supports("f16c");
+  if (f16c) return ToHalfF16c(in, n, scale, out);
+#endif
+  ToHalfPortable(in, n, scale, out);
+}
+
 // Bytes of one chunk as the file stores them uncompressed: for each scanline,
 // the channels in name order (B, G, R), each a row of little-endian values.
-void LayOutChunk(const RgbaImage& image, int y0, int lines, bool half_pixels, float scale, uint8_t* out) {
+void LayOutChunk(const RgbaImage& image, int y0, int lines, bool half_pixels, float scale, uint8_t* out,
+                 std::vector<uint16_t>& row_half) {
   const int w = image.width;
+  row_half.resize(size_t(w) * 4);
   for (int y = y0; y < y0 + lines; ++y) {
     const float* row = image.rgba.data() + size_t(y) * w * 4;
+    if (half_pixels) ToHalf(row, size_t(w) * 4, scale, row_half.data());
     for (int channel : {2, 1, 0}) {  // B, G, R
       if (half_pixels) {
         for (int x = 0; x < w; ++x) {
-          const uint16_t bits = half(row[4 * x + channel] * scale).bits();
-          std::memcpy(out, &bits, 2);
+          std::memcpy(out, &row_half[4 * size_t(x) + channel], 2);
           out += 2;
         }
       } else {
@@ -93,22 +126,22 @@ void EncodeChunks(const RgbaImage& image, const ExrWriteOptions& options, int li
   const size_t line_bytes = size_t(image.width) * 3 * (half_pixels ? 2 : 4);
   std::vector<uint8_t> raw(line_bytes * lines_per_chunk);
   std::vector<uint8_t> predicted(raw.size());
+  std::vector<uint16_t> row_half;
   libdeflate_compressor* compressor = deflate ? ThreadCompressor(options.zip_level) : nullptr;
+  std::vector<uint8_t> packed(deflate ? libdeflate_zlib_compress_bound(compressor, raw.size()) : 0);
   for (size_t i = first; i < last; ++i) {
     Chunk& chunk = chunks[i];
     chunk.y = int(i) * lines_per_chunk;
     const int lines = std::min(lines_per_chunk, image.height - chunk.y);
     const size_t n = line_bytes * lines;
-    LayOutChunk(image, chunk.y, lines, half_pixels, float(options.scale), raw.data());
+    LayOutChunk(image, chunk.y, lines, half_pixels, float(options.scale), raw.data(), row_half);
     if (deflate) {
       Predict(raw.data(), n, predicted.data());
-      chunk.bytes.resize(libdeflate_zlib_compress_bound(compressor, n));
-      const size_t packed = libdeflate_zlib_compress(compressor, predicted.data(), n, chunk.bytes.data(),
-                                                     chunk.bytes.size());
+      const size_t size = libdeflate_zlib_compress(compressor, predicted.data(), n, packed.data(), packed.size());
       // A chunk that does not shrink is stored raw; readers tell the two
       // apart by comparing its size with the uncompressed size.
-      if (packed > 0 && packed < n) {
-        chunk.bytes.resize(packed);
+      if (size > 0 && size < n) {
+        chunk.bytes.assign(packed.begin(), packed.begin() + size);
         continue;
       }
     }

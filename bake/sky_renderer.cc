@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <future>
@@ -11,6 +12,10 @@
 #include "shaders/sky_render.spv.h"
 #include "shaders/skyview_lut.spv.h"
 #include "shaders/transmittance_lut.spv.h"
+#include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
+#include "shaders/kSkyRenderSkyViewSpv.spv.h"
+#include "shaders/kSkyviewLutAnalyticSpv.spv.h"
+#include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
 
 namespace skybake {
 namespace {
@@ -95,13 +100,27 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     const uint32_t* code;
     size_t bytes;
   };
+  // The variants built with the presets' settings fixed (CMakeLists.txt)
+  // compile 10-20 times faster; they compute the same values to float
+  // rounding (tests/sky_renderer_test.cc). SKYBAKE_GENERIC_SHADERS=1 turns
+  // them off, to tell a variant's fault from the shader's.
+  const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
+  const bool variants = !generic || std::string(generic) != "1";
+  const bool analytic = variants && quality.integrator == INTEGRATOR_ANALYTIC;
+  const bool sky_view = quality.sky_view_lut && !aoas.switches.skydome;
+  auto job = [this](VkPipeline* pipeline, bool variant, const auto& variant_code, const auto& generic_code) {
+    if (variant) ++counters_.variant_pipelines;
+    return variant ? PipelineJob{pipeline, variant_code, sizeof(variant_code)}
+                   : PipelineJob{pipeline, generic_code, sizeof(generic_code)};
+  };
   std::vector<PipelineJob> jobs;
   if (NeedsTransmittanceLut(quality, effects))
-    jobs.push_back({&transmittance_pipeline_, kTransmittanceLutSpv, sizeof(kTransmittanceLutSpv)});
+    jobs.push_back(job(&transmittance_pipeline_, analytic, kTransmittanceLutAnalyticSpv, kTransmittanceLutSpv));
   if (effects.multiple_scattering)
-    jobs.push_back({&multiscattering_pipeline_, kMultiscatteringLutSpv, sizeof(kMultiscatteringLutSpv)});
-  if (quality.sky_view_lut && !aoas.switches.skydome) jobs.push_back({&skyview_pipeline_, kSkyviewLutSpv, sizeof(kSkyviewLutSpv)});
-  jobs.push_back({&sky_pipeline_, kSkyRenderSpv, sizeof(kSkyRenderSpv)});
+    jobs.push_back(
+        job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
+  if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
+  jobs.push_back(job(&sky_pipeline_, variants && sky_view, kSkyRenderSkyViewSpv, kSkyRenderSpv));
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
     compiled.push_back(std::async(std::launch::async, [this, job] { return CreatePipeline(job.code, job.bytes); }));

@@ -42,14 +42,31 @@ layout(constant_id = 14) const bool kNight = false;
 layout(constant_id = 3) const bool kOutputDirection = false;
 // The AOAS principles (AoasSwitches); a style that does not use one compiles
 // it out. The sky hue needs no switch: it is the Rayleigh vector itself.
+#ifdef SKYBAKE_VARIANT_SKY_VIEW
+// The sky-view variant of sky_render (CMakeLists.txt): texels read the
+// sky-view LUT and the skydome is off, fixed when compiling, so that the
+// per-texel ray march is not in the SPIR-V at all.
+const bool kSkydome = false;
+#else
 layout(constant_id = 4) const bool kSkydome = false;
+#endif
 layout(constant_id = 5) const bool kAmbiguity = false;
 layout(constant_id = 6) const bool kCloudNoise = false;
 layout(constant_id = 7) const bool kCloudShapes = false;
 // Quadrature rule (INTEGRATOR_*) and whether output texels read the sky-view
 // LUT instead of ray-marching; ids from 10 on are the quality settings.
+#ifdef SKYBAKE_VARIANT_ANALYTIC
+// The analytic variant of a LUT shader (CMakeLists.txt): the other rules
+// compiled out.
+const int kIntegrator = INTEGRATOR_ANALYTIC;
+#else
 layout(constant_id = 10) const int kIntegrator = INTEGRATOR_ANALYTIC;
+#endif
+#ifdef SKYBAKE_VARIANT_SKY_VIEW
+const bool kUseSkyView = true;
+#else
 layout(constant_id = 11) const bool kUseSkyView = false;
+#endif
 
 vec3 TransmittanceLutTexel(int x, int y) {
   return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;

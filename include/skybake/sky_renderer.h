@@ -35,6 +35,7 @@ struct RenderCounters {
   int skyview_lut_builds = 0;
   int frames = 0;
   int pipelines = 0;  // compute pipelines compiled
+  int variant_pipelines = 0;  // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
 };
 
 class SkyRenderer {
