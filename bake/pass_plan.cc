@@ -7,6 +7,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/pipeline.h"
+#include "skybake/sky_renderer.h"
 
 namespace skybake {
 namespace {
@@ -133,6 +134,12 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
       p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
       xp.ambiguity.enabled,
       xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
+  const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled);
+  plan.variant += fmt::format(
+      "\n  SPIR-V: sky_render {}; LUT shaders {}", sources.sky_view_render
+          ? "from the built-in sky-view variant (ray march compiled out)"
+          : "generic, specialized at pipeline creation",
+      sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
   if (plan.frames > 1) {
     if (plan.atmospheres == 1)
       plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +

@@ -104,9 +104,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   // compile 10-20 times faster; they compute the same values to float
   // rounding (tests/sky_renderer_test.cc). SKYBAKE_GENERIC_SHADERS=1 turns
   // them off, to tell a variant's fault from the shader's.
-  const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
-  const bool variants = !generic || std::string(generic) != "1";
-  const bool analytic = variants && quality.integrator == INTEGRATOR_ANALYTIC;
+  const ShaderSources sources = ChooseShaderSources(quality, aoas.switches.skydome);
+  const bool analytic = sources.analytic_luts;
   const bool sky_view = quality.sky_view_lut && !aoas.switches.skydome;
   auto job = [this](VkPipeline* pipeline, bool variant, const auto& variant_code, const auto& generic_code) {
     if (variant) ++counters_.variant_pipelines;
@@ -120,7 +119,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     jobs.push_back(
         job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
   if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
-  jobs.push_back(job(&sky_pipeline_, variants && sky_view, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+  jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
     compiled.push_back(std::async(std::launch::async, [this, job] { return CreatePipeline(job.code, job.bytes); }));
@@ -156,6 +155,15 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, families.data());
   timestamps_supported_ = families[context_.queue_family()].timestampValidBits > 0 &&
                           context_.properties().limits.timestampPeriod > 0.0f;
+}
+
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome) {
+  const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
+  if (generic && std::string(generic) == "1") return {};
+  ShaderSources sources;
+  sources.analytic_luts = quality.integrator == INTEGRATOR_ANALYTIC;
+  sources.sky_view_render = quality.sky_view_lut && !skydome;
+  return sources;
 }
 
 SkyRenderer::~SkyRenderer() {

@@ -55,6 +55,16 @@ TEST(PassPlanTest, DefaultStyleRunsEveryPhysicalPass) {
                         "cloud shapes"})
     EXPECT_FALSE(Effect(plan, e).on) << e;
   EXPECT_NE(plan.variant.find("multiple_scattering=true"), std::string::npos) << plan.variant;
+  EXPECT_NE(plan.variant.find("sky_render from the built-in sky-view variant"), std::string::npos) << plan.variant;
+  EXPECT_NE(plan.variant.find("LUT shaders from the built-in analytic variants"), std::string::npos) << plan.variant;
+}
+
+// The reference preset (Simpson, ray march per texel) is outside the built-in
+// variants: the plan says the generic shaders are used.
+TEST(PassPlanTest, ReferencePresetUsesTheGenericShaders) {
+  PassPlan plan = PlanPasses({Style("[quality]\npreset = \"reference\"\n")});
+  EXPECT_NE(plan.variant.find("sky_render generic"), std::string::npos) << plan.variant;
+  EXPECT_NE(plan.variant.find("LUT shaders generic"), std::string::npos) << plan.variant;
 }
 
 TEST(PassPlanTest, UnreadLutsAreNotComputed) {

@@ -38,6 +38,16 @@ struct RenderCounters {
   int variant_pipelines = 0;  // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
 };
 
+// Where each pipeline's SPIR-V comes from: the variants compiled with the
+// presets' quality fixed and optimized by spirv-opt (CMakeLists.txt), when the
+// settings match them and SKYBAKE_GENERIC_SHADERS is not 1; else the generic
+// shaders, specialized when the pipeline is created.
+struct ShaderSources {
+  bool analytic_luts = false;    // LUT shaders from the analytic-integrator variants
+  bool sky_view_render = false;  // sky_render from the sky-view variant
+};
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome);
+
 class SkyRenderer {
  public:
   // With `output_directions`, views contain the unit direction of each texel
