@@ -16,7 +16,7 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 // Each preset is the cheapest case of the accuracy study's Pareto front that
 // meets its bound (docs/accuracy.md, `skybake accuracy`):
 //   draft       analytic 24 quadratic steps, sky-view LUT 192 x 108   1.57e-2
-//   production  analytic 32 quadratic steps, sky-view LUT 320 x 180   7.07e-3
+//   production  analytic 32 quadratic steps, sky-view LUT 256 x 144   8.59e-3
 //   reference   Simpson 64 quadratic steps per texel, transmittance
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
 QualitySettings QualityPreset(const std::string& name) {

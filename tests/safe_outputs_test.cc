@@ -187,7 +187,7 @@ TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
 // Cube 4096 with latlong 8192x4096: 235 Mtexels x 32 bytes (device buffer
 // and host copy), the 101 Mtexel cube strip's RGB half copy and encoding
 // (x 12 bytes), the preview (34 Mtexels x 22 bytes), the LUTs (the
-// production preset's 320 x 180 sky-view LUT among them): 9025 MiB.
+// production preset's 256 x 144 sky-view LUT among them): 9025 MiB.
 TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
   CommandRun run = RunSkybake("check '" + Style() + "' --set render.cube_size=4096 --set render.latlong_height=4096");
   EXPECT_EQ(run.exit_code, 7) << run.output;

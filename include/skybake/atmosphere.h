@@ -66,8 +66,8 @@ struct QualitySettings {
   // In-scattering per output texel: ray-marched (false), or read from a
   // per-frame sky-view LUT of this size (Hillaire 2020 section 5.3).
   bool sky_view_lut = true;
-  int sky_view_width = 320;
-  int sky_view_height = 180;
+  int sky_view_width = 256;
+  int sky_view_height = 144;
 };
 
 // The named presets, chosen from the accuracy study (docs/accuracy.md):
