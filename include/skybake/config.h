@@ -35,7 +35,7 @@ struct RenderSettings {
   int device = -1;           // Vulkan device index; -1 = best available
 };
 
-// zlib level of ZIP-compressed EXRs, chosen from the codec table of
+// Deflate level of ZIP-compressed EXRs, chosen from the codec table of
 // docs/performance.md (`build/tests/exr_codec_benchmark`).
 constexpr int kDefaultZipLevel = 1;
 
@@ -43,7 +43,7 @@ struct OutputSettings {
   std::string basename = "sky";
   PixelType pixel_type = PixelType::kHalf;
   std::string compression = "zip";  // none | rle | zips | zip | piz
-  int zip_level = kDefaultZipLevel;  // zlib level of zip and zips, 1..9
+  int zip_level = kDefaultZipLevel;  // deflate level of zip and zips, 1..9
   OverflowPolicy overflow = OverflowPolicy::kScale;
   OutputUnits units = OutputUnits::kLuminance;
   bool faces = true;       // six face files

@@ -32,7 +32,7 @@ constexpr double kHalfMax = 65504.0;
 struct ExrWriteOptions {
   PixelType pixel_type = PixelType::kHalf;
   std::string compression = "zip";
-  int zip_level = kDefaultZipLevel;  // zlib level 1..9 of zip and zips (docs/performance.md)
+  int zip_level = kDefaultZipLevel;  // deflate level 1..9 of zip and zips (docs/performance.md)
   int envmap = -1;               // -1: none; 0: ENVMAP_LATLONG; 1: ENVMAP_CUBE
   double scale = 1.0;            // multiplies every value before writing
   double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
