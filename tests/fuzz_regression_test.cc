@@ -1,5 +1,5 @@
-// Replays every input of fuzz/regressions/ and configs/ through the parser
-// invariants of the fuzz target (fuzz/parser_invariants.h), so that a crasher
+// Replays every input of tests/fuzz/regressions/ and configs/ through the parser
+// invariants of the fuzz target (tests/fuzz/parser_invariants.h), so that a crasher
 // found once stays fixed in every build, not only in the clang fuzz build.
 #include <filesystem>
 #include <fstream>
@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 TEST(FuzzRegression, EveryRegressionAndSeedHoldsTheInvariants) {
   size_t replayed = 0;
-  for (const char* folder : {"/fuzz/regressions", "/configs", "/configs/schedules"}) {
+  for (const char* folder : {"/tests/fuzz/regressions", "/configs", "/configs/schedules"}) {
     for (const auto& entry : fs::directory_iterator(testing::SourceDir() + folder)) {
       if (!entry.is_regular_file() || entry.path().extension() == ".md") continue;
       std::ifstream in(entry.path(), std::ios::binary);
