@@ -204,6 +204,9 @@ std::string EncodeExrDeflate(const std::string& name, const RgbaImage& image, co
     if (failure) std::rethrow_exception(failure);
 
   Sink sink;
+  size_t chunk_bytes = 0;
+  for (const Chunk& chunk : chunks) chunk_bytes += chunk.bytes.size() + 8;
+  sink.bytes.reserve(chunk_bytes + 16 * 1024);  // chunks, their offsets, a header of a few KiB
   exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
   init.user_data = &sink;
   init.write_fn = &WriteToSink;

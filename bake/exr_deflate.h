@@ -1,9 +1,11 @@
 // skybake's own encoder of scanline EXR files without compression or with
 // ZIP/ZIPS: pixels are laid out, predicted and deflated chunk by chunk with
-// libdeflate (about twice as fast as zlib at the same level), on several
-// threads, and OpenEXRCore writes the header, the chunks and the offset
-// table. Any OpenEXR reader decodes the result (tests/exr_io_test.cc checks
-// it against OpenEXR's own encoder pixel for pixel).
+// libdeflate, on several threads, and OpenEXRCore writes the header, the
+// chunks and the offset table. Against OpenEXR 3.1's own (zlib) encoder at
+// the same level: half the time on 2 threads and files a quarter smaller
+// (the codec table of docs/performance.md). Any OpenEXR reader decodes the
+// result (tests/exr_io_test.cc checks it against OpenEXR's encoder bit for
+// bit).
 #pragma once
 
 #include <string>
