@@ -351,8 +351,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
   // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
   RendererCache renderers(context, result);
-  renderers.Main(first);
-  timer.Finish("pipelines");
+  {
+    const RenderCounters& c = renderers.Main(first).counters();
+    timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants", c.pipelines,
+                                          c.variant_pipelines));
+  }
   renderers.Main(first).PrecomputeLuts();
   for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
   timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}",
