@@ -3,10 +3,10 @@
 #include "exr_deflate.h"
 #include "oiio_module.h"
 
+#include <atomic>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <atomic>
 #include <cstring>
 #include <filesystem>
 #include <memory>

@@ -8,10 +8,10 @@
 #include <exception>
 #include <future>
 
-#include "shaders/multiscattering_lut.spv.h"
-#include "shaders/sky_render.spv.h"
-#include "shaders/skyview_lut.spv.h"
-#include "shaders/transmittance_lut.spv.h"
+#include "shaders/kMultiscatteringLutSpv.spv.h"
+#include "shaders/kSkyRenderSpv.spv.h"
+#include "shaders/kSkyviewLutSpv.spv.h"
+#include "shaders/kTransmittanceLutSpv.spv.h"
 #include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
 #include "shaders/kSkyRenderSkyViewSpv.spv.h"
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"

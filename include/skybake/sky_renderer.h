@@ -39,7 +39,7 @@ struct RenderCounters {
 };
 
 // Where each pipeline's SPIR-V comes from: the variants compiled with the
-// presets' quality fixed and optimized by spirv-opt (CMakeLists.txt), when the
+// presets' quality fixed and optimized by glslang -Os (CMakeLists.txt), when the
 // settings match them and SKYBAKE_GENERIC_SHADERS is not 1; else the generic
 // shaders, specialized when the pipeline is created.
 struct ShaderSources {
