@@ -125,6 +125,14 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
     plan.passes.push_back({name, Size(v.width, v.height), sky_view ? "once per frame (LUT reads)" : "once per frame",
                            plan.frames, double(v.width) * v.height * per_texel});
   }
+  AoasSwitches switches;
+  switches.skydome = xp.skydome.enabled;
+  switches.ambiguity = xp.ambiguity.enabled;
+  switches.cloud_noise = xp.clouds.enabled;
+  switches.cloud_shapes = xp.shapes.enabled;
+  const bool disc_pass = UsesSunDiscPass(q, p, switches);
+  if (disc_pass)
+    plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
 
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
@@ -140,6 +148,8 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
           ? "from the built-in sky-view variant (ray march compiled out)"
           : "generic, specialized at pipeline creation",
       sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
+  if (disc_pass)
+    plan.variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
   if (plan.frames > 1) {
     if (plan.atmospheres == 1)
       plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +

@@ -211,20 +211,17 @@ glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3&
          impl_->output_scale;
 }
 
+glm::dvec3 ViewTexelDirection(const ViewRequest& v, int x, int y) {
+  if (v.mapping == MAPPING_LATLONG) return reference::DirectionFromLatLongPixel(x, y, v.width, v.height);
+  if (v.mapping == MAPPING_CUBE_STRIP) return reference::DirectionFromCubeStripPixel(x, y, v.width);
+  if (v.mapping == MAPPING_VULKAN_FACE) return reference::DirectionFromVulkanCubeTexel(v.face, x, y, v.width);
+  return glm::dvec3(0.0, 1.0, 0.0);
+}
+
 std::vector<glm::dvec3> ViewDirections(const ViewRequest& v) {
   std::vector<glm::dvec3> dirs(size_t(v.width) * v.height);
-  for (int y = 0; y < v.height; ++y) {
-    for (int x = 0; x < v.width; ++x) {
-      glm::dvec3 d(0.0, 1.0, 0.0);
-      if (v.mapping == MAPPING_LATLONG)
-        d = reference::DirectionFromLatLongPixel(x, y, v.width, v.height);
-      else if (v.mapping == MAPPING_CUBE_STRIP)
-        d = reference::DirectionFromCubeStripPixel(x, y, v.width);
-      else if (v.mapping == MAPPING_VULKAN_FACE)
-        d = reference::DirectionFromVulkanCubeTexel(v.face, x, y, v.width);
-      dirs[size_t(y) * v.width + x] = d;
-    }
-  }
+  for (int y = 0; y < v.height; ++y)
+    for (int x = 0; x < v.width; ++x) dirs[size_t(y) * v.width + x] = ViewTexelDirection(v, x, y);
   return dirs;
 }
 

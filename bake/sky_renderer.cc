@@ -8,6 +8,8 @@
 #include <exception>
 #include <future>
 
+#include <glm/geometric.hpp>
+
 #include "shaders/kMultiscatteringLutSpv.spv.h"
 #include "shaders/kSkyRenderSpv.spv.h"
 #include "shaders/kSkyviewLutSpv.spv.h"
@@ -16,6 +18,7 @@
 #include "shaders/kSkyRenderSkyViewSpv.spv.h"
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
+#include "skybake/reference_model.h"
 
 namespace skybake {
 namespace {
@@ -41,6 +44,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
       aoas_switches_(aoas.switches),
       output_directions_(output_directions) {
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
+  disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches);
   VkDevice device = context_.device();
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -54,7 +58,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
       VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
   output_buffer_ = CreateBuffer(16 * 64, storage);
   skyview_buffer_ = CreateBuffer(
-      quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 16 : 16, storage);
+      quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 8 : 16, storage);
 
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -99,6 +103,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     VkPipeline* pipeline;
     const uint32_t* code;
     size_t bytes;
+    bool sun_disc = false;
+    bool sun_disc_pass = false;
   };
   // The variants built with the presets' settings fixed (CMakeLists.txt)
   // compile 10-20 times faster; they compute the same values to float
@@ -120,9 +126,19 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
         job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
   if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
   jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+  for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
+  if (disc_pass_) {
+    // The sky pass without the disc, and the disc pass that adds it.
+    jobs.back().sun_disc = false;
+    jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+    jobs.back().sun_disc = true;
+    jobs.back().sun_disc_pass = true;
+  }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
-    compiled.push_back(std::async(std::launch::async, [this, job] { return CreatePipeline(job.code, job.bytes); }));
+    compiled.push_back(std::async(std::launch::async, [this, job] { 
+      return CreatePipeline(job.code, job.bytes, job.sun_disc, job.sun_disc_pass);
+    }));
   std::exception_ptr failure;
   for (size_t i = 0; i < jobs.size(); ++i) {
     try {
@@ -157,6 +173,49 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
                           context_.properties().limits.timestampPeriod > 0.0f;
 }
 
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas) {
+  const char* env = std::getenv("SKYBAKE_SUN_DISC_PASS");
+  if (env && std::string(env) == "0") return false;
+  return effects.sun_disc && quality.sky_view_lut && !aoas.skydome && !aoas.ambiguity && !aoas.cloud_noise &&
+         !aoas.cloud_shapes;
+}
+
+std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle) {
+  if (view.mapping == MAPPING_DIRECTIONS) return {{0, 0, view.width, view.height}};
+  constexpr int kTile = 16;
+  auto angle_between = [](const glm::dvec3& a, const glm::dvec3& b) {
+    // atan2 of |a x b| and a . b: accurate at small angles, unlike acos.
+    return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  };
+  std::vector<TexelRect> rects;
+  for (int ty = 0; ty < view.height; ty += kTile) {
+    const int y1 = std::min(ty + kTile, view.height);
+    int first = -1, last = -1;
+    for (int tx = 0; tx < view.width; tx += kTile) {
+      const int x1 = std::min(tx + kTile, view.width);
+      const glm::dvec3 centre = ViewTexelDirection(view, (tx + x1 - 1) / 2, (ty + y1 - 1) / 2);
+      double radius = 0.0;
+      for (int corner = 0; corner < 4; ++corner) {
+        const int x = corner & 1 ? x1 - 1 : tx;
+        const int y = corner & 2 ? y1 - 1 : ty;
+        radius = std::max(radius, angle_between(centre, ViewTexelDirection(view, x, y)));
+      }
+      if (angle_between(centre, direction) <= angle + 1.5 * radius) {
+        if (first < 0) first = tx;
+        last = x1;
+      }
+    }
+    if (first >= 0) {
+      // Joined with the row of tiles above when they span the same columns.
+      if (!rects.empty() && rects.back().y1 == ty && rects.back().x0 == first && rects.back().x1 == last)
+        rects.back().y1 = y1;
+      else
+        rects.push_back({first, ty, last, y1});
+    }
+  }
+  return rects;
+}
+
 ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome) {
   const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
   if (generic && std::string(generic) == "1") return {};
@@ -176,7 +235,8 @@ void SkyRenderer::DestroyAll() {
   if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
-  for (VkPipeline* p : {&sky_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_, &transmittance_pipeline_}) {
+  for (VkPipeline* p :
+       {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_, &transmittance_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -265,7 +325,7 @@ void SkyRenderer::UpdateDescriptors() {
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
 }
 
-VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass) {
   VkDevice device = context_.device();
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = bytes;
@@ -275,23 +335,24 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes) {
 
   // Specialization constants of common.glsl: ids 0..3 the optional effects,
   // 4..7 the AOAS principles that act per texel, 10..11 the quality
-  // settings, 12..13 the Mie and ozone constituents. Every pipeline gets them all; a shader that does not use one
-  // ignores it.
+  // settings, 12..14 the Mie and ozone constituents and night dimming, 15
+  // the sun-disc pass. Every pipeline gets them all; a shader that does not
+  // use one ignores it.
   struct {
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
     VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
     int32_t integrator;
-    VkBool32 sky_view, mie, ozone, night;
-  } values = {effects_.multiple_scattering, effects_.sun_disc, effects_.ground,
+    VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
+  } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
-              effects_.night_dimming};
-  const VkSpecializationMapEntry entries[13] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+              effects_.night_dimming,       sun_disc_pass};
+  const VkSpecializationMapEntry entries[14] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
                                                 {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
                                                 {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4},
-                                                {14, 48, 4}};
-  VkSpecializationInfo specialization{13, entries, sizeof(values), &values};
+                                                {14, 48, 4}, {15, 52, 4}};
+  VkSpecializationInfo specialization{14, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -457,7 +518,8 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     gpu::SkyPush push{};
     push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
     push.view = {v.mapping, v.width, v.height, v.face};
-    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, 0, 0};
+    // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
+    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
     std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
                        : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
                        : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
@@ -466,6 +528,30 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                           GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
     // Views write disjoint ranges of the output buffer: no barriers between them.
     barriers.push_back(false);
+  }
+  if (disc_pass_ && sun_disc) {
+    // The disc, added to the texels near the Sun once the sky pass has
+    // written them. Its angular radius with the margin NearSunDisc leaves.
+    const double disc_angle = std::min(2.0 * double(gpu_atmosphere_.solar_irradiance.w), 3.14159265358979);
+    bool first = true;
+    for (size_t i = 0; i < views.size(); ++i) {
+      const ViewRequest& v = views[i];
+      for (const TexelRect& r : TexelsNearDirection(v, sun, disc_angle)) {
+        if (first) barriers.back() = true;  // the sky pass's writes before the disc's reads
+        first = false;
+        gpu::SkyPush push{};
+        push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+        push.view = {v.mapping, v.width, v.height, v.face};
+        push.offsets = {int32_t(offsets[i]), 0, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
+        push.rect = {r.x0, r.y0, r.x1, r.y1};
+        dispatches.push_back({"sun disc", disc_pipeline_, push, GroupCount(r.x1 - r.x0, SKYBAKE_LOCAL_SIZE_X),
+                              GroupCount(r.y1 - r.y0, SKYBAKE_LOCAL_SIZE_Y)});
+        // Rectangles are disjoint, within and across views.
+        barriers.push_back(false);
+        ++counters_.sun_disc_dispatches;
+        counters_.sun_disc_texels += (long long)(r.x1 - r.x0) * (r.y1 - r.y0);
+      }
+    }
   }
   Submit(dispatches, barriers);
   ++counters_.frames;
@@ -482,8 +568,10 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
 std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
                                                  const std::vector<glm::dvec3>& directions, bool sun_disc) {
   if (!luts_ready_) PrecomputeLuts();
-  EnsureOutputCapacity(std::max<size_t>(directions.size(), 1) * 16);
-  float* data = static_cast<float*>(output_buffer_.mapped);
+  // The directions after the view's texels, where the sun-disc pass still
+  // finds them once the sky pass has written radiance.
+  EnsureOutputCapacity(std::max<size_t>(directions.size(), 1) * 2 * 16);
+  float* data = static_cast<float*>(output_buffer_.mapped) + 4 * directions.size();
   for (size_t i = 0; i < directions.size(); ++i) {
     data[4 * i + 0] = float(directions[i].x);
     data[4 * i + 1] = float(directions[i].y);

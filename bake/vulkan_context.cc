@@ -86,6 +86,12 @@ int ComputeQueueFamily(VkPhysicalDevice device) {
   return -1;
 }
 
+bool SupportsShaderInt64(VkPhysicalDevice device) {
+  VkPhysicalDeviceFeatures features;
+  vkGetPhysicalDeviceFeatures(device, &features);
+  return features.shaderInt64 == VK_TRUE;
+}
+
 DeviceInfo Describe(VkPhysicalDevice device, int index) {
   VkPhysicalDeviceProperties p;
   vkGetPhysicalDeviceProperties(device, &p);
@@ -99,6 +105,8 @@ DeviceInfo Describe(VkPhysicalDevice device, int index) {
     info.rejected_because = "supports Vulkan " + info.api_version + ", skybake needs 1.1";
   } else if (ComputeQueueFamily(device) < 0) {
     info.rejected_because = "has no compute queue";
+  } else if (!SupportsShaderInt64(device)) {
+    info.rejected_because = "has no 64-bit integers in shaders (shaderInt64), which the sky-view LUT is packed in";
   } else {
     info.usable = true;
   }
@@ -228,6 +236,9 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
     VkDeviceCreateInfo device_info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     device_info.queueCreateInfoCount = 1;
     device_info.pQueueCreateInfos = &queue_info;
+    VkPhysicalDeviceFeatures features{};
+    features.shaderInt64 = VK_TRUE;  // the packed sky-view LUT (shaders/common.glsl)
+    device_info.pEnabledFeatures = &features;
     VK_CHECK(vkCreateDevice(physical_device_, &device_info, nullptr, &device_));
     vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
   } catch (...) {

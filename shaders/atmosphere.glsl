@@ -651,10 +651,15 @@ vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
 // twilight (sun at -6 deg) and astronomical night (-18 deg) the sky blends,
 // by night_strength, from the physical sky to a night-sky floor (airglow and
 // starlight) above the horizon and to black below it.
-vec3 ApplyNightDimming(IN(AtmosphereParameters) atm, vec3 radiance, vec3 view, vec3 sun) {
+// The blend weight: 0 by day, night_strength at night.
+Real NightDimmingWeight(IN(AtmosphereParameters) atm, vec3 sun) {
   // 1 - smoothstep(sin(-18 deg), sin(-6 deg), sun.y): 0 by day, 1 at night.
   Real night = 1.0 - smoothstep(-0.30901699437494740, -0.10452846326765347, sun.y);
-  Real k = atm.night_strength * night;
+  return atm.night_strength * night;
+}
+
+vec3 ApplyNightDimming(IN(AtmosphereParameters) atm, vec3 radiance, vec3 view, vec3 sun) {
+  Real k = NightDimmingWeight(atm, sun);
   vec3 floor_radiance = view.y > 0.0 ? atm.night_radiance : vec3(0.0);
   return radiance * (1.0 - k) + floor_radiance * k;
 }
@@ -793,6 +798,21 @@ vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azim
   return mix(a, b, fy);
 }
 
+// The solar disc seen along `view`, per unit solar irradiance, through the
+// transmittance LUT: zero away from the disc and where the ground hides it.
+vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  vec3 disc = vec3(0.0);
+  if (NearSunDisc(atm, view, sun)) {
+    SkyRay ray = SetUpSkyRay(atm, view, sun);
+    if (ray.in_atmosphere && !ray.hits_ground) {
+      disc = SunDiscContribution(atm, view, sun, GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));
+    } else if (!ray.in_atmosphere) {
+      disc = SunDiscContribution(atm, view, sun, vec3(1.0));
+    }
+  }
+  return disc;
+}
+
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
 // the solar disc seen through the transmittance LUT.
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
@@ -817,15 +837,7 @@ vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3
                                  ClampCosine(view.y));
   }
   vec3 radiance = SampleSkyViewLut(atm, zenith_angle, azimuth, ground);
-  if (atm.sun_disc && NearSunDisc(atm, view, sun)) {
-    SkyRay ray = SetUpSkyRay(atm, view, sun);
-    if (ray.in_atmosphere && !ray.hits_ground) {
-      radiance += SunDiscContribution(atm, view, sun,
-                                      GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, ray.mu));
-    } else if (!ray.in_atmosphere) {
-      radiance += SunDiscContribution(atm, view, sun, vec3(1.0));
-    }
-  }
+  if (atm.sun_disc) radiance += SunDiscThroughAtmosphere(atm, view, sun);
   return radiance * atm.solar_irradiance;
 }
 

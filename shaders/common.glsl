@@ -4,6 +4,7 @@
 #ifndef SKYBAKE_COMMON_GLSL
 #define SKYBAKE_COMMON_GLSL
 
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 #include "glsl_prelude.glsl"
 #include "skybake/gpu_shared.h"
 
@@ -21,8 +22,12 @@ layout(std430, set = 0, binding = BINDING_MULTISCATTERING) buffer MultiScatterin
 layout(std430, set = 0, binding = BINDING_OUTPUT) buffer OutputBuffer {
   vec4 output_texels[];
 };
+// One 64-bit word per texel (PackSkyViewTexel): lavapipe fetches each
+// component of a storage-buffer read with a loop over the SIMD lanes, so one
+// word per texel instead of three floats makes the bilinear read that every
+// output texel does a third as costly (docs/performance.md).
 layout(std430, set = 0, binding = BINDING_SKYVIEW) buffer SkyViewBuffer {
-  vec4 skyview_texels[];
+  uint64_t skyview_texels[];
 };
 layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
   GpuAoas gpu_aoas;
@@ -40,6 +45,9 @@ layout(constant_id = 13) const bool kOzone = true;
 layout(constant_id = 14) const bool kNight = false;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
+// sky_render as the sun-disc pass (SkyRenderer::Render): adds the disc to the
+// texels of push.rect that the sky pass wrote without it.
+layout(constant_id = 15) const bool kSunDiscPass = false;
 // The AOAS principles (AoasSwitches); a style that does not use one compiles
 // it out. The sky hue needs no switch: it is the Rayleigh vector itself.
 #ifdef SKYBAKE_VARIANT_SKY_VIEW
@@ -76,8 +84,24 @@ vec3 MultipleScatteringLutTexel(int x, int y) {
   return multiscattering_texels[y * gpu_atmosphere.lut_sizes.z + x].xyz;
 }
 
+// Three non-negative floats in one 64-bit word, 21 bits each: the float32
+// bits without the sign bit, rounded to 12 mantissa bits, so the relative
+// error of a texel is at most 2^-13 = 1.2e-4 (the sky-view LUT's own error
+// in the production preset is 8.6e-3, docs/accuracy_skyview_results.md).
+uint64_t PackSkyViewTexel(vec3 radiance) {
+  uvec3 bits = min((floatBitsToUint(max(radiance, vec3(0.0))) + 0x400u) >> 11, uvec3(0x1FFFFFu));
+  return packUint2x32(uvec2(bits.x | (bits.y << 21), (bits.y >> 11) | (bits.z << 10)));
+}
+
+vec3 UnpackSkyViewTexel(uint64_t word) {
+  uvec2 halves = unpackUint2x32(word);
+  uvec3 bits = uvec3(halves.x & 0x1FFFFFu, (halves.x >> 21) | ((halves.y & 0x3FFu) << 11),
+                     (halves.y >> 10) & 0x1FFFFFu);
+  return uintBitsToFloat(bits << 11);
+}
+
 vec3 SkyViewLutTexel(int x, int y) {
-  return skyview_texels[y * gpu_atmosphere.render.y + x].xyz;
+  return UnpackSkyViewTexel(skyview_texels[y * gpu_atmosphere.render.y + x]);
 }
 
 vec4 ShapeSegmentStart(int i) { return gpu_aoas.shape_segments[2 * i]; }

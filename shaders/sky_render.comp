@@ -11,11 +11,15 @@ vec3 ViewDirection(ivec2 texel) {
   if (mapping == MAPPING_CUBE_STRIP) return DirectionFromCubeStripPixel(texel.x, texel.y, push.view.y);
   if (mapping == MAPPING_VULKAN_FACE)
     return DirectionFromVulkanCubeTexel(push.view.w, texel.x, texel.y, push.view.y);
-  return normalize(output_texels[push.offsets.x + texel.y * push.view.y + texel.x].xyz);
+  return normalize(output_texels[push.offsets.z + texel.y * push.view.y + texel.x].xyz);
 }
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (kSunDiscPass) {
+    texel += push.rect.xy;
+    if (texel.x >= push.rect.z || texel.y >= push.rect.w) return;
+  }
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   vec3 view = ViewDirection(texel);
   uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
@@ -24,6 +28,16 @@ void main() {
     return;
   }
   AtmosphereParameters atm = AtmosphereFromUniform();
+  if (kSunDiscPass) {
+    // Every branch costs every SIMD lane on lavapipe, so the disc's test and
+    // transmittance read run here, on the few texels near the Sun, and not
+    // in the sky pass (which then has the disc compiled out).
+    vec3 sun = push.sun_direction.xyz;
+    vec3 disc = SunDiscThroughAtmosphere(atm, view, sun) * atm.solar_irradiance;
+    if (atm.night) disc *= 1.0 - NightDimmingWeight(atm, sun);
+    output_texels[index].xyz += disc * gpu_atmosphere.output_scale.xyz;
+    return;
+  }
   // The sky alone (for the SH of the sky without the Sun): the disc switched
   // off per dispatch, so one pipeline serves both.
   if (push.offsets.y != 0) atm.sun_disc = false;

@@ -10,5 +10,5 @@ void main() {
   if (texel.x >= gpu_atmosphere.render.y || texel.y >= gpu_atmosphere.render.z) return;
   AtmosphereParameters atm = AtmosphereFromUniform();
   vec3 radiance = ComputeSkyViewLutTexel(atm, texel.x, texel.y, push.sun_direction.y);
-  skyview_texels[texel.y * gpu_atmosphere.render.y + texel.x] = vec4(radiance, 1.0);
+  skyview_texels[texel.y * gpu_atmosphere.render.y + texel.x] = PackSkyViewTexel(radiance);
 }

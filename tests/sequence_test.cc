@@ -294,7 +294,7 @@ times = { start = 09:00:00, end = 09:30:00, step_minutes = 15 }
   EXPECT_EQ(result.renderer_builds, 1);
   // Frames 1, then 3 (the highest sun, for the exposure), then 1, 2, 3.
   EXPECT_EQ(result.atmosphere_updates, 4);
-  EXPECT_EQ(result.counters.pipelines, 4);  // transmittance, multiple scattering, sky-view, sky
+  EXPECT_EQ(result.counters.pipelines, 5);  // transmittance, multiple scattering, sky-view, sky, sun disc
   EXPECT_EQ(result.counters.transmittance_lut_builds, 5);
   EXPECT_EQ(result.counters.multiscattering_lut_builds, 5);
   // The haze grows: frames differ in their files.

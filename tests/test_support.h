@@ -19,6 +19,12 @@ VulkanContext& Vulkan();
 // Asserts that the validation layer has said nothing since the last call.
 void ExpectNoValidationMessages();
 
+// Relative step of a sky-view LUT texel as stored: PackSkyViewTexel
+// (shaders/common.glsl) keeps 12 mantissa bits, rounded, so two renders whose
+// LUTs differ by float rounding alone may store a texel one step, 2^-12,
+// apart. Comparisons of two GPU renders that read the sky-view LUT allow it.
+inline constexpr double kSkyViewLutStorageStep = 1.0 / 4096.0;
+
 // Path of the repository's configs/ and of shared/ beside the checkout.
 std::string SourceDir();
 std::string SharedDir();

@@ -23,7 +23,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_TRANSMITTANCE 1    // storage vec4[], transmittance LUT
 #define BINDING_MULTISCATTERING 2  // storage vec4[], multiple-scattering LUT
 #define BINDING_OUTPUT 3           // storage vec4[], rendered texels
-#define BINDING_SKYVIEW 4          // storage vec4[], sky-view LUT
+#define BINDING_SKYVIEW 4          // storage uint64[], sky-view LUT (PackSkyViewTexel)
 #define BINDING_AOAS 5             // uniform GpuAoas, the style's aesthetic principles
 
 // Output mappings (SkyPush.view.x).
@@ -113,12 +113,14 @@ SKYBAKE_GPU_STRUCT(GpuAoas) {
 SKYBAKE_GPU_STRUCT(SkyPush) {
   vec4 sun_direction;  // xyz: unit vector towards the Sun; w: unused
   ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE)
-  ivec4 offsets;       // x: first output texel of this view in the output buffer; y: 1 = no sun disc
+  ivec4 offsets;       // x: first output texel of this view in the output buffer; y: 1 = no sun disc;
+                       // z: first direction of a MAPPING_DIRECTIONS view
+  ivec4 rect;          // sun-disc pass: texels [x, z) x [y, w) of the view
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
-static_assert(sizeof(SkyPush) == 3 * 16, "SkyPush must be vec4-packed");
+static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
               "GpuAoas must be vec4-packed");
 }  // namespace skybake::gpu

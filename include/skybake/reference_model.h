@@ -62,4 +62,7 @@ class ReferenceModel {
 // precision (rows from the top).
 std::vector<glm::dvec3> ViewDirections(const ViewRequest& view);
 
+// Unit direction of texel (x, y) of `view` (+Y for MAPPING_DIRECTIONS).
+glm::dvec3 ViewTexelDirection(const ViewRequest& view, int x, int y);
+
 }  // namespace skybake

@@ -36,7 +36,28 @@ struct RenderCounters {
   int frames = 0;
   int pipelines = 0;  // compute pipelines compiled
   int variant_pipelines = 0;  // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
+  int sun_disc_dispatches = 0;  // dispatches of the sun-disc pass
+  long long sun_disc_texels = 0;  // texels they covered
 };
+
+// Texels [x0, x1) x [y0, y1) of a view.
+struct TexelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// Rectangles, disjoint, that hold every texel of `view` whose direction is
+// within `angle` radians of unit `direction`: tiles of 16 x 16 texels whose
+// centre is within `angle` plus 1.5 times the tile's own angular radius (the
+// largest angle from its centre to a corner), joined along each row of
+// tiles. Every texel of a MAPPING_DIRECTIONS view.
+std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle);
+
+// Whether the sun disc is added by a pass of its own over the texels near
+// the Sun (SkyRenderer::Render) rather than tested by every texel of the sky
+// pass: with the sky-view LUT and none of the AOAS principles that act on
+// the disc after it is added (ambiguity, clouds); SKYBAKE_SUN_DISC_PASS=0
+// turns it off.
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas);
 
 // Where each pipeline's SPIR-V comes from: the variants compiled with the
 // presets' quality fixed and optimized by glslang -Os (CMakeLists.txt), when the
@@ -114,7 +135,8 @@ class SkyRenderer {
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
   void UpdateDescriptors();
-  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes);
+  // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
   void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
@@ -129,6 +151,7 @@ class SkyRenderer {
   EffectSettings effects_;
   AoasSwitches aoas_switches_;
   bool output_directions_ = false;
+  bool disc_pass_ = false;  // UsesSunDiscPass
   bool luts_ready_ = false;
   bool skyview_ready_ = false;
   glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
@@ -148,6 +171,7 @@ class SkyRenderer {
   VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
   VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline disc_pipeline_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
