@@ -98,6 +98,36 @@ void Predict(const uint8_t* raw, size_t n, uint8_t* out) {
   }
 }
 
+// Half pixels: the predictor's output straight from the image, without the
+// chunk's raw bytes (LayOutChunk then Predict give the same bytes). The raw
+// bytes are the chunk's values in file order, two little-endian bytes each,
+// so the predictor's even bytes are the values' low bytes and its odd bytes
+// their high bytes. `split` holds those, `out` gets their differences.
+void PredictHalfChunk(const RgbaImage& image, int y0, int lines, float scale, uint8_t* split, uint8_t* out,
+                      std::vector<uint16_t>& row_half) {
+  const int w = image.width;
+  row_half.resize(size_t(w) * 4);
+  const size_t count = size_t(lines) * w * 3;  // values in the chunk
+  uint8_t* lo = split;
+  uint8_t* hi = split + count;
+  for (int y = y0; y < y0 + lines; ++y) {
+    ToHalf(image.rgba.data() + size_t(y) * w * 4, size_t(w) * 4, scale, row_half.data());
+    const uint16_t* h = row_half.data();
+    for (int channel : {2, 1, 0}) {  // B, G, R
+      for (int x = 0; x < w; ++x) {
+        const uint16_t v = h[4 * x + channel];
+        lo[x] = uint8_t(v);
+        hi[x] = uint8_t(v >> 8);
+      }
+      lo += w;
+      hi += w;
+    }
+  }
+  const size_t n = 2 * count;
+  out[0] = split[0];
+  for (size_t i = 1; i < n; ++i) out[i] = uint8_t(split[i] - split[i - 1] + 128);
+}
+
 struct CompressorDeleter {
   void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
 };
@@ -134,8 +164,16 @@ void EncodeChunks(const RgbaImage& image, const ExrWriteOptions& options, int li
     chunk.y = int(i) * lines_per_chunk;
     const int lines = std::min(lines_per_chunk, image.height - chunk.y);
     const size_t n = line_bytes * lines;
+    if (deflate && half_pixels) {
+      PredictHalfChunk(image, chunk.y, lines, float(options.scale), raw.data(), predicted.data(), row_half);
+      const size_t size = libdeflate_zlib_compress(compressor, predicted.data(), n, packed.data(), packed.size());
+      if (size > 0 && size < n) {
+        chunk.bytes.assign(packed.begin(), packed.begin() + size);
+        continue;
+      }
+    }
     LayOutChunk(image, chunk.y, lines, half_pixels, float(options.scale), raw.data(), row_half);
-    if (deflate) {
+    if (deflate && !half_pixels) {
       Predict(raw.data(), n, predicted.data());
       const size_t size = libdeflate_zlib_compress(compressor, predicted.data(), n, packed.data(), packed.size());
       // A chunk that does not shrink is stored raw; readers tell the two

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -139,6 +140,21 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir, const st
 }
 
 double CheckedMaxValue(const std::vector<const RgbaImage*>& images) {
+  // One pass without branches (the compiler vectorizes it): a value is bad
+  // unless 0 <= v <= FLT_MAX, which NaN fails too.
+  float max_rgb = 0.0f;
+  bool bad = false;
+  for (const RgbaImage* image : images) {
+    const float* p = image->rgba.data();
+    const size_t texels = image->rgba.size() / 4;
+    for (size_t t = 0; t < texels; ++t) {
+      const float r = p[4 * t], g = p[4 * t + 1], b = p[4 * t + 2];
+      bad |= !(r >= 0.0f && r <= FLT_MAX) | !(g >= 0.0f && g <= FLT_MAX) | !(b >= 0.0f && b <= FLT_MAX);
+      max_rgb = std::max(max_rgb, std::max(r, std::max(g, b)));
+    }
+  }
+  if (!bad) return double(max_rgb);
+  // Which value, for the message.
   double max_value = 0.0;
   for (const RgbaImage* image : images) {
     for (size_t i = 0; i < image->rgba.size(); ++i) {
