@@ -136,7 +136,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
-    compiled.push_back(std::async(std::launch::async, [this, job] { 
+    compiled.push_back(std::async(std::launch::async, [this, job] {
       return CreatePipeline(job.code, job.bytes, job.sun_disc, job.sun_disc_pass);
     }));
   std::exception_ptr failure;
@@ -513,6 +513,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     barriers.push_back(true);
     ++counters_.skyview_lut_builds;
   }
+  const size_t first_view = dispatches.size();
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
     gpu::SkyPush push{};
@@ -533,16 +534,10 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     // The disc, added to the texels near the Sun once the sky pass has
     // written them. Its angular radius with the margin NearSunDisc leaves.
     const double disc_angle = std::min(2.0 * double(gpu_atmosphere_.solar_irradiance.w), 3.14159265358979);
-    bool first = true;
+    const size_t last_view = dispatches.size() - 1;
     for (size_t i = 0; i < views.size(); ++i) {
-      const ViewRequest& v = views[i];
-      for (const TexelRect& r : TexelsNearDirection(v, sun, disc_angle)) {
-        if (first) barriers.back() = true;  // the sky pass's writes before the disc's reads
-        first = false;
-        gpu::SkyPush push{};
-        push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-        push.view = {v.mapping, v.width, v.height, v.face};
-        push.offsets = {int32_t(offsets[i]), 0, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
+      for (const TexelRect& r : TexelsNearDirection(views[i], sun, disc_angle)) {
+        gpu::SkyPush push = dispatches[first_view + i].push;  // the view's own constants
         push.rect = {r.x0, r.y0, r.x1, r.y1};
         dispatches.push_back({"sun disc", disc_pipeline_, push, GroupCount(r.x1 - r.x0, SKYBAKE_LOCAL_SIZE_X),
                               GroupCount(r.y1 - r.y0, SKYBAKE_LOCAL_SIZE_Y)});
@@ -552,6 +547,8 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
         counters_.sun_disc_texels += (long long)(r.x1 - r.x0) * (r.y1 - r.y0);
       }
     }
+    // The sky pass's writes before the disc's reads.
+    if (dispatches.size() > last_view + 1) barriers[last_view] = true;
   }
   Submit(dispatches, barriers);
   ++counters_.frames;
