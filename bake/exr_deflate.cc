@@ -65,7 +65,7 @@ void LayOutChunk(const RgbaImage& image, int y0, int lines, bool half_pixels, fl
   const int w = image.width;
   row_half.resize(size_t(w) * 4);
   for (int y = y0; y < y0 + lines; ++y) {
-    const float* row = image.rgba.data() + size_t(y) * w * 4;
+    const float* row = image.data() + size_t(y) * w * 4;
     if (half_pixels) ToHalf(row, size_t(w) * 4, scale, row_half.data());
     for (int channel : {2, 1, 0}) {  // B, G, R
       if (half_pixels) {
@@ -111,7 +111,7 @@ void PredictHalfChunk(const RgbaImage& image, int y0, int lines, float scale, ui
   uint8_t* lo = split;
   uint8_t* hi = split + count;
   for (int y = y0; y < y0 + lines; ++y) {
-    ToHalf(image.rgba.data() + size_t(y) * w * 4, size_t(w) * 4, scale, row_half.data());
+    ToHalf(image.data() + size_t(y) * w * 4, size_t(w) * 4, scale, row_half.data());
     const uint16_t* h = row_half.data();
     for (int channel : {2, 1, 0}) {  // B, G, R
       for (int x = 0; x < w; ++x) {
@@ -134,6 +134,7 @@ struct CompressorDeleter {
 
 // One libdeflate compressor per thread and level (a compressor is not
 // shareable between threads; allocating one costs more than a small chunk).
+// Its output depends on the chunk and the level only.
 libdeflate_compressor* ThreadCompressor(int level) {
   thread_local std::unique_ptr<libdeflate_compressor, CompressorDeleter> compressor;
   thread_local int compressor_level = -1;

@@ -145,8 +145,8 @@ double CheckedMaxValue(const std::vector<const RgbaImage*>& images) {
   float max_rgb = 0.0f;
   bool bad = false;
   for (const RgbaImage* image : images) {
-    const float* p = image->rgba.data();
-    const size_t texels = image->rgba.size() / 4;
+    const float* p = image->data();
+    const size_t texels = image->texels();
     for (size_t t = 0; t < texels; ++t) {
       const float r = p[4 * t], g = p[4 * t + 1], b = p[4 * t + 2];
       bad |= !(r >= 0.0f && r <= FLT_MAX) | !(g >= 0.0f && g <= FLT_MAX) | !(b >= 0.0f && b <= FLT_MAX);
@@ -157,9 +157,9 @@ double CheckedMaxValue(const std::vector<const RgbaImage*>& images) {
   // Which value, for the message.
   double max_value = 0.0;
   for (const RgbaImage* image : images) {
-    for (size_t i = 0; i < image->rgba.size(); ++i) {
+    for (size_t i = 0; i < image->texels() * 4; ++i) {
       if (i % 4 == 3) continue;
-      float v = image->rgba[i];
+      float v = image->data()[i];
       if (!std::isfinite(v) || v < 0.0f)
         throw OutputError(fmt::format(
             "internal error: rendered value {} at texel {} is not a finite non-negative radiance", v, i / 4));
@@ -223,13 +223,13 @@ std::string EncodeExr(const std::string& path, const RgbaImage& image, const Exr
   if (type == Imf::HALF) {
     rgb_half.resize(n * 3);
     for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) rgb_half[3 * i + c] = half(image.rgba[4 * i + c] * scale);
+      for (int c = 0; c < 3; ++c) rgb_half[3 * i + c] = half(image.data()[4 * i + c] * scale);
     base = reinterpret_cast<char*>(rgb_half.data());
     element = sizeof(half);
   } else {
     rgb_float.resize(n * 3);
     for (size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c) rgb_float[3 * i + c] = image.rgba[4 * i + c] * scale;
+      for (int c = 0; c < 3; ++c) rgb_float[3 * i + c] = image.data()[4 * i + c] * scale;
     base = reinterpret_cast<char*>(rgb_float.data());
     element = sizeof(float);
   }

@@ -125,6 +125,10 @@ class RendererCache {
         return;
       }
     }
+    // A renderer whose frame the writer thread still reads lives on until
+    // that frame is written.
+    std::erase_if(retired_, [](const std::unique_ptr<SkyRenderer>& r) { return !r->HoldsFrames(); });
+    if (main_ && main_->HoldsFrames()) retired_.push_back(std::move(main_));
     main_.reset();
     main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
                                           OutputScale(style.output.units), false, in.aoas);
@@ -136,13 +140,14 @@ class RendererCache {
   VulkanContext& context_;
   BakeResult& result_;
   std::unique_ptr<SkyRenderer> main_;
+  std::vector<std::unique_ptr<SkyRenderer>> retired_;
   gpu::GpuAtmosphere key_{};
   AoasInputs aoas_key_;
 };
 
 // Converts spectral output to luminance for exposure; a copy.
-std::vector<float> DisplayLuminance(const std::vector<float>& rgba, OutputUnits units) {
-  std::vector<float> display = rgba;
+std::vector<float> DisplayLuminance(const float* rgba, size_t texels, OutputUnits units) {
+  std::vector<float> display(rgba, rgba + 4 * texels);
   if (units == OutputUnits::kLuminance) return display;
   Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
   for (size_t i = 0; i < display.size(); ++i)
@@ -259,6 +264,7 @@ struct FrameJob {
   FramePlan plan;
   FrameNames names;
   std::vector<RgbaImage> images;  // the frame's views, in PlanViews order
+  std::shared_ptr<const void> hold;  // the renderer's memory the images view (RenderInPlace)
   double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
 };
@@ -384,7 +390,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       const int h = ref.style->render.latlong_height;
       std::vector<float> latlong =
           renderers.Main(*ref.style).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
-      ev100 = AutoEv100(DisplayLuminance(latlong, ref.style->output.units), 2 * h, h);
+      ev100 = AutoEv100(DisplayLuminance(latlong.data(), latlong.size() / 4, ref.style->output.units), 2 * h, h);
       exposure_source = fmt::format("auto exposure of frame {} (highest sun), applied to every frame", ref.number);
     } else {
       ev100 = ref.style->preview.ev100;
@@ -553,7 +559,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     w.ev100 = job.ev100;
     if (latlong && (style.output.preview || style.gltf.enabled)) {
       Clock::time_point preview_start = Clock::now();
-      std::vector<float> display = DisplayLuminance(latlong->rgba, style.output.units);
+      std::vector<float> display = DisplayLuminance(latlong->data(), latlong->texels(), style.output.units);
       if (!w.ev100) {
         w.ev100 = style.preview.auto_exposure ? AutoEv100(display, latlong->width, latlong->height)
                                               : style.preview.ev100;
@@ -626,9 +632,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       const int h = style.render.latlong_height;
       views.push_back({MAPPING_LATLONG, 2 * h, h, 0});  // the glTF texture needs the latlong
     }
-    std::vector<std::vector<float>> pixels;
+    RenderedViews rendered;
     if (!verified) {
-      pixels = renderer.Render(plan.sun, views);
+      // In place: the writer thread reads the texels where the device wrote
+      // them while the next frame renders into other memory.
+      rendered = renderer.RenderInPlace(plan.sun, views);
       for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
     }
     // SH: the sky without the disc from small faces; the disc added as the
@@ -678,9 +686,9 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     // the device renders the next frame (the last frame's, or a single
     // bake's, are waited for at once).
     std::vector<RgbaImage> images;
-    for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, std::move(pixels[i])});
+    for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     collect_pending();
-    FrameJob job{plan, names, std::move(images), half_scale, ev100};
+    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
@@ -251,6 +252,8 @@ void SkyRenderer::DestroyAll() {
   set_layout_ = VK_NULL_HANDLE;
   DestroyBuffer(skyview_buffer_);
   DestroyBuffer(output_buffer_);
+  for (std::unique_ptr<FrameSlot>& slot : frame_slots_) DestroyBuffer(slot->buffer);
+  frame_slots_.clear();
   DestroyBuffer(multiscattering_buffer_);
   DestroyBuffer(transmittance_buffer_);
   DestroyBuffer(aoas_buffer_);
@@ -464,7 +467,6 @@ void SkyRenderer::PrecomputeLuts() {
 
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                                                     const std::vector<ViewRequest>& views, bool sun_disc) {
-  const VkPipeline sky_pipeline = sky_pipeline_;
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
   std::vector<size_t> offsets;
   size_t total = 0;
@@ -494,6 +496,81 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     return images;
   }
   EnsureOutputCapacity(std::max<size_t>(total, 1) * 16);
+  SubmitViews(sun, views, sun_disc, offsets);
+
+  std::vector<std::vector<float>> images;
+  const float* data = static_cast<const float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < views.size(); ++i) {
+    size_t count = size_t(views[i].width) * views[i].height * 4;
+    images.emplace_back(data + offsets[i] * 4, data + offsets[i] * 4 + count);
+  }
+  return images;
+}
+
+RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                         bool sun_disc) {
+  if (!luts_ready_ && !output_directions_) PrecomputeLuts();
+  std::vector<size_t> offsets;
+  size_t total = 0;
+  for (const ViewRequest& v : views) {
+    offsets.push_back(total);
+    total += size_t(v.width) * v.height;
+  }
+  const VkDeviceSize bytes = VkDeviceSize(std::max<size_t>(total, 1)) * 16;
+  RenderedViews result;
+  if (bytes > context_.properties().limits.maxStorageBufferRange) {
+    // Rendered in groups (Render) and held in memory of their own.
+    auto images = std::make_shared<std::vector<std::vector<float>>>(Render(sun, views, sun_disc));
+    for (const std::vector<float>& image : *images) result.views.push_back(image.data());
+    result.hold = images;
+    return result;
+  }
+  // A slot whose texels nobody holds any more, large enough; else a new one.
+  FrameSlot* slot = nullptr;
+  for (const std::unique_ptr<FrameSlot>& s : frame_slots_) {
+    if (s->hold.use_count() == 1) {
+      slot = s.get();
+      break;
+    }
+  }
+  if (!slot) {
+    frame_slots_.push_back(std::make_unique<FrameSlot>());
+    slot = frame_slots_.back().get();
+    slot->hold = std::make_shared<int>(0);
+  }
+  // The last holder's reads of the slot before the device writes it again.
+  std::atomic_thread_fence(std::memory_order_acquire);
+  if (slot->buffer.size < bytes) {
+    DestroyBuffer(slot->buffer);
+    slot->buffer = CreateBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  }
+  // The views render into the slot: it takes the output binding for this submission.
+  std::swap(output_buffer_, slot->buffer);
+  UpdateDescriptors();
+  try {
+    SubmitViews(sun, views, sun_disc, offsets);
+  } catch (...) {
+    std::swap(output_buffer_, slot->buffer);
+    UpdateDescriptors();
+    throw;
+  }
+  std::swap(output_buffer_, slot->buffer);
+  UpdateDescriptors();
+  const float* data = static_cast<const float*>(slot->buffer.mapped);
+  for (size_t offset : offsets) result.views.push_back(data + offset * 4);
+  result.hold = slot->hold;
+  return result;
+}
+
+bool SkyRenderer::HoldsFrames() const {
+  for (const std::unique_ptr<FrameSlot>& slot : frame_slots_)
+    if (slot->hold.use_count() > 1) return true;
+  return false;
+}
+
+void SkyRenderer::SubmitViews(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
+                              const std::vector<size_t>& offsets) {
+  const VkPipeline sky_pipeline = sky_pipeline_;
 
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
@@ -552,14 +629,6 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
   }
   Submit(dispatches, barriers);
   ++counters_.frames;
-
-  std::vector<std::vector<float>> images;
-  const float* data = static_cast<const float*>(output_buffer_.mapped);
-  for (size_t i = 0; i < views.size(); ++i) {
-    size_t count = size_t(views[i].width) * views[i].height * 4;
-    images.emplace_back(data + offsets[i] * 4, data + offsets[i] * 4 + count);
-  }
-  return images;
 }
 
 std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,

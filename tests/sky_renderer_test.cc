@@ -2,6 +2,8 @@
 // compiled from the same source, under the Khronos validation layer.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
@@ -416,6 +418,47 @@ TEST(SkyRendererTest, SunDiscPassMatchesDiscInTheSkyPass) {
       }
     }
   }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SkyRendererTest, RenderInPlaceHoldsTexelsUntilReleased) {
+  QualitySettings quality;  // production: the sky-view LUT and the sun-disc pass
+  EffectSettings effects;
+  SkyRenderer renderer(testing::Vulkan(), AtmosphereParams(), quality, effects, {1, 1, 1});
+  const std::vector<ViewRequest> views = {{MAPPING_LATLONG, 256, 128, 0}, {MAPPING_CUBE_STRIP, 64, 384, 0},
+                                          {MAPPING_VULKAN_FACE, 64, 64, 2}};
+  const glm::dvec3 noon = SunDirectionFromElevationAzimuth(60.0, 180.0);
+  const glm::dvec3 dusk = SunDirectionFromElevationAzimuth(2.0, 290.0);
+  const auto copied_noon = renderer.Render(noon, views);
+  const auto copied_dusk = renderer.Render(dusk, views);
+  auto same = [&](const RenderedViews& r, const std::vector<std::vector<float>>& copies, const char* what) {
+    ASSERT_EQ(r.views.size(), copies.size()) << what;
+    for (size_t v = 0; v < copies.size(); ++v)
+      EXPECT_EQ(std::memcmp(r.views[v], copies[v].data(), copies[v].size() * sizeof(float)), 0) << what << " view " << v;
+  };
+  EXPECT_FALSE(renderer.HoldsFrames());
+  RenderedViews first = renderer.RenderInPlace(noon, views);
+  same(first, copied_noon, "noon in place");
+  EXPECT_TRUE(renderer.HoldsFrames());
+  // The next frames render elsewhere while the first is held, and also
+  // Render and RenderDirections (the SH views of a bake) leave it alone.
+  RenderedViews second = renderer.RenderInPlace(dusk, views);
+  renderer.Render(dusk, {{MAPPING_VULKAN_FACE, 64, 64, 0}}, false);
+  renderer.RenderDirections(dusk, {dusk});
+  same(first, copied_noon, "noon held while dusk renders");
+  same(second, copied_dusk, "dusk in place");
+  for (size_t v = 0; v < views.size(); ++v) EXPECT_NE(first.views[v], second.views[v]);
+  // Released on another thread (as a bake's writer does): the memory is used again.
+  const float* first_memory = first.views[0];
+  std::thread([hold = std::move(first.hold)]() mutable { hold.reset(); }).join();
+  first.views.clear();
+  RenderedViews third = renderer.RenderInPlace(noon, views);
+  EXPECT_EQ(third.views[0], first_memory);
+  same(third, copied_noon, "noon again in the released memory");
+  same(second, copied_dusk, "dusk still held");
+  second = RenderedViews();
+  third = RenderedViews();
+  EXPECT_FALSE(renderer.HoldsFrames());
   testing::ExpectNoValidationMessages();
 }
 

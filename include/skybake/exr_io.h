@@ -24,7 +24,10 @@ class OutputError : public std::runtime_error {
 struct RgbaImage {
   int width = 0;
   int height = 0;
-  std::vector<float> rgba;
+  std::vector<float> rgba;        // RGBA float texels, rows from the top; empty when `view` is set
+  const float* view = nullptr;    // or texels held elsewhere (SkyRenderer::RenderInPlace), laid out as `rgba`
+  const float* data() const { return view ? view : rgba.data(); }
+  size_t texels() const { return size_t(width) * size_t(height); }
 };
 
 constexpr double kHalfMax = 65504.0;

@@ -4,6 +4,7 @@
 // views of a frame in one submission. Each pass is timed with GPU timestamps.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -69,6 +70,14 @@ struct ShaderSources {
 };
 ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome);
 
+// Views rendered in place (SkyRenderer::RenderInPlace): RGBA float texels,
+// rows from the top, in the renderer's host-visible memory. The memory stays
+// unchanged while any copy of `hold` lives, and only that long.
+struct RenderedViews {
+  std::vector<const float*> views;  // one per requested view
+  std::shared_ptr<const void> hold;
+};
+
 class SkyRenderer {
  public:
   // With `output_directions`, views contain the unit direction of each texel
@@ -93,6 +102,17 @@ class SkyRenderer {
   // push constant), from the same LUTs.
   std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
                                          const std::vector<ViewRequest>& views, bool sun_disc = true);
+
+  // Render without the copy: the texels stay where the device wrote them,
+  // for as long as the result's `hold` lives (a bake's writer thread reads
+  // them while the next frame renders into other memory). Must be called on
+  // the renderer's thread; `hold` may be released on any thread. The
+  // renderer must outlive every `hold`.
+  RenderedViews RenderInPlace(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                              bool sun_disc = true);
+
+  // True while the texels of a RenderInPlace are held.
+  bool HoldsFrames() const;
 
   // Radiance (RGBA) along each unit direction.
   std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
@@ -124,6 +144,11 @@ class SkyRenderer {
     void* mapped = nullptr;
     VkDeviceSize size = 0;
   };
+  // Memory of a frame rendered in place; free when `hold` has no other owner.
+  struct FrameSlot {
+    Buffer buffer;
+    std::shared_ptr<int> hold;
+  };
   struct Dispatch {
     std::string name;
     VkPipeline pipeline;
@@ -142,6 +167,10 @@ class SkyRenderer {
   // records per-dispatch timings. A barrier follows every dispatch that a
   // later one reads (`barrier_after`).
   void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
+  // The sky-view LUT when the Sun moved, the views at `offsets` (texels) of
+  // the output binding, the sun-disc pass; submitted and waited for.
+  void SubmitViews(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
+                   const std::vector<size_t>& offsets);
 
   static constexpr uint32_t kBindingCount = 6;  // bindings 0..5 of gpu_shared.h
 
@@ -162,6 +191,7 @@ class SkyRenderer {
   Buffer multiscattering_buffer_;
   Buffer output_buffer_;
   Buffer skyview_buffer_;
+  std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
 
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
