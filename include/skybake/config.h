@@ -37,7 +37,7 @@ struct RenderSettings {
 
 // Deflate level of ZIP-compressed EXRs, chosen from the codec table of
 // docs/performance.md (`build/tests/exr_codec_benchmark`).
-constexpr int kDefaultZipLevel = 1;
+constexpr int kDefaultZipLevel = 2;
 
 struct OutputSettings {
   std::string basename = "sky";
