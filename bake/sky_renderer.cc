@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <exception>
 #include <future>
 
 #include <glm/geometric.hpp>
+#include <sys/mman.h>
 
 #include "shaders/kMultiscatteringLutSpv.spv.h"
 #include "shaders/kSkyRenderSpv.spv.h"
@@ -260,6 +262,24 @@ void SkyRenderer::DestroyAll() {
   DestroyBuffer(atmosphere_buffer_);
 }
 
+namespace {
+
+// Asks the kernel for 2 MiB pages behind a large mapping (transparent huge
+// pages, where the system allows them on request). A CPU device's buffers
+// are ordinary memory that the shaders touch first; a 4 KiB page fault cost
+// about 12 us on the development VM (the 84 MB of a W1 frame: 250 ms of
+// faults, 9 ms with huge pages). Advice only: an error (device memory, no
+// huge pages) changes nothing.
+void AdviseHugePages(void* mapped, VkDeviceSize size) {
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  if (!mapped || size < 2 * kHuge) return;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(mapped) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(mapped) + uintptr_t(size)) & ~(kHuge - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
+}  // namespace
+
 SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
   VkDevice device = context_.device();
   Buffer b;
@@ -288,6 +308,7 @@ SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFl
   }
   VK_CHECK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
   VK_CHECK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  AdviseHugePages(b.mapped, size);
   return b;
 }
 
