@@ -264,6 +264,18 @@ void SkyRenderer::DestroyAll() {
 
 namespace {
 
+// Where each view's texels start in a buffer holding them all, in texels;
+// `total` gets the texels of all.
+std::vector<size_t> TexelOffsets(const std::vector<ViewRequest>& views, size_t& total) {
+  std::vector<size_t> offsets;
+  total = 0;
+  for (const ViewRequest& v : views) {
+    offsets.push_back(total);
+    total += size_t(v.width) * v.height;
+  }
+  return offsets;
+}
+
 // Asks the kernel for 2 MiB pages behind a large mapping (transparent huge
 // pages, where the system allows them on request). A CPU device's buffers
 // are ordinary memory that the shaders touch first; a 4 KiB page fault cost
@@ -489,12 +501,8 @@ void SkyRenderer::PrecomputeLuts() {
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                                                     const std::vector<ViewRequest>& views, bool sun_disc) {
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
-  std::vector<size_t> offsets;
   size_t total = 0;
-  for (const ViewRequest& v : views) {
-    offsets.push_back(total);
-    total += size_t(v.width) * v.height;
-  }
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
   // The views share one storage buffer; when they do not fit in the largest
   // range the device can bind, they are rendered in groups that do.
   const VkDeviceSize max_range = context_.properties().limits.maxStorageBufferRange;
@@ -531,12 +539,8 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
 RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                                          bool sun_disc) {
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
-  std::vector<size_t> offsets;
   size_t total = 0;
-  for (const ViewRequest& v : views) {
-    offsets.push_back(total);
-    total += size_t(v.width) * v.height;
-  }
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
   const VkDeviceSize bytes = VkDeviceSize(std::max<size_t>(total, 1)) * 16;
   RenderedViews result;
   if (bytes > context_.properties().limits.maxStorageBufferRange) {
