@@ -302,5 +302,52 @@ times = { start = 09:00:00, end = 09:30:00, step_minutes = 15 }
   fs::remove_all(options.out_dir);
 }
 
+// A drift that switches an effect on mid-sequence needs another shader
+// variant, so a new renderer, while the writer thread still encodes the last
+// frame of the old one straight from its memory (RenderInPlace): the old
+// renderer must live until that frame is written. Every frame's files equal
+// those of a bake of that frame alone.
+TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact) {
+  ScheduleResult schedule = ParseSchedule(R"(
+[schedule]
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
+[schedule.per_hour]
+"effects.sun_disc_strength" = 1.5
+)", "variants.toml");
+  ASSERT_TRUE(schedule.ok());
+  // The disc pruned in the first frame (strength 0), on from the second.
+  const std::vector<std::string> overrides = {"render.cube_size=128", "render.latlong_height=128",
+                                              "effects.sun_disc_strength=0"};
+  FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", overrides,
+                                          schedule.schedule);
+  ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
+  BakeOptions options;
+  options.out_dir = (fs::temp_directory_path() / fmt::format("skybake-variants-test-{}", ::getpid())).string();
+  options.vulkan.validation = true;
+  options.force = true;
+  const BakeResult whole = BakeSequence(styles.styles, schedule.schedule, options);
+  EXPECT_EQ(whole.validation_messages, 0);
+  ASSERT_EQ(whole.frames.size(), 4u);
+  EXPECT_GE(whole.renderer_builds, 2);
+  for (int number = 1; number <= 4; ++number) {
+    BakeOptions alone = options;
+    alone.out_dir = options.out_dir + fmt::format("-frame{}", number);
+    alone.frames = FrameRange{number, number};
+    const BakeResult part = BakeSequence(styles.styles, schedule.schedule, alone);
+    ASSERT_EQ(part.frames.size(), 1u);
+    const std::vector<BakedFile>& a = whole.frames[size_t(number - 1)].files;
+    const std::vector<BakedFile>& b = part.frames[0].files;
+    ASSERT_EQ(a.size(), b.size());
+    for (size_t i = 0; i < a.size(); ++i)
+      EXPECT_EQ(a[i].sha256, b[i].sha256) << "frame " << number << " " << a[i].path;
+    fs::remove_all(alone.out_dir);
+  }
+  fs::remove_all(options.out_dir);
+}
+
 }  // namespace
 }  // namespace skybake
