@@ -329,6 +329,8 @@ void SkyRenderer::DestroyBuffer(Buffer& b) {
   if (b.mapped) vkUnmapMemory(device, b.memory);
   if (b.buffer) vkDestroyBuffer(device, b.buffer, nullptr);
   if (b.memory) vkFreeMemory(device, b.memory, nullptr);
+  // A new buffer may get the same handle: the binding must be written again.
+  if (b.buffer != VK_NULL_HANDLE && b.buffer == bound_output_) bound_output_ = VK_NULL_HANDLE;
   b = Buffer{};
 }
 
@@ -359,6 +361,20 @@ void SkyRenderer::UpdateDescriptors() {
     writes[i].pBufferInfo = &infos[i];
   }
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
+  bound_output_ = output_buffer_.buffer;
+}
+
+void SkyRenderer::BindOutput(const Buffer& target) {
+  if (target.buffer == bound_output_) return;
+  const VkDescriptorBufferInfo info{target.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  write.dstSet = descriptor_set_;
+  write.dstBinding = BINDING_OUTPUT;
+  write.descriptorCount = 1;
+  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  write.pBufferInfo = &info;
+  vkUpdateDescriptorSets(context_.device(), 1, &write, 0, nullptr);
+  bound_output_ = target.buffer;
 }
 
 VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass) {
@@ -525,7 +541,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     return images;
   }
   EnsureOutputCapacity(std::max<size_t>(total, 1) * 16);
-  SubmitViews(sun, views, sun_disc, offsets);
+  SubmitViews(output_buffer_, sun, views, sun_disc, offsets);
 
   std::vector<std::vector<float>> images;
   const float* data = static_cast<const float*>(output_buffer_.mapped);
@@ -569,18 +585,7 @@ RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vecto
     DestroyBuffer(slot->buffer);
     slot->buffer = CreateBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   }
-  // The views render into the slot: it takes the output binding for this submission.
-  std::swap(output_buffer_, slot->buffer);
-  UpdateDescriptors();
-  try {
-    SubmitViews(sun, views, sun_disc, offsets);
-  } catch (...) {
-    std::swap(output_buffer_, slot->buffer);
-    UpdateDescriptors();
-    throw;
-  }
-  std::swap(output_buffer_, slot->buffer);
-  UpdateDescriptors();
+  SubmitViews(slot->buffer, sun, views, sun_disc, offsets);
   const float* data = static_cast<const float*>(slot->buffer.mapped);
   for (size_t offset : offsets) result.views.push_back(data + offset * 4);
   result.hold = slot->hold;
@@ -593,8 +598,9 @@ bool SkyRenderer::HoldsFrames() const {
   return false;
 }
 
-void SkyRenderer::SubmitViews(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
-                              const std::vector<size_t>& offsets) {
+void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                              bool sun_disc, const std::vector<size_t>& offsets) {
+  BindOutput(target);
   const VkPipeline sky_pipeline = sky_pipeline_;
 
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};

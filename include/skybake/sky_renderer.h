@@ -167,10 +167,12 @@ class SkyRenderer {
   // records per-dispatch timings. A barrier follows every dispatch that a
   // later one reads (`barrier_after`).
   void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
+  // Points the output binding at `target` (a frame slot, or output_buffer_).
+  void BindOutput(const Buffer& target);
   // The sky-view LUT when the Sun moved, the views at `offsets` (texels) of
-  // the output binding, the sun-disc pass; submitted and waited for.
-  void SubmitViews(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
-                   const std::vector<size_t>& offsets);
+  // `target`, the sun-disc pass; submitted and waited for.
+  void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                   bool sun_disc, const std::vector<size_t>& offsets);
 
   static constexpr uint32_t kBindingCount = 6;  // bindings 0..5 of gpu_shared.h
 
@@ -192,6 +194,7 @@ class SkyRenderer {
   Buffer output_buffer_;
   Buffer skyview_buffer_;
   std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
+  VkBuffer bound_output_ = VK_NULL_HANDLE;                // what the output binding points at
 
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
