@@ -266,28 +266,41 @@ TEST_F(Sequence, ThreeJsRendersTheDomeInHeadlessChromium) {
   EXPECT_NE(output.find("\"animations\":\"1\""), std::string::npos) << output;
 }
 
-// A scheduled drift of the atmosphere's constants changes uniforms and LUTs
-// only: one renderer, its pipelines compiled once, the transmittance and
-// multiple-scattering LUTs rebuilt per frame; and the frames differ.
-TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
-  ScheduleResult schedule = ParseSchedule(R"(
+// Every 15 minutes from 09:00 to `end` on 2013-05-27 at Cornell, with the
+// style keys of `per_hour` drifting at their rates.
+ScheduleResult MorningDrift(const std::string& end, const std::string& per_hour, const std::string& name) {
+  return ParseSchedule(fmt::format(R"(
 [schedule]
 date = 2013-05-27
 latitude_deg = 42.44337
 longitude_deg = -76.48163
 utc_offset_hours = -4.0
-times = { start = 09:00:00, end = 09:30:00, step_minutes = 15 }
+times = {{ start = 09:00:00, end = {}, step_minutes = 15 }}
 [schedule.per_hour]
+{})", end, per_hour), name);
+}
+
+// A bake into a fresh temporary folder under the validation layer.
+BakeOptions ValidatedBakeOptions(const std::string& name) {
+  BakeOptions options;
+  options.out_dir = (fs::temp_directory_path() / fmt::format("skybake-{}-test-{}", name, ::getpid())).string();
+  options.vulkan.validation = true;
+  options.force = true;
+  return options;
+}
+
+// A scheduled drift of the atmosphere's constants changes uniforms and LUTs
+// only: one renderer, its pipelines compiled once, the transmittance and
+// multiple-scattering LUTs rebuilt per frame; and the frames differ.
+TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
+  ScheduleResult schedule = MorningDrift("09:30:00", R"(
 "atmosphere.mie.scattering_per_km" = 0.004
 "atmosphere.mie.extinction_per_km" = 0.0044
 )", "drift.toml");
   ASSERT_TRUE(schedule.ok());
   FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", kSmall, schedule.schedule);
   ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
-  BakeOptions options;
-  options.out_dir = (fs::temp_directory_path() / fmt::format("skybake-drift-test-{}", ::getpid())).string();
-  options.vulkan.validation = true;
-  options.force = true;
+  const BakeOptions options = ValidatedBakeOptions("drift");
   const BakeResult result = BakeSequence(styles.styles, schedule.schedule, options);
   EXPECT_EQ(result.validation_messages, 0);
   ASSERT_EQ(result.frames.size(), 3u);
@@ -308,14 +321,7 @@ times = { start = 09:00:00, end = 09:30:00, step_minutes = 15 }
 // renderer must live until that frame is written. Every frame's files equal
 // those of a bake of that frame alone.
 TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact) {
-  ScheduleResult schedule = ParseSchedule(R"(
-[schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
-[schedule.per_hour]
+  ScheduleResult schedule = MorningDrift("09:45:00", R"(
 "effects.sun_disc_strength" = 1.5
 )", "variants.toml");
   ASSERT_TRUE(schedule.ok());
@@ -325,10 +331,7 @@ times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
   FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", overrides,
                                           schedule.schedule);
   ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
-  BakeOptions options;
-  options.out_dir = (fs::temp_directory_path() / fmt::format("skybake-variants-test-{}", ::getpid())).string();
-  options.vulkan.validation = true;
-  options.force = true;
+  const BakeOptions options = ValidatedBakeOptions("variants");
   const BakeResult whole = BakeSequence(styles.styles, schedule.schedule, options);
   EXPECT_EQ(whole.validation_messages, 0);
   ASSERT_EQ(whole.frames.size(), 4u);
