@@ -61,6 +61,9 @@ int RunDevices() {
     std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(),
                 d.api_version.c_str(), d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
   }
+  if (!DriverSelection().empty())
+    std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
+                "every installed driver)\n");
   return kExitOk;
 }
 
@@ -382,6 +385,8 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitUsage;
   }
 
+  // Single-threaded still: the only point where the environment may change.
+  SelectSoftwareDriversWithoutGpu();
   try {
     if (devices->parsed()) return RunDevices();
     if (accuracy->parsed()) {

@@ -341,7 +341,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
   // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
   VulkanContext context(options.vulkan);
-  timer.Finish("device", fmt::format("{} ({})", context.device_info().name, context.device_info().type));
+  timer.Finish("device", fmt::format("{} ({}){}", context.device_info().name, context.device_info().type,
+                                     DriverSelection().empty() ? "" : ", software driver only (no GPU device node)"));
   // Each render's output is one storage buffer: refuse views the device cannot bind.
   const uint64_t max_range = context.properties().limits.maxStorageBufferRange;
   for (const FramePlan& plan : plans) {

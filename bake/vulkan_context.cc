@@ -1,7 +1,10 @@
 #include "skybake/vulkan_context.h"
 
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <sstream>
 
 #include <fmt/format.h>
 
@@ -122,6 +125,77 @@ std::vector<VkPhysicalDevice> EnumerateDevices(VkInstance instance) {
 }
 
 }  // namespace
+
+namespace {
+std::string driver_selection;  // SelectSoftwareDriversWithoutGpu
+
+bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+// The folders the Vulkan loader searches for driver manifests on Linux
+// (its LoaderInterfaceArchitecture.md, "Driver Discovery on Linux").
+std::vector<std::filesystem::path> ManifestFolders() {
+  auto env = [](const char* name, const char* fallback) {
+    const char* v = std::getenv(name);
+    return std::string(v && *v ? v : fallback);
+  };
+  const std::string home = env("HOME", "");
+  std::vector<std::filesystem::path> folders;
+  auto add_list = [&](const std::string& list) {
+    std::stringstream in(list);
+    for (std::string dir; std::getline(in, dir, ':');)
+      if (!dir.empty()) folders.push_back(std::filesystem::path(dir) / "vulkan" / "icd.d");
+  };
+  add_list(env("XDG_CONFIG_HOME", home.empty() ? "" : (home + "/.config").c_str()));
+  add_list(env("XDG_CONFIG_DIRS", "/etc/xdg"));
+  folders.push_back("/etc/vulkan/icd.d");
+  add_list(env("XDG_DATA_HOME", home.empty() ? "" : (home + "/.local/share").c_str()));
+  add_list(env("XDG_DATA_DIRS", "/usr/local/share:/usr/share"));
+  return folders;
+}
+}  // namespace
+
+DriverEnvironment ProbeDriverEnvironment() {
+  DriverEnvironment e;
+  for (const char* name : {"VK_ICD_FILENAMES", "VK_DRIVER_FILES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
+                           "VK_LOADER_DRIVERS_DISABLE"}) {
+    const char* v = std::getenv(name);
+    if (v && *v) e.drivers_chosen_by_user = true;
+  }
+  const char* all = std::getenv("SKYBAKE_ALL_VULKAN_DRIVERS");
+  if (all && std::strcmp(all, "1") == 0) e.drivers_chosen_by_user = true;
+  auto gpu_node = [](const std::string& folder, const std::string& name) {
+    if (folder == "/dev/dri") return StartsWith(name, "renderD") || StartsWith(name, "card");
+    return StartsWith(name, "nvidia") || name == "dxg" || StartsWith(name, "kgsl") || StartsWith(name, "mali");
+  };
+  std::error_code ec;  // a folder that does not exist lists nothing
+  try {
+    for (const char* folder : {"/dev/dri", "/dev"})
+      for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
+        if (e.gpu_device_node.empty() && gpu_node(folder, entry.path().filename().string()))
+          e.gpu_device_node = entry.path().string();
+    for (const std::filesystem::path& folder : ManifestFolders())
+      for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
+        if (entry.path().extension() == ".json") e.manifests.push_back(entry.path().filename().string());
+  } catch (const std::filesystem::filesystem_error&) {
+    e.gpu_device_node = "(unknown: a folder could not be listed)";  // keep every driver
+  }
+  return e;
+}
+
+std::string SoftwareDriverSelection(const DriverEnvironment& environment) {
+  if (environment.drivers_chosen_by_user || !environment.gpu_device_node.empty()) return "";
+  for (const std::string& manifest : environment.manifests)
+    if (StartsWith(manifest, "lvp_icd")) return "*lvp_icd*";
+  return "";
+}
+
+std::string SelectSoftwareDriversWithoutGpu() {
+  driver_selection = SoftwareDriverSelection(ProbeDriverEnvironment());
+  if (!driver_selection.empty()) ::setenv("VK_LOADER_DRIVERS_SELECT", driver_selection.c_str(), 1);
+  return driver_selection;
+}
+
+const std::string& DriverSelection() { return driver_selection; }
 
 const char* VkResultName(VkResult result) {
   switch (result) {

@@ -27,6 +27,8 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CommandRun;
 using testing::FreshTempDir;
+using testing::FileNames;
+using testing::ReadFileBytes;
 using testing::RunSkybake;
 
 std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
@@ -42,20 +44,6 @@ std::string WriteFile(const std::string& dir, const std::string& name, const std
   return path;
 }
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::set<std::string> Names(const std::string& dir) {
-  std::set<std::string> names;
-  if (fs::exists(dir))
-    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
-  return names;
-}
-
 // What differs between any two runs of a bake: its wall-clock timings, kept
 // out of manifest.json.
 bool IsTimings(const std::string& name) { return name == "timings.json"; }
@@ -65,16 +53,16 @@ TEST(SafeOutputs, ExistingOutputsNeedForce) {
   const std::string bake = "bake '" + Style() + "' --size 8 -q --out '" + out + "'";
   CommandRun first = RunSkybake(bake);
   ASSERT_EQ(first.exit_code, 0) << first.output;
-  std::string before = ReadBytes(out + "/sky_px.exr");
+  std::string before = ReadFileBytes(out + "/sky_px.exr");
   CommandRun again = RunSkybake(bake);
   EXPECT_EQ(again.exit_code, 6) << again.output;
   EXPECT_EQ(again.output, "skybake: error: " + out +
                               "/sky_px.exr already exists: pass --force to overwrite the bake's files, or choose "
                               "another --out\n");
-  EXPECT_EQ(ReadBytes(out + "/sky_px.exr"), before);
+  EXPECT_EQ(ReadFileBytes(out + "/sky_px.exr"), before);
   CommandRun forced = RunSkybake(bake + " --force");
   EXPECT_EQ(forced.exit_code, 0) << forced.output;
-  EXPECT_EQ(ReadBytes(out + "/sky_px.exr"), before) << "the same bake gives the same bytes";
+  EXPECT_EQ(ReadFileBytes(out + "/sky_px.exr"), before) << "the same bake gives the same bytes";
   CommandRun resume_single = RunSkybake(bake + " --resume");
   EXPECT_EQ(resume_single.exit_code, 2) << resume_single.output;
   EXPECT_NE(resume_single.output.find("--resume continues a sequence bake"), std::string::npos);
@@ -117,7 +105,7 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
   // After the kill: every file under a real output name is complete (the
   // manifest lists the frames done; any other output file has the bytes of
   // the uninterrupted bake, since it was renamed into place only once whole).
-  const std::set<std::string> after_kill = Names(killed);
+  const std::set<std::string> after_kill = FileNames(killed);
   nlohmann::json partial = nlohmann::json::parse(std::ifstream(killed + "/manifest.json"));
   EXPECT_FALSE(partial["complete"].get<bool>());
   EXPECT_GE(partial["frames"].size(), 4u);
@@ -130,17 +118,17 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
       continue;
     }
     if (name == "manifest.json" || IsTimings(name)) continue;
-    EXPECT_EQ(ReadBytes(killed + "/" + name), ReadBytes(root + "/whole/out/" + name)) << name << " is partial";
+    EXPECT_EQ(ReadFileBytes(killed + "/" + name), ReadFileBytes(root + "/whole/out/" + name)) << name << " is partial";
   }
 
   CommandRun resumed = RunSkybake(bake + " --resume", "cd '" + root + "/killed' &&");
   ASSERT_EQ(resumed.exit_code, 0) << resumed.output;
-  const std::set<std::string> whole_names = Names(root + "/whole/out");
-  EXPECT_EQ(Names(killed), whole_names) << "no temporary left, no file missing";
+  const std::set<std::string> whole_names = FileNames(root + "/whole/out");
+  EXPECT_EQ(FileNames(killed), whole_names) << "no temporary left, no file missing";
   EXPECT_TRUE(whole_names.count("manifest.json") && whole_names.count("timings.json"));
   for (const std::string& name : whole_names) {
     if (IsTimings(name)) continue;
-    EXPECT_EQ(ReadBytes(killed + "/" + name), ReadBytes(root + "/whole/out/" + name)) << name;
+    EXPECT_EQ(ReadFileBytes(killed + "/" + name), ReadFileBytes(root + "/whole/out/" + name)) << name;
   }
   nlohmann::json timings = nlohmann::json::parse(std::ifstream(killed + "/timings.json"));
   EXPECT_GT(timings["total_s"].get<double>(), 0.0);
@@ -163,7 +151,7 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
   for (size_t at = changed.output.find(" 8 views"); at != std::string::npos; at = changed.output.find(" 8 views", at + 1))
     ++rendered;
   EXPECT_EQ(rendered, 20u) << changed.output;
-  EXPECT_NE(ReadBytes(killed + "/sky_px.0001.exr"), ReadBytes(root + "/whole/out/sky_px.0001.exr"));
+  EXPECT_NE(ReadFileBytes(killed + "/sky_px.0001.exr"), ReadFileBytes(root + "/whole/out/sky_px.0001.exr"));
   fs::remove_all(root);
 }
 
@@ -180,7 +168,7 @@ TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
                                                                                run.output.find(".tmp") - 4) +
                             ": File too large): the file is larger than the file-size limit (ulimit -f) or the "
                             "file system allows\n");
-  EXPECT_TRUE(Names(out).empty()) << "left: " << *Names(out).begin();
+  EXPECT_TRUE(FileNames(out).empty()) << "left: " << *FileNames(out).begin();
   fs::remove_all(root);
 }
 
@@ -233,7 +221,7 @@ TEST(SafeOutputs, ViewBeyondTheDeviceLimitIsAClearVulkanError) {
                             "render.latlong_height\n"),
             std::string::npos)
       << run.output;
-  EXPECT_TRUE(Names(root + "/out").empty());
+  EXPECT_TRUE(FileNames(root + "/out").empty());
   fs::remove_all(root);
 }
 

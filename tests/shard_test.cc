@@ -23,6 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 using testing::CommandRun;
 using testing::FreshTempDir;
+using testing::FileNames;
+using testing::ReadFileBytes;
 using testing::RunSkybake;
 
 // Six clock times numbered from 11, so frame numbers and indices differ;
@@ -52,20 +54,6 @@ time = 12:00:00
 
 std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-std::set<std::string> Names(const std::string& dir) {
-  std::set<std::string> names;
-  if (fs::exists(dir))
-    for (const auto& e : fs::directory_iterator(dir)) names.insert(e.path().filename().string());
-  return names;
-}
-
 class Shard : public ::testing::Test {
  protected:
   // One folder per process (ctest runs each test in its own), with the
@@ -94,12 +82,12 @@ class Shard : public ::testing::Test {
   // Every file of the unsharded bake is in `dir` with the same bytes
   // (manifest.json and the glTF scene included), timings.json apart.
   static void ExpectSameAsWhole(const std::string& dir) {
-    const std::set<std::string> whole = Names(Whole());
+    const std::set<std::string> whole = FileNames(Whole());
     ASSERT_EQ(whole.size(), 6u * 9 + 3 + 2) << "9 files per frame, the scene, manifest.json, timings.json";
     for (const std::string& name : whole) {
       if (name == "timings.json") continue;
       ASSERT_TRUE(fs::exists(dir + "/" + name)) << name;
-      EXPECT_TRUE(ReadBytes(dir + "/" + name) == ReadBytes(Whole() + "/" + name)) << name << " differs";
+      EXPECT_TRUE(ReadFileBytes(dir + "/" + name) == ReadFileBytes(Whole() + "/" + name)) << name << " differs";
     }
   }
 
@@ -114,7 +102,7 @@ TEST_F(Shard, ThreeShardsInOneFolderMergeToTheUnshardedBake) {
     ASSERT_EQ(run.exit_code, 0) << run.output;
   }
   // Contiguous blocks of two, each with its own manifest and no scene yet.
-  const std::set<std::string> names = Names(out);
+  const std::set<std::string> names = FileNames(out);
   for (const char* name : {"manifest.shard-0011-0012.json", "manifest.shard-0013-0014.json",
                            "manifest.shard-0015-0016.json", "timings.shard-0013-0014.json"})
     EXPECT_TRUE(names.count(name)) << name;
@@ -164,9 +152,9 @@ TEST_F(Shard, FrameRangesInSeparateFoldersCopiedTogetherMergeToTheUnshardedBake)
       expected.insert(fmt::format("sky_{}.{:04d}.exr", kind, frame));
       if (std::string(kind) == "latlong") expected.insert(fmt::format("sky_latlong.{:04d}.png", frame));
     }
-  EXPECT_EQ(Names(a), expected);
-  EXPECT_TRUE(Names(b).count("manifest.shard-0014-0014.json"));
-  EXPECT_TRUE(Names(c).count("manifest.shard-0015-0016.json"));
+  EXPECT_EQ(FileNames(a), expected);
+  EXPECT_TRUE(FileNames(b).count("manifest.shard-0014-0014.json"));
+  EXPECT_TRUE(FileNames(c).count("manifest.shard-0015-0016.json"));
 
   const std::string together = root_ + "/together";
   fs::create_directories(together);

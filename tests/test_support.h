@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -39,5 +40,10 @@ CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix =
 
 // A new, empty folder under the temporary directory, unique to this process.
 std::string FreshTempDir(const std::string& name);
+
+// A file's bytes ("" when it cannot be read), and the names in a folder
+// (none when it does not exist).
+std::string ReadFileBytes(const std::string& path);
+std::set<std::string> FileNames(const std::string& dir);
 
 }  // namespace skybake::testing

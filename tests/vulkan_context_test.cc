@@ -1,5 +1,8 @@
 // The headless Vulkan context: device choice, and proof that the validation
 // layer the other tests rely on is really listening.
+#include <filesystem>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "skybake/vulkan_context.h"
@@ -52,6 +55,48 @@ TEST(VulkanContextTest, BadDeviceIndexIsAClearError) {
   } catch (const VulkanUnavailable& e) {
     EXPECT_NE(std::string(e.what()).find("skybake devices"), std::string::npos) << e.what();
   }
+}
+
+TEST(VulkanDriversTest, OnlyLavapipeWithoutAGpuDeviceNodeUnlessTheUserChose) {
+  DriverEnvironment e;
+  e.manifests = {"intel_icd.x86_64.json", "lvp_icd.x86_64.json", "radeon_icd.x86_64.json"};
+  EXPECT_EQ(SoftwareDriverSelection(e), "*lvp_icd*");
+  DriverEnvironment gpu = e;
+  gpu.gpu_device_node = "/dev/dri/renderD128";
+  EXPECT_EQ(SoftwareDriverSelection(gpu), "");
+  DriverEnvironment chosen = e;
+  chosen.drivers_chosen_by_user = true;
+  EXPECT_EQ(SoftwareDriverSelection(chosen), "");
+  DriverEnvironment no_lavapipe = e;
+  no_lavapipe.manifests = {"intel_icd.x86_64.json", "radeon_icd.x86_64.json"};
+  EXPECT_EQ(SoftwareDriverSelection(no_lavapipe), "");  // leave the loader to find whatever exists
+  EXPECT_EQ(SoftwareDriverSelection(DriverEnvironment{}), "");
+}
+
+// The CLI asks the loader for lavapipe alone exactly when this machine
+// calls for it, the loader then skips every other driver, and the bake's
+// files are the same bytes as with every driver loaded.
+TEST(VulkanDriversTest, CliLoadsOnlyTheSoftwareDriverWhenTheMachineHasNoGpu) {
+  const bool expected = !SoftwareDriverSelection(ProbeDriverEnvironment()).empty();
+  testing::CommandRun selected = testing::RunSkybake("devices", "VK_LOADER_DEBUG=driver");
+  ASSERT_EQ(selected.exit_code, 0) << selected.output;
+  EXPECT_EQ(selected.output.find("software driver only") != std::string::npos, expected) << selected.output;
+  EXPECT_EQ(selected.output.find("not selected by env var") != std::string::npos, expected) << selected.output;
+  testing::CommandRun all = testing::RunSkybake("devices", "VK_LOADER_DEBUG=driver SKYBAKE_ALL_VULKAN_DRIVERS=1");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  EXPECT_EQ(all.output.find("software driver only"), std::string::npos) << all.output;
+  EXPECT_EQ(all.output.find("not selected by env var"), std::string::npos) << all.output;
+
+  const std::string dir = testing::FreshTempDir("drivers");
+  const std::string style = testing::SourceDir() + "/configs/default.toml --size 32 --set output.preview=false";
+  testing::CommandRun a = testing::RunSkybake("bake " + style + " --out " + dir + "/a");
+  testing::CommandRun b = testing::RunSkybake("bake " + style + " --out " + dir + "/b", "SKYBAKE_ALL_VULKAN_DRIVERS=1");
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  EXPECT_EQ(a.output.find("software driver only") != std::string::npos, expected) << a.output;
+  for (const char* name : {"sky_latlong.exr", "sky_cube.exr", "sky_px.exr"})
+    EXPECT_EQ(testing::ReadFileBytes(dir + "/a/" + name), testing::ReadFileBytes(dir + "/b/" + name)) << name;
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

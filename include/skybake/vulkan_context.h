@@ -54,6 +54,35 @@ struct DeviceInfo {
   std::string rejected_because;  // empty when usable
 };
 
+// Loading a Vulkan driver costs start-up whether or not it finds a device:
+// the loader opens every installed driver, and Mesa's hardware drivers each
+// link LLVM, whose relocation is most of lavapipe's 0.07-0.09 s device
+// creation on the benchmark machine (docs/performance.md). A hardware driver
+// offers a device only through a GPU's device node, so on a machine with
+// none skybake asks the loader for the software driver alone.
+struct DriverEnvironment {
+  bool drivers_chosen_by_user = false;  // VK_ICD_FILENAMES, VK_DRIVER_FILES, VK_ADD_DRIVER_FILES,
+                                        // VK_LOADER_DRIVERS_SELECT/_DISABLE or SKYBAKE_ALL_VULKAN_DRIVERS=1
+  std::string gpu_device_node;          // the first of /dev/dri/renderD*, /dev/dri/card*, /dev/nvidia*,
+                                        // /dev/dxg, /dev/kgsl*, /dev/mali*; empty when none exists
+  std::vector<std::string> manifests;   // file names of the installed driver manifests (vulkan/icd.d)
+};
+
+// This machine's: environment variables, /dev, the loader's manifest folders.
+DriverEnvironment ProbeDriverEnvironment();
+
+// The loader's VK_LOADER_DRIVERS_SELECT that loads only lavapipe, or "" to
+// load every driver: when the user chose none, no GPU device node exists
+// and lavapipe's manifest is installed.
+std::string SoftwareDriverSelection(const DriverEnvironment& environment);
+
+// Sets VK_LOADER_DRIVERS_SELECT to SoftwareDriverSelection of this machine
+// (call it before any Vulkan call and any thread: it changes the
+// environment); returns the value set, or "". DriverSelection() returns it
+// afterwards.
+std::string SelectSoftwareDriversWithoutGpu();
+const std::string& DriverSelection();
+
 struct VulkanOptions {
   int device_index = -1;      // -1: choose the best usable device
   bool validation = false;    // load VK_LAYER_KHRONOS_validation
