@@ -1,6 +1,8 @@
 #include "exr_deflate.h"
 
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <bit>
 #include <cstring>
 #include <memory>
@@ -151,42 +153,53 @@ struct Chunk {
   std::vector<uint8_t> bytes;  // as stored: deflated, or raw when that is not smaller
 };
 
-void EncodeChunks(const RgbaImage& image, const ExrWriteOptions& options, int lines_per_chunk, bool deflate,
-                  size_t first, size_t last, std::vector<Chunk>& chunks) {
-  const bool half_pixels = options.pixel_type == PixelType::kHalf;
-  const size_t line_bytes = size_t(image.width) * 3 * (half_pixels ? 2 : 4);
-  std::vector<uint8_t> raw(line_bytes * lines_per_chunk);
-  std::vector<uint8_t> predicted(raw.size());
-  std::vector<uint16_t> row_half;
-  libdeflate_compressor* compressor = deflate ? ThreadCompressor(options.zip_level) : nullptr;
-  std::vector<uint8_t> packed(deflate ? libdeflate_zlib_compress_bound(compressor, raw.size()) : 0);
-  for (size_t i = first; i < last; ++i) {
-    Chunk& chunk = chunks[i];
-    chunk.y = int(i) * lines_per_chunk;
+// One thread's buffers, grown to the largest chunk it has met.
+class ChunkEncoder {
+ public:
+  // Chunk `index` of `file` (chunks of `lines_per_chunk` lines).
+  void Encode(const ExrFile& file, int lines_per_chunk, size_t index, Chunk& chunk) {
+    const RgbaImage& image = *file.image;
+    const ExrWriteOptions& options = file.options;
+    const bool half_pixels = options.pixel_type == PixelType::kHalf;
+    const bool deflate = options.compression != "none";
+    const float scale = float(options.scale);
+    const size_t line_bytes = size_t(image.width) * 3 * (half_pixels ? 2 : 4);
+    chunk.y = int(index) * lines_per_chunk;
     const int lines = std::min(lines_per_chunk, image.height - chunk.y);
     const size_t n = line_bytes * lines;
-    if (deflate && half_pixels) {
-      PredictHalfChunk(image, chunk.y, lines, float(options.scale), raw.data(), predicted.data(), row_half);
-      const size_t size = libdeflate_zlib_compress(compressor, predicted.data(), n, packed.data(), packed.size());
-      if (size > 0 && size < n) {
-        chunk.bytes.assign(packed.begin(), packed.begin() + size);
-        continue;
-      }
+    if (raw_.size() < n) {
+      raw_.resize(n);
+      predicted_.resize(n);
     }
-    LayOutChunk(image, chunk.y, lines, half_pixels, float(options.scale), raw.data(), row_half);
-    if (deflate && !half_pixels) {
-      Predict(raw.data(), n, predicted.data());
-      const size_t size = libdeflate_zlib_compress(compressor, predicted.data(), n, packed.data(), packed.size());
+    if (deflate) {
+      libdeflate_compressor* compressor = ThreadCompressor(options.zip_level);
+      packed_.resize(std::max(packed_.size(), libdeflate_zlib_compress_bound(compressor, n)));
+      if (half_pixels) {
+        PredictHalfChunk(image, chunk.y, lines, scale, raw_.data(), predicted_.data(), row_half_);
+      } else {
+        LayOutChunk(image, chunk.y, lines, false, scale, raw_.data(), row_half_);
+        Predict(raw_.data(), n, predicted_.data());
+      }
+      const size_t size = libdeflate_zlib_compress(compressor, predicted_.data(), n, packed_.data(), packed_.size());
       // A chunk that does not shrink is stored raw; readers tell the two
       // apart by comparing its size with the uncompressed size.
       if (size > 0 && size < n) {
-        chunk.bytes.assign(packed.begin(), packed.begin() + size);
-        continue;
+        chunk.bytes.assign(packed_.begin(), packed_.begin() + size);
+        return;
+      }
+      if (!half_pixels) {  // raw_ holds the chunk's bytes already
+        chunk.bytes.assign(raw_.begin(), raw_.begin() + n);
+        return;
       }
     }
-    chunk.bytes.assign(raw.begin(), raw.begin() + n);
+    LayOutChunk(image, chunk.y, lines, half_pixels, scale, raw_.data(), row_half_);
+    chunk.bytes.assign(raw_.begin(), raw_.begin() + n);
   }
-}
+
+ private:
+  std::vector<uint8_t> raw_, predicted_, packed_;
+  std::vector<uint16_t> row_half_;
+};
 
 struct Sink {
   std::string bytes;
@@ -207,41 +220,12 @@ void RecordError(exr_const_context_t context, exr_result_t code, const char* mes
     static_cast<Sink*>(user_data)->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
 }
 
-}  // namespace
-
-bool DeflateEncoderHandles(const std::string& compression) {
-  return compression == "none" || compression == "zip" || compression == "zips";
-}
-
-std::string EncodeExrDeflate(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options,
-                             int threads) {
-  if (!DeflateEncoderHandles(options.compression))
-    throw OutputError(fmt::format("cannot encode {}: compression {} is not ZIP, ZIPS or none", name,
-                                  options.compression));
-  const int lines_per_chunk = LinesPerChunk(options.compression);
-  const bool deflate = options.compression != "none";
-  const size_t count = size_t((image.height + lines_per_chunk - 1) / lines_per_chunk);
-  std::vector<Chunk> chunks(count);
-
-  // Chunks in contiguous blocks, one block per thread.
-  const size_t blocks = std::clamp<size_t>(size_t(std::max(threads, 1)), 1, std::max<size_t>(count, 1));
-  std::vector<std::thread> workers;
-  std::vector<std::exception_ptr> failures(blocks);
-  for (size_t b = 0; b < blocks; ++b) {
-    auto work = [&, b] {
-      try {
-        EncodeChunks(image, options, lines_per_chunk, deflate, count * b / blocks, count * (b + 1) / blocks, chunks);
-      } catch (...) {
-        failures[b] = std::current_exception();
-      }
-    };
-    if (b + 1 < blocks) workers.emplace_back(work);
-    else work();
-  }
-  for (std::thread& t : workers) t.join();
-  for (const std::exception_ptr& failure : failures)
-    if (failure) std::rethrow_exception(failure);
-
+// The file around its encoded chunks: OpenEXRCore writes the header, the
+// chunks in order and the offset table into memory.
+std::string AssembleExr(const ExrFile& file, const std::vector<Chunk>& chunks) {
+  const std::string& name = file.name;
+  const RgbaImage& image = *file.image;
+  const ExrWriteOptions& options = file.options;
   Sink sink;
   size_t chunk_bytes = 0;
   for (const Chunk& chunk : chunks) chunk_bytes += chunk.bytes.size() + 8;
@@ -283,6 +267,66 @@ std::string EncodeExrDeflate(const std::string& name, const RgbaImage& image, co
   context = nullptr;
   check(finished, "the offset table");
   return std::move(sink.bytes);
+}
+
+}  // namespace
+
+bool DeflateEncoderHandles(const std::string& compression) {
+  return compression == "none" || compression == "zip" || compression == "zips";
+}
+
+std::vector<std::string> EncodeExrsDeflate(const std::vector<const ExrFile*>& files, int threads) {
+  // Work items: runs of a file's chunks of about 64 KiB of pixels or more
+  // (one ZIP chunk of a 512-texel face holds 48 KiB of half pixels, of a
+  // 2048-texel latlong 192 KiB), handed out in file order as threads come
+  // free.
+  struct Item {
+    size_t file, first, last;
+  };
+  std::vector<std::vector<Chunk>> chunks(files.size());
+  std::vector<Item> items;
+  for (size_t f = 0; f < files.size(); ++f) {
+    const ExrFile& file = *files[f];
+    if (!DeflateEncoderHandles(file.options.compression))
+      throw OutputError(fmt::format("cannot encode {}: compression {} is not ZIP, ZIPS or none", file.name,
+                                    file.options.compression));
+    const int lines = LinesPerChunk(file.options.compression);
+    const size_t count = size_t((file.image->height + lines - 1) / lines);
+    chunks[f].resize(count);
+    const size_t chunk_bytes =
+        size_t(file.image->width) * 3 * (file.options.pixel_type == PixelType::kHalf ? 2 : 4) * size_t(lines);
+    const size_t per_item = std::max<size_t>(1, (64 * 1024) / std::max<size_t>(chunk_bytes, 1));
+    for (size_t first = 0; first < count; first += per_item)
+      items.push_back({f, first, std::min(count, first + per_item)});
+  }
+  std::atomic<size_t> next{0};
+  std::atomic<bool> failed{false};
+  const size_t workers = std::clamp<size_t>(size_t(std::max(threads, 1)), 1, std::max<size_t>(items.size(), 1));
+  std::vector<std::exception_ptr> failures(workers);
+  auto work = [&](size_t w) {
+    try {
+      ChunkEncoder encoder;
+      for (size_t i; !failed && (i = next.fetch_add(1)) < items.size();) {
+        const Item& item = items[i];
+        const ExrFile& file = *files[item.file];
+        for (size_t c = item.first; c < item.last; ++c)
+          encoder.Encode(file, LinesPerChunk(file.options.compression), c, chunks[item.file][c]);
+      }
+    } catch (...) {
+      failures[w] = std::current_exception();
+      failed = true;
+    }
+  };
+  std::vector<std::thread> helpers;
+  for (size_t w = 1; w < workers; ++w) helpers.emplace_back(work, w);
+  work(0);
+  for (std::thread& t : helpers) t.join();
+  for (const std::exception_ptr& failure : failures)
+    if (failure) std::rethrow_exception(failure);
+
+  std::vector<std::string> encoded;
+  for (size_t f = 0; f < files.size(); ++f) encoded.push_back(AssembleExr(*files[f], chunks[f]));
+  return encoded;
 }
 
 }  // namespace skybake

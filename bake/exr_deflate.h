@@ -17,9 +17,10 @@ namespace skybake {
 // True when EncodeExrDeflate handles `compression` ("none", "zip", "zips").
 bool DeflateEncoderHandles(const std::string& compression);
 
-// The bytes of an EXR file of R, G, B (`name` is for messages), compressed on
-// `threads` threads (at least 1).
-std::string EncodeExrDeflate(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options,
-                             int threads);
+// The bytes of EXR files of R, G, B (ExrFile::name is for messages; each
+// file's compression is one DeflateEncoderHandles accepts), their chunks
+// compressed on `threads` threads (at least 1), taken in turn as each
+// thread comes free.
+std::vector<std::string> EncodeExrsDeflate(const std::vector<const ExrFile*>& files, int threads);
 
 }  // namespace skybake

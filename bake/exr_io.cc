@@ -194,9 +194,10 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
   return bytes.size();
 }
 
-std::string EncodeExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
-  if (!options.openexr_encoder && DeflateEncoderHandles(options.compression))
-    return EncodeExrDeflate(path, image, options, exr_threads);
+namespace {
+
+// OpenEXR's own encoder (every compression; the zlib ZIP for comparison).
+std::string EncodeWithOpenExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
   const int w = image.width;
   const int h = image.height;
   Imf::PixelType type = options.pixel_type == PixelType::kHalf ? Imf::HALF : Imf::FLOAT;
@@ -249,6 +250,31 @@ std::string EncodeExr(const std::string& path, const RgbaImage& image, const Exr
     throw OutputError(fmt::format("cannot encode {}: {}", path, e.what()));
   }  // the OutputFile destructor writes the line offsets: encoded is complete here
   return encoded.TakeBytes();
+}
+
+}  // namespace
+
+std::vector<std::string> EncodeExrs(const std::vector<ExrFile>& files) {
+  std::vector<std::string> encoded(files.size());
+  std::vector<const ExrFile*> ours;
+  std::vector<size_t> where;
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (!files[i].options.openexr_encoder && DeflateEncoderHandles(files[i].options.compression)) {
+      ours.push_back(&files[i]);
+      where.push_back(i);
+    } else {
+      encoded[i] = EncodeWithOpenExr(files[i].name, *files[i].image, files[i].options);
+    }
+  }
+  if (!ours.empty()) {
+    std::vector<std::string> bytes = EncodeExrsDeflate(ours, exr_threads);
+    for (size_t k = 0; k < ours.size(); ++k) encoded[where[k]] = std::move(bytes[k]);
+  }
+  return encoded;
+}
+
+std::string EncodeExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options) {
+  return std::move(EncodeExrs({ExrFile{path, &image, options}})[0]);
 }
 
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {

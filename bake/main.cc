@@ -10,7 +10,6 @@
 //
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
-#include <malloc.h>
 
 #include <csignal>
 #include <cstdio>
@@ -264,13 +263,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  // A frame's images (up to 34 MB each) are allocated and freed every frame.
-  // glibc serves blocks above its mmap threshold (at most 32 MB) from fresh
-  // mappings and trims freed heap back to the system, so every frame paid
-  // for page faults and zeroed pages again; keeping them in the heap made W2
-  // 7% faster for 5% more peak memory (docs/performance.md).
-  mallopt(M_MMAP_THRESHOLD, 1 << 30);
-  mallopt(M_TRIM_THRESHOLD, 1 << 30);
+  KeepFrameMemoryInHeap();
   CLI::App app{"skybake " SKYBAKE_VERSION
                ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
                "into OpenEXR environment maps with Vulkan compute.\n"

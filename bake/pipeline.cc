@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <future>
+#include <malloc.h>
 #include <thread>
 #include <map>
 #include <memory>
@@ -520,35 +521,54 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     };
     if (plan.number > 0) exr.attributes["skybake:frame_number"] = std::to_string(plan.number);
     if (plan.time) exr.attributes["skybake:time"] = plan.time->Iso8601();
-    // Encoded in memory, written atomically, checksummed from the same bytes.
-    auto write_exr = [&](const std::string& name, const std::string& kind, const RgbaImage& image,
-                         const ExrWriteOptions& o) {
-      const std::string path = path_of(name);
-      const std::string bytes = EncodeExr(path, image, o);
-      WriteFileAtomically(path, bytes);
-      w.files.push_back({path, kind, bytes.size(), Sha256OfText(bytes)});
-    };
+    // The frame's files encoded together in memory (their chunks shared
+    // among the threads), then each written atomically and checksummed from
+    // the same bytes.
+    std::vector<ExrFile> exrs;
+    std::vector<std::string> kinds;
     size_t view_index = 0;
     if (style.output.faces) {
       for (int face = 0; face < 6; ++face, ++view_index) {
         ExrWriteOptions face_exr = exr;
         face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
         face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
-        write_exr(names.faces[face], "face", images[view_index], face_exr);
+        exrs.push_back({path_of(names.faces[face]), &images[view_index], face_exr});
+        kinds.push_back("face");
       }
     }
     if (style.output.cube_strip) {
       ExrWriteOptions cube_exr = exr;
       cube_exr.envmap = 1;  // ENVMAP_CUBE
-      write_exr(names.cube, "cube", images[view_index], cube_exr);
+      exrs.push_back({path_of(names.cube), &images[view_index], cube_exr});
+      kinds.push_back("cube");
       ++view_index;
     }
     const RgbaImage* latlong = view_index < images.size() ? &images[view_index] : nullptr;
     if (style.output.latlong) {
       ExrWriteOptions latlong_exr = exr;
       latlong_exr.envmap = 0;  // ENVMAP_LATLONG
-      write_exr(names.latlong, "latlong", *latlong, latlong_exr);
+      exrs.push_back({path_of(names.latlong), latlong, latlong_exr});
+      kinds.push_back("latlong");
     }
+    const std::vector<std::string> encoded = EncodeExrs(exrs);
+    // Each file on a thread of its own: most of a write is waiting for the
+    // disk to confirm the fsync (about 1 ms a file here), which the files
+    // can do together.
+    std::vector<std::future<std::string>> checksums;
+    for (size_t i = 0; i < exrs.size(); ++i)
+      checksums.push_back(std::async(std::launch::async, [&, i] {
+        WriteFileAtomically(exrs[i].name, encoded[i]);
+        return Sha256OfText(encoded[i]);
+      }));
+    std::exception_ptr failure;
+    for (size_t i = 0; i < exrs.size(); ++i) {
+      try {
+        w.files.push_back({exrs[i].name, kinds[i], encoded[i].size(), checksums[i].get()});
+      } catch (...) {
+        if (!failure) failure = std::current_exception();
+      }
+    }
+    if (failure) std::rethrow_exception(failure);
     w.exr_seconds = SecondsSince(write_start);
     w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
                                style.output.compression == "zip" || style.output.compression == "zips"
@@ -760,6 +780,11 @@ std::string Sha256OfFile(const std::string& path) {
     if (in.gcount() > 0) sha.Update(chunk.data(), size_t(in.gcount()));
   }
   return sha.HexDigest();
+}
+
+void KeepFrameMemoryInHeap() {
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
 }
 
 std::string Sha256OfText(std::string_view text) {

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <random>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <OpenEXR/ImfChannelList.h>
 #include <OpenEXR/ImfFrameBuffer.h>
@@ -238,6 +239,46 @@ TEST(ExrIoTest, SameBytesOnAnyThreadsWhateverWasEncodedBefore) {
       }
     }
   }
+  SetExrThreads(1);
+}
+
+TEST(ExrIoTest, FilesEncodedTogetherAreTheBytesOfEachAlone) {
+  // A bake encodes a frame's files in one EncodeExrs call whose threads take
+  // chunks of any file as they come free; every file must still be the
+  // bytes EncodeExr gives it alone, whatever else is in the call: other
+  // sizes, codecs, levels and pixel types, OpenEXR's encoder, an empty list.
+  std::mt19937 random(5);
+  std::uniform_real_distribution<float> noise(0.0f, 60000.0f);
+  RgbaImage noisy = Ramp(300, 45, 1.0f);
+  for (float& v : noisy.rgba) v = noise(random);
+  const std::vector<RgbaImage> images = {Ramp(512, 40, 3.0e4f), Ramp(37, 33, 3.0e4f), noisy, Ramp(1, 1, 2.0f),
+                                         Ramp(2048, 17, 3.0e4f)};
+  std::vector<ExrFile> files;
+  int k = 0;
+  for (const RgbaImage& image : images) {
+    for (const char* compression : {"zip", "zips", "none", "piz"}) {
+      ExrFile file{fmt::format("file{}.exr", k), &image, ExrWriteOptions{}};
+      file.options.compression = compression;
+      file.options.zip_level = 1 + k % 4;
+      file.options.pixel_type = k % 3 == 0 ? PixelType::kFloat : PixelType::kHalf;
+      file.options.scale = 0.5;
+      file.options.openexr_encoder = k % 7 == 6;
+      files.push_back(file);
+      ++k;
+    }
+  }
+  SetExrThreads(1);
+  std::vector<std::string> alone;
+  for (const ExrFile& f : files) alone.push_back(EncodeExr(f.name, *f.image, f.options));
+  for (int threads : {1, 2, 3, 8}) {
+    SCOPED_TRACE(::testing::Message() << threads << " threads");
+    SetExrThreads(threads);
+    const std::vector<std::string> together = EncodeExrs(files);
+    ASSERT_EQ(together.size(), files.size());
+    for (size_t i = 0; i < files.size(); ++i)
+      EXPECT_TRUE(together[i] == alone[i]) << files[i].name << " " << files[i].options.compression;
+  }
+  EXPECT_TRUE(EncodeExrs({}).empty());
   SetExrThreads(1);
 }
 

@@ -57,6 +57,20 @@ double HalfRangeScale(double max_value, OverflowPolicy policy);
 // messages). Chunks are compressed on SetExrThreads threads.
 std::string EncodeExr(const std::string& name, const RgbaImage& image, const ExrWriteOptions& options);
 
+// One file of EncodeExrs.
+struct ExrFile {
+  std::string name;  // for messages
+  const RgbaImage* image = nullptr;
+  ExrWriteOptions options;
+};
+
+// Encodes several files at once (a frame's faces, strip and latlong): the
+// chunks of every file are shared among SetExrThreads threads as each comes
+// free, so a file whose lower half is uniform ground does not leave a thread
+// idle. The bytes of each file, in order; the same bytes as EncodeExr of
+// each file alone, on any number of threads.
+std::vector<std::string> EncodeExrs(const std::vector<ExrFile>& files);
+
 // Encodes and writes atomically; returns the size of the written file in bytes.
 uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWriteOptions& options);
 

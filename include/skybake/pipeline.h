@@ -140,6 +140,14 @@ BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& sch
                         const BakeOptions& options);
 
 // SHA-256 of a file, lowercase hex. Throws OutputError.
+// A frame's images and encoded files (up to 34 MB each) are allocated and
+// freed every frame. glibc serves blocks above its mmap threshold (at most
+// 32 MB) from fresh mappings and trims freed heap back to the system, so
+// every frame paid for page faults and zeroed pages again; keeping them in
+// the heap made W2 7% faster for 5% more peak memory (docs/performance.md).
+// The CLI calls this first; so do the benchmarks that time frames.
+void KeepFrameMemoryInHeap();
+
 std::string Sha256OfFile(const std::string& path);
 std::string Sha256OfText(std::string_view text);
 
