@@ -19,6 +19,7 @@
 #include "shaders/kTransmittanceLutSpv.spv.h"
 #include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
 #include "shaders/kSkyRenderSkyViewSpv.spv.h"
+#include "shaders/kSkyRenderSunDiscPassSpv.spv.h"
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
 #include "skybake/reference_model.h"
@@ -133,7 +134,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   if (disc_pass_) {
     // The sky pass without the disc, and the disc pass that adds it.
     jobs.back().sun_disc = false;
-    jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+    jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSunDiscPassSpv, kSkyRenderSpv));
     jobs.back().sun_disc = true;
     jobs.back().sun_disc_pass = true;
   }

@@ -46,8 +46,14 @@ layout(constant_id = 14) const bool kNight = false;
 // Writes the texel direction instead of radiance (mapping tests).
 layout(constant_id = 3) const bool kOutputDirection = false;
 // sky_render as the sun-disc pass (SkyRenderer::Render): adds the disc to the
-// texels of push.rect that the sky pass wrote without it.
+// texels of push.rect that the sky pass wrote without it. Its variant
+// (CMakeLists.txt) has the pass fixed, so that glslang drops the sky pass's
+// code and lavapipe has a fifth of the SPIR-V to translate.
+#ifdef SKYBAKE_VARIANT_SUN_DISC_PASS
+const bool kSunDiscPass = true;
+#else
 layout(constant_id = 15) const bool kSunDiscPass = false;
+#endif
 // The AOAS principles (AoasSwitches); a style that does not use one compiles
 // it out. The sky hue needs no switch: it is the Rayleigh vector itself.
 #ifdef SKYBAKE_VARIANT_SKY_VIEW
