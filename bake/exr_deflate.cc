@@ -324,8 +324,13 @@ std::vector<std::string> EncodeExrsDeflate(const std::vector<const ExrFile*>& fi
   for (const std::exception_ptr& failure : failures)
     if (failure) std::rethrow_exception(failure);
 
+  // Each file's chunks freed once it is assembled: float chunks barely
+  // compress, and a frame's are 27 MB.
   std::vector<std::string> encoded;
-  for (size_t f = 0; f < files.size(); ++f) encoded.push_back(AssembleExr(*files[f], chunks[f]));
+  for (size_t f = 0; f < files.size(); ++f) {
+    encoded.push_back(AssembleExr(*files[f], chunks[f]));
+    std::vector<Chunk>().swap(chunks[f]);
+  }
   return encoded;
 }
 

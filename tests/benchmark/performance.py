@@ -48,12 +48,14 @@ def run(cmd, cwd=ROOT, log=None, env=None):
     return wall, usage.ru_maxrss / 1024.0
 
 
-def median_run(label, cmd, reps, before=None, env=None):
+def median_run(label, cmd, reps, before=None, env=None, after=None):
     walls, peaks = [], []
     for i in range(reps):
         if before:
             before()
         wall, peak = run(cmd, env=env)
+        if after:
+            after()
         walls.append(wall)
         peaks.append(peak)
         sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, peak {peak:.0f} MiB\n")
@@ -103,8 +105,11 @@ def main():
         return [args.skybake, "bake", *extra, "--out", os.path.join(work, out), "--force", "--quiet"]
 
     results = {}
-    results["w1_half"] = median_run("W1 half", bake(w1, "w1"), args.reps_w1)
-    w1_timings = json.load(open(os.path.join(work, "w1", "timings.json")))
+    w1_stage_runs = []  # stage seconds of each W1 run, from its timings.json
+    results["w1_half"] = median_run(
+        "W1 half", bake(w1, "w1"), args.reps_w1,
+        after=lambda: w1_stage_runs.append(
+            {s["stage"]: s["seconds"] for s in json.load(open(os.path.join(work, "w1", "timings.json")))["stages"]}))
     # Mesa keeps the machine code of every shader it compiled in a disk cache
     # (~/.cache/mesa_shader_cache): every bake but a machine's first finds it.
     results["w1_cold"] = median_run("W1 half, Mesa shader cache off", bake(w1, "w1c"), args.reps_w1,
@@ -176,11 +181,16 @@ def main():
         print(f"\nskybake is {blender['w1']['wall'] / results['w1_half']['wall']:.1f}x faster than Blender on W1 "
               f"and {blender['w2']['wall'] / results['w2_half']['wall']:.1f}x on W2 (target: 8x on W2).")
     print("\n## Stages\n")
-    print("W1 (one process, stages of timings.json):\n")
-    print("| stage | seconds |")
-    print("| --- | ---: |")
-    for s in w1_timings["stages"]:
-        print(f"| {s['stage']} | {s['seconds']:.3f} |")
+    print(f"W1, stages of timings.json: medians over its {len(w1_stage_runs)} runs, and the whole process:\n")
+    print("| stage | seconds (median) | runs |")
+    print("| --- | ---: | --- |")
+    for stage in w1_stage_runs[0]:
+        values = [r[stage] for r in w1_stage_runs]
+        print(f"| {stage} | {statistics.median(values):.3f} | {', '.join(f'{v:.3f}' for v in values)} |")
+    walls = results["w1_half"]["walls"]
+    print(f"| sum of the stages | {statistics.median([sum(r.values()) for r in w1_stage_runs]):.3f} | |")
+    print(f"| whole process (wall, incl. loading and exit) | {statistics.median(walls):.3f} | "
+          f"{', '.join(f'{v:.3f}' for v in walls)} |")
     print(f"\nW2, medians over its {len(frames)} frames (files of a frame are written while the next renders):\n")
     print("| stage | per frame | limit | how close |")
     print("| --- | ---: | --- | --- |")
