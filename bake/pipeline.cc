@@ -45,6 +45,17 @@ class StageTimer {
     if (progress_) progress_(report);
     start_ = now;
   }
+  // The first `seconds` of the time since the last Finish, timed elsewhere
+  // (on the writer thread), as a stage of its own; the next Finish times the
+  // rest.
+  void Split(const std::string& name, double seconds, const std::string& detail = "") {
+    Clock::time_point end = std::min(Clock::now(), start_ + std::chrono::duration_cast<Clock::duration>(
+                                                                 std::chrono::duration<double>(seconds)));
+    StageReport report{name, std::chrono::duration<double>(end - start_).count(), detail};
+    result_.stages.push_back(report);
+    if (progress_) progress_(report);
+    start_ = end;
+  }
   // A stage timed elsewhere (on the writer thread): reported, not counted
   // against the time since the last Finish.
   void Report(const std::string& name, double seconds, const std::string& detail = "") {
@@ -604,8 +615,16 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     WrittenFrame w = pending->second.get();
     FrameResult frame = std::move(pending->first);
     pending.reset();
+    const std::string preview_detail =
+        w.ev100 ? fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *w.ev100) : std::string();
     if (!sequence) {
-      timer.Finish("write EXR", w.exr_detail);  // a single bake waits for its files: the same time
+      // A single bake waits for its files: the wait is the EXRs, then the preview.
+      if (w.preview_seconds > 0.0) {
+        timer.Split("write EXR", w.exr_seconds, w.exr_detail);
+        timer.Finish("preview", preview_detail);
+      } else {
+        timer.Finish("write EXR", w.exr_detail);
+      }
     } else {
       if (SecondsSince(wait_start) > 0.005) timer.Finish("waiting for files");
       timer.Report("write EXR", w.exr_seconds,
@@ -615,7 +634,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       if (!ev100) exposure_source = w.exposure_source;
       ev100 = w.ev100;
       result.preview_ev100 = *w.ev100;
-      if (w.preview_seconds > 0.0) timer.Report("preview", w.preview_seconds, fmt::format("EV100 {:.2f}, ACES filmic, sRGB", *ev100));
+      if (sequence && w.preview_seconds > 0.0) timer.Report("preview", w.preview_seconds, preview_detail);
     }
     if (!sequence) {
       half_scale = w.half_scale;

@@ -3,11 +3,13 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <set>
 #include <string>
 
 #include <sys/wait.h>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <OpenImageIO/imageio.h>
 
 #include "test_support.h"
@@ -58,6 +60,16 @@ TEST(CliTest, FullBakeUnderValidationWritesReadableFiles) {
   // One progress line per stage, with its time.
   for (const char* stage : {"device", "pipelines", "LUTs", "render", "write EXR", "preview"})
     EXPECT_NE(run.output.find(std::string("skybake: ") + stage), std::string::npos) << stage;
+  // Each stage once, and the stages of timings.json add up to the bake's
+  // time: the EXRs' time does not also count the preview's.
+  const nlohmann::json timings = nlohmann::json::parse(testing::ReadFileBytes(out + "/timings.json"));
+  double sum = 0.0;
+  std::set<std::string> stages;
+  for (const nlohmann::json& stage : timings["stages"]) {
+    sum += stage["seconds"].get<double>();
+    EXPECT_TRUE(stages.insert(stage["stage"].get<std::string>()).second) << stage["stage"];
+  }
+  EXPECT_NEAR(sum, timings["total_s"].get<double>(), 0.002);
 
   for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"}) {
     ExrInfo f = Inspect(out + "/sky_" + face + ".exr");
