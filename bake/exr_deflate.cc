@@ -148,6 +148,11 @@ libdeflate_compressor* ThreadCompressor(int level) {
   return compressor.get();
 }
 
+// Bytes of one scanline of `file` as stored uncompressed: B, G, R.
+size_t LineBytes(const ExrFile& file) {
+  return size_t(file.image->width) * 3 * (file.options.pixel_type == PixelType::kHalf ? 2 : 4);
+}
+
 struct Chunk {
   int y = 0;
   std::vector<uint8_t> bytes;  // as stored: deflated, or raw when that is not smaller
@@ -163,7 +168,7 @@ class ChunkEncoder {
     const bool half_pixels = options.pixel_type == PixelType::kHalf;
     const bool deflate = options.compression != "none";
     const float scale = float(options.scale);
-    const size_t line_bytes = size_t(image.width) * 3 * (half_pixels ? 2 : 4);
+    const size_t line_bytes = LineBytes(file);
     chunk.y = int(index) * lines_per_chunk;
     const int lines = std::min(lines_per_chunk, image.height - chunk.y);
     const size_t n = line_bytes * lines;
@@ -293,9 +298,7 @@ std::vector<std::string> EncodeExrsDeflate(const std::vector<const ExrFile*>& fi
     const int lines = LinesPerChunk(file.options.compression);
     const size_t count = size_t((file.image->height + lines - 1) / lines);
     chunks[f].resize(count);
-    const size_t chunk_bytes =
-        size_t(file.image->width) * 3 * (file.options.pixel_type == PixelType::kHalf ? 2 : 4) * size_t(lines);
-    const size_t per_item = std::max<size_t>(1, (64 * 1024) / std::max<size_t>(chunk_bytes, 1));
+    const size_t per_item = std::max<size_t>(1, (64 * 1024) / std::max<size_t>(LineBytes(file) * size_t(lines), 1));
     for (size_t first = 0; first < count; first += per_item)
       items.push_back({f, first, std::min(count, first + per_item)});
   }

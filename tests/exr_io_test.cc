@@ -35,6 +35,15 @@ RgbaImage Ramp(int w, int h, float top) {
   return image;
 }
 
+// Values uniform in [0, 60000), from `seed`: chunks that do not compress.
+RgbaImage NoisyImage(int w, int h, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<float> noise(0.0f, 60000.0f);
+  RgbaImage image = Ramp(w, h, 1.0f);
+  for (float& v : image.rgba) v = noise(random);
+  return image;
+}
+
 TEST(ExrIoTest, HalfRangeScaleIsAPowerOfTwoThatFits) {
   EXPECT_EQ(HalfRangeScale(1.0, OverflowPolicy::kScale), 1.0);
   EXPECT_EQ(HalfRangeScale(kHalfMax, OverflowPolicy::kScale), 1.0);
@@ -136,16 +145,12 @@ Decoded DecodeExr(const std::string& bytes) {
 // chunks and chunks that do not compress (stored raw), OpenEXR decodes both
 // files to the same bits and the same attributes.
 TEST(ExrIoTest, DeflateEncoderDecodesLikeOpenExrEncoder) {
-  std::mt19937 random(7);
-  std::uniform_real_distribution<float> noise(0.0f, 60000.0f);
   struct Case {
     int w, h;
     bool noisy;
   };
   for (const Case& k : {Case{1, 1, false}, Case{37, 33, false}, Case{512, 40, false}, Case{64, 20, true}}) {
-    RgbaImage image = Ramp(k.w, k.h, 3.0e4f);
-    if (k.noisy)
-      for (float& v : image.rgba) v = noise(random);
+    const RgbaImage image = k.noisy ? NoisyImage(k.w, k.h, 7) : Ramp(k.w, k.h, 3.0e4f);
     for (const char* compression : {"none", "zip", "zips"}) {
       for (int level : {1, 4}) {
         for (PixelType type : {PixelType::kHalf, PixelType::kFloat}) {
@@ -211,10 +216,7 @@ TEST(ExrIoTest, SameBytesOnAnyThreadsWhateverWasEncodedBefore) {
   // so state kept between chunks or calls, or bytes read past a chunk, would
   // show. (ISA-L's igzip, tried as a faster level 1, failed this test now
   // and then: docs/performance.md.)
-  std::mt19937 random(11);
-  std::uniform_real_distribution<float> noise(0.0f, 60000.0f);
-  RgbaImage other = Ramp(64, 20, 1.0f);
-  for (float& v : other.rgba) v = noise(random);
+  const RgbaImage other = NoisyImage(64, 20, 11);
   for (const RgbaImage& image : {Ramp(37, 33, 3.0e4f), Ramp(512, 40, 3.0e4f)}) {
     for (const char* compression : {"zip", "zips"}) {
       for (int level : {1, 4}) {
@@ -247,11 +249,8 @@ TEST(ExrIoTest, FilesEncodedTogetherAreTheBytesOfEachAlone) {
   // chunks of any file as they come free; every file must still be the
   // bytes EncodeExr gives it alone, whatever else is in the call: other
   // sizes, codecs, levels and pixel types, OpenEXR's encoder, an empty list.
-  std::mt19937 random(5);
-  std::uniform_real_distribution<float> noise(0.0f, 60000.0f);
-  RgbaImage noisy = Ramp(300, 45, 1.0f);
-  for (float& v : noisy.rgba) v = noise(random);
-  const std::vector<RgbaImage> images = {Ramp(512, 40, 3.0e4f), Ramp(37, 33, 3.0e4f), noisy, Ramp(1, 1, 2.0f),
+  const std::vector<RgbaImage> images = {Ramp(512, 40, 3.0e4f), Ramp(37, 33, 3.0e4f), NoisyImage(300, 45, 5),
+                                         Ramp(1, 1, 2.0f),
                                          Ramp(2048, 17, 3.0e4f)};
   std::vector<ExrFile> files;
   int k = 0;
