@@ -147,12 +147,6 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
         job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
   if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
   jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
-  if (cloud_layers_ > 0) {
-    // Built from the analytic variant alone: their own marches of the air
-    // use the analytic step whatever the style's integrator.
-    jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
-    jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
-  }
   for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
   if (disc_pass_) {
     // The sky pass without the disc, and the disc pass that adds it.
@@ -160,6 +154,12 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSunDiscPassSpv, kSkyRenderSpv));
     jobs.back().sun_disc = true;
     jobs.back().sun_disc_pass = true;
+  }
+  if (cloud_layers_ > 0) {
+    // Built from the analytic variant alone: their own marches of the air
+    // use the analytic step whatever the style's integrator.
+    jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
+    jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
   }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)

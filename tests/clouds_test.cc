@@ -5,7 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <functional>
+#include <map>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -15,6 +18,7 @@
 #include "skybake/config.h"
 #include "skybake/envmap.h"
 #include "skybake/pass_plan.h"
+#include "skybake/reference_model.h"
 #include "skybake/sky_renderer.h"
 #include "test_support.h"
 
@@ -183,6 +187,266 @@ TEST(CloudNoise, DeterministicSpreadAndSeeded) {
   c.renderer->PrecomputeLuts();
   EXPECT_NE(std::memcmp(noise.data(), c.renderer->ReadCloudNoise().data(), noise.size() * 4), 0);
   testing::ExpectNoValidationMessages();
+}
+
+// ---------------------------------------------------------------- the cloud pass
+
+const char* kFast = R"(
+[quality]
+preset = "draft"
+)";
+
+// Every view of a small bake plus the SH faces and the sun direction, from
+// one renderer.
+std::vector<std::vector<float>> RenderAll(const SkyStyle& style, const glm::dvec3& sun, int n, double time_s = 0.0) {
+  StyleRenderer r(style, time_s);
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 2 * n, n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+  for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+  std::vector<std::vector<float>> images = r.renderer->Render(sun, views);
+  images.push_back(r.renderer->RenderDirections(sun, {sun}));
+  images.push_back(r.renderer->RenderDirections(sun, {sun}, false));
+  return images;
+}
+
+// A layer of coverage 0 or density 0 is pruned: no cloud pipeline, and the
+// same bytes as the style without it.
+TEST(CloudPass, PrunedLayerIsByteIdenticalToNoLayer) {
+  const glm::dvec3 sun = Sun(20.0);
+  const SkyStyle plain = Style(kFast);
+  const std::vector<std::vector<float>> expected = RenderAll(plain, sun, 16);
+  for (const char* layer : {"coverage = 0.0", "density_per_m = 0.0"}) {
+    SkyStyle pruned = Style(std::string(kFast) + "[[cloud_layer]]\ntype = \"cumulus\"\n" + layer + "\n");
+    ASSERT_EQ(pruned.clouds.layers.size(), 1u);
+    EXPECT_FALSE(PlanPasses({pruned}).variant.find("clouds: none") == std::string::npos) << layer;
+    StyleRenderer r(pruned);
+    EXPECT_EQ(r.renderer->counters().pipelines, StyleRenderer(plain).renderer->counters().pipelines) << layer;
+    const std::vector<std::vector<float>> images = RenderAll(pruned, sun, 16);
+    ASSERT_EQ(images.size(), expected.size());
+    for (size_t i = 0; i < images.size(); ++i)
+      EXPECT_TRUE(images[i] == expected[i]) << layer << ", view " << i;
+  }
+  // The same layer with coverage does change the sky (the test is not vacuous).
+  const std::vector<std::vector<float>> cloudy = RenderAll(Style(std::string(kFast) + kCumulus), sun, 16);
+  EXPECT_FALSE(cloudy[0] == expected[0]);
+  testing::ExpectNoValidationMessages();
+}
+
+// Wind moves the clouds by wind x time and nothing else: after exactly one
+// tile period of every noise (8 km at 80 m/s in 100 s) the sky is the same
+// to float rounding; after half of it, it differs; two renders of the same
+// time give the same bytes.
+TEST(CloudPass, WindMovesTheCloudsWithoutReRandomising) {
+  const SkyStyle style = Style(std::string(kFast) + R"(
+[[cloud_layer]]
+altitude_m = 1000
+thickness_m = 1000
+coverage = 0.5
+weather_size_m = 8000
+shape_size_m = 4000
+detail_size_m = 400
+wind_m_s = [80.0, 0.0]
+)");
+  const glm::dvec3 sun = Sun(30.0);
+  const ViewRequest latlong{MAPPING_LATLONG, 64, 32, 0};
+  auto render = [&](double t) { return StyleRenderer(style, t).renderer->Render(sun, {latlong})[0]; };
+  const std::vector<float> t0 = render(0.0), t50 = render(50.0), t100 = render(100.0);
+  EXPECT_TRUE(render(50.0) == t50);
+  double moved = 0.0, back = 0.0, sum = 0.0;
+  for (size_t i = 0; i < t0.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) {
+      moved += std::abs(t50[i + c] - t0[i + c]);
+      back = std::max(back, double(std::abs(t100[i + c] - t0[i + c])) / std::max(t0[i + c], 1e-3f));
+      sum += t0[i + c];
+    }
+  }
+  EXPECT_GT(moved / sum, 0.01) << "half a period later the clouds have moved";
+  EXPECT_LT(back, 2e-3) << "a whole period later they are back where they were";
+  // UpdateClouds (what a sequence does between frames) gives the same bytes
+  // as a renderer built for that time.
+  StyleRenderer r(style, 0.0);
+  r.renderer->Render(sun, {latlong});
+  ASSERT_TRUE(r.renderer->UpdateClouds(ToCloudInputs(PrunedStyle(style).clouds, 1, "", 50.0)));
+  EXPECT_TRUE(r.renderer->Render(sun, {latlong})[0] == t50);
+  EXPECT_EQ(r.renderer->counters().cloud_noise_builds, 1) << "the wind does not regenerate the noise";
+  testing::ExpectNoValidationMessages();
+}
+
+struct CloudCase {
+  std::string name;
+  std::string toml;                 // after kFast
+  std::vector<double> suns_deg;     // sun elevations
+  int cube = 24;
+  bool dim_not_black = false;       // overcast: the sky under it is dim but not black
+};
+
+void CheckFiniteNonNegative(const std::vector<float>& image, const std::string& what) {
+  for (size_t i = 0; i < image.size(); ++i) {
+    if (i % 4 == 3) continue;
+    ASSERT_TRUE(std::isfinite(image[i]) && image[i] >= 0.0f) << what << ": texel " << i / 4 << " = " << image[i];
+  }
+}
+
+class CloudHardCase : public ::testing::TestWithParam<CloudCase> {};
+
+TEST_P(CloudHardCase, FiniteNonNegativeAndContinuous) {
+  const CloudCase& c = GetParam();
+  const SkyStyle style = Style(std::string(kFast) + c.toml);
+  const SkyStyle clear = Style(kFast + std::string(c.toml.substr(0, c.toml.find("[[cloud_layer]]"))));
+  ASSERT_FALSE(ActiveCloudLayers(style.clouds).empty());
+  StyleRenderer r(style);
+  for (double elevation : c.suns_deg) {
+    const glm::dvec3 sun = Sun(elevation);
+    const std::string what = fmt::format("{}, sun {} deg", c.name, elevation);
+    const int n = c.cube;
+    const ViewRequest strip{MAPPING_CUBE_STRIP, n, 6 * n, 0};
+    const ViewRequest latlong{MAPPING_LATLONG, 64, 32, 0};
+    std::vector<std::vector<float>> images = r.renderer->Render(sun, {strip, latlong});
+    CheckFiniteNonNegative(images[0], what + ", strip");
+    CheckFiniteNonNegative(images[1], what + ", latlong");
+    // Cube edges: the strip's edge texels of neighbouring faces sit on the
+    // same directions (Imf::CubeMap), so they must agree.
+    const std::vector<glm::dvec3> dirs = ViewDirections(strip);
+    std::map<std::array<long, 3>, std::vector<size_t>> by_direction;
+    for (size_t i = 0; i < dirs.size(); ++i)
+      by_direction[{std::lround(dirs[i].x * 1e6), std::lround(dirs[i].y * 1e6), std::lround(dirs[i].z * 1e6)}]
+          .push_back(i);
+    int pairs = 0;
+    double worst = 0.0;
+    for (const auto& [key, texels] : by_direction)
+      for (size_t k = 1; k < texels.size(); ++k, ++pairs)
+        for (int ch = 0; ch < 3; ++ch) {
+          const double a = images[0][4 * texels[0] + ch], b = images[0][4 * texels[k] + ch];
+          worst = std::max(worst, std::abs(a - b) / std::max(std::max(a, b), 1e-6));
+        }
+    EXPECT_EQ(pairs, 12 * (n - 2) + 8 * 2) << what;
+    EXPECT_LT(worst, 2e-3) << what << ": cube edges";
+    // Latlong seam: the step from the last column to the first is no larger
+    // than the steps between neighbouring columns elsewhere in that row.
+    const std::vector<float>& ll = images[1];
+    double seam = 0.0, interior = 0.0;
+    for (int y = 0; y < 32; ++y)
+      for (int ch = 0; ch < 3; ++ch) {
+        seam = std::max(seam, double(std::abs(ll[4 * (y * 64 + 63) + ch] - ll[4 * (y * 64) + ch])));
+        for (int x = 0; x + 1 < 64; ++x)
+          interior = std::max(interior, double(std::abs(ll[4 * (y * 64 + x + 1) + ch] - ll[4 * (y * 64 + x) + ch])));
+      }
+    EXPECT_LE(seam, interior * 1.0 + 1e-6) << what << ": latlong seam";
+    if (c.dim_not_black) {
+      // Straight up under the deck: dimmer than a white Lambertian ground
+      // lit by the clear sky's sun (E cos(zenith) / pi; the deck passes on
+      // only part of the light), and not black.
+      StyleRenderer clear_renderer(clear);
+      const double centre = clear_renderer.renderer->RenderDirections(sun, {sun})[1] -
+                            clear_renderer.renderer->RenderDirections(sun, {sun}, false)[1];
+      const AtmosphereParams& a = style.atmosphere;
+      const double sun_illuminance =
+          centre * M_PI * a.sun_angular_radius_rad * a.sun_angular_radius_rad * (1.0 - a.limb_darkening_u / 3.0);
+      const double white = sun_illuminance * sun.y / M_PI;
+      const std::vector<float> up = r.renderer->RenderDirections(sun, {glm::dvec3(0, 1, 0)}, false);
+      EXPECT_LT(up[1], 0.5 * white) << what;
+      EXPECT_GT(up[1], 1e-3 * white) << what;
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+std::string Layer(double altitude_m, double thickness_m, const std::string& extra) {
+  return fmt::format("[[cloud_layer]]\naltitude_m = {}\nthickness_m = {}\n{}\n", altitude_m, thickness_m, extra);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CloudHardCase,
+    ::testing::Values(
+        CloudCase{"overcast_coverage_1", Layer(1000, 800, "type = \"stratus\"\ncoverage = 1.0\ndensity_per_m = 0.05"),
+                  {45.0}, 24, true},
+        CloudCase{"extinction_1_per_m", Layer(1500, 1500, "coverage = 0.6\ndensity_per_m = 1.0"), {30.0}},
+        CloudCase{"thin_layer_at_10_km", Layer(10000, 100, "type = \"cirrus\"\ncoverage = 0.7\ndensity_per_m = 0.002"),
+                  {30.0}},
+        CloudCase{"overlapping_layers", Layer(1000, 2000, "coverage = 0.5") + Layer(2500, 1500, "type = \"stratocumulus\"\ncoverage = 0.4\nseed = 7"),
+                  {30.0}},
+        CloudCase{"observer_inside_a_layer",
+                  "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+        CloudCase{"observer_2_km_above_the_top_layer",
+                  "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+        CloudCase{"sun_at_zenith_horizon_and_minus_6_deg", Layer(1500, 1500, "coverage = 0.5"), {90.0, 0.0, -6.0}},
+        CloudCase{"cube_size_16", Layer(1500, 1500, "coverage = 0.5"), {30.0}, 16}),
+    [](const ::testing::TestParamInfo<CloudCase>& info) { return info.param.name; });
+
+// A cube of 2048: the faces the clouds are in (+X, +Y) at full size, the
+// draft preset with 8 view and 2 light steps to keep the case within a
+// minute on lavapipe; no NaN, Inf or negative value.
+TEST(CloudPass, CubeSize2048) {
+  const SkyStyle style = Style(std::string(kFast) + "cloud_view_steps = 8\ncloud_light_steps = 2\n" +
+                               Layer(1500, 1500, "coverage = 0.5"));
+  StyleRenderer r(style);
+  for (int face : {0, 2}) {
+    std::vector<float> image = r.renderer->Render(Sun(30.0), {{MAPPING_VULKAN_FACE, 2048, 2048, face}})[0];
+    CheckFiniteNonNegative(image, fmt::format("face {}", face));
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+// The sun disc: hidden behind a thick deck, seen through a thin one.
+TEST(CloudPass, SunDiscHiddenByThickCloudsSeenThroughThin) {
+  const glm::dvec3 sun = Sun(60.0);
+  auto disc = [&](const std::string& toml) {
+    StyleRenderer r(Style(std::string(kFast) + toml));
+    const double with_disc = r.renderer->RenderDirections(sun, {sun})[1];
+    const double without = r.renderer->RenderDirections(sun, {sun}, false)[1];
+    std::printf("%s: with %g without %g\n", toml.c_str(), with_disc, without);
+    return with_disc - without;
+  };
+  const double clear = disc("");
+  const double thick = disc(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"));
+  const double thin = disc(Layer(9000, 300, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.001"));
+  EXPECT_GT(clear, 0.0);
+  // The march stops once the clouds' transmittance is below 1e-3.
+  EXPECT_LT(thick, 1e-3 * clear);
+  EXPECT_GT(thin, 0.2 * clear);
+  EXPECT_LT(thin, 0.95 * clear);
+  testing::ExpectNoValidationMessages();
+}
+
+// A sequence with wind bakes to the same bytes in shards and when resumed
+// as in one go (the wind's offsets come from each frame's own clock time).
+TEST(CloudSequence, ShardsAndResumeAreByteIdentical) {
+  namespace fs = std::filesystem;
+  const std::string root = testing::FreshTempDir("cloud_sequence");
+  const std::string style = root + "/style.toml", schedule = root + "/schedule.toml";
+  std::ofstream(style) << std::string(kFast) + Layer(1500, 1500, "coverage = 0.5\nwind_m_s = [15.0, 5.0]");
+  std::ofstream(schedule) << R"([schedule]
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
+)";
+  auto bake = [&](const std::string& out, const std::string& extra) {
+    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --schedule '" + schedule +
+                                                  "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+  };
+  bake(root + "/whole", "");
+  bake(root + "/shards", "--shard 1/2");
+  bake(root + "/shards", "--shard 2/2");
+  EXPECT_EQ(testing::RunSkybake("merge-manifest '" + root + "/shards'").exit_code, 0);
+  // Resume: one frame's files lost, the rest verified by checksum.
+  fs::copy(root + "/whole", root + "/resumed");
+  for (const std::string& name : testing::FileNames(root + "/resumed"))
+    if (name.find(".0003.") != std::string::npos) fs::remove(root + "/resumed/" + name);
+  bake(root + "/resumed", "--resume");
+  const std::set<std::string> whole = testing::FileNames(root + "/whole");
+  EXPECT_GT(whole.size(), 30u);
+  for (const std::string& dir : {root + "/shards", root + "/resumed"})
+    for (const std::string& name : whole) {
+      if (name == "timings.json") continue;
+      EXPECT_TRUE(testing::ReadFileBytes(dir + "/" + name) == testing::ReadFileBytes(root + "/whole/" + name))
+          << dir << "/" << name;
+    }
+  // The wind moved the clouds between frames: the frames differ.
+  EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
+            testing::ReadFileBytes(root + "/whole/sky_latlong.0002.exr"));
+  fs::remove_all(root);
 }
 
 }  // namespace
