@@ -12,6 +12,7 @@
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
 #include <glm/glm.hpp>
 
 #include "skybake/clouds.h"
@@ -447,6 +448,74 @@ times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
   EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
             testing::ReadFileBytes(root + "/whole/sky_latlong.0002.exr"));
   fs::remove_all(root);
+}
+
+// ---------------------------------------------------------------- weather images
+
+void WriteImage(const std::string& path, int w, int h, int channels, const std::function<float(int, int)>& value) {
+  std::vector<float> pixels(size_t(w) * h * channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) pixels[(size_t(y) * w + x) * channels + c] = value(x, y);
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << path;
+  OIIO::ImageSpec spec(w, h, channels, path.ends_with(".png") ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  ASSERT_TRUE(out->open(path, spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+  out->close();
+}
+
+// A weather image puts the clouds where its first channel says: the west
+// half covered, the east half clear, in a PNG and in a one-channel EXR.
+TEST(CloudWeather, ImageCoverageIsWhereTheImageSays) {
+  const std::string dir = testing::FreshTempDir("cloud_weather");
+  WriteImage(dir + "/west.png", 64, 64, 3, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
+  WriteImage(dir + "/west.exr", 64, 64, 1, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
+  const glm::dvec3 sun = Sun(50.0, 180.0);
+  const glm::dvec3 west = SunDirectionFromElevationAzimuth(30.0, 270.0), east = SunDirectionFromElevationAzimuth(30.0, 90.0);
+  StyleRenderer clear(Style(kFast));
+  const std::vector<float> sky = clear.renderer->RenderDirections(sun, {west, east}, false);
+  for (const char* image : {"west.png", "west.exr"}) {
+    // 20 km square centred on the viewer: x < 0 (west) covered.
+    const std::string toml = std::string(kFast) + fmt::format(R"(
+[[cloud_layer]]
+altitude_m = 1500
+thickness_m = 1000
+type = "stratus"
+shape_amount = 0.0
+coverage = 0.5
+weather_image = "{}"
+weather_extent_m = [20000.0, 20000.0]
+weather_origin_m = [-10000.0, -10000.0]
+)", image);
+    ConfigResult r = ParseSkyStyle(toml, dir + "/style.toml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].Format();
+    const SkyStyle style = PrunedStyle(r.style);
+    SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
+                         style.effects, OutputScale(style.output.units), false,
+                         ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                         ToCloudInputs(style.clouds, style.aoas.seed, dir, 0.0));
+    const std::vector<float> cloudy = renderer.RenderDirections(sun, {west, east}, false);
+    EXPECT_EQ(cloudy[4 + 1], sky[4 + 1]) << image << ": the east is clear";
+    EXPECT_GT(std::abs(cloudy[1] - sky[1]), 0.05 * sky[1]) << image << ": the west is under the deck";
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(CloudWeather, BadImagesAreReportedWithTheirPath) {
+  const std::string dir = testing::FreshTempDir("cloud_weather_bad");
+  WriteImage(dir + "/two.exr", 8, 8, 2, [](int, int) { return 0.5f; });
+  std::ofstream(dir + "/broken.png") << "not a png";
+  for (const auto& [file, message] : std::vector<std::pair<std::string, std::string>>{
+           {"two.exr", "two.exr: 2 channels; expected 1 (coverage) or 3/4 (R = coverage)"},
+           {"broken.png", "broken.png: cannot read it as an image"},
+           {"missing.exr", "missing.exr: no such file"}}) {
+    ConfigResult r = ParseSkyStyle("[[cloud_layer]]\nweather_image = \"" + file + "\"\n", dir + "/style.toml");
+    ASSERT_EQ(r.errors.size(), 1u) << file;
+    EXPECT_NE(r.errors[0].Format().find(dir + "/style.toml:2:17: cloud_layer[0].weather_image: " + dir + "/" + message),
+              std::string::npos)
+        << r.errors[0].Format();
+  }
 }
 
 }  // namespace
