@@ -431,7 +431,7 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
 // crossing near the horizon all).
 void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(CloudApTexel) ap, float t0, float t1,
                        float band_top, float band_thickness, inout CloudMarch m) {
-  if (t1 <= t0 || m.transmittance < 1e-3) return;
+  if (t1 <= t0 || m.transmittance <= 0.0) return;
   float r0 = atm.bottom_radius + atm.observer_altitude;
   int max_steps = gpu_clouds.counts.y;
   float crossings = (t1 - t0) / band_thickness;
@@ -488,7 +488,12 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     // cloud where the cloud hides what lies behind.
     m.radiance += CloudAerialPerspective(ap, t, 1) * source * absorbed + CloudAerialPerspective(ap, t, 0) * absorbed;
     m.transmittance *= step_transmittance;
-    if (m.transmittance < 1e-3) return;
+    // Early exit: what lies behind would add less than 1e-3 of itself; it
+    // is dropped (transmittance 0), so a thick deck hides the sun disc.
+    if (m.transmittance < 1e-3) {
+      m.transmittance = 0.0;
+      return;
+    }
   }
 }
 
