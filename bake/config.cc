@@ -746,7 +746,9 @@ class StyleWriter {
       t.insert("altitude_m", l.altitude_m);
       t.insert("thickness_m", l.thickness_m);
       t.insert("type", std::string(CloudTypeName(l.type)));
-      t.insert("profile", toml::array{l.profile[0], l.profile[1], l.profile[2], l.profile[3]});
+      // The type decides the profile, except "custom", which gives it.
+      if (l.type == CloudType::kCustom)
+        t.insert("profile", toml::array{l.profile[0], l.profile[1], l.profile[2], l.profile[3]});
       t.insert("coverage", l.coverage);
       t.insert("density_per_m", l.density_per_m);
       t.insert("albedo", l.albedo);

@@ -19,6 +19,7 @@
 #include "skybake/config.h"
 #include "skybake/envmap.h"
 #include "skybake/pass_plan.h"
+#include "skybake/pipeline.h"
 #include "skybake/reference_model.h"
 #include "skybake/sky_renderer.h"
 #include "test_support.h"
@@ -108,6 +109,11 @@ weather_size_m = 20000
   EXPECT_NE(s.resolved_toml.find("[[cloud_layer]]"), std::string::npos) << s.resolved_toml;
   SkyStyle again = Style(s.resolved_toml);
   EXPECT_EQ(again.resolved_toml, s.resolved_toml);
+  // A named type's resolved style round-trips too (its profile is the type's).
+  SkyStyle named = Style(kCumulus);
+  SkyStyle named_again = Style(named.resolved_toml);
+  EXPECT_EQ(named_again.resolved_toml, named.resolved_toml);
+  EXPECT_EQ(named_again.clouds.layers[0].profile, CloudTypeProfile(CloudType::kCumulus));
 }
 
 TEST(CloudStyle, PresetsSetTheCloudSampling) {
@@ -516,6 +522,36 @@ TEST(CloudWeather, BadImagesAreReportedWithTheirPath) {
               std::string::npos)
         << r.errors[0].Format();
   }
+}
+
+// The bake's SH irradiance, sun irradiance and preview see the clouds: under
+// an overcast deck the sun's transmitted irradiance is gone (the disc is
+// hidden) and the sky's irradiance and the preview differ from the clear bake.
+TEST(CloudBake, ShIrradianceAndPreviewIncludeTheClouds) {
+  const std::string root = testing::FreshTempDir("cloud_bake");
+  auto bake = [&](const std::string& toml, const std::string& out) {
+    SkyStyle style = Style(std::string(kFast) + "[render]\ncube_size = 16\nlatlong_height = 16\n" + toml);
+    BakeOptions options;
+    options.out_dir = root + "/" + out;
+    options.vulkan.validation = true;
+    BakeResult r = BakeStyle(style, options);
+    EXPECT_EQ(r.validation_messages, 0);
+    return r;
+  };
+  const BakeResult clear = bake("", "clear");
+  const BakeResult overcast =
+      bake(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"), "overcast");
+  ASSERT_EQ(clear.frames.size(), 1u);
+  ASSERT_EQ(overcast.frames.size(), 1u);
+  EXPECT_GT(clear.frames[0].sun_illuminance_lux, 1e4);
+  EXPECT_EQ(overcast.frames[0].sun_illuminance_lux, 0.0);
+  const double clear_sky = clear.frames[0].sh_irradiance_without_sun[0][1];
+  const double overcast_sky = overcast.frames[0].sh_irradiance_without_sun[0][1];
+  EXPECT_GT(overcast_sky, 0.0);
+  EXPECT_GT(std::abs(overcast_sky - clear_sky), 0.05 * clear_sky);
+  EXPECT_NE(testing::ReadFileBytes(root + "/clear/sky_latlong.png"),
+            testing::ReadFileBytes(root + "/overcast/sky_latlong.png"));
+  std::filesystem::remove_all(root);
 }
 
 }  // namespace
