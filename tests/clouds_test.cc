@@ -554,5 +554,50 @@ TEST(CloudBake, ShIrradianceAndPreviewIncludeTheClouds) {
   std::filesystem::remove_all(root);
 }
 
+// Convergence of the cloud march: the presets' view and light steps against
+// a fine march (768 view, 128 light steps), same noise and model (8 octaves,
+// production noise sizes). The error: mean over the upper
+// hemisphere of |L - L_ref| / mean L_ref, green channel, 96 x 48 latlong.
+TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
+  const glm::dvec3 sun = Sun(30.0);
+  const ViewRequest latlong{MAPPING_LATLONG, 96, 48, 0};
+  auto render = [&](int view_steps, int light_steps) {
+    SkyStyle style = Style(kCumulus);
+    style.clouds.quality.view_steps = view_steps;
+    style.clouds.quality.light_steps = light_steps;
+    return StyleRenderer(style).renderer->Render(sun, {latlong})[0];
+  };
+  auto error = [&](const std::vector<float>& a, const std::vector<float>& reference) {
+    double diff = 0.0, sum = 0.0;
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const size_t i = 4 * (size_t(y) * 96 + x) + 1;
+        diff += std::abs(double(a[i]) - reference[i]);
+        sum += reference[i];
+      }
+    return diff / sum;
+  };
+  const std::vector<float> converged = render(768, 128);
+  // Halving the steps of the converged march changes it by less than the
+  // reference preset's error; doubling them does not converge further (the
+  // difference grows above ~1e5 light x view samples per texel: an open
+  // problem, docs/clouds.md "Not done yet"), so it is printed, not asserted.
+  const double half = error(render(384, 64), converged);
+  const double self = error(render(1536, 256), converged);
+  struct Setting { const char* name; int view, light; };
+  std::vector<double> errors;
+  for (Setting s : {Setting{"draft", 32, 6}, Setting{"production", 48, 6}, Setting{"reference", 192, 32}}) {
+    errors.push_back(error(render(s.view, s.light), converged));
+    std::printf("cloud march %-10s view %3d light %2d: mean relative error %.4f\n", s.name, s.view, s.light,
+                errors.back());
+  }
+  std::printf("768/128 against 384/64: %.5f, against 1536/256: %.5f\n", half, self);
+  EXPECT_GT(errors[0], errors[1]);
+  EXPECT_GT(errors[1], errors[2]);
+  EXPECT_LT(half, errors[2]);
+  EXPECT_LT(errors[1], 0.1);
+  testing::ExpectNoValidationMessages();
+}
+
 }  // namespace
 }  // namespace skybake
