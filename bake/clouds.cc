@@ -85,6 +85,16 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
     problems.push_back({kMaxCloudLayers, "",
                         fmt::format("{} cloud layers; at most {} fit: merge or remove [[cloud_layer]] tables",
                                     clouds.layers.size(), kMaxCloudLayers)});
+  const double loops = CloudLoopIterationsPerTexel(clouds);
+  if (loops > kMaxCloudLoopIterations)
+    problems.push_back({-2, "",
+                        fmt::format("{} cloud layer(s) x {} view steps x {} light steps may run {:.0f} loop "
+                                    "iterations per texel; lavapipe ends a shader's loops after 65535 in all "
+                                    "(LP_MAX_TGSI_LOOP_ITERATIONS): lower quality.cloud_view_steps or "
+                                    "quality.cloud_light_steps (at most {:.0f} iterations)",
+                                    std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers),
+                                    clouds.quality.view_steps, clouds.quality.light_steps, loops,
+                                    kMaxCloudLoopIterations)});
   const double atmosphere_m = (atmosphere.top_radius_km - atmosphere.bottom_radius_km) * 1000.0;
   for (size_t i = 0; i < clouds.layers.size(); ++i) {
     const CloudLayer& l = clouds.layers[i];
@@ -111,6 +121,16 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
     }
   }
   return problems;
+}
+
+double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
+  const double layers = double(std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers));
+  if (layers == 0.0) return 0.0;
+  const CloudQuality& q = clouds.quality;
+  // Per view sample: the layer loop; per lit sample also the light march
+  // (each step a layer loop), the octaves and the albedo's layer loop.
+  const double per_sample = 1.0 + layers + q.light_steps * (1.0 + layers) + q.octaves + layers;
+  return layers * q.view_steps * per_sample;
 }
 
 size_t CloudNoiseFloats(const gpu::GpuClouds& c) {

@@ -944,6 +944,13 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
     const std::string style_dir = std::filesystem::path(name).parent_path().string();
     for (const CloudProblem& p : ValidateClouds(result.style.clouds, a, style_dir)) {
       std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
+      if (p.layer == -2) {  // the sampling settings
+        ConfigError e = locate(root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
+                                                                                : "quality.cloud_view_steps");
+        e.message = p.message;
+        result.errors.push_back(e);
+        continue;
+      }
       ConfigError e = locate("cloud_layer");
       if (const toml::array* layers = root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
                                                                       size_t(p.layer) < layers->size()) {

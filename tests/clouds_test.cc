@@ -151,6 +151,12 @@ TEST(CloudStyle, BadLayersAreLocated) {
   e = Errors(five);
   ASSERT_EQ(e.size(), 1u);
   EXPECT_TRUE(has(e, "cloud_layer[4]: 5 cloud layers; at most 4 fit")) << e[0];
+  e = Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n[[cloud_layer]]\n");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_TRUE(has(e, "clouds_test.toml:3:21: quality.cloud_light_steps: 1 cloud layer(s) x 768 view steps x 128 "
+                     "light steps may run")) << e[0];
+  EXPECT_TRUE(Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n").empty())
+      << "without layers the cloud settings run nothing";
   e = Errors("[[cloud_layer]]\nweather_image = \"no_such_weather.png\"\n");
   ASSERT_EQ(e.size(), 1u);
   EXPECT_TRUE(has(e, "clouds_test.toml:2:17: cloud_layer[0].weather_image: no_such_weather.png: no such file")) << e[0];
@@ -555,8 +561,9 @@ TEST(CloudBake, ShIrradianceAndPreviewIncludeTheClouds) {
 }
 
 // Convergence of the cloud march: the presets' view and light steps against
-// a fine march (768 view, 128 light steps), same noise and model (8 octaves,
-// production noise sizes). The error: mean over the upper
+// a fine march (400 view, 50 light steps: near lavapipe's 65535 loop
+// iterations per invocation, CloudLoopIterationsPerTexel), same noise and
+// model (8 octaves, production noise sizes). The error: mean over the upper
 // hemisphere of |L - L_ref| / mean L_ref, green channel, 96 x 48 latlong.
 TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
   const glm::dvec3 sun = Sun(30.0);
@@ -577,13 +584,8 @@ TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
       }
     return diff / sum;
   };
-  const std::vector<float> converged = render(768, 128);
-  // Halving the steps of the converged march changes it by less than the
-  // reference preset's error; doubling them does not converge further (the
-  // difference grows above ~1e5 light x view samples per texel: an open
-  // problem, docs/clouds.md "Not done yet"), so it is printed, not asserted.
-  const double half = error(render(384, 64), converged);
-  const double self = error(render(1536, 256), converged);
+  const std::vector<float> converged = render(400, 50);
+  const double half = error(render(200, 25), converged);
   struct Setting { const char* name; int view, light; };
   std::vector<double> errors;
   for (Setting s : {Setting{"draft", 32, 6}, Setting{"production", 48, 6}, Setting{"reference", 192, 32}}) {
@@ -591,10 +593,12 @@ TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
     std::printf("cloud march %-10s view %3d light %2d: mean relative error %.4f\n", s.name, s.view, s.light,
                 errors.back());
   }
-  std::printf("768/128 against 384/64: %.5f, against 1536/256: %.5f\n", half, self);
+  std::printf("400/50 against 200/25: %.5f\n", half);
   EXPECT_GT(errors[0], errors[1]);
   EXPECT_GT(errors[1], errors[2]);
-  EXPECT_LT(half, errors[2]);
+  // The fine march is first order in its steps: halving them changes it by
+  // about its own error, which is a tenth of the production preset's.
+  EXPECT_LT(half, 0.1 * errors[1]);
   EXPECT_LT(errors[1], 0.1);
   testing::ExpectNoValidationMessages();
 }

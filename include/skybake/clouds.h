@@ -99,6 +99,16 @@ struct CloudProblem {
 std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const AtmosphereParams& atmosphere,
                                          const std::string& style_dir);
 
+// Loop iterations one texel of the cloud pass may run, at most: every band
+// crossed with view_steps samples, each lit sample marching light_steps
+// samples over every layer and summing the octaves. Lavapipe ends all the
+// loops of an invocation after 65535 iterations in all (Mesa's
+// LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of a shader), which
+// would cut the march short silently; the style check refuses settings
+// above kMaxCloudLoopIterations.
+double CloudLoopIterationsPerTexel(const CloudSettings& clouds);
+constexpr double kMaxCloudLoopIterations = 60000.0;
+
 // What the renderer needs: the uniform block, the weather images (R channel,
 // resampled to the procedural map's resolution), and the sizes of the noise
 // volumes. Empty `uniform.counts.x` (0 layers) means no cloud pass at all.
