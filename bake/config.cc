@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -51,6 +52,7 @@ constexpr Range kDomeFraction{0.0, 1.0, true, false};
 constexpr Range kNoiseOffset{-1e4, 1e4, false, false};
 constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
+constexpr Range kCloudDistance{1.0, 2000.0, false, false};
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -133,7 +135,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
 
   QualitySettings& q = s.quality;
-  v.Preset("quality.preset", s.quality_preset, q);  // first: the keys below refine it
+  v.Preset("quality.preset", s.quality_preset, q, s.clouds.quality);  // first: the keys below refine it
   v.Choice("quality.integrator", q.integrator,
            {{"analytic", INTEGRATOR_ANALYTIC}, {"midpoint", INTEGRATOR_MIDPOINT},
             {"trapezoid", INTEGRATOR_TRAPEZOID}, {"simpson", INTEGRATOR_SIMPSON}});
@@ -150,6 +152,19 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Int("quality.transmittance_lut_width", q.transmittance_width, 2, kMaxLutSize);
   v.Int("quality.transmittance_lut_height", q.transmittance_height, 2, kMaxLutSize);
   v.Int("quality.multiscattering_lut_size", q.multiscattering_size, 2, kMaxLutSize);
+  // The cloud sampling keys: read always; written into the resolved style
+  // only when it has cloud layers, so a style without them resolves (and
+  // its EXR headers record it) as before clouds existed.
+  CloudQuality& cq = s.clouds.quality;
+  if (v.kReads || !s.clouds.layers.empty()) {
+    v.Int("quality.cloud_view_steps", cq.view_steps, 1, kMaxSteps);
+    v.Int("quality.cloud_light_steps", cq.light_steps, 1, 256);
+    v.Int("quality.cloud_octaves", cq.octaves, 1, 16);
+    v.Int("quality.cloud_shape_resolution", cq.shape_resolution, 8, 256);
+    v.Int("quality.cloud_detail_resolution", cq.detail_resolution, 8, 256);
+    v.Int("quality.cloud_weather_resolution", cq.weather_resolution, 8, 2048);
+    v.Real("quality.cloud_max_distance_km", cq.max_distance_km, kCloudDistance);
+  }
 
   v.Int("render.cube_size", s.render.cube_size, 1, kMaxCubeSize);
   v.Int("render.latlong_height", s.render.latlong_height, 1, kMaxLatlongHeight);
@@ -197,6 +212,9 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("shapes.strength", x.shapes.strength, kUnit);
   v.Shapes("shapes.shape", x.shapes.shapes);
 
+  // Volumetric cloud layers (clouds.h, docs/clouds.md).
+  v.CloudLayers("cloud_layer", s.clouds.layers);
+
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
   v.Choice("gltf.dome", g.dome, {{"sphere", DomeShape::kSphere}, {"hemisphere", DomeShape::kHemisphere}});
@@ -209,6 +227,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
 class StyleReader {
  public:
+  static constexpr bool kReads = true;
   StyleReader(const toml::table& root, std::string file, std::vector<ConfigError>& errors)
       : root_(root), file_(std::move(file)), errors_(errors) {}
 
@@ -313,7 +332,7 @@ class StyleReader {
     Error(node, path, fmt::format("'{}' is not one of {}", text, JoinNames(names)));
   }
 
-  void Preset(const char* path, std::string& name, QualitySettings& quality) {
+  void Preset(const char* path, std::string& name, QualitySettings& quality, CloudQuality& cloud_quality) {
     const toml::node* node = Find(path);
     if (!node) return;
     std::vector<std::string> list = QualityPresetNames();
@@ -328,6 +347,7 @@ class StyleReader {
     }
     name = text;
     quality = QualityPreset(text);
+    cloud_quality = CloudQualityPreset(text);
   }
 
   void FileName(const char* path, std::string& out) {
@@ -480,6 +500,118 @@ class StyleReader {
     out = std::move(shapes);
   }
 
+  // [[cloud_layer]] tables (clouds.h): every key optional, checked against
+  // its range; an explicit profile needs type = "custom".
+  void CloudLayers(const char* path, std::vector<CloudLayer>& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    const toml::array* array = node->as_array();
+    if (!array || !array->is_array_of_tables()) {
+      Error(node, path, "expected [[cloud_layer]] tables");
+      return;
+    }
+    std::vector<CloudLayer> layers;
+    for (size_t i = 0; i < array->size(); ++i) {
+      const toml::table& t = *array->get(i)->as_table();
+      const std::string where = fmt::format("{}[{}]", path, i);
+      CloudLayer layer;
+      bool ok = true;
+      bool has_profile = false;
+      auto number = [&](const toml::node& value, const std::string& key_path, const Range& range, double& to) {
+        std::optional<double> v = value.value<double>();
+        if (!v || value.is_boolean() || !std::isfinite(*v) || !range.Contains(*v)) {
+          ok = false;
+          Error(&value, key_path, fmt::format("expected a number in {}", range.Describe()));
+          return;
+        }
+        to = *v;
+      };
+      auto numbers = [&](const toml::node& value, const std::string& key_path, const Range& range, double* to,
+                         size_t count, const char* shape) {
+        const toml::array* a = value.as_array();
+        if (!a || a->size() != count) {
+          ok = false;
+          Error(&value, key_path, fmt::format("expected {}", shape));
+          return;
+        }
+        for (size_t j = 0; j < count; ++j) number(*a->get(j), fmt::format("{}[{}]", key_path, j), range, to[j]);
+      };
+      static const Range kAltitude{0.0, 1e5, false, false}, kThickness{0.0, 1e5, true, false};
+      static const Range kDensity{0.0, 10.0, false, false}, kNoiseSize{1.0, 1e6, false, false};
+      static const Range kWeatherSize{10.0, 1e7, false, false}, kWind{-200.0, 200.0, false, false};
+      static const Range kShear{-100.0, 100.0, false, false}, kOrigin{-1e7, 1e7, false, false};
+      for (const auto& [key, value] : t) {
+        const std::string k(key.str());
+        const std::string key_path = where + "." + k;
+        if (k == "altitude_m") number(value, key_path, kAltitude, layer.altitude_m);
+        else if (k == "thickness_m") number(value, key_path, kThickness, layer.thickness_m);
+        else if (k == "coverage") number(value, key_path, kUnit, layer.coverage);
+        else if (k == "density_per_m") number(value, key_path, kDensity, layer.density_per_m);
+        else if (k == "albedo") number(value, key_path, kUnit, layer.albedo);
+        else if (k == "shape_amount") number(value, key_path, kUnit, layer.shape_amount);
+        else if (k == "shape_size_m") number(value, key_path, kNoiseSize, layer.shape_size_m);
+        else if (k == "detail_amount") number(value, key_path, kUnit, layer.detail_amount);
+        else if (k == "detail_size_m") number(value, key_path, kNoiseSize, layer.detail_size_m);
+        else if (k == "weather_size_m") number(value, key_path, kWeatherSize, layer.weather_size_m);
+        else if (k == "wind_m_s") numbers(value, key_path, kWind, layer.wind_m_s.data(), 2, "[east, north] in m/s");
+        else if (k == "shear_m_s_per_km")
+          numbers(value, key_path, kShear, layer.shear_m_s_per_km.data(), 2, "[east, north] in m/s per km");
+        else if (k == "weather_extent_m")
+          numbers(value, key_path, kWeatherSize, layer.weather_extent_m.data(), 2, "[east, north] size in m");
+        else if (k == "weather_origin_m")
+          numbers(value, key_path, kOrigin, layer.weather_origin_m.data(), 2, "[east, north] of the south-west corner in m");
+        else if (k == "profile") {
+          numbers(value, key_path, kUnit, layer.profile.data(), 4, "[bottom_in, bottom_full, top_full, top_out]");
+          has_profile = true;
+        } else if (k == "type") {
+          const std::string type = value.value_or(std::string());
+          bool known = false;
+          for (CloudType c : {CloudType::kStratus, CloudType::kStratocumulus, CloudType::kCumulus,
+                              CloudType::kCumulonimbus, CloudType::kCirrus, CloudType::kCustom})
+            if (type == CloudTypeName(c)) layer.type = c, known = true;
+          if (!known) {
+            ok = false;
+            Error(&value, key_path,
+                  "expected 'stratus', 'stratocumulus', 'cumulus', 'cumulonimbus', 'cirrus' or 'custom'");
+          }
+        } else if (k == "seed") {
+          if (!value.is_integer() || value.as_integer()->get() < 0 || value.as_integer()->get() > int64_t(UINT32_MAX)) {
+            ok = false;
+            Error(&value, key_path, fmt::format("expected an integer in [0, {}]", UINT32_MAX));
+          } else {
+            layer.seed = uint32_t(value.as_integer()->get());
+          }
+        } else if (k == "weather_image") {
+          if (!value.is_string() || value.as_string()->get().empty()) {
+            ok = false;
+            Error(&value, key_path, "expected the path of an EXR or PNG image (relative to the style file)");
+          } else {
+            layer.weather_image = value.as_string()->get();
+          }
+        } else {
+          ok = false;
+          Error(&value, key_path,
+                fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
+                            "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
+                            "wind_m_s, shear_m_s_per_km, seed, weather_size_m, weather_image, weather_extent_m, "
+                            "weather_origin_m)",
+                            k));
+        }
+      }
+      if (ok && has_profile && layer.type != CloudType::kCustom) {
+        ok = false;
+        Error(t.get("profile"), where + ".profile", "an explicit profile needs type = \"custom\"");
+      }
+      if (ok && !has_profile && layer.type == CloudType::kCustom) {
+        ok = false;
+        Error(array->get(i), where + ".type", "type = \"custom\" needs profile = [bottom_in, bottom_full, top_full, top_out]");
+      }
+      if (ok && !has_profile) layer.profile = CloudTypeProfile(layer.type);
+      if (ok) layers.push_back(std::move(layer));
+    }
+    out = std::move(layers);
+  }
+
   // Reports every key of the file that no Visit call asked for. Tables named
   // in `opaque` belong to another reader (a style's inline [schedule]).
   void ReportUnknownKeys(const std::set<std::string>& opaque = {}) {
@@ -573,6 +705,7 @@ class StyleReader {
 
 class StyleWriter {
  public:
+  static constexpr bool kReads = false;
   void Real(const char* path, double& v, const Range&) { Put(path, v); }
   void Triple(const char* path, Rgb& v, const Range&) { Put(path, toml::array{v[0], v[1], v[2]}); }
   void Int(const char* path, int& v, int, int) { Put(path, int64_t(v)); }
@@ -583,7 +716,7 @@ class StyleWriter {
       if (c.second == v) Put(path, std::string(c.first));
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
-  void Preset(const char* path, std::string& name, QualitySettings&) { Put(path, name); }
+  void Preset(const char* path, std::string& name, QualitySettings&, CloudQuality&) { Put(path, name); }
   void Uint(const char* path, uint32_t& v) { Put(path, int64_t(v)); }
   void Vector(const char* path, glm::dvec3& v, const Range&) { Put(path, toml::array{v.x, v.y, v.z}); }
   void Color(const char* path, std::string& v) {
@@ -602,6 +735,36 @@ class StyleWriter {
       t.insert("closed", shape.closed);
       t.insert("radius_deg", shape.radius_deg);
       t.insert("strength", shape.strength);
+      array.push_back(std::move(t));
+    }
+    if (!array.empty()) Put(path, std::move(array));
+  }
+  void CloudLayers(const char* path, std::vector<CloudLayer>& layers) {
+    toml::array array;
+    for (const CloudLayer& l : layers) {
+      toml::table t;
+      t.insert("altitude_m", l.altitude_m);
+      t.insert("thickness_m", l.thickness_m);
+      t.insert("type", std::string(CloudTypeName(l.type)));
+      // The type decides the profile, except "custom", which gives it.
+      if (l.type == CloudType::kCustom)
+        t.insert("profile", toml::array{l.profile[0], l.profile[1], l.profile[2], l.profile[3]});
+      t.insert("coverage", l.coverage);
+      t.insert("density_per_m", l.density_per_m);
+      t.insert("albedo", l.albedo);
+      t.insert("shape_amount", l.shape_amount);
+      t.insert("shape_size_m", l.shape_size_m);
+      t.insert("detail_amount", l.detail_amount);
+      t.insert("detail_size_m", l.detail_size_m);
+      t.insert("wind_m_s", toml::array{l.wind_m_s[0], l.wind_m_s[1]});
+      t.insert("shear_m_s_per_km", toml::array{l.shear_m_s_per_km[0], l.shear_m_s_per_km[1]});
+      if (l.seed) t.insert("seed", int64_t(*l.seed));
+      t.insert("weather_size_m", l.weather_size_m);
+      if (!l.weather_image.empty()) {
+        t.insert("weather_image", l.weather_image);
+        t.insert("weather_extent_m", toml::array{l.weather_extent_m[0], l.weather_extent_m[1]});
+        t.insert("weather_origin_m", toml::array{l.weather_origin_m[0], l.weather_origin_m[1]});
+      }
       array.push_back(std::move(t));
     }
     if (!array.empty()) Put(path, std::move(array));
@@ -773,6 +936,33 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       ConfigError e = locate("shapes.shape");
       e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
                               arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
+      result.errors.push_back(e);
+    }
+  }
+  // Volumetric cloud layers: counts, the atmosphere's top, weather images.
+  {
+    const std::string style_dir = std::filesystem::path(name).parent_path().string();
+    for (const CloudProblem& p : ValidateClouds(result.style.clouds, a, style_dir)) {
+      std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
+      if (p.layer == -2) {  // the sampling settings
+        ConfigError e = locate(root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
+                                                                                : "quality.cloud_view_steps");
+        e.message = p.message;
+        result.errors.push_back(e);
+        continue;
+      }
+      ConfigError e = locate("cloud_layer");
+      if (const toml::array* layers = root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
+                                                                      size_t(p.layer) < layers->size()) {
+        const toml::node* at = layers->get(size_t(p.layer));
+        if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->get(p.key)) at = t->get(p.key);
+        if (at->source().begin) {
+          e.line = int(at->source().begin.line);
+          e.column = int(at->source().begin.column);
+        }
+      }
+      e.key = p.key.empty() ? key : key + "." + p.key;
+      e.message = p.message;
       result.errors.push_back(e);
     }
   }

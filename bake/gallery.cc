@@ -38,6 +38,8 @@ std::string DescribePrinciples(const SkyStyle& style) {
   if (a.clouds.enabled) parts.push_back(fmt::format("clouds s_noise {:g}", a.clouds.s_noise));
   if (a.shapes.enabled)
     parts.push_back(fmt::format("{} shape{}", a.shapes.shapes.size(), a.shapes.shapes.size() == 1 ? "" : "s"));
+  for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
+    parts.push_back(fmt::format("{} {:g} km", CloudTypeName(l.type), l.altitude_m * 1e-3));
   parts.push_back(fmt::format("sun {:g} deg", style.sun.elevation_deg));
   std::string out;
   for (size_t i = 0; i < parts.size(); ++i) out += (i ? ", " : "") + parts[i];

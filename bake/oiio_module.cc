@@ -79,7 +79,29 @@ bool ComposeSheet(const std::vector<SheetCell>& cells, const SheetLayout& l, std
   return true;
 }
 
-const OiioModule kModule = {EncodePng, ComposeSheet};
+bool ReadImage(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels,
+               std::string& error) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    error = OIIO::geterror();
+    return false;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.depth > 1) {
+    error = "a 3D image (depth " + std::to_string(spec.depth) + "); expected a 2D image";
+    return false;
+  }
+  width = spec.width;
+  height = spec.height;
+  channels = spec.nchannels;
+  pixels.assign(size_t(width) * height * channels, 0.0f);
+  bool ok = in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, pixels.data());
+  if (!ok) error = in->geterror();
+  in->close();
+  return ok;
+}
+
+const OiioModule kModule = {EncodePng, ComposeSheet, ReadImage};
 
 }  // namespace
 }  // namespace skybake

@@ -31,6 +31,10 @@ struct OiioModule {
                      std::string& error);
   bool (*compose_sheet)(const std::vector<SheetCell>& cells, const SheetLayout& layout, std::vector<uint8_t>& rgb,
                         int& width, int& height, std::string& error);
+  // Any 2D image OpenImageIO reads (EXR, PNG, ...): its first subimage as
+  // floats, channels interleaved, values as stored (no colour conversion).
+  bool (*read_image)(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels,
+                     std::string& error);
 };
 
 // Loads the module once (thread-safe); throws OutputError naming the file

@@ -85,6 +85,18 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
          fmt::format("[clouds] enabled, strength {}", xr.clouds.strength));
   decide("cloud shapes", xr.shapes.enabled, xp.shapes.enabled, "shapes.strength = 0 or no shape",
          fmt::format("[shapes] enabled, {} shapes", xr.shapes.shapes.size()));
+  {
+    // Volumetric cloud layers: on when a layer has coverage and density.
+    const std::vector<CloudLayer> active = ActiveCloudLayers(first.clouds);
+    std::string why_on;
+    for (const CloudLayer& l : active)
+      why_on += fmt::format("{}{} at {}-{} m, coverage {}, density {} /m", why_on.empty() ? "" : "; ",
+                            CloudTypeName(l.type), l.altitude_m, l.altitude_m + l.thickness_m, l.coverage,
+                            l.density_per_m);
+    decide("volumetric clouds", !first.clouds.layers.empty(), !active.empty(),
+           "every [[cloud_layer]] has coverage 0 or density_per_m 0 (pruned)",
+           fmt::format("{} [[cloud_layer]]: {}", active.size(), why_on));
+  }
   decide("twilight and night dimming", r.night_dimming, p.night_dimming, "effects.night_dimming_strength = 0",
          fmt::format("effects.night_dimming = true, strength {}, night sky {} cd/m^2", r.night_dimming_strength,
                      r.night_sky_luminance_cd_m2));
@@ -104,7 +116,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
 
   const QualitySettings& q = first.quality;
   const int light = std::max(q.light_steps, 1);
-  if (NeedsTransmittanceLut(q, p))
+  if (NeedsTransmittanceLut(q, p) || !ActiveCloudLayers(first.clouds).empty())
     plan.passes.push_back({"transmittance LUT", Size(q.transmittance_width, q.transmittance_height),
                            "once per atmosphere", plan.atmospheres,
                            double(q.transmittance_width) * q.transmittance_height * q.transmittance_steps});
@@ -133,6 +145,30 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
   const bool disc_pass = UsesSunDiscPass(q, p, switches);
   if (disc_pass)
     plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
+  const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
+  const CloudQuality& cq = first.clouds.quality;
+  if (!cloud_layers.empty()) {
+    const int layers = int(cloud_layers.size());
+    const double shape = double(cq.shape_resolution) * cq.shape_resolution * cq.shape_resolution;
+    const double detail = double(cq.detail_resolution) * cq.detail_resolution * cq.detail_resolution;
+    plan.passes.push_back({"cloud noise volumes",
+                           fmt::format("{} x ({}^3 + {}^3 + {}^2)", layers, cq.shape_resolution,
+                                       cq.detail_resolution, cq.weather_resolution),
+                           "once per bake (from the seeds)", 1,
+                           layers * (shape + detail + double(cq.weather_resolution) * cq.weather_resolution)});
+    // CloudInputs: aerial perspective 32 x 64 x 32 (4 steps per slice),
+    // ambient 16 altitudes x 64 directions x 16 steps.
+    plan.passes.push_back({"cloud tables", "AP 32 x 64 x 32, ambient 16", "once per frame", plan.frames,
+                           32.0 * 64 * 32 * 4 + 16.0 * 64 * 16});
+    for (const ViewRequest& v : PlanViews(first)) {
+      std::string name = v.mapping == MAPPING_LATLONG      ? "clouds latlong"
+                         : v.mapping == MAPPING_CUBE_STRIP ? "clouds cube strip"
+                                                           : fmt::format("clouds face {}", v.face);
+      // At most view_steps per layer crossing, each lit sample light_steps more.
+      plan.passes.push_back({name, Size(v.width, v.height), "once per frame (at most)", plan.frames,
+                             double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
+    }
+  }
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
 
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
@@ -150,6 +186,14 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
       sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
   if (disc_pass)
     plan.variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
+  if (!cloud_layers.empty())
+    plan.variant += fmt::format(
+        "\n  clouds: cloud_render with {} layer(s) compiled in (constant 20), after the sky and sun-disc passes; "
+        "per texel at most {} view steps per layer crossing (a third of them for a vertical crossing), {} light "
+        "steps per lit sample, {} scattering octaves, no cloud beyond {} km",
+        cloud_layers.size(), cq.view_steps, cq.light_steps, cq.octaves, cq.max_distance_km);
+  else
+    plan.variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
   if (plan.frames > 1) {
     if (plan.atmospheres == 1)
       plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +

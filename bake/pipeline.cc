@@ -84,6 +84,11 @@ struct FramePlan {
   glm::dvec3 sun{0, 1, 0};
 };
 
+// Clock time of a frame since the sequence's first frame, in seconds: what
+// the wind moves the clouds by (0 for a single bake, and for a schedule
+// without clock times).
+double CloudTimeOf(const FramePlan& plan) { return plan.hours_from_start * 3600.0; }
+
 // What the shaders of one style see: the atmosphere with the hue principle
 // applied (its Rayleigh constants), and the per-texel AOAS principles, whose
 // saturation is judged in Rec.709 luminance RGB.
@@ -103,27 +108,34 @@ class RendererCache {
  public:
   RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
 
-  SkyRenderer& Main(const SkyStyle& style) {
-    Update(style);
+  // `cloud_time_s`: the frame's clock time since the sequence's first frame,
+  // which the wind moves the clouds by.
+  SkyRenderer& Main(const SkyStyle& style, double cloud_time_s = 0.0) {
+    Update(style, cloud_time_s);
     return *main_;
   }
   // The renderer of the last frame.
   SkyRenderer& Current() { return *main_; }
  private:
-  void Update(const SkyStyle& unpruned) {
+  void Update(const SkyStyle& unpruned, double cloud_time_s) {
     // The pass plan's pruning: zero-strength and unused effects compiled out.
     const SkyStyle style = PrunedStyle(unpruned);
     StyledInputs in = StyledInputsOf(style);
+    const CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
+                                             std::filesystem::path(style.source_path).parent_path().string(),
+                                             cloud_time_s);
+    // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
+    const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
     gpu::GpuAtmosphere key =
         ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
     // A new atmosphere with the same shader variant (a scheduled drift of
     // its constants): new uniforms and LUTs, the same pipelines.
-    if (main_ && std::memcmp(&key, &key_, sizeof key) != 0 &&
+    if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) != 0 &&
         main_->UpdateAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units))) {
       key_ = key;
       ++result_.atmosphere_updates;
     }
-    if (main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
+    if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
       // Same atmosphere: the LUTs stay; per-texel AOAS parameters (a cloud
       // drift, say) change in place when the shader variant is the same.
       if (std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0 &&
@@ -143,7 +155,7 @@ class RendererCache {
     if (main_ && main_->HoldsFrames()) retired_.push_back(std::move(main_));
     main_.reset();
     main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
-                                          OutputScale(style.output.units), false, in.aoas);
+                                          OutputScale(style.output.units), false, in.aoas, clouds);
     ++result_.renderer_builds;
     key_ = key;
     aoas_key_ = in.aoas;
@@ -402,7 +414,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     } else if (ref.style->preview.auto_exposure) {
       const int h = ref.style->render.latlong_height;
       std::vector<float> latlong =
-          renderers.Main(*ref.style).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
+          renderers.Main(*ref.style, CloudTimeOf(ref)).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
       ev100 = AutoEv100(DisplayLuminance(latlong.data(), latlong.size() / 4, ref.style->output.units), 2 * h, h);
       exposure_source = fmt::format("auto exposure of frame {} (highest sun), applied to every frame", ref.number);
     } else {
@@ -419,7 +431,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       for (const FramePlan& plan : plans)
         if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) max_value = std::max(max_value, *bound);
       for (const FramePlan& plan : max_value > 0.0 ? std::vector<FramePlan>{} : plans) {
-        SkyRenderer& r = renderers.Main(*plan.style);
+        SkyRenderer& r = renderers.Main(*plan.style, CloudTimeOf(plan));
         std::vector<float> coarse = r.Render(plan.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];
         std::vector<float> centre = r.RenderDirections(plan.sun, {plan.sun});
         RgbaImage a{128, 64, coarse}, b{1, 1, centre};
@@ -666,7 +678,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
     // Render: every view of the frame in one submission, then the SH views.
     Clock::time_point render_start = Clock::now();
-    SkyRenderer& renderer = renderers.Main(style);
+    SkyRenderer& renderer = renderers.Main(style, CloudTimeOf(plan));
     std::vector<ViewRequest> views = PlanViews(style);
     if (style.gltf.enabled && !style.output.latlong && !style.output.preview) {
       const int h = style.render.latlong_height;

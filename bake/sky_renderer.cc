@@ -13,6 +13,8 @@
 #include <glm/geometric.hpp>
 #include <sys/mman.h>
 
+#include "shaders/kCloudLutSpv.spv.h"
+#include "shaders/kCloudRenderSpv.spv.h"
 #include "shaders/kMultiscatteringLutSpv.spv.h"
 #include "shaders/kSkyRenderSpv.spv.h"
 #include "shaders/kSkyviewLutSpv.spv.h"
@@ -27,9 +29,15 @@
 namespace skybake {
 namespace {
 
-// Of the bindings of gpu_shared.h, the atmosphere and AOAS blocks are uniform.
+// Of the bindings of gpu_shared.h, the atmosphere, AOAS and cloud blocks are uniform.
 bool IsUniformBinding(uint32_t binding) {
-  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS;
+  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS || binding == BINDING_CLOUDS;
+}
+
+// Texels of the cloud tables: the aerial-perspective LUT's in-scattering and
+// transmittance halves, then two per ambient altitude (clouds.glsl).
+size_t CloudLutTexels(const gpu::GpuClouds& c) {
+  return 2 * size_t(c.lut.x) * c.lut.y * c.lut.z + 2 * size_t(c.lut.w);
 }
 
 uint32_t GroupCount(int texels, int local_size) {
@@ -41,7 +49,7 @@ uint32_t GroupCount(int texels, int local_size) {
 SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
                          const QualitySettings& quality, const EffectSettings& effects,
                          const Rgb& output_scale, bool output_directions,
-                         const AoasInputs& aoas)
+                         const AoasInputs& aoas, const CloudInputs& clouds)
     : context_(context),
       quality_(quality),
       effects_(effects),
@@ -49,6 +57,11 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
       output_directions_(output_directions) {
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
   disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches);
+  // Clouds (clouds.h): a style without layers gets no cloud pipeline, no
+  // noise and no cloud pass; its buffers are placeholders.
+  cloud_layers_ = output_directions ? 0 : clouds.layers();
+  gpu_clouds_ = clouds.uniform;
+  cloud_weather_images_ = clouds.weather_images;
   VkDevice device = context_.device();
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -63,6 +76,10 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   output_buffer_ = CreateBuffer(16 * 64, storage);
   skyview_buffer_ = CreateBuffer(
       quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 8 : 16, storage);
+  clouds_buffer_ = CreateBuffer(sizeof(gpu::GpuClouds), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
+  cloud_noise_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_)) * 4 : 16, storage);
+  cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
 
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -85,8 +102,8 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   layout_info.pPushConstantRanges = &push_range;
   VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
 
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 3}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = 2;
@@ -123,7 +140,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
                    : PipelineJob{pipeline, generic_code, sizeof(generic_code)};
   };
   std::vector<PipelineJob> jobs;
-  if (NeedsTransmittanceLut(quality, effects))
+  if (NeedsTransmittanceLut(quality, effects) || cloud_layers_ > 0)
     jobs.push_back(job(&transmittance_pipeline_, analytic, kTransmittanceLutAnalyticSpv, kTransmittanceLutSpv));
   if (effects.multiple_scattering)
     jobs.push_back(
@@ -137,6 +154,12 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSunDiscPassSpv, kSkyRenderSpv));
     jobs.back().sun_disc = true;
     jobs.back().sun_disc_pass = true;
+  }
+  if (cloud_layers_ > 0) {
+    // Built from the analytic variant alone: their own marches of the air
+    // use the analytic step whatever the style's integrator.
+    jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
+    jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
   }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
@@ -239,8 +262,8 @@ void SkyRenderer::DestroyAll() {
   if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
-  for (VkPipeline* p :
-       {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_, &transmittance_pipeline_}) {
+  for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
+                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -254,6 +277,9 @@ void SkyRenderer::DestroyAll() {
   pipeline_layout_ = VK_NULL_HANDLE;
   set_layout_ = VK_NULL_HANDLE;
   DestroyBuffer(skyview_buffer_);
+  DestroyBuffer(cloud_lut_buffer_);
+  DestroyBuffer(cloud_noise_buffer_);
+  DestroyBuffer(clouds_buffer_);
   DestroyBuffer(output_buffer_);
   for (std::unique_ptr<FrameSlot>& slot : frame_slots_) DestroyBuffer(slot->buffer);
   frame_slots_.clear();
@@ -350,6 +376,9 @@ void SkyRenderer::UpdateDescriptors() {
       {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {skyview_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {aoas_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {clouds_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {cloud_noise_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {cloud_lut_buffer_.buffer, 0, VK_WHOLE_SIZE},
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -389,23 +418,24 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   // Specialization constants of common.glsl: ids 0..3 the optional effects,
   // 4..7 the AOAS principles that act per texel, 10..11 the quality
   // settings, 12..14 the Mie and ozone constituents and night dimming, 15
-  // the sun-disc pass. Every pipeline gets them all; a shader that does not
-  // use one ignores it.
+  // the sun-disc pass, 20 the cloud layers. Every pipeline gets them all; a
+  // shader that does not use one ignores it.
   struct {
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
     VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
+    int32_t cloud_layers;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
-              effects_.night_dimming,       sun_disc_pass};
-  const VkSpecializationMapEntry entries[14] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+              effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1)};
+  const VkSpecializationMapEntry entries[15] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
                                                 {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
                                                 {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4},
-                                                {14, 48, 4}, {15, 52, 4}};
-  VkSpecializationInfo specialization{14, entries, sizeof(values), &values};
+                                                {14, 48, 4}, {15, 52, 4}, {20, 56, 4}};
+  VkSpecializationInfo specialization{15, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
   info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
@@ -495,8 +525,9 @@ void SkyRenderer::PrecomputeLuts() {
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
   gpu::SkyPush push{};
-  // A LUT that nothing reads is not computed (pass_plan.h).
-  const bool transmittance = NeedsTransmittanceLut(quality_, effects_);
+  // A LUT that nothing reads is not computed (pass_plan.h); the clouds read
+  // the transmittance LUT for the sunlight at each sample.
+  const bool transmittance = NeedsTransmittanceLut(quality_, effects_) || cloud_layers_ > 0;
   if (transmittance) {
     dispatches.push_back({"transmittance LUT", transmittance_pipeline_, push,
                           GroupCount(gpu_atmosphere_.lut_sizes.x, SKYBAKE_LOCAL_SIZE_X),
@@ -513,6 +544,63 @@ void SkyRenderer::PrecomputeLuts() {
   if (transmittance) ++counters_.transmittance_lut_builds;
   if (effects_.multiple_scattering) ++counters_.multiscattering_lut_builds;
   luts_ready_ = true;
+  if (cloud_layers_ > 0 && !cloud_noise_ready_) GenerateCloudNoise();
+}
+
+void SkyRenderer::GenerateCloudNoise() {
+  // The weather images first (host writes to the mapped buffer; the
+  // submission below makes them visible to the device), then the volumes
+  // and procedural maps, from the seeds alone.
+  float* noise = static_cast<float*>(cloud_noise_buffer_.mapped);
+  const int n_weather = gpu_clouds_.resolution.z;
+  size_t image = 0;
+  std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  for (int l = 0; l < cloud_layers_; ++l) {
+    const gpu::GpuCloudLayer& layer = gpu_clouds_.layers[l];
+    gpu::SkyPush push{};
+    push.view = {CLOUD_PASS_SHAPE, 0, 0, l};
+    const int ns = gpu_clouds_.resolution.x, nd = gpu_clouds_.resolution.y;
+    dispatches.push_back({"cloud shape noise", cloud_lut_pipeline_, push, GroupCount(ns, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(ns * ns, SKYBAKE_LOCAL_SIZE_Y)});
+    push.view.x = CLOUD_PASS_DETAIL;
+    dispatches.push_back({"cloud detail noise", cloud_lut_pipeline_, push, GroupCount(nd, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(nd * nd, SKYBAKE_LOCAL_SIZE_Y)});
+    if (layer.weather.w > 0.5f) {
+      const size_t count = size_t(n_weather) * n_weather;
+      std::memcpy(noise + layer.noise.z, cloud_weather_images_.data() + image * count, count * sizeof(float));
+      ++image;
+    } else {
+      push.view.x = CLOUD_PASS_WEATHER;
+      dispatches.push_back({"cloud weather map", cloud_lut_pipeline_, push,
+                            GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_X), GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_Y)});
+    }
+  }
+  // Each dispatch writes its own range of the noise buffer: no barriers
+  // between them; the submission's end orders them before later reads.
+  barriers.assign(dispatches.size(), false);
+  Submit(dispatches, barriers);
+  cloud_noise_ready_ = true;
+  ++counters_.cloud_noise_builds;
+}
+
+void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
+                                 std::vector<bool>& barriers) {
+  if (cloud_tables_ready_ && cloud_sun_ == sun) return;
+  cloud_tables_ready_ = true;
+  cloud_sun_ = sun;
+  gpu::SkyPush push{};
+  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+  push.view = {CLOUD_PASS_AERIAL, 0, 0, 0};
+  dispatches.push_back({"cloud aerial perspective", cloud_lut_pipeline_, push,
+                        GroupCount(gpu_clouds_.lut.x, SKYBAKE_LOCAL_SIZE_X),
+                        GroupCount(gpu_clouds_.lut.y, SKYBAKE_LOCAL_SIZE_Y)});
+  barriers.push_back(false);  // the two tables are disjoint ranges of one buffer
+  push.view.x = CLOUD_PASS_AMBIENT;
+  dispatches.push_back({"cloud ambient", cloud_lut_pipeline_, push, GroupCount(gpu_clouds_.lut.w, SKYBAKE_LOCAL_SIZE_X), 1});
+  // The tables' writes before the cloud pass reads them.
+  barriers.push_back(true);
+  ++counters_.cloud_table_builds;
 }
 
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
@@ -622,6 +710,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     barriers.push_back(true);
     ++counters_.skyview_lut_builds;
   }
+  if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
   const size_t first_view = dispatches.size();
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
@@ -658,6 +747,18 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     }
     // The sky pass's writes before the disc's reads.
     if (dispatches.size() > last_view + 1) barriers[last_view] = true;
+  }
+  if (cloud_layers_ > 0) {
+    // The sky and disc passes' writes before the cloud pass reads them.
+    barriers.back() = true;
+    for (size_t i = 0; i < views.size(); ++i) {
+      Dispatch d = dispatches[first_view + i];
+      d.name = "clouds " + d.name;
+      d.pipeline = cloud_pipeline_;
+      dispatches.push_back(d);
+      barriers.push_back(false);  // views are disjoint
+      ++counters_.cloud_dispatches;
+    }
   }
   Submit(dispatches, barriers);
   ++counters_.frames;
@@ -701,7 +802,39 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
   luts_ready_ = false;
   skyview_ready_ = false;
+  cloud_tables_ready_ = false;
   return true;
+}
+
+bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
+  const gpu::GpuClouds& c = clouds.uniform;
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
+      !same(c.lut, gpu_clouds_.lut))
+    return false;
+  // The noise depends on the seeds, the buffer layout and the weather images.
+  bool noise_same = clouds.weather_images == cloud_weather_images_;
+  for (int l = 0; l < cloud_layers_; ++l)
+    noise_same = noise_same && same(c.layers[l].noise, gpu_clouds_.layers[l].noise) &&
+                 (c.layers[l].weather.w > 0.5f) == (gpu_clouds_.layers[l].weather.w > 0.5f);
+  if (same(c, gpu_clouds_) && noise_same) return true;
+  // Every submission waits for its fence, so no dispatch reads the buffers now.
+  if (!noise_same) {
+    cloud_noise_ready_ = false;
+    cloud_weather_images_ = clouds.weather_images;
+  }
+  // The tables depend on the layers' top (the ambient table's range) and distances.
+  if (!same(c.range, gpu_clouds_.range)) cloud_tables_ready_ = false;
+  gpu_clouds_ = c;
+  std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
+  if (!cloud_noise_ready_ && luts_ready_) GenerateCloudNoise();
+  return true;
+}
+
+std::vector<float> SkyRenderer::ReadCloudNoise() const {
+  if (cloud_layers_ == 0) return {};
+  const float* data = static_cast<const float*>(cloud_noise_buffer_.mapped);
+  return std::vector<float>(data, data + CloudNoiseFloats(gpu_clouds_));
 }
 
 bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {

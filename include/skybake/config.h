@@ -12,6 +12,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
+#include "skybake/clouds.h"
 
 namespace skybake {
 
@@ -78,6 +79,7 @@ struct SkyStyle {
   OutputSettings output;
   PreviewSettings preview;
   AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
+  CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   GltfSettings gltf;
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance

@@ -25,6 +25,9 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_OUTPUT 3           // storage vec4[], rendered texels
 #define BINDING_SKYVIEW 4          // storage uint64[], sky-view LUT (PackSkyViewTexel)
 #define BINDING_AOAS 5             // uniform GpuAoas, the style's aesthetic principles
+#define BINDING_CLOUDS 6           // uniform GpuClouds, the volumetric cloud layers (clouds.h)
+#define BINDING_CLOUD_NOISE 7      // storage float[], per layer: shape volume, detail volume, weather map
+#define BINDING_CLOUD_LUT 8        // storage vec4[], aerial perspective LUT, then the ambient light table
 
 // Output mappings (SkyPush.view.x).
 #define MAPPING_LATLONG 0      // OpenEXR latlong, 2N x N, Imf::LatLongMap
@@ -118,7 +121,43 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
   ivec4 rect;          // sun-disc pass: texels [x, z) x [y, w) of the view
 };
 
+// Volumetric cloud layers (include/skybake/clouds.h, shaders/clouds.glsl).
+// Lengths in km, extinction in km^-1; world x, z as in the sky's frame.
+#define CLOUD_MAX_LAYERS 4
+// What one dispatch of cloud_lut.comp computes (SkyPush.view.x).
+#define CLOUD_PASS_AERIAL 0   // aerial-perspective LUT, once per sun position
+#define CLOUD_PASS_AMBIENT 1  // sky/ground ambient light per altitude, once per sun position
+#define CLOUD_PASS_SHAPE 2    // shape noise volume of layer SkyPush.view.w, once per renderer
+#define CLOUD_PASS_DETAIL 3   // detail noise volume of layer SkyPush.view.w
+#define CLOUD_PASS_WEATHER 4  // procedural weather map of layer SkyPush.view.w
+
+SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
+  vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo
+  vec4 profile;         // height-profile stops (bottom in, bottom full, top full, top out), fractions of the thickness
+  vec4 shape;           // x: shape amount; y: 1 / shape tile, km^-1; z: detail amount; w: 1 / detail tile, km^-1
+  vec4 weather;         // x: coverage; y: 1 / weather extent along x, km^-1; z: along z; w: 1 = user image
+  vec4 wind_offset;     // xy: world x, z moved by the wind at the bottom, km; zw: more per km of height (shear), km/km
+  vec4 weather_origin;  // xy: world x, z of the weather map's corner, km; zw: unused
+  ivec4 noise;          // x, y, z: first float of the shape volume, detail volume, weather map; w: seed
+};
+
+SKYBAKE_GPU_STRUCT(GpuClouds) {
+  ivec4 counts;      // x: layers; y: view steps per layer crossing; z: light steps; w: scattering octaves
+  ivec4 resolution;  // x: shape volume edge; y: detail volume edge; z: weather map edge; w: bands
+  ivec4 lut;         // aerial perspective LUT x: azimuth texels; y: zenith texels; z: distance slices; w: ambient altitudes
+  vec4 phase;        // x: forward g; y: backward g; z: forward weight; w: unused
+  vec4 octave;       // Wrenninge 2013 x: contribution a; y: attenuation b; z: eccentricity c; w: unused
+  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; zw: unused
+  // The union of the layers' shells, overlapping layers merged: x, y: bottom
+  // and top altitude km, by altitude; resolution.w of them. The view ray is
+  // marched through each band it crosses, in order along the ray.
+  vec4 bands[CLOUD_MAX_LAYERS];
+  GpuCloudLayer layers[CLOUD_MAX_LAYERS];
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
+static_assert(sizeof(GpuClouds) == (6 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,

@@ -12,6 +12,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
+#include "skybake/clouds.h"
 #include "skybake/vulkan_context.h"
 
 namespace skybake {
@@ -38,6 +39,9 @@ struct RenderCounters {
   int pipelines = 0;  // compute pipelines compiled
   int variant_pipelines = 0;  // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
   int sun_disc_dispatches = 0;  // dispatches of the sun-disc pass
+  int cloud_noise_builds = 0;   // noise volumes generated (once per renderer unless seeds change)
+  int cloud_table_builds = 0;   // aerial-perspective LUT and ambient table (once per sun position)
+  int cloud_dispatches = 0;     // dispatches of the cloud pass
   long long sun_disc_texels = 0;  // texels they covered
 };
 
@@ -87,7 +91,7 @@ class SkyRenderer {
   SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
               const QualitySettings& quality, const EffectSettings& effects,
               const Rgb& output_scale, bool output_directions = false,
-              const AoasInputs& aoas = AoasInputs());
+              const AoasInputs& aoas = AoasInputs(), const CloudInputs& clouds = CloudInputs());
   ~SkyRenderer();
   SkyRenderer(const SkyRenderer&) = delete;
   SkyRenderer& operator=(const SkyRenderer&) = delete;
@@ -130,6 +134,15 @@ class SkyRenderer {
   // shader variant is needed).
   bool UpdateAoas(const AoasInputs& aoas);
 
+  // Replaces the cloud layers' parameters (the wind's offsets of a new
+  // frame, say) without new pipelines; the noise volumes are generated again
+  // only when their seeds or weather images change. False when the layer
+  // count or a noise size differs (a new renderer is needed).
+  bool UpdateClouds(const CloudInputs& clouds);
+
+  // The noise buffer of the cloud layers (shape, detail, weather per layer),
+  // for tests; empty without clouds.
+  std::vector<float> ReadCloudNoise() const;
   // LUT contents (RGBA float per texel, row-major), for tests.
   std::vector<float> ReadTransmittanceLut() const;
   std::vector<float> ReadMultipleScatteringLut() const;
@@ -174,7 +187,12 @@ class SkyRenderer {
   void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                    bool sun_disc, const std::vector<size_t>& offsets);
 
-  static constexpr uint32_t kBindingCount = 6;  // bindings 0..5 of gpu_shared.h
+  // The cloud passes' dispatches of a frame: noise (when not yet built) and
+  // tables (when the sun moved) before the views; the cloud pass after them.
+  void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
+  void GenerateCloudNoise();
+
+  static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
 
   VulkanContext& context_;
   gpu::GpuAtmosphere gpu_atmosphere_{};
@@ -186,6 +204,12 @@ class SkyRenderer {
   bool luts_ready_ = false;
   bool skyview_ready_ = false;
   glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
+  gpu::GpuClouds gpu_clouds_{};
+  int cloud_layers_ = 0;           // 0: no cloud pass, no cloud pipelines
+  bool cloud_noise_ready_ = false;
+  bool cloud_tables_ready_ = false;
+  glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
+  std::vector<float> cloud_weather_images_;
 
   Buffer atmosphere_buffer_;
   Buffer aoas_buffer_;
@@ -193,6 +217,9 @@ class SkyRenderer {
   Buffer multiscattering_buffer_;
   Buffer output_buffer_;
   Buffer skyview_buffer_;
+  Buffer clouds_buffer_;       // GpuClouds
+  Buffer cloud_noise_buffer_;  // noise volumes and weather maps
+  Buffer cloud_lut_buffer_;    // aerial-perspective LUT and ambient table
   std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
   VkBuffer bound_output_ = VK_NULL_HANDLE;                // what the output binding points at
 
@@ -205,6 +232,8 @@ class SkyRenderer {
   VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
   VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
   VkPipeline disc_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

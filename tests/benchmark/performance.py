@@ -94,6 +94,9 @@ def main():
     parser.add_argument("--no-blender", action="store_true")
     parser.add_argument("--blender", default=shutil.which("blender"))
     parser.add_argument("--work", default=None, help="scratch folder (default: a temporary one)")
+    parser.add_argument("--reps-w3", type=int, default=1, help="runs of W3 (W1 with one cumulus layer)")
+    parser.add_argument("--w3-sequence", action="store_true", help="also W3's 96-frame time-lapse (slow)")
+    parser.add_argument("--only-clouds", action="store_true", help="W1 and W3 single frames only (no W2, no Blender)")
     args = parser.parse_args()
     work = args.work or tempfile.mkdtemp(prefix="skybake-bench-")
     os.makedirs(work, exist_ok=True)
@@ -112,6 +115,19 @@ def main():
             {s["stage"]: s["seconds"] for s in json.load(open(os.path.join(work, "w1", "timings.json")))["stages"]}))
     # Mesa keeps the machine code of every shader it compiled in a disk cache
     # (~/.cache/mesa_shader_cache): every bake but a machine's first finds it.
+    # W3 (issue 15): W1 with one production cumulus layer; the render stage
+    # beside W1's, and the cloud passes' GPU time.
+    w3 = ["configs/benchmark/w3.toml"]
+    w3_stage_runs = []
+    results["w3_half"] = median_run(
+        "W3 half (W1 + cumulus layer)", bake(w3, "w3"), args.reps_w3,
+        after=lambda: w3_stage_runs.append(json.load(open(os.path.join(work, "w3", "timings.json")))))
+    if args.w3_sequence:
+        results["w3_sequence"] = median_run("W3 96 frames", bake(w3 + ["--schedule", "configs/benchmark/w2.toml"],
+                                                                 "w3s"), 1)
+    if args.only_clouds:
+        print_clouds(results, w1_stage_runs, w3_stage_runs)
+        return
     results["w1_cold"] = median_run("W1 half, Mesa shader cache off", bake(w1, "w1c"), args.reps_w1,
                                     env={"MESA_SHADER_CACHE_DISABLE": "true"})
     results["w1_float"] = median_run("W1 float", bake(w1 + floats, "w1f"), args.reps_w1)
@@ -203,6 +219,30 @@ def main():
     print(f"| render incl. SH (wall) | {render_s * 1e3:.0f} ms | | |")
     print(f"| encode + write + checksum 8 EXRs | {write_s * 1e3:.0f} ms | {raw_mb:.1f} MB of half RGB in, "
           f"{frame_mb:.2f} MB written | {raw_mb / write_s:.0f} MB/s in, {frame_mb / write_s:.1f} MB/s out |")
+    print_clouds(results, w1_stage_runs, w3_stage_runs)
+
+
+def print_clouds(results, w1_stage_runs, w3_stage_runs):
+    """W3 beside W1: the render stage, and the cloud passes of W3's first frame."""
+    def median_stage(runs, name):
+        return statistics.median([r[name] for r in runs])
+    w1_render = median_stage(w1_stage_runs, "render")
+    w3_render = statistics.median([{s["stage"]: s["seconds"] for s in t["stages"]}["render"] for t in w3_stage_runs])
+    passes = w3_stage_runs[-1]["frames"][0]["gpu_passes"]
+    cloud_ms = sum(p["gpu_ms"] for p in passes if p["name"].startswith("cloud"))
+    print("\n## Clouds (W3)\n")
+    print("| case | render stage (median) | runs |")
+    print("| --- | ---: | ---: |")
+    print(f"| W1 | {w1_render:.3f} s | {len(w1_stage_runs)} |")
+    print(f"| W3 | {w3_render:.3f} s ({w3_render / w1_render:.1f}x W1; target 8x) | {len(w3_stage_runs)} |")
+    for key in ("w3_half", "w3_sequence"):
+        if key in results:
+            r = results[key]
+            print(f"| {r['label']}, whole process | {r['wall']:.2f} s, {r['peak_max']:.0f} MiB peak | {len(r['walls'])} |")
+    print(f"\nW3's cloud passes (GPU, last run, frame and SH views): {cloud_ms:.0f} ms")
+    for p in passes:
+        if p["name"].startswith("cloud"):
+            print(f"- {p['name']}: {p['gpu_ms']:.1f} ms")
 
 
 if __name__ == "__main__":

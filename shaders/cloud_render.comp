@@ -1,0 +1,30 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// The cloud pass: for every texel of one output view, after the sky and
+// sun-disc passes wrote the clear sky there, the clouds in front of it and
+// the sky behind them attenuated by the clouds' transmittance.
+#include "common.glsl"
+#include "clouds.glsl"
+
+vec3 ViewDirection(ivec2 texel) {
+  int mapping = push.view.x;
+  if (mapping == MAPPING_LATLONG)
+    return DirectionFromLatLongPixel(float(texel.x), float(texel.y), push.view.y, push.view.z);
+  if (mapping == MAPPING_CUBE_STRIP) return DirectionFromCubeStripPixel(texel.x, texel.y, push.view.y);
+  if (mapping == MAPPING_VULKAN_FACE)
+    return DirectionFromVulkanCubeTexel(push.view.w, texel.x, texel.y, push.view.y);
+  return normalize(output_texels[push.offsets.z + texel.y * push.view.y + texel.x].xyz);
+}
+
+void main() {
+  ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  if (texel.x >= push.view.y || texel.y >= push.view.z) return;
+  vec3 view = ViewDirection(texel);
+  uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
+  AtmosphereParameters atm = AtmosphereFromUniform();
+  CloudMarch m = MarchClouds(atm, view, push.sun_direction.xyz);
+  if (m.transmittance == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
+  vec4 sky = output_texels[index];
+  output_texels[index] = vec4(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
+                                  m.transmittance * sky.xyz, sky.w);
+}

@@ -1,0 +1,546 @@
+// Volumetric cloud layers (include/skybake/clouds.h, docs/clouds.md), after
+// common.glsl: the noise volumes, the density, the aerial-perspective and
+// ambient tables, and the ray march that composites the clouds over the sky
+// the sky pass wrote.
+//
+// Frames and units: planet-centred world frame in km (+Y up, the observer
+// at (0, bottom_radius + observer_altitude, 0), North = -Z, East = +X);
+// extinction in km^-1; radiance per unit solar irradiance until the pass
+// multiplies by it.
+#ifndef SKYBAKE_CLOUDS_GLSL
+#define SKYBAKE_CLOUDS_GLSL
+
+layout(std140, set = 0, binding = BINDING_CLOUDS) uniform CloudBlock {
+  GpuClouds gpu_clouds;
+};
+layout(std430, set = 0, binding = BINDING_CLOUD_NOISE) buffer CloudNoiseBuffer {
+  float cloud_noise[];
+};
+layout(std430, set = 0, binding = BINDING_CLOUD_LUT) buffer CloudLutBuffer {
+  vec4 cloud_lut[];
+};
+// Active layers: the loops over layers have this bound, so a style's layer
+// count is compiled in (the cloud pipelines exist only when it is > 0).
+layout(constant_id = 20) const int kCloudLayers = 1;
+
+// ---------------------------------------------------------------- hashing and tiling noise
+
+// An integer mix with full avalanche (xor-shift-multiply rounds); the noise
+// depends on integer cell coordinates and the seed alone, so two bakes give
+// the same bytes.
+uint CloudHash(uint x) {
+  x ^= x >> 16;
+  x *= 0x21f0aaadu;
+  x ^= x >> 15;
+  x *= 0xd35a2d97u;
+  x ^= x >> 15;
+  return x;
+}
+
+uint CloudCellHash(ivec3 cell, uint seed) {
+  return CloudHash(uint(cell.x) ^ CloudHash(uint(cell.y) ^ CloudHash(uint(cell.z) ^ CloudHash(seed))));
+}
+
+float UnitFromHash(uint h) { return float(h >> 8) * (1.0 / 16777216.0); }
+
+// Cell coordinates wrapped into one tile of `period` cells (c >= -period).
+ivec3 WrapCell(ivec3 c, int period) { return (c + ivec3(period)) % ivec3(period); }
+
+// Worley (cellular) noise of a tile of period^3 cells, one feature point per
+// cell: 1 - distance to the nearest, in cell units, clamped. x in [0, 1)^3.
+float TiledWorley(vec3 x, int period, uint seed) {
+  vec3 p = x * float(period);
+  vec3 base = floor(p);
+  vec3 f = p - base;
+  ivec3 cell = ivec3(base);
+  float d2 = 1e9;
+  for (int k = -1; k <= 1; ++k) {
+    for (int j = -1; j <= 1; ++j) {
+      for (int i = -1; i <= 1; ++i) {
+        ivec3 o = ivec3(i, j, k);
+        uint h = CloudCellHash(WrapCell(cell + o, period), seed);
+        vec3 feature = vec3(UnitFromHash(h), UnitFromHash(CloudHash(h ^ 0x68e31da4u)),
+                            UnitFromHash(CloudHash(h ^ 0xb5297a4du)));
+        vec3 d = vec3(o) + feature - f;
+        d2 = min(d2, dot(d, d));
+      }
+    }
+  }
+  return 1.0 - clamp(sqrt(d2), 0.0, 1.0);
+}
+
+// Gradient (Perlin) noise of a tile of period^3 lattice cells; gradients
+// are the 12 cube-edge directions, picked by the hash. About [-1, 1].
+float LatticeGradient(ivec3 c, int period, uint seed, vec3 d) {
+  uint h = CloudCellHash(WrapCell(c, period), seed ^ 0x1b873593u);
+  vec3 g = vec3((h & 1u) != 0u ? 1.0 : -1.0, (h & 2u) != 0u ? 1.0 : -1.0, (h & 4u) != 0u ? 1.0 : -1.0);
+  uint zero = (h >> 3) % 3u;
+  if (zero == 0u) g.x = 0.0;
+  else if (zero == 1u) g.y = 0.0;
+  else g.z = 0.0;
+  return dot(g, d);
+}
+
+float TiledPerlin(vec3 x, int period, uint seed) {
+  vec3 p = x * float(period);
+  vec3 base = floor(p);
+  vec3 f = p - base;
+  ivec3 c = ivec3(base);
+  vec3 u = f * f * f * (f * (f * 6.0 - 15.0) + 10.0);  // Perlin 2002's quintic fade
+  float n000 = LatticeGradient(c + ivec3(0, 0, 0), period, seed, f - vec3(0, 0, 0));
+  float n100 = LatticeGradient(c + ivec3(1, 0, 0), period, seed, f - vec3(1, 0, 0));
+  float n010 = LatticeGradient(c + ivec3(0, 1, 0), period, seed, f - vec3(0, 1, 0));
+  float n110 = LatticeGradient(c + ivec3(1, 1, 0), period, seed, f - vec3(1, 1, 0));
+  float n001 = LatticeGradient(c + ivec3(0, 0, 1), period, seed, f - vec3(0, 0, 1));
+  float n101 = LatticeGradient(c + ivec3(1, 0, 1), period, seed, f - vec3(1, 0, 1));
+  float n011 = LatticeGradient(c + ivec3(0, 1, 1), period, seed, f - vec3(0, 1, 1));
+  float n111 = LatticeGradient(c + ivec3(1, 1, 1), period, seed, f - vec3(1, 1, 1));
+  float x00 = mix(n000, n100, u.x), x10 = mix(n010, n110, u.x);
+  float x01 = mix(n001, n101, u.x), x11 = mix(n011, n111, u.x);
+  return mix(mix(x00, x10, u.y), mix(x01, x11, u.y), u.z);
+}
+
+// Fractal sums over octaves of doubling period (each octave still tiles).
+float TiledPerlinFbm(vec3 x, int period, int octaves, uint seed) {
+  float sum = 0.0, weight = 1.0, total = 0.0;
+  for (int o = 0; o < octaves; ++o) {
+    sum += weight * TiledPerlin(x, period << o, seed + uint(o) * 101u);
+    total += weight;
+    weight *= 0.5;
+  }
+  return sum / total;
+}
+
+// Schneider 2015's Worley fbm: three octaves weighted 0.625, 0.25, 0.125.
+float TiledWorleyFbm(vec3 x, int period, uint seed) {
+  return 0.625 * TiledWorley(x, period, seed) + 0.25 * TiledWorley(x, 2 * period, seed + 7u) +
+         0.125 * TiledWorley(x, 4 * period, seed + 13u);
+}
+
+float Remap(float v, float lo, float hi, float new_lo, float new_hi) {
+  return new_lo + (v - lo) / (hi - lo) * (new_hi - new_lo);
+}
+
+// The shape volume: Perlin-Worley (Perlin fbm remapped by an inverted
+// low-frequency Worley, Schneider 2015), then eroded by a higher-frequency
+// Worley fbm; [0, 1].
+float ShapeNoiseValue(vec3 x, uint seed) {
+  float perlin = clamp(0.5 + 0.75 * TiledPerlinFbm(x, 4, 3, seed), 0.0, 1.0);
+  float worley = TiledWorleyFbm(x, 4, seed + 1000u);
+  float perlin_worley = clamp(Remap(perlin, worley - 1.0, 1.0, 0.0, 1.0), 0.0, 1.0);
+  float erosion = TiledWorleyFbm(x, 8, seed + 2000u);
+  float shape = Remap(perlin_worley, erosion - 1.0, 1.0, 0.0, 1.0);
+  // Spread over [0, 1] (the remaps leave it at mean 0.78, sd 0.07 for 48^3
+  // voxels, tests/clouds_test.cc): mean about 0.5, sd about 0.2.
+  return clamp((shape - 0.6) / 0.35, 0.0, 1.0);
+}
+
+// The detail volume: Worley fbm, [0, 1].
+float DetailNoiseValue(vec3 x, uint seed) { return TiledWorleyFbm(x, 4, seed + 3000u); }
+
+// The procedural weather map: 2D Perlin-Worley (the z = 0 plane of the
+// tiling 3D noise), spread over [0, 1] so that coverage 0.5 covers about half.
+float WeatherNoiseValue(vec2 x, uint seed) {
+  vec3 p = vec3(x, 0.0);
+  float perlin = clamp(0.5 + 0.9 * TiledPerlinFbm(p, 3, 4, seed + 4000u), 0.0, 1.0);
+  float worley = TiledWorleyFbm(p, 3, seed + 5000u);
+  float v = smoothstep(0.15, 0.85, clamp(Remap(perlin, worley - 1.0, 1.0, 0.0, 1.0), 0.0, 1.0));
+  // Spread over [0, 1] (v has mean 0.81, sd 0.14 on a 128^2 map): mean about 0.5.
+  return clamp((v - 0.81) / 0.56 + 0.5, 0.0, 1.0);
+}
+
+// ---------------------------------------------------------------- sampling the volumes
+
+// Wrapped neighbours of a texel index for p in [-0.5, n - 0.5): selects, not
+// integer modulo, which lavapipe runs lane by lane (a division each).
+ivec3 WrapLow(vec3 base, int n) {
+  ivec3 i = ivec3(base);
+  return mix(i, ivec3(n - 1), lessThan(base, vec3(0.0)));
+}
+ivec3 WrapHigh(ivec3 i0, int n) { return mix(i0 + ivec3(1), ivec3(0), equal(i0, ivec3(n - 1))); }
+
+// Trilinear read of an n^3 volume at `first`, wrapping (the volume tiles).
+float SampleVolume(int first, int n, vec3 uvw) {
+  vec3 p = fract(uvw) * float(n) - 0.5;
+  vec3 base = floor(p);
+  vec3 f = p - base;
+  ivec3 i0 = WrapLow(base, n);
+  ivec3 i1 = WrapHigh(i0, n);
+  int row0 = first + (i0.z * n + i0.y) * n, row1 = first + (i0.z * n + i1.y) * n;
+  int row2 = first + (i1.z * n + i0.y) * n, row3 = first + (i1.z * n + i1.y) * n;
+  float a = mix(cloud_noise[row0 + i0.x], cloud_noise[row0 + i1.x], f.x);
+  float b = mix(cloud_noise[row1 + i0.x], cloud_noise[row1 + i1.x], f.x);
+  float c = mix(cloud_noise[row2 + i0.x], cloud_noise[row2 + i1.x], f.x);
+  float d = mix(cloud_noise[row3 + i0.x], cloud_noise[row3 + i1.x], f.x);
+  return mix(mix(a, b, f.y), mix(c, d, f.y), f.z);
+}
+
+// Bilinear read of an n^2 map at `first`, wrapping.
+float SampleMap(int first, int n, vec2 uv) {
+  vec2 p = fract(uv) * float(n) - 0.5;
+  vec2 base = floor(p);
+  vec2 f = p - base;
+  ivec2 i0 = WrapLow(vec3(base, 0.0), n).xy;
+  ivec2 i1 = WrapHigh(ivec3(i0, 0), n).xy;
+  float a = mix(cloud_noise[first + i0.y * n + i0.x], cloud_noise[first + i0.y * n + i1.x], f.x);
+  float b = mix(cloud_noise[first + i1.y * n + i0.x], cloud_noise[first + i1.y * n + i1.x], f.x);
+  return mix(a, b, f.y);
+}
+
+// ---------------------------------------------------------------- density
+
+// The height profile: 0 below `stops.x`, rising to 1 at `stops.y`, 1 up to
+// `stops.z`, falling to 0 at `stops.w` (fractions of the thickness).
+float HeightProfile(vec4 stops, float hf) {
+  float rise = smoothstep(stops.x, max(stops.y, stops.x + 1e-4), hf);
+  float fall = 1.0 - smoothstep(stops.z, max(stops.w, stops.z + 1e-4), hf);
+  return rise * fall;
+}
+
+// Extinction (km^-1) of layer `l` at world horizontal position `xz` (km)
+// and altitude `h` (km). `detail`: erode with the detail noise (view
+// samples; the light march leaves it out).
+float LayerExtinction(int l, vec2 xz, float h, bool detail) {
+  GpuCloudLayer layer = gpu_clouds.layers[l];
+  float hf = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
+  if (hf <= 0.0 || hf >= 1.0) return 0.0;
+  float profile = HeightProfile(layer.profile, hf);
+  float coverage_key = layer.weather.x;
+  // Wind moves the whole layer (shear: more with height).
+  vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
+  float weather = SampleMap(layer.noise.z, gpu_clouds.resolution.z,
+                            (q - layer.weather_origin.xy) * layer.weather.yz);
+  // Local coverage: coverage 0.5 is the weather map as it is, 0 none, 1 all.
+  float coverage = clamp(2.0 * coverage_key - 1.0 + weather, 0.0, 1.0);
+  // Schneider 2015: remap(shape x profile, 1 - coverage, 1) x coverage; the
+  // shape is at most 1, so where the profile alone is below 1 - coverage
+  // there is no cloud and no volume is read.
+  if (coverage <= 0.0 || profile <= 1.0 - coverage) return 0.0;
+  float lift = h - layer.shell.x;
+  float shape = SampleVolume(layer.noise.x, gpu_clouds.resolution.x, vec3(q.x, lift, q.y) * layer.shape.y);
+  float base = mix(1.0, shape, layer.shape.x) * profile;
+  float d = clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage;
+  if (d <= 0.0) return 0.0;
+  if (detail && layer.shape.z > 0.0) {
+    float n = SampleVolume(layer.noise.y, gpu_clouds.resolution.y, vec3(q.x, lift, q.y) * layer.shape.w);
+    // Wispy at the base (inverted noise), billowy above (Schneider 2015).
+    float modifier = mix(1.0 - n, n, clamp(hf * 5.0, 0.0, 1.0));
+    float threshold = 0.35 * layer.shape.z * modifier;
+    d = clamp((d - threshold) / (1.0 - threshold), 0.0, 1.0);
+  }
+  return d * layer.shell.z;
+}
+
+float CloudExtinction(vec2 xz, float h, bool detail) {
+  float sigma = 0.0;
+  for (int l = 0; l < kCloudLayers; ++l) sigma += LayerExtinction(l, xz, h, detail);
+  return sigma;
+}
+
+// ---------------------------------------------------------------- the tables
+
+// Aerial-perspective LUT texel (x, y): x the azimuth from the Sun in [0, pi],
+// y the zenith angle in [0, pi], both with texel centres on the ends; slice
+// k at distance max_distance ((k + 1) / slices)^2.
+int CloudApWidth() { return gpu_clouds.lut.x; }
+int CloudApHeight() { return gpu_clouds.lut.y; }
+int CloudApSlices() { return gpu_clouds.lut.z; }
+float CloudApSliceDistance(int k) {
+  float s = float(k + 1) / float(CloudApSlices());
+  return gpu_clouds.range.x * s * s;
+}
+int CloudApIndex(int x, int y, int k) { return (k * CloudApHeight() + y) * CloudApWidth() + x; }
+int CloudApTexels() { return CloudApWidth() * CloudApHeight() * CloudApSlices(); }
+// Ambient rows after the LUT's in-scattering and transmittance halves:
+// altitude row i at range.y i / (rows - 1); two texels (sky above, ground below).
+int CloudAmbientIndex(int row, int half_) { return 2 * CloudApTexels() + 2 * row + half_; }
+
+vec3 CloudApDirection(int x, int y, out vec3 sun_frame_sun, float mu_s) {
+  float azimuth = kPi * float(x) / float(CloudApWidth() - 1);
+  float zenith = kPi * float(y) / float(CloudApHeight() - 1);
+  sun_frame_sun = SunInSkyViewFrame(mu_s);
+  return vec3(sin(zenith) * cos(azimuth), cos(zenith), sin(zenith) * sin(azimuth));
+}
+
+// The atmosphere's in-scattering and transmittance from the observer along
+// the texel's direction to every slice distance (Hillaire 2020's aerial
+// perspective, in the sky-view LUT's sun frame), 4 analytic steps per slice.
+void ComputeCloudApColumn(IN(AtmosphereParameters) atm, int x, int y, vec3 sun_world) {
+  vec3 sun;
+  vec3 view = CloudApDirection(x, y, sun, ClampCosine(sun_world.y));
+  SkyRay ray;
+  ray.altitude = atm.observer_altitude;
+  ray.r = atm.bottom_radius + ray.altitude;
+  ray.mu = ClampCosine(view.y);
+  ray.mu_s = ClampCosine(sun.y);
+  ray.nu = ClampCosine(dot(view, sun));
+  ray.in_atmosphere = true;
+  ray.hits_ground = false;
+  ray.t_max = gpu_clouds.range.x;
+  float rayleigh_phase = RayleighPhase(ray.nu);
+  float mie_phase = atm.mie ? MiePhase(atm.mie_g, view, sun) : 0.0;
+  vec3 radiance = vec3(0.0);
+  vec3 transmittance = vec3(1.0);
+  float t_start = 0.0;
+  const int kSubsteps = 4;
+  for (int k = 0; k < CloudApSlices(); ++k) {
+    float t_end = CloudApSliceDistance(k);
+    float dt = (t_end - t_start) / float(kSubsteps);
+    for (int s = 0; s < kSubsteps; ++s) {
+      float t_mid = t_start + (float(s) + 0.5) * dt;
+      ScatteringSample sample_ = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_mid);
+      radiance += transmittance * sample_.source * (dt * OneMinusExpOverX3(sample_.extinction * dt));
+      transmittance *= exp(-sample_.extinction * dt);
+    }
+    t_start = t_end;
+    cloud_lut[CloudApIndex(x, y, k)] = vec4(radiance, 0.0);
+    cloud_lut[CloudApTexels() + CloudApIndex(x, y, k)] = vec4(transmittance, 0.0);
+  }
+}
+
+// Mean sky radiance over the upper hemisphere and mean radiance from below
+// (the sunlit ground through the air, and the air) at altitude row `row`:
+// 8 azimuths x 4 rings of equal solid angle per hemisphere, 16 steps each.
+void ComputeCloudAmbientRow(IN(AtmosphereParameters) atm_in, int row, vec3 sun) {
+  AtmosphereParameters atm = atm_in;
+  int rows = gpu_clouds.lut.w;
+  atm.observer_altitude = gpu_clouds.range.y * float(row) / float(rows - 1);
+  atm.view_steps = 16;
+  atm.integrator = INTEGRATOR_ANALYTIC;
+  vec3 up = vec3(0.0), down = vec3(0.0);
+  for (int ring = 0; ring < 4; ++ring) {
+    float mu = (float(ring) + 0.5) / 4.0;
+    float s = sqrt(1.0 - mu * mu);
+    for (int a = 0; a < 8; ++a) {
+      float phi = 2.0 * kPi * (float(a) + 0.5) / 8.0;
+      up += ComputeSkyRadianceWithoutSun(atm, vec3(s * cos(phi), mu, s * sin(phi)), sun).radiance;
+      down += ComputeSkyRadianceWithoutSun(atm, vec3(s * cos(phi), -mu, s * sin(phi)), sun).radiance;
+    }
+  }
+  cloud_lut[CloudAmbientIndex(row, 0)] = vec4(up / 32.0, 0.0);
+  cloud_lut[CloudAmbientIndex(row, 1)] = vec4(down / 32.0, 0.0);
+}
+
+// ---------------------------------------------------------------- lighting
+
+float HenyeyGreenstein(float g, float cos_theta) {
+  float denom = 1.0 + g * g - 2.0 * g * cos_theta;
+  return (1.0 - g * g) / (4.0 * kPi * denom * sqrt(denom));
+}
+
+// Dual-lobe Henyey-Greenstein, both lobes' g scaled by `eccentricity`.
+float CloudPhase(float cos_theta, float eccentricity) {
+  return mix(HenyeyGreenstein(gpu_clouds.phase.y * eccentricity, cos_theta),
+             HenyeyGreenstein(gpu_clouds.phase.x * eccentricity, cos_theta), gpu_clouds.phase.z);
+}
+
+// Optical depth (dimensionless) toward the Sun from a view sample, marched
+// with light_steps samples placed quadratically (dense near the sample)
+// over the distance to the top of the sample's band along the Sun, at most
+// kCloudLightDistanceKm.
+const float kCloudLightDistanceKm = 8.0;
+float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top) {
+  float reach = (band_top - h) / max(mu_s, 0.1);
+  float distance = min(max(reach, 0.05), kCloudLightDistanceKm);
+  int n = gpu_clouds.counts.z;
+  float r = atm.bottom_radius + h;
+  float depth = 0.0;
+  float s0 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    float u1 = float(i + 1) / float(n);
+    float s1 = distance * u1 * u1;
+    float s = 0.5 * (s0 + s1);
+    float hs = AltitudeAlongRay(atm, r, h, mu_s, s);
+    depth += CloudExtinction(xz + s * sun.xz, hs, false) * (s1 - s0);
+    s0 = s1;
+  }
+  return depth;
+}
+
+// The ambient table at altitude h: x sky above, y ground below.
+vec3 CloudAmbient(float h, float hf) {
+  int rows = gpu_clouds.lut.w;
+  float y = clamp(h / gpu_clouds.range.y, 0.0, 1.0) * float(rows - 1);
+  int y0 = min(int(y), rows - 2);
+  float f = y - float(y0);
+  vec3 up = mix(cloud_lut[CloudAmbientIndex(y0, 0)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 0)].xyz, f);
+  vec3 down = mix(cloud_lut[CloudAmbientIndex(y0, 1)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 1)].xyz, f);
+  // Mean incident radiance over the sphere, the sky half occluded towards
+  // the cloud's base and the ground half towards its top (takram's height
+  // factor hf / 2 + 1 / 2).
+  return 0.5 * up * (0.5 + 0.5 * hf) + 0.5 * down * (1.0 - 0.5 * hf);
+}
+
+// ---------------------------------------------------------------- the march
+
+struct CloudApTexel {
+  int x0, x1, y0, y1;
+  float fx, fy;
+};
+
+CloudApTexel CloudApTexelOf(vec3 view, vec3 sun) {
+  float horizontal = length(vec2(view.x, view.z));
+  float zenith = atan(horizontal, view.y);
+  float cos_part = view.x * sun.x + view.z * sun.z;
+  float sin_part = abs(view.x * sun.z - view.z * sun.x);
+  float azimuth = (sin_part > 0.0 || cos_part != 0.0) ? atan(sin_part, cos_part) : 0.0;
+  CloudApTexel t;
+  float x = clamp(azimuth / kPi, 0.0, 1.0) * float(CloudApWidth() - 1);
+  float y = clamp(zenith / kPi, 0.0, 1.0) * float(CloudApHeight() - 1);
+  t.x0 = min(int(x), CloudApWidth() - 2);
+  t.y0 = min(int(y), CloudApHeight() - 2);
+  t.x1 = t.x0 + 1;
+  t.y1 = t.y0 + 1;
+  t.fx = x - float(t.x0);
+  t.fy = y - float(t.y0);
+  return t;
+}
+
+vec3 CloudApRead(IN(CloudApTexel) t, int k, int half_) {
+  int o = half_ * CloudApTexels();
+  vec3 a = mix(cloud_lut[o + CloudApIndex(t.x0, t.y0, k)].xyz, cloud_lut[o + CloudApIndex(t.x1, t.y0, k)].xyz, t.fx);
+  vec3 b = mix(cloud_lut[o + CloudApIndex(t.x0, t.y1, k)].xyz, cloud_lut[o + CloudApIndex(t.x1, t.y1, k)].xyz, t.fx);
+  return mix(a, b, t.fy);
+}
+
+// In-scattering (half 0) or transmittance (half 1) of the atmosphere from
+// the viewer to distance t along the texel's direction.
+vec3 CloudAerialPerspective(IN(CloudApTexel) texel, float t, int half_) {
+  float s = sqrt(clamp(t / gpu_clouds.range.x, 0.0, 1.0)) * float(CloudApSlices()) - 1.0;
+  vec3 at_zero = half_ == 0 ? vec3(0.0) : vec3(1.0);
+  if (s < 0.0) return mix(at_zero, CloudApRead(texel, 0, half_), s + 1.0);
+  int k0 = min(int(s), CloudApSlices() - 2);
+  return mix(CloudApRead(texel, k0, half_), CloudApRead(texel, k0 + 1, half_), s - float(k0));
+}
+
+struct CloudMarch {
+  vec3 radiance;        // clouds and the air in front of them, per unit solar irradiance
+  float transmittance;  // of the clouds along the whole ray (grey)
+};
+
+// Distance along the ray (r0, mu) to altitude H on the descending (sign
+// -1) or ascending (+1) branch; r_H^2 - r0^2 formed from altitudes.
+float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float mu, float H, float branch) {
+  float disc = r0 * r0 * mu * mu + (H - h0) * (2.0 * atm.bottom_radius + H + h0);
+  return -r0 * mu + branch * sqrt(max(disc, 0.0));
+}
+
+// Marches the view ray through the part [t0, t1] of a band of thickness
+// `band_thickness`: steps of a third of view_steps per thickness crossed,
+// at most view_steps (a vertical crossing takes a third of them, a
+// crossing near the horizon all).
+void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(CloudApTexel) ap, float t0, float t1,
+                       float band_top, float band_thickness, inout CloudMarch m) {
+  if (t1 <= t0 || m.transmittance <= 0.0) return;
+  float r0 = atm.bottom_radius + atm.observer_altitude;
+  int max_steps = gpu_clouds.counts.y;
+  float crossings = (t1 - t0) / band_thickness;
+  int n = clamp(int(ceil(crossings * float(max_steps) / 3.0)), 1, max_steps);
+  float dt = (t1 - t0) / float(n);
+  float cos_theta = dot(view, sun);
+  int octaves = gpu_clouds.counts.w;
+  for (int i = 0; i < n; ++i) {
+    float t = t0 + (float(i) + 0.5) * dt;
+    float h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
+    vec2 xz = t * view.xz;
+    float sigma_t = CloudExtinction(xz, h, true);
+    if (sigma_t <= 0.0) continue;
+    // The sample's local vertical and the Sun's cosine zenith there.
+    vec3 p = vec3(xz.x, r0 + t * view.y, xz.y);
+    float mu_s = dot(p, sun) / (atm.bottom_radius + h);
+    float r = atm.bottom_radius + h;
+    vec3 sun_light = GetTransmittanceToSun(atm, r, h, ClampCosine(mu_s));
+    vec3 scattered = vec3(0.0);
+    if (max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
+      float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
+      // Wrenninge 2013: octave o scatters a^o of the light, sees b^o of the
+      // optical depth and a phase of eccentricity c^o.
+      float a = 1.0, b = 1.0, c = 1.0, sum = 0.0;
+      for (int o = 0; o < octaves; ++o) {
+        sum += a * exp(-b * tau) * CloudPhase(cos_theta, c);
+        a *= gpu_clouds.octave.x;
+        b *= gpu_clouds.octave.y;
+        c *= gpu_clouds.octave.z;
+      }
+      scattered = sun_light * sum;
+    }
+    // The layer the sample is in decides albedo and the height factor
+    // (overlapping layers: the first that has density there).
+    float albedo = gpu_clouds.layers[0].shell.w;
+    float hf = 0.5;
+    for (int l = 0; l < kCloudLayers; ++l) {
+      GpuCloudLayer layer = gpu_clouds.layers[l];
+      float f = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
+      if (f > 0.0 && f < 1.0) {
+        albedo = layer.shell.w;
+        hf = f;
+        break;
+      }
+    }
+    vec3 source = albedo * (scattered + CloudAmbient(h, hf));
+    // Hillaire 2016 section 5.6.3: the in-scattering integrated over the step
+    // with the transmittance inside it, S (1 - exp(-sigma_t dt)) / sigma_t,
+    // here with S = sigma_s J = albedo sigma_t J.
+    float step_transmittance = exp(-sigma_t * dt);
+    float absorbed = m.transmittance * (1.0 - step_transmittance);
+    // The air between the viewer and the sample: the cloud's light through
+    // its transmittance, and the air's own in-scattering in front of the
+    // cloud where the cloud hides what lies behind.
+    m.radiance += CloudAerialPerspective(ap, t, 1) * source * absorbed + CloudAerialPerspective(ap, t, 0) * absorbed;
+    m.transmittance *= step_transmittance;
+    // Early exit: what lies behind would add less than 1e-3 of itself; it
+    // is dropped (transmittance 0), so a thick deck hides the sun disc.
+    if (m.transmittance < 1e-3) {
+      m.transmittance = 0.0;
+      return;
+    }
+  }
+}
+
+// The clouds along `view`: every band the ray crosses, in order, before the
+// ground and within range.x of the viewer.
+CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  CloudMarch m;
+  m.radiance = vec3(0.0);
+  m.transmittance = 1.0;
+  CloudApTexel ap = CloudApTexelOf(view, sun);
+  float h0 = atm.observer_altitude;
+  float r0 = atm.bottom_radius + h0;
+  float mu = ClampCosine(view.y);
+  float t_far = gpu_clouds.range.x;
+  int bands = gpu_clouds.resolution.w;
+  // The descending branch (mu < 0): altitude falls to the perigee, or to
+  // the ground.
+  float t_perigee = 0.0;
+  float h_perigee = h0;
+  bool ground = false;
+  if (mu < 0.0) {
+    t_perigee = -r0 * mu;
+    h_perigee = AltitudeAlongRay(atm, r0, h0, mu, t_perigee);
+    ground = h_perigee <= 0.0;
+    float t_end = ground ? CloudRayToAltitude(atm, r0, h0, mu, 0.0, -1.0) : t_perigee;
+    for (int b = CLOUD_MAX_LAYERS - 1; b >= 0; --b) {
+      if (b >= bands) continue;
+      float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
+      if (h0 <= lo || h_perigee >= hi) continue;
+      float ta = h0 > hi ? CloudRayToAltitude(atm, r0, h0, mu, hi, -1.0) : 0.0;
+      float tb = h_perigee < lo ? CloudRayToAltitude(atm, r0, h0, mu, lo, -1.0) : t_end;
+      MarchCloudSegment(atm, view, sun, ap, ta, min(min(tb, t_end), t_far), hi, hi - lo, m);
+    }
+  }
+  if (!ground) {
+    // The ascending branch, from the perigee (or the viewer) up.
+    float t_start = max(t_perigee, 0.0);
+    for (int b = 0; b < CLOUD_MAX_LAYERS; ++b) {
+      if (b >= bands) continue;
+      float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
+      if (hi <= h_perigee) continue;
+      float ta = h_perigee < lo ? CloudRayToAltitude(atm, r0, h0, mu, lo, 1.0) : t_start;
+      float tb = CloudRayToAltitude(atm, r0, h0, mu, hi, 1.0);
+      MarchCloudSegment(atm, view, sun, ap, max(ta, t_start), min(tb, t_far), hi, hi - lo, m);
+    }
+  }
+  return m;
+}
+
+#endif  // SKYBAKE_CLOUDS_GLSL

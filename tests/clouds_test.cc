@@ -1,0 +1,607 @@
+// Volumetric cloud layers (clouds.h): the style's keys and their checks, the
+// noise volumes (deterministic, tiling, spread over [0, 1]), and the cloud
+// pass on lavapipe under the validation layer.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <OpenImageIO/imageio.h>
+#include <glm/glm.hpp>
+
+#include "skybake/clouds.h"
+#include "skybake/config.h"
+#include "skybake/envmap.h"
+#include "skybake/pass_plan.h"
+#include "skybake/pipeline.h"
+#include "skybake/reference_model.h"
+#include "skybake/sky_renderer.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+SkyStyle Style(const std::string& toml, const std::vector<std::string>& overrides = {}) {
+  ConfigResult r = ParseSkyStyle(toml, "clouds_test.toml", overrides);
+  EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].Format());
+  return r.style;
+}
+
+std::vector<std::string> Errors(const std::string& toml) {
+  ConfigResult r = ParseSkyStyle(toml, "clouds_test.toml");
+  std::vector<std::string> out;
+  for (const ConfigError& e : r.errors) out.push_back(e.Format());
+  return out;
+}
+
+const char* kCumulus = R"(
+[[cloud_layer]]
+altitude_m = 1500
+thickness_m = 1500
+type = "cumulus"
+coverage = 0.5
+)";
+
+// A renderer for a style as the bake builds it (pruned, styled).
+struct StyleRenderer {
+  explicit StyleRenderer(const SkyStyle& unpruned, double time_s = 0.0) {
+    const SkyStyle style = PrunedStyle(unpruned);
+    renderer = std::make_unique<SkyRenderer>(
+        testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+        OutputScale(style.output.units), false, ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+        ToCloudInputs(style.clouds, style.aoas.seed, "", time_s));
+  }
+  std::unique_ptr<SkyRenderer> renderer;
+};
+
+[[maybe_unused]] glm::dvec3 Sun(double elevation_deg, double azimuth_deg = 135.0) {
+  return SunDirectionFromElevationAzimuth(elevation_deg, azimuth_deg);
+}
+
+// ---------------------------------------------------------------- the style
+
+TEST(CloudStyle, NoLayersByDefault) {
+  SkyStyle s = Style("");
+  EXPECT_TRUE(s.clouds.layers.empty());
+  EXPECT_EQ(ToCloudInputs(s.clouds, s.aoas.seed, "", 0.0).layers(), 0);
+}
+
+TEST(CloudStyle, LayerKeysAreRead) {
+  SkyStyle s = Style(R"(
+[aoas]
+seed = 9
+[[cloud_layer]]
+altitude_m = 800
+thickness_m = 400
+type = "custom"
+profile = [0.0, 0.2, 0.4, 0.9]
+coverage = 0.7
+density_per_m = 0.02
+albedo = 0.95
+shape_amount = 0.5
+shape_size_m = 3000
+detail_amount = 0.2
+detail_size_m = 300
+wind_m_s = [10.0, -5.0]
+shear_m_s_per_km = [2.0, 0.0]
+weather_size_m = 20000
+)");
+  ASSERT_EQ(s.clouds.layers.size(), 1u);
+  const CloudLayer& l = s.clouds.layers[0];
+  EXPECT_EQ(l.type, CloudType::kCustom);
+  EXPECT_EQ(l.profile[3], 0.9);
+  EXPECT_EQ(l.wind_m_s[1], -5.0);
+  EXPECT_FALSE(l.seed.has_value());
+  // The seed falls back to aoas.seed; wind x time moves the layer (east = +x, north = -z).
+  CloudInputs in = ToCloudInputs(s.clouds, s.aoas.seed, "", 100.0);
+  EXPECT_EQ(in.uniform.layers[0].noise.w, 9);
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.x, 1.0f);   // 10 m/s x 100 s = 1 km
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.y, 0.5f);   // 5 m/s south
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.z, 0.2f);   // 2 m/s per km x 100 s
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].shell.z, 20.0f);        // 0.02 /m = 20 /km
+  // The resolved style records the layer, so a bake says what it used.
+  EXPECT_NE(s.resolved_toml.find("[[cloud_layer]]"), std::string::npos) << s.resolved_toml;
+  SkyStyle again = Style(s.resolved_toml);
+  EXPECT_EQ(again.resolved_toml, s.resolved_toml);
+  // A named type's resolved style round-trips too (its profile is the type's).
+  SkyStyle named = Style(kCumulus);
+  SkyStyle named_again = Style(named.resolved_toml);
+  EXPECT_EQ(named_again.resolved_toml, named.resolved_toml);
+  EXPECT_EQ(named_again.clouds.layers[0].profile, CloudTypeProfile(CloudType::kCumulus));
+}
+
+TEST(CloudStyle, PresetsSetTheCloudSampling) {
+  EXPECT_EQ(Style("[quality]\npreset = \"draft\"\n").clouds.quality.view_steps, CloudQualityPreset("draft").view_steps);
+  EXPECT_EQ(Style("[quality]\npreset = \"reference\"\n").clouds.quality.light_steps,
+            CloudQualityPreset("reference").light_steps);
+  EXPECT_LT(CloudQualityPreset("draft").view_steps, CloudQualityPreset("production").view_steps);
+  EXPECT_LT(CloudQualityPreset("production").view_steps, CloudQualityPreset("reference").view_steps);
+  EXPECT_EQ(Style("[quality]\npreset = \"draft\"\ncloud_view_steps = 7\n").clouds.quality.view_steps, 7);
+}
+
+TEST(CloudStyle, BadLayersAreLocated) {
+  auto has = [](const std::vector<std::string>& errors, const std::string& text) {
+    for (const std::string& e : errors)
+      if (e.find(text) != std::string::npos) return true;
+    return false;
+  };
+  std::vector<std::string> e = Errors("[[cloud_layer]]\ncoverage = 1.5\n");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_EQ(e[0], "clouds_test.toml:2:12: cloud_layer[0].coverage: expected a number in [0, 1]");
+  e = Errors("[[cloud_layer]]\naltitude_m = 99000\nthickness_m = 2000\n");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_TRUE(has(e, "clouds_test.toml:3:15: cloud_layer[0].thickness_m: the layer's top at 101000 m is above"))
+      << e[0];
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\naltitude_m = -10\n"), "cloud_layer[0].altitude_m: expected a number in [0"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\nthickness_m = 0\n"), "cloud_layer[0].thickness_m"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\ntype = \"nimbus\"\n"), "expected 'stratus'"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\nprofile = [0, 0.1, 0.2, 0.3]\n"), "needs type = \"custom\""));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\ntype = \"custom\"\nprofile = [0.5, 0.1, 0.2, 0.3]\n"),
+                  "cloud_layer[0].profile: [0.5, 0.1, 0.2, 0.3]: expected"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\ncolour = 3\n"), "cloud_layer[0].colour: unknown key 'colour'"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\nwind_m_s = [1.0]\n"), "cloud_layer[0].wind_m_s: expected [east, north]"));
+  std::string five;
+  for (int i = 0; i < 5; ++i) five += fmt::format("[[cloud_layer]]\naltitude_m = {}\n", 1000 * i);
+  e = Errors(five);
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_TRUE(has(e, "cloud_layer[4]: 5 cloud layers; at most 4 fit")) << e[0];
+  e = Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n[[cloud_layer]]\n");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_TRUE(has(e, "clouds_test.toml:3:21: quality.cloud_light_steps: 1 cloud layer(s) x 768 view steps x 128 "
+                     "light steps may run")) << e[0];
+  EXPECT_TRUE(Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n").empty())
+      << "without layers the cloud settings run nothing";
+  e = Errors("[[cloud_layer]]\nweather_image = \"no_such_weather.png\"\n");
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_TRUE(has(e, "clouds_test.toml:2:17: cloud_layer[0].weather_image: no_such_weather.png: no such file")) << e[0];
+}
+
+// ---------------------------------------------------------------- noise
+
+TEST(CloudNoise, DeterministicSpreadAndSeeded) {
+  SkyStyle style = Style(std::string("[quality]\npreset = \"draft\"\n") + kCumulus);
+  StyleRenderer a(style);
+  a.renderer->PrecomputeLuts();
+  const std::vector<float> noise = a.renderer->ReadCloudNoise();
+  const gpu::GpuClouds g = ToCloudInputs(PrunedStyle(style).clouds, 1, "", 0.0).uniform;
+  ASSERT_EQ(noise.size(), CloudNoiseFloats(g));
+  auto stats = [&](int first, size_t count, const char* name) {
+    double mean = 0.0, mean2 = 0.0, lo = 1e9, hi = -1e9;
+    for (size_t i = 0; i < count; ++i) {
+      const double v = noise[first + i];
+      ASSERT_TRUE(std::isfinite(v) && v >= 0.0 && v <= 1.0) << name << " " << i << " " << v;
+      mean += v;
+      mean2 += v * v;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    mean /= count;
+    const double sd = std::sqrt(std::max(mean2 / count - mean * mean, 0.0));
+    std::printf("%s: mean %.3f sd %.3f min %.3f max %.3f\n", name, mean, sd, lo, hi);
+    EXPECT_GT(sd, 0.08) << name;
+    EXPECT_GT(hi - lo, 0.5) << name;
+  };
+  const int ns = g.resolution.x, nd = g.resolution.y, nw = g.resolution.z;
+  stats(g.layers[0].noise.x, size_t(ns) * ns * ns, "shape");
+  stats(g.layers[0].noise.y, size_t(nd) * nd * nd, "detail");
+  stats(g.layers[0].noise.z, size_t(nw) * nw, "weather");
+  // The same seed gives the same bytes; another seed other noise.
+  StyleRenderer b(style);
+  b.renderer->PrecomputeLuts();
+  EXPECT_EQ(std::memcmp(noise.data(), b.renderer->ReadCloudNoise().data(), noise.size() * 4), 0);
+  style.aoas.seed = 2;
+  StyleRenderer c(style);
+  c.renderer->PrecomputeLuts();
+  EXPECT_NE(std::memcmp(noise.data(), c.renderer->ReadCloudNoise().data(), noise.size() * 4), 0);
+  testing::ExpectNoValidationMessages();
+}
+
+// ---------------------------------------------------------------- the cloud pass
+
+const char* kFast = R"(
+[quality]
+preset = "draft"
+)";
+
+// Every view of a small bake plus the SH faces and the sun direction, from
+// one renderer.
+std::vector<std::vector<float>> RenderAll(const SkyStyle& style, const glm::dvec3& sun, int n, double time_s = 0.0) {
+  StyleRenderer r(style, time_s);
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 2 * n, n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+  for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+  std::vector<std::vector<float>> images = r.renderer->Render(sun, views);
+  images.push_back(r.renderer->RenderDirections(sun, {sun}));
+  images.push_back(r.renderer->RenderDirections(sun, {sun}, false));
+  return images;
+}
+
+// A layer of coverage 0 or density 0 is pruned: no cloud pipeline, and the
+// same bytes as the style without it.
+TEST(CloudPass, PrunedLayerIsByteIdenticalToNoLayer) {
+  const glm::dvec3 sun = Sun(20.0);
+  const SkyStyle plain = Style(kFast);
+  const std::vector<std::vector<float>> expected = RenderAll(plain, sun, 16);
+  for (const char* layer : {"coverage = 0.0", "density_per_m = 0.0"}) {
+    SkyStyle pruned = Style(std::string(kFast) + "[[cloud_layer]]\ntype = \"cumulus\"\n" + layer + "\n");
+    ASSERT_EQ(pruned.clouds.layers.size(), 1u);
+    EXPECT_FALSE(PlanPasses({pruned}).variant.find("clouds: none") == std::string::npos) << layer;
+    StyleRenderer r(pruned);
+    EXPECT_EQ(r.renderer->counters().pipelines, StyleRenderer(plain).renderer->counters().pipelines) << layer;
+    const std::vector<std::vector<float>> images = RenderAll(pruned, sun, 16);
+    ASSERT_EQ(images.size(), expected.size());
+    for (size_t i = 0; i < images.size(); ++i)
+      EXPECT_TRUE(images[i] == expected[i]) << layer << ", view " << i;
+  }
+  // The same layer with coverage does change the sky (the test is not vacuous).
+  const std::vector<std::vector<float>> cloudy = RenderAll(Style(std::string(kFast) + kCumulus), sun, 16);
+  EXPECT_FALSE(cloudy[0] == expected[0]);
+  testing::ExpectNoValidationMessages();
+}
+
+// Wind moves the clouds by wind x time and nothing else: after exactly one
+// tile period of every noise (8 km at 80 m/s in 100 s) the sky is the same
+// to float rounding; after half of it, it differs; two renders of the same
+// time give the same bytes.
+TEST(CloudPass, WindMovesTheCloudsWithoutReRandomising) {
+  const SkyStyle style = Style(std::string(kFast) + R"(
+[[cloud_layer]]
+altitude_m = 1000
+thickness_m = 1000
+coverage = 0.5
+weather_size_m = 8000
+shape_size_m = 4000
+detail_size_m = 400
+wind_m_s = [80.0, 0.0]
+)");
+  const glm::dvec3 sun = Sun(30.0);
+  const ViewRequest latlong{MAPPING_LATLONG, 64, 32, 0};
+  auto render = [&](double t) { return StyleRenderer(style, t).renderer->Render(sun, {latlong})[0]; };
+  const std::vector<float> t0 = render(0.0), t50 = render(50.0), t100 = render(100.0);
+  EXPECT_TRUE(render(50.0) == t50);
+  double moved = 0.0, back = 0.0, sum = 0.0;
+  for (size_t i = 0; i < t0.size(); i += 4) {
+    for (int c = 0; c < 3; ++c) {
+      moved += std::abs(t50[i + c] - t0[i + c]);
+      back = std::max(back, double(std::abs(t100[i + c] - t0[i + c])) / std::max(t0[i + c], 1e-3f));
+      sum += t0[i + c];
+    }
+  }
+  EXPECT_GT(moved / sum, 0.01) << "half a period later the clouds have moved";
+  EXPECT_LT(back, 2e-3) << "a whole period later they are back where they were";
+  // UpdateClouds (what a sequence does between frames) gives the same bytes
+  // as a renderer built for that time.
+  StyleRenderer r(style, 0.0);
+  r.renderer->Render(sun, {latlong});
+  ASSERT_TRUE(r.renderer->UpdateClouds(ToCloudInputs(PrunedStyle(style).clouds, 1, "", 50.0)));
+  EXPECT_TRUE(r.renderer->Render(sun, {latlong})[0] == t50);
+  EXPECT_EQ(r.renderer->counters().cloud_noise_builds, 1) << "the wind does not regenerate the noise";
+  testing::ExpectNoValidationMessages();
+}
+
+struct CloudCase {
+  std::string name;
+  std::string toml;                 // after kFast
+  std::vector<double> suns_deg;     // sun elevations
+  int cube = 24;
+  bool dim_not_black = false;       // overcast: the sky under it is dim but not black
+};
+
+void CheckFiniteNonNegative(const std::vector<float>& image, const std::string& what) {
+  for (size_t i = 0; i < image.size(); ++i) {
+    if (i % 4 == 3) continue;
+    ASSERT_TRUE(std::isfinite(image[i]) && image[i] >= 0.0f) << what << ": texel " << i / 4 << " = " << image[i];
+  }
+}
+
+class CloudHardCase : public ::testing::TestWithParam<CloudCase> {};
+
+TEST_P(CloudHardCase, FiniteNonNegativeAndContinuous) {
+  const CloudCase& c = GetParam();
+  const SkyStyle style = Style(std::string(kFast) + c.toml);
+  const SkyStyle clear = Style(kFast + std::string(c.toml.substr(0, c.toml.find("[[cloud_layer]]"))));
+  ASSERT_FALSE(ActiveCloudLayers(style.clouds).empty());
+  StyleRenderer r(style);
+  for (double elevation : c.suns_deg) {
+    const glm::dvec3 sun = Sun(elevation);
+    const std::string what = fmt::format("{}, sun {} deg", c.name, elevation);
+    const int n = c.cube;
+    const ViewRequest strip{MAPPING_CUBE_STRIP, n, 6 * n, 0};
+    const ViewRequest latlong{MAPPING_LATLONG, 64, 32, 0};
+    std::vector<std::vector<float>> images = r.renderer->Render(sun, {strip, latlong});
+    CheckFiniteNonNegative(images[0], what + ", strip");
+    CheckFiniteNonNegative(images[1], what + ", latlong");
+    // Cube edges: the strip's edge texels of neighbouring faces sit on the
+    // same directions (Imf::CubeMap), so they must agree.
+    const std::vector<glm::dvec3> dirs = ViewDirections(strip);
+    std::map<std::array<long, 3>, std::vector<size_t>> by_direction;
+    for (size_t i = 0; i < dirs.size(); ++i)
+      by_direction[{std::lround(dirs[i].x * 1e6), std::lround(dirs[i].y * 1e6), std::lround(dirs[i].z * 1e6)}]
+          .push_back(i);
+    int pairs = 0;
+    double worst = 0.0;
+    for (const auto& [key, texels] : by_direction)
+      for (size_t k = 1; k < texels.size(); ++k, ++pairs)
+        for (int ch = 0; ch < 3; ++ch) {
+          const double a = images[0][4 * texels[0] + ch], b = images[0][4 * texels[k] + ch];
+          worst = std::max(worst, std::abs(a - b) / std::max(std::max(a, b), 1e-6));
+        }
+    EXPECT_EQ(pairs, 12 * (n - 2) + 8 * 2) << what;
+    EXPECT_LT(worst, 2e-3) << what << ": cube edges";
+    // Latlong seam: the step from the last column to the first is no larger
+    // than the steps between neighbouring columns elsewhere in that row.
+    const std::vector<float>& ll = images[1];
+    double seam = 0.0, interior = 0.0;
+    for (int y = 0; y < 32; ++y)
+      for (int ch = 0; ch < 3; ++ch) {
+        seam = std::max(seam, double(std::abs(ll[4 * (y * 64 + 63) + ch] - ll[4 * (y * 64) + ch])));
+        for (int x = 0; x + 1 < 64; ++x)
+          interior = std::max(interior, double(std::abs(ll[4 * (y * 64 + x + 1) + ch] - ll[4 * (y * 64 + x) + ch])));
+      }
+    EXPECT_LE(seam, interior * 1.0 + 1e-6) << what << ": latlong seam";
+    if (c.dim_not_black) {
+      // Straight up under the deck: dimmer than a white Lambertian ground
+      // lit by the clear sky's sun (E cos(zenith) / pi; the deck passes on
+      // only part of the light), and not black.
+      StyleRenderer clear_renderer(clear);
+      const double centre = clear_renderer.renderer->RenderDirections(sun, {sun})[1] -
+                            clear_renderer.renderer->RenderDirections(sun, {sun}, false)[1];
+      const AtmosphereParams& a = style.atmosphere;
+      const double sun_illuminance =
+          centre * M_PI * a.sun_angular_radius_rad * a.sun_angular_radius_rad * (1.0 - a.limb_darkening_u / 3.0);
+      const double white = sun_illuminance * sun.y / M_PI;
+      const std::vector<float> up = r.renderer->RenderDirections(sun, {glm::dvec3(0, 1, 0)}, false);
+      EXPECT_LT(up[1], 0.5 * white) << what;
+      EXPECT_GT(up[1], 1e-3 * white) << what;
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+std::string Layer(double altitude_m, double thickness_m, const std::string& extra) {
+  return fmt::format("[[cloud_layer]]\naltitude_m = {}\nthickness_m = {}\n{}\n", altitude_m, thickness_m, extra);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, CloudHardCase,
+    ::testing::Values(
+        CloudCase{"overcast_coverage_1", Layer(1000, 800, "type = \"stratus\"\ncoverage = 1.0\ndensity_per_m = 0.05"),
+                  {45.0}, 24, true},
+        CloudCase{"extinction_1_per_m", Layer(1500, 1500, "coverage = 0.6\ndensity_per_m = 1.0"), {30.0}},
+        CloudCase{"thin_layer_at_10_km", Layer(10000, 100, "type = \"cirrus\"\ncoverage = 0.7\ndensity_per_m = 0.002"),
+                  {30.0}},
+        CloudCase{"overlapping_layers", Layer(1000, 2000, "coverage = 0.5") + Layer(2500, 1500, "type = \"stratocumulus\"\ncoverage = 0.4\nseed = 7"),
+                  {30.0}},
+        CloudCase{"observer_inside_a_layer",
+                  "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+        CloudCase{"observer_2_km_above_the_top_layer",
+                  "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+        CloudCase{"sun_at_zenith_horizon_and_minus_6_deg", Layer(1500, 1500, "coverage = 0.5"), {90.0, 0.0, -6.0}},
+        CloudCase{"cube_size_16", Layer(1500, 1500, "coverage = 0.5"), {30.0}, 16}),
+    [](const ::testing::TestParamInfo<CloudCase>& info) { return info.param.name; });
+
+// A cube of 2048: the faces the clouds are in (+X, +Y) at full size, the
+// draft preset with 8 view and 2 light steps to keep the case within a
+// minute on lavapipe; no NaN, Inf or negative value.
+TEST(CloudPass, CubeSize2048) {
+  const SkyStyle style = Style(std::string(kFast) + "cloud_view_steps = 8\ncloud_light_steps = 2\n" +
+                               Layer(1500, 1500, "coverage = 0.5"));
+  StyleRenderer r(style);
+  for (int face : {0, 2}) {
+    std::vector<float> image = r.renderer->Render(Sun(30.0), {{MAPPING_VULKAN_FACE, 2048, 2048, face}})[0];
+    CheckFiniteNonNegative(image, fmt::format("face {}", face));
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+// The sun disc: hidden behind a thick deck, seen through a thin one.
+TEST(CloudPass, SunDiscHiddenByThickCloudsSeenThroughThin) {
+  const glm::dvec3 sun = Sun(60.0);
+  auto disc = [&](const std::string& toml) {
+    StyleRenderer r(Style(std::string(kFast) + toml));
+    const double with_disc = r.renderer->RenderDirections(sun, {sun})[1];
+    const double without = r.renderer->RenderDirections(sun, {sun}, false)[1];
+    return with_disc - without;
+  };
+  const double clear = disc("");
+  const double thick = disc(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"));
+  const double thin = disc(Layer(9000, 300, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.001"));
+  EXPECT_GT(clear, 0.0);
+  // The march stops once the clouds' transmittance is below 1e-3 and drops
+  // what lies behind: no disc at all.
+  EXPECT_EQ(thick, 0.0);
+  EXPECT_GT(thin, 0.2 * clear);
+  EXPECT_LT(thin, 0.95 * clear);
+  testing::ExpectNoValidationMessages();
+}
+
+// A sequence with wind bakes to the same bytes in shards and when resumed
+// as in one go (the wind's offsets come from each frame's own clock time).
+TEST(CloudSequence, ShardsAndResumeAreByteIdentical) {
+  namespace fs = std::filesystem;
+  const std::string root = testing::FreshTempDir("cloud_sequence");
+  const std::string style = root + "/style.toml", schedule = root + "/schedule.toml";
+  std::ofstream(style) << std::string(kFast) + Layer(1500, 1500, "coverage = 0.5\nwind_m_s = [15.0, 5.0]");
+  std::ofstream(schedule) << R"([schedule]
+date = 2013-05-27
+latitude_deg = 42.44337
+longitude_deg = -76.48163
+utc_offset_hours = -4.0
+times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
+)";
+  auto bake = [&](const std::string& out, const std::string& extra) {
+    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --schedule '" + schedule +
+                                                  "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+  };
+  bake(root + "/whole", "");
+  bake(root + "/shards", "--shard 1/2");
+  bake(root + "/shards", "--shard 2/2");
+  EXPECT_EQ(testing::RunSkybake("merge-manifest '" + root + "/shards'").exit_code, 0);
+  // Resume: one frame's files lost, the rest verified by checksum.
+  fs::copy(root + "/whole", root + "/resumed");
+  for (const std::string& name : testing::FileNames(root + "/resumed"))
+    if (name.find(".0003.") != std::string::npos) fs::remove(root + "/resumed/" + name);
+  bake(root + "/resumed", "--resume");
+  const std::set<std::string> whole = testing::FileNames(root + "/whole");
+  EXPECT_GT(whole.size(), 30u);
+  for (const std::string& dir : {root + "/shards", root + "/resumed"})
+    for (const std::string& name : whole) {
+      if (name == "timings.json") continue;
+      EXPECT_TRUE(testing::ReadFileBytes(dir + "/" + name) == testing::ReadFileBytes(root + "/whole/" + name))
+          << dir << "/" << name;
+    }
+  // The wind moved the clouds between frames: the frames differ.
+  EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
+            testing::ReadFileBytes(root + "/whole/sky_latlong.0002.exr"));
+  fs::remove_all(root);
+}
+
+// ---------------------------------------------------------------- weather images
+
+void WriteImage(const std::string& path, int w, int h, int channels, const std::function<float(int, int)>& value) {
+  std::vector<float> pixels(size_t(w) * h * channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) pixels[(size_t(y) * w + x) * channels + c] = value(x, y);
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << path;
+  OIIO::ImageSpec spec(w, h, channels, path.ends_with(".png") ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  ASSERT_TRUE(out->open(path, spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+  out->close();
+}
+
+// A weather image puts the clouds where its first channel says: the west
+// half covered, the east half clear, in a PNG and in a one-channel EXR.
+TEST(CloudWeather, ImageCoverageIsWhereTheImageSays) {
+  const std::string dir = testing::FreshTempDir("cloud_weather");
+  WriteImage(dir + "/west.png", 64, 64, 3, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
+  WriteImage(dir + "/west.exr", 64, 64, 1, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
+  const glm::dvec3 sun = Sun(50.0, 180.0);
+  const glm::dvec3 west = SunDirectionFromElevationAzimuth(30.0, 270.0), east = SunDirectionFromElevationAzimuth(30.0, 90.0);
+  StyleRenderer clear(Style(kFast));
+  const std::vector<float> sky = clear.renderer->RenderDirections(sun, {west, east}, false);
+  for (const char* image : {"west.png", "west.exr"}) {
+    // 20 km square centred on the viewer: x < 0 (west) covered.
+    const std::string toml = std::string(kFast) + fmt::format(R"(
+[[cloud_layer]]
+altitude_m = 1500
+thickness_m = 1000
+type = "stratus"
+shape_amount = 0.0
+coverage = 0.5
+weather_image = "{}"
+weather_extent_m = [20000.0, 20000.0]
+weather_origin_m = [-10000.0, -10000.0]
+)", image);
+    ConfigResult r = ParseSkyStyle(toml, dir + "/style.toml");
+    ASSERT_TRUE(r.ok()) << r.errors[0].Format();
+    const SkyStyle style = PrunedStyle(r.style);
+    SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
+                         style.effects, OutputScale(style.output.units), false,
+                         ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                         ToCloudInputs(style.clouds, style.aoas.seed, dir, 0.0));
+    const std::vector<float> cloudy = renderer.RenderDirections(sun, {west, east}, false);
+    EXPECT_EQ(cloudy[4 + 1], sky[4 + 1]) << image << ": the east is clear";
+    EXPECT_GT(std::abs(cloudy[1] - sky[1]), 0.05 * sky[1]) << image << ": the west is under the deck";
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(CloudWeather, BadImagesAreReportedWithTheirPath) {
+  const std::string dir = testing::FreshTempDir("cloud_weather_bad");
+  WriteImage(dir + "/two.exr", 8, 8, 2, [](int, int) { return 0.5f; });
+  std::ofstream(dir + "/broken.png") << "not a png";
+  for (const auto& [file, message] : std::vector<std::pair<std::string, std::string>>{
+           {"two.exr", "two.exr: 2 channels; expected 1 (coverage) or 3/4 (R = coverage)"},
+           {"broken.png", "broken.png: cannot read it as an image"},
+           {"missing.exr", "missing.exr: no such file"}}) {
+    ConfigResult r = ParseSkyStyle("[[cloud_layer]]\nweather_image = \"" + file + "\"\n", dir + "/style.toml");
+    ASSERT_EQ(r.errors.size(), 1u) << file;
+    EXPECT_NE(r.errors[0].Format().find(dir + "/style.toml:2:17: cloud_layer[0].weather_image: " + dir + "/" + message),
+              std::string::npos)
+        << r.errors[0].Format();
+  }
+}
+
+// The bake's SH irradiance, sun irradiance and preview see the clouds: under
+// an overcast deck the sun's transmitted irradiance is gone (the disc is
+// hidden) and the sky's irradiance and the preview differ from the clear bake.
+TEST(CloudBake, ShIrradianceAndPreviewIncludeTheClouds) {
+  const std::string root = testing::FreshTempDir("cloud_bake");
+  auto bake = [&](const std::string& toml, const std::string& out) {
+    SkyStyle style = Style(std::string(kFast) + "[render]\ncube_size = 16\nlatlong_height = 16\n" + toml);
+    BakeOptions options;
+    options.out_dir = root + "/" + out;
+    options.vulkan.validation = true;
+    BakeResult r = BakeStyle(style, options);
+    EXPECT_EQ(r.validation_messages, 0);
+    return r;
+  };
+  const BakeResult clear = bake("", "clear");
+  const BakeResult overcast =
+      bake(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"), "overcast");
+  ASSERT_EQ(clear.frames.size(), 1u);
+  ASSERT_EQ(overcast.frames.size(), 1u);
+  EXPECT_GT(clear.frames[0].sun_illuminance_lux, 1e4);
+  EXPECT_EQ(overcast.frames[0].sun_illuminance_lux, 0.0);
+  const double clear_sky = clear.frames[0].sh_irradiance_without_sun[0][1];
+  const double overcast_sky = overcast.frames[0].sh_irradiance_without_sun[0][1];
+  EXPECT_GT(overcast_sky, 0.0);
+  EXPECT_GT(std::abs(overcast_sky - clear_sky), 0.05 * clear_sky);
+  EXPECT_NE(testing::ReadFileBytes(root + "/clear/sky_latlong.png"),
+            testing::ReadFileBytes(root + "/overcast/sky_latlong.png"));
+  std::filesystem::remove_all(root);
+}
+
+// Convergence of the cloud march: the presets' view and light steps against
+// a fine march (400 view, 50 light steps: near lavapipe's 65535 loop
+// iterations per invocation, CloudLoopIterationsPerTexel), same noise and
+// model (8 octaves, production noise sizes). The error: mean over the upper
+// hemisphere of |L - L_ref| / mean L_ref, green channel, 96 x 48 latlong.
+TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
+  const glm::dvec3 sun = Sun(30.0);
+  const ViewRequest latlong{MAPPING_LATLONG, 96, 48, 0};
+  auto render = [&](int view_steps, int light_steps) {
+    SkyStyle style = Style(kCumulus);
+    style.clouds.quality.view_steps = view_steps;
+    style.clouds.quality.light_steps = light_steps;
+    return StyleRenderer(style).renderer->Render(sun, {latlong})[0];
+  };
+  auto error = [&](const std::vector<float>& a, const std::vector<float>& reference) {
+    double diff = 0.0, sum = 0.0;
+    for (int y = 0; y < 24; ++y)
+      for (int x = 0; x < 96; ++x) {
+        const size_t i = 4 * (size_t(y) * 96 + x) + 1;
+        diff += std::abs(double(a[i]) - reference[i]);
+        sum += reference[i];
+      }
+    return diff / sum;
+  };
+  const std::vector<float> converged = render(400, 50);
+  const double half = error(render(200, 25), converged);
+  struct Setting { const char* name; int view, light; };
+  std::vector<double> errors;
+  for (Setting s : {Setting{"draft", 32, 6}, Setting{"production", 48, 6}, Setting{"reference", 192, 32}}) {
+    errors.push_back(error(render(s.view, s.light), converged));
+    std::printf("cloud march %-10s view %3d light %2d: mean relative error %.4f\n", s.name, s.view, s.light,
+                errors.back());
+  }
+  std::printf("400/50 against 200/25: %.5f\n", half);
+  EXPECT_GT(errors[0], errors[1]);
+  EXPECT_GT(errors[1], errors[2]);
+  // The fine march is first order in its steps: halving them changes it by
+  // about its own error, which is a tenth of the production preset's.
+  EXPECT_LT(half, 0.1 * errors[1]);
+  EXPECT_LT(errors[1], 0.1);
+  testing::ExpectNoValidationMessages();
+}
+
+}  // namespace
+}  // namespace skybake
