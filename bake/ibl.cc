@@ -278,7 +278,10 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
 
   // Output texels: specular levels 1.. (level 0 is the source itself), the
   // irradiance cube, the DFG table.
-  const int levels = IblLevelCount(s);
+  const int levels = request.roughness.empty() ? IblLevelCount(s) : int(request.roughness.size());
+  auto roughness_of = [&](int level) {
+    return request.roughness.empty() ? IblRoughness(level, levels) : request.roughness[level];
+  };
   struct Pass {
     int mode, size, level;
     VkDeviceSize first_texel;
@@ -438,7 +441,7 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
       open_mode = p.mode;
     }
     gpu::IblPush push{};
-    const double roughness = IblRoughness(p.level, levels);
+    const double roughness = roughness_of(p.level);
     const double alpha = roughness * roughness;
     const int samples = p.mode == IBL_MODE_SPECULAR ? s.samples : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
                                                                                                : s.dfg_samples;

@@ -75,6 +75,10 @@ struct IblRequest {
   glm::dvec3 sun_direction{0, 1, 0};  // unit, towards the Sun
   Rgb sun_irradiance{0, 0, 0};        // the Sun's irradiance at normal incidence, output units x sr
   bool dfg = false;                   // compute the DFG table too (once per bake)
+  // The perceptual roughness of each level (level 0's must be 0), for a
+  // comparison with another tool's mapping; empty: IblRoughness of
+  // IblLevelCount(settings) levels.
+  std::vector<double> roughness;
 };
 
 struct IblMaps {
