@@ -80,17 +80,23 @@ glm::dvec3 Apply(Transform t, glm::dvec3 d) {
 
 // Mean relative difference of cmgen's face `f` at a level against the texel
 // of skybake's cube of the same size that holds the same direction (texel
-// centres map to texel centres under each transform).
-double MeanRelativeDifference(const Image& cmgen, int f, const CubeLevel& ours, Transform t) {
+// centres map to texel centres under each transform). With `sky_only`, the
+// sum of |difference| over the sum of skybake's values over the texels above
+// the horizon instead (the dark ground and the horizon's sharp edge weigh
+// on the mean of ratios).
+double MeanRelativeDifference(const Image& cmgen, int f, const CubeLevel& ours, Transform t, bool sky_only = false) {
   const int n = ours.size;
-  double sum = 0.0;
+  double sum = 0.0, difference = 0.0, total = 0.0;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
       CubeTexel s = VulkanCubeTexelFromDirection(Apply(t, VulkanCubeTexelDirection(f, x, y, n)), n);
       const float* a = &cmgen.rgb[(size_t(y) * n + x) * 3];
       const float* b = &ours.faces[s.face][(size_t(s.y) * n + s.x) * 4];
       for (int c = 0; c < 3; ++c) sum += std::abs(a[c] - b[c]) / std::max(1e-6f, b[c]);
+      if (VulkanCubeTexelDirection(f, x, y, n).y > 0.05)
+        for (int c = 0; c < 3; ++c) difference += std::abs(a[c] - b[c]), total += b[c];
     }
+  if (sky_only) return total > 0.0 ? difference / total : 0.0;
   return sum / (3.0 * n * n);
 }
 
@@ -141,16 +147,32 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   IblMaps maps = baker.Bake(request, source);
   ASSERT_EQ(int(maps.specular.size()), levels);
 
-  auto level_difference = [&](const std::string& mode, int level, Transform t) {
+  auto level_difference = [&](const std::string& mode, int level, Transform t, bool sky_only = false) {
     double sum = 0.0;
     for (int f = 0; f < 6; ++f) {
       Image cm = Read(dir + "/" + mode + "/sky_latlong/m" + std::to_string(level) + "_" + kCmgenNames[f] + ".exr");
       EXPECT_EQ(cm.width, n >> level);
       if (cm.width != n >> level) return 1e30;
-      sum += MeanRelativeDifference(cm, f, maps.specular[level], t);
+      sum += MeanRelativeDifference(cm, f, maps.specular[level], t, sky_only);
     }
     return sum / 6;
   };
+  {
+    // Where each puts the brightest sky (the aureole round the Sun).
+    glm::dvec3 ours_max(0), cm_max(0);
+    float ours_v = 0, cm_v = 0;
+    for (int f = 0; f < 6; ++f) {
+      Image cm = Read(dir + "/cmgen_mirror/sky_latlong/m0_" + std::string(kCmgenNames[f]) + ".exr");
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          float a = cm.rgb[(size_t(y) * n + x) * 3 + 1], b = source.faces[f][(size_t(y) * n + x) * 4 + 1];
+          if (a > cm_v) cm_v = a, cm_max = VulkanCubeTexelDirection(f, x, y, n);
+          if (b > ours_v) ours_v = b, ours_max = VulkanCubeTexelDirection(f, x, y, n);
+        }
+    }
+    std::printf("brightest: skybake %.3f %.3f %.3f (%g), cmgen %.3f %.3f %.3f (%g)\n", ours_max.x, ours_max.y,
+                ours_max.z, ours_v, cm_max.x, cm_max.y, cm_max.z, cm_v);
+  }
   // The frames: at level 0 (no filtering), cmgen --no-mirror's cube is
   // skybake's mirrored along X (Filament reads an equirect with +X at three
   // quarters of the width, the mirror image of OpenEXR's latlong), and
@@ -168,8 +190,8 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   }
   // The levels, cmgen's default (mirrored) cube against skybake's at
   // cmgen's roughness. Level 0 already differs (cmgen resamples the latlong
-  // into its cube; measured 21%, most of it a colour difference on the sky
-  // faces, e.g. 8-13% on the zenith face, before any filtering). Both tools
+  // into its cube and blurs the thin bright band along the horizon; the
+  // zenith agrees to four digits; measured 21%, docs/ibl.md). Both tools
   // then average the sky with the same GGX kernel, and a weighted average
   // does not increase a difference between its inputs, so each filtered
   // level must differ by no more than level 0 does, plus 1% for the two
@@ -177,8 +199,9 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   const double level0 = level_difference("cmgen_mirror", 0, kSame);
   for (int level = 0; level < levels; ++level) {
     const double d = level_difference("cmgen_mirror", level, kSame);
-    std::printf("level %d, roughness %.4f, %d^2: mean relative difference %.4f\n", level, request.roughness[level],
-                n >> level, d);
+    const double sky = level_difference("cmgen_mirror", level, kSame, true);
+    std::printf("level %d, roughness %.4f, %d^2: mean relative difference %.4f; above 3 deg, relative L1 %.4f\n",
+                level, request.roughness[level], n >> level, d, sky);
     RecordProperty("level" + std::to_string(level), std::to_string(d));
     EXPECT_LE(d, level0 + 0.01) << "level " << level;
   }
