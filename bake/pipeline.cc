@@ -22,6 +22,7 @@
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/ibl.h"
+#include "skybake/sh.h"
 #include "skybake/manifest.h"
 #include "skybake/tonemap.h"
 
@@ -427,7 +428,18 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       // A factor 2 of margin; writing checks the bound.
       double max_value = 0.0;
       for (const FramePlan& plan : plans)
-        if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) max_value = std::max(max_value, *bound);
+        if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) {
+          // ibl.include_sun puts the Sun's energy into one texel of the
+          // specular level 0: brighter than the disc by the ratio of their
+          // solid angles when the texel is the smaller (ibl.h).
+          const IblSettings& ibl = plan.style->ibl;
+          double scale = 1.0;
+          if (ibl.specular && ibl.include_sun) {
+            const double a = plan.style->atmosphere.sun_angular_radius_rad;
+            scale = std::max(1.0, M_PI * a * a / CubeTexelSolidAngle(0, 0, ibl.size));
+          }
+          max_value = std::max(max_value, *bound * scale);
+        }
       for (const FramePlan& plan : max_value > 0.0 ? std::vector<FramePlan>{} : plans) {
         SkyRenderer& r = renderers.Main(*plan.style);
         std::vector<float> coarse = r.Render(plan.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];

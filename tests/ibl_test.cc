@@ -381,3 +381,24 @@ TEST(IblCliTest, BakeWritesEveryLevel) {
 
 }  // namespace
 }  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// A sequence with the Sun in the maps: level 0 holds the Sun's energy in one
+// texel, brighter than the disc itself on a 512 cube (its texels are smaller
+// than the disc): the sequence's half-float scale, chosen before any file is
+// written, accounts for it (without that the bake stopped with exit code 5).
+TEST(IblCliTest, SequenceWithTheSunInTheMapsFitsItsHalfScale) {
+  const std::string dir = testing::FreshTempDir("ibl_sequence_sun");
+  testing::CommandRun r = testing::RunSkybake(
+      "bake " + Style() + " --schedule " + testing::SourceDir() +
+      "/configs/schedules/day.toml --frames 20:21 --size 16 --set render.latlong_height=16 -q "
+      "--set ibl.size=512 --set ibl.levels=1 --set ibl.specular=true --set ibl.include_sun=true --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_TRUE(std::filesystem::exists(dir + "/sky_specular_m0.0020.exr"));
+  EXPECT_TRUE(std::filesystem::exists(dir + "/sky_specular_m0.0021.exr"));
+}
+
+}  // namespace
+}  // namespace skybake
