@@ -53,6 +53,7 @@ constexpr Range kNoiseOffset{-1e4, 1e4, false, false};
 constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
 constexpr Range kCloudDistance{1.0, 2000.0, false, false};
+constexpr Range kIblLodBias{-4.0, 4.0, false, false};
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -221,6 +222,25 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("gltf.radius_m", g.radius_m, kPositive);
   v.Real("gltf.flattening", g.flattening, kFlattening);
   v.Int("gltf.segments", g.segments, 8, 1024);
+
+  IblSettings& i = s.ibl;
+  v.Bool("ibl.specular", i.specular);
+  v.Bool("ibl.irradiance", i.irradiance);
+  v.Bool("ibl.dfg_lut", i.dfg);
+  v.Int("ibl.size", i.size, 8, 1024);
+  v.Int("ibl.levels", i.levels, 0, 11);
+  v.Int("ibl.samples", i.samples, 1, 65536);
+  v.Int("ibl.irradiance_size", i.irradiance_size, 1, 256);
+  v.Int("ibl.irradiance_samples", i.irradiance_samples, 1, 65536);
+  v.Int("ibl.dfg_size", i.dfg_size, 2, 1024);
+  v.Int("ibl.dfg_samples", i.dfg_samples, 1, 65536);
+  v.Real("ibl.lod_bias", i.lod_bias, kIblLodBias);
+  v.Bool("ibl.include_sun", i.include_sun);
+  v.Bool("ibl.exr", i.exr);
+  v.Bool("ibl.ktx2", i.ktx2);
+  v.Choice("ibl.ktx2_format", i.ktx2_format,
+           {{"rgba16f", KtxFormat::kRgba16f}, {"b10g11r11", KtxFormat::kB10g11r11}, {"e5b9g9r9", KtxFormat::kE5b9g9r9}});
+  v.Int("ibl.ktx2_zstd_level", i.ktx2_zstd_level, 0, 19);
 }
 
 // --------------------------------------------------------------- reading
@@ -981,6 +1001,33 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       break;
     }
   }
+  // IBL: a cube mip chain needs a power-of-two level 0 and at most one
+  // level per halving; some file format must be asked for.
+  const IblSettings& ibl = result.style.ibl;
+  if (ibl.Requested()) {
+    int log2_size = 0;
+    while ((2 << log2_size) <= ibl.size) ++log2_size;
+    if ((1 << log2_size) != ibl.size) {
+      ConfigError e = locate("ibl.size");
+      e.message = fmt::format("{} is not a power of two: use {} or {}", ibl.size, 1 << log2_size, 2 << log2_size);
+      result.errors.push_back(e);
+    } else if (ibl.levels > log2_size + 1) {
+      ConfigError e = locate("ibl.levels");
+      e.message = fmt::format("a {} cube has at most {} mip levels (down to 1 x 1): lower ibl.levels or raise ibl.size",
+                              ibl.size, log2_size + 1);
+      result.errors.push_back(e);
+    }
+    if (!ibl.exr && !ibl.ktx2) {
+      ConfigError e = locate("ibl.exr");
+      e.message = "IBL maps are asked for but neither ibl.exr nor ibl.ktx2 is true: set one of them";
+      result.errors.push_back(e);
+    }
+    if (ibl.ktx2_zstd_level > 0 && !ibl.ktx2) {
+      ConfigError e = locate("ibl.ktx2_zstd_level");
+      e.message = "zstd supercompression applies to KTX2 files: set ibl.ktx2 = true or ibl.ktx2_zstd_level = 0";
+      result.errors.push_back(e);
+    }
+  }
   if (!result.ok()) return result;
 
   // A target colour decides the hue vector (README "Styles").
@@ -993,8 +1040,12 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
 
   StyleWriter writer;
   VisitStyle(result.style, writer);
+  // Without IBL outputs their keys are left out of the record, so such a
+  // bake's files are the same bytes as before the keys existed.
+  toml::table recorded = writer.table();
+  if (!result.style.ibl.Requested()) recorded.erase("ibl");
   std::ostringstream resolved;
-  resolved << writer.table();
+  resolved << recorded;
   result.style.resolved_toml = resolved.str();
   return result;
 }

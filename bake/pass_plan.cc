@@ -1,5 +1,7 @@
 #include "skybake/pass_plan.h"
 
+#include "skybake/ibl.h"
+
 #include <algorithm>
 #include <cstring>
 
@@ -170,6 +172,28 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
     }
   }
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+  // Image-based lighting (ibl.h): only when an IBL output is asked for.
+  // Its samples are filtered cube reads, not medium samples: not in the total.
+  const IblSettings& ibl = first.ibl;
+  if (ibl.Requested()) {
+    const double source_texels = 6.0 * ibl.size * ibl.size;
+    plan.passes.push_back({"IBL source (no sun disc)", Size(ibl.size, ibl.size) + " x6", "once per frame",
+                           plan.frames, source_texels * per_texel});
+    if (ibl.specular) {
+      double texels = 0.0;
+      for (int level = 1; level < IblLevelCount(ibl); ++level) texels += 6.0 * std::pow(double(ibl.size >> level), 2);
+      plan.passes.push_back({fmt::format("IBL specular {} levels", IblLevelCount(ibl)),
+                             fmt::format("{} samples", ibl.samples), "once per frame (cube reads)", plan.frames,
+                             texels * ibl.samples});
+    }
+    if (ibl.irradiance)
+      plan.passes.push_back({"IBL irradiance", Size(ibl.irradiance_size, ibl.irradiance_size) + " x6",
+                             "once per frame (cube reads)", plan.frames,
+                             6.0 * ibl.irradiance_size * ibl.irradiance_size * ibl.irradiance_samples});
+    if (ibl.dfg)
+      plan.passes.push_back({"IBL DFG table", Size(ibl.dfg_size, ibl.dfg_size), "once per bake", 1,
+                             double(ibl.dfg_size) * ibl.dfg_size * ibl.dfg_samples});
+  }
 
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
   plan.variant = fmt::format(

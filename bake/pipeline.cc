@@ -21,6 +21,8 @@
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
+#include "skybake/ibl.h"
+#include "skybake/sh.h"
 #include "skybake/manifest.h"
 #include "skybake/tonemap.h"
 
@@ -191,15 +193,19 @@ std::vector<ViewRequest> ShViews(const SkyStyle& style) {
 struct FrameNames {
   std::vector<std::string> faces;  // six, when output.faces
   std::string cube, latlong, png;  // empty when not written
+  std::vector<IblFileName> ibl;    // the IBL maps' files (ibl.h), when asked for
+  bool with_dfg = false;           // the bake's first frame carries the DFG table
   std::vector<std::string> All() const {
     std::vector<std::string> all = faces;
-    for (const std::string* n : {&cube, &latlong, &png})
+    for (const std::string* n : {&cube, &latlong})
       if (!n->empty()) all.push_back(*n);
+    for (const IblFileName& n : ibl) all.push_back(n.name);
+    if (!png.empty()) all.push_back(png);
     return all;
   }
 };
 
-FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
+FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_dfg = false) {
   const OutputSettings& o = style.output;
   const std::string number = number_in_name > 0 ? fmt::format(".{:04d}", number_in_name) : "";
   FrameNames names;
@@ -208,6 +214,8 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
   if (o.cube_strip) names.cube = o.basename + "_cube" + number + ".exr";
   if (o.latlong) names.latlong = o.basename + "_latlong" + number + ".exr";
   if (o.preview || style.gltf.enabled) names.png = o.basename + "_latlong" + number + ".png";
+  names.ibl = IblFileNames(style, number_in_name, with_dfg);
+  names.with_dfg = with_dfg;
   return names;
 }
 
@@ -217,7 +225,8 @@ std::vector<std::string> PlannedFileNames(const std::vector<FramePlan>& plans, c
   std::vector<std::string> names;
   for (const FramePlan& plan : plans)
     if (!part || part->Contains(plan.number))
-      for (const std::string& n : FrameFileNames(*plan.style, plan.number).All()) names.push_back(n);
+      for (const std::string& n : FrameFileNames(*plan.style, plan.number, &plan == &plans.front()).All())
+        names.push_back(n);
   const SkyStyle& first = *plans.front().style;
   if (first.gltf.enabled && !part)
     for (const char* ext : {".gltf", ".bin", ".glb"}) names.push_back(first.output.basename + ext);
@@ -258,7 +267,7 @@ PreviousBake ReadPreviousManifest(const std::string& path) {
 // style, exposure and half scale; otherwise nothing.
 std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous, const FramePlan& plan,
                                                     const std::string& out_dir, double half_scale,
-                                                    double ev100) {
+                                                    double ev100, bool with_dfg) {
   if (!previous.loaded || previous.half_scale != half_scale || previous.exposure_ev100 != ev100)
     return std::nullopt;
   auto it = previous.frames.find(plan.number);
@@ -266,7 +275,7 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   const json& f = it->second;
   if (f.value("style_sha256", std::string()) != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
   if (!f.contains("files") || !f["files"].is_array()) return std::nullopt;
-  std::vector<std::string> expected = FrameFileNames(*plan.style, plan.number).All();
+  std::vector<std::string> expected = FrameFileNames(*plan.style, plan.number, with_dfg).All();
   std::vector<BakedFile> files;
   for (const json& entry : f["files"]) {
     if (!entry.is_object()) return std::nullopt;
@@ -291,6 +300,7 @@ struct FrameJob {
   std::shared_ptr<const void> hold;  // the renderer's memory the images view (RenderInPlace)
   double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
+  std::optional<IblMaps> ibl;     // the frame's IBL maps, when asked for
 };
 
 // What it gives back.
@@ -382,6 +392,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
   // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
   RendererCache renderers(context, result);
+  std::unique_ptr<IblBaker> ibl_baker;  // created by the first frame that asks for IBL maps
   {
     const RenderCounters& c = renderers.Main(first).counters();
     timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants", c.pipelines,
@@ -429,7 +440,18 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       // A factor 2 of margin; writing checks the bound.
       double max_value = 0.0;
       for (const FramePlan& plan : plans)
-        if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) max_value = std::max(max_value, *bound);
+        if (auto bound = VisibleDiscBound(*plan.style, plan.elevation_deg)) {
+          // ibl.include_sun puts the Sun's energy into one texel of the
+          // specular level 0: brighter than the disc by the ratio of their
+          // solid angles when the texel is the smaller (ibl.h).
+          const IblSettings& ibl = plan.style->ibl;
+          double scale = 1.0;
+          if (ibl.specular && ibl.include_sun) {
+            const double a = plan.style->atmosphere.sun_angular_radius_rad;
+            scale = std::max(1.0, M_PI * a * a / CubeTexelSolidAngle(0, 0, ibl.size));
+          }
+          max_value = std::max(max_value, *bound * scale);
+        }
       for (const FramePlan& plan : max_value > 0.0 ? std::vector<FramePlan>{} : plans) {
         SkyRenderer& r = renderers.Main(*plan.style, CloudTimeOf(plan));
         std::vector<float> coarse = r.Render(plan.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];
@@ -513,6 +535,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     Clock::time_point write_start = Clock::now();
     std::vector<const RgbaImage*> all;
     for (const RgbaImage& image : images) all.push_back(&image);
+    const std::vector<RgbaImage> ibl_images = job.ibl ? IblImagesForRangeCheck(*job.ibl) : std::vector<RgbaImage>();
+    for (const RgbaImage& image : ibl_images) all.push_back(&image);
     const double max_value = CheckedMaxValue(all);
     w.half_scale = job.half_scale;
     if (style.output.pixel_type == PixelType::kHalf) {
@@ -592,6 +616,15 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       }
     }
     if (failure) std::rethrow_exception(failure);
+    // The IBL maps, with the frame's scale and provenance (ibl.h).
+    if (job.ibl) {
+      const std::vector<std::string> ibl_files = EncodeIblFiles(*job.ibl, style, exr, names.with_dfg);
+      for (size_t i = 0; i < ibl_files.size(); ++i) {
+        const std::string path = path_of(names.ibl[i].name);
+        WriteFileAtomically(path, ibl_files[i]);
+        w.files.push_back({path, names.ibl[i].kind, ibl_files[i].size(), Sha256OfText(ibl_files[i])});
+      }
+    }
     w.exr_seconds = SecondsSince(write_start);
     w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
                                style.output.compression == "zip" || style.output.compression == "zips"
@@ -671,10 +704,10 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.sun_elevation_deg = plan.elevation_deg;
     frame.sun_azimuth_deg = plan.azimuth_deg;
     const std::string label = plan.number > 0 ? fmt::format("frame {}", plan.number) : "render";
-    const FrameNames names = FrameFileNames(style, plan.number);
+    const FrameNames names = FrameFileNames(style, plan.number, index == 0);
     // A resumed sequence skips frames whose files are verified against the manifest.
     std::optional<std::vector<BakedFile>> verified;
-    if (sequence && options.resume) verified = VerifiedFrame(previous, plan, options.out_dir, half_scale, ev100.value_or(0.0));
+    if (sequence && options.resume) verified = VerifiedFrame(previous, plan, options.out_dir, half_scale, ev100.value_or(0.0), index == 0);
 
     // Render: every view of the frame in one submission, then the SH views.
     Clock::time_point render_start = Clock::now();
@@ -724,6 +757,29 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                     verified ? 0 : views.size(), texels * 1e-6, plan.elevation_deg, plan.azimuth_deg,
                                     plan.time ? ", " + plan.time->Iso8601() : "",
                                     verified ? ", files verified by checksum: not rendered again" : ""));
+    // IBL: the sky without the disc at ibl.size, filtered on the device into
+    // the specular chain, the irradiance cube and (first frame) the DFG table.
+    std::optional<IblMaps> ibl_maps;
+    if (style.ibl.Requested() && !verified) {
+      if (!ibl_baker) ibl_baker = std::make_unique<IblBaker>(context);
+      const int n = style.ibl.size;
+      std::vector<ViewRequest> source_views;
+      for (int face = 0; face < 6; ++face) source_views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+      std::vector<std::vector<float>> source_faces = renderer.Render(plan.sun, source_views, false);
+      for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back({"IBL source " + t.name, t.gpu_ms});
+      CubeLevel source;
+      source.size = n;
+      for (int face = 0; face < 6; ++face) source.faces[face] = std::move(source_faces[face]);
+      IblRequest request{style.ibl, plan.sun, frame.sun_irradiance, style.ibl.dfg && names.with_dfg};
+      ibl_maps = ibl_baker->Bake(request, source);
+      for (const PassTiming& t : ibl_baker->last_timings()) frame.gpu_passes.push_back(t);
+      timer.Finish("IBL", fmt::format("{}: {} x {} source without the sun disc, {} specular levels x {} samples, "
+                                      "irradiance {} x {} samples{}{}",
+                                      label, n, n, style.ibl.specular ? IblLevelCount(style.ibl) : 0,
+                                      style.ibl.samples, style.ibl.irradiance ? style.ibl.irradiance_size : 0,
+                                      style.ibl.irradiance_samples, request.dfg ? ", DFG table" : "",
+                                      style.ibl.include_sun ? ", sun included" : ""));
+    }
     if (verified) {
       collect_pending();
       frame.files = *verified;
@@ -740,7 +796,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     collect_pending();
-    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100};
+    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps)};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

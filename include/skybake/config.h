@@ -69,6 +69,30 @@ struct GltfSettings {
   int segments = 64;                // around the horizon; half as many rings pole to pole
 };
 
+// Image-based lighting outputs from the same bake (include/skybake/ibl.h):
+// split-sum GGX-prefiltered radiance, an irradiance cube, the DFG table. All
+// off by default, and then no pass runs and no key is recorded.
+enum class KtxFormat { kRgba16f, kB10g11r11, kE5b9g9r9 };
+struct IblSettings {
+  bool specular = false;        // GGX-prefiltered radiance, one cube mip level per roughness
+  bool irradiance = false;      // irradiance cube, stored as E / pi (a white Lambertian surface's radiance)
+  bool dfg = false;             // split-sum DFG table (N.V x roughness -> scale, bias of F0)
+  int size = 256;               // face edge of level 0, texels: a power of two in [8, 1024]
+  int levels = 0;               // mip levels; 0: down to 8 x 8 (log2(size) - 2); at most log2(size) + 1
+  int samples = 256;            // GGX samples per texel of a level (filtered importance sampling)
+  int irradiance_size = 32;     // irradiance face edge, texels
+  int irradiance_samples = 512; // cosine samples per irradiance texel
+  int dfg_size = 128;           // DFG table edge, texels
+  int dfg_samples = 1024;       // GGX samples per DFG texel
+  double lod_bias = 0.0;        // mip bias of the filtered lookups, log2 texels (docs/ibl.md: 0 measured best)
+  bool include_sun = false;     // the Sun's energy in the maps (else it is the glTF sun light alone)
+  bool exr = true;              // one EXR per cube level / irradiance / DFG
+  bool ktx2 = false;            // KTX2 cube files with their mips
+  KtxFormat ktx2_format = KtxFormat::kRgba16f;
+  int ktx2_zstd_level = 0;      // 0: no supercompression; 1..19: zstd level
+  bool Requested() const { return specular || irradiance || dfg; }
+};
+
 struct SkyStyle {
   AtmosphereParams atmosphere;
   std::string quality_preset = "production";  // see QualityPreset()
@@ -81,6 +105,7 @@ struct SkyStyle {
   AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   GltfSettings gltf;
+  IblSettings ibl;
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance
 };

@@ -155,9 +155,27 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   GpuCloudLayer layers[CLOUD_MAX_LAYERS];
 };
 
+
+// --- Image-based lighting (shaders/ibl_prefilter.comp, bake/ibl.cc)
+#define IBL_BINDING_SOURCE 0  // samplerCube: the sky without the Sun, RGBA float, its box-filtered mips
+#define IBL_BINDING_OUTPUT 1  // storage vec4[]: the filtered texels, level after level
+#define IBL_MODE_SPECULAR 0    // GGX-prefiltered radiance of one mip level (split sum, N = V = R)
+#define IBL_MODE_IRRADIANCE 1  // cosine-filtered radiance E / pi (a white Lambertian surface's radiance)
+#define IBL_MODE_DFG 2         // split-sum DFG table: x = N.V, y = perceptual roughness
+
+SKYBAKE_GPU_STRUCT(IblPush) {
+  ivec4 target;         // x: IBL_MODE_*; y: face size of this level, texels; z: first output texel; w: samples
+  ivec4 source;         // x: face size of the source's level 0, texels; y: source mip count; zw: unused
+  vec4 lobe;            // x: GGX alpha = roughness^2; y: mip bias of the filtered lookups (log2 texels);
+                        // z: normalization W of the sun's kernel (IblSunKernelNormalization); w: 1 = add the sun
+  vec4 sun_direction;   // xyz: unit vector towards the Sun; w: unused
+  vec4 sun_irradiance;  // xyz: the Sun's irradiance at normal incidence (output units x sr); w: unused
+};
+
 #ifdef __cplusplus
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
 static_assert(sizeof(GpuClouds) == (6 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
+static_assert(sizeof(IblPush) == 5 * 16, "IblPush must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,

@@ -1,0 +1,41 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Image-based lighting from the baked sky: one dispatch per output level.
+// z of the global id is the cube face (+X -X +Y -Y +Z -Z, Vulkan face
+// orientation); the DFG table is one 2D image (z = 0).
+#include "glsl_prelude.glsl"
+#include "skybake/gpu_shared.h"
+#include "envmap.glsl"
+#include "ibl.glsl"
+
+layout(local_size_x = SKYBAKE_LOCAL_SIZE_X, local_size_y = SKYBAKE_LOCAL_SIZE_Y, local_size_z = 1) in;
+layout(set = 0, binding = IBL_BINDING_SOURCE) uniform samplerCube source_cube;
+layout(std430, set = 0, binding = IBL_BINDING_OUTPUT) buffer OutputTexels { vec4 output_texels[]; };
+layout(push_constant) uniform Push { IblPush push; };
+
+void main() {
+  ivec3 id = ivec3(gl_GlobalInvocationID);
+  int size = push.target.y;
+  if (id.x >= size || id.y >= size) return;
+  uint samples = uint(push.target.w);
+  uint index = uint(push.target.z + (id.z * size + id.y) * size + id.x);
+  int mode = push.target.x;
+  if (mode == IBL_MODE_DFG) {
+    float n_dot_v = (float(id.x) + 0.5) / float(size);
+    float roughness = (float(id.y) + 0.5) / float(size);
+    output_texels[index] = vec4(IntegrateDfg(n_dot_v, roughness * roughness, samples), 0.0, 1.0);
+    return;
+  }
+  vec3 n = DirectionFromVulkanCubeTexel(id.z, id.x, id.y, size);
+  vec3 radiance;
+  if (mode == IBL_MODE_SPECULAR) {
+    radiance = PrefilterGgx(source_cube, n, push.lobe.x, samples, push.source.x, push.source.y, push.lobe.y);
+    if (push.lobe.w != 0.0)
+      radiance += SunThroughGgx(n, push.sun_direction.xyz, push.sun_irradiance.xyz, push.lobe.x, push.lobe.z);
+  } else {
+    radiance = FilterCosine(source_cube, n, samples, push.source.x, push.source.y, push.lobe.y);
+    if (push.lobe.w != 0.0)
+      radiance += push.sun_irradiance.xyz * (max(dot(n, push.sun_direction.xyz), 0.0) / kIblPi);
+  }
+  output_texels[index] = vec4(radiance, 1.0);
+}
