@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <signal.h>
 #include <sys/wait.h>
@@ -152,6 +153,68 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
     ++rendered;
   EXPECT_EQ(rendered, 20u) << changed.output;
   EXPECT_NE(ReadFileBytes(killed + "/sky_px.0001.exr"), ReadFileBytes(root + "/whole/out/sky_px.0001.exr"));
+  fs::remove_all(root);
+}
+
+// A hostile folder: links planted at every temporary name a bake used to
+// pick (`.NAME.tmpPID`, the pid known once the process starts: here the
+// child plants them before it execs skybake, keeping its pid), pointing at
+// files elsewhere. Temporaries are created with O_EXCL | O_NOFOLLOW under
+// unguessable names, so every victim keeps its bytes and every output is
+// the bake's own.
+TEST(SafeOutputs, PlantedTemporaryLinksAreNeverFollowed) {
+  const std::string root = FreshTempDir("planted");
+  const std::string out = root + "/out";
+  const std::string victims = root + "/victims";
+  fs::create_directories(out);
+  fs::create_directories(victims);
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  std::vector<std::string> names = {"manifest.json", "timings.json", "sky.gltf", "sky.bin", "sky.glb"};
+  for (const char* frame : {"0001", "0002"}) {
+    for (const char* face : {"px", "nx", "py", "ny", "pz", "nz", "cube", "latlong"})
+      names.push_back(std::string("sky_") + face + "." + frame + ".exr");
+    names.push_back(std::string("sky_latlong.") + frame + ".png");
+  }
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    for (const std::string& name : names) {
+      const std::string victim = victims + "/" + name;
+      std::ofstream(victim) << "victim " << name;
+      if (symlink(victim.c_str(), (out + "/." + name + ".tmp" + std::to_string(getpid())).c_str()) != 0) _exit(126);
+    }
+    execl(SKYBAKE_BINARY, "skybake", "bake", Style().c_str(), "--schedule", schedule.c_str(), "--size", "8", "-q",
+          "--out", out.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "the bake crashed";
+  ASSERT_EQ(WEXITSTATUS(status), 0) << "planting failed (126) or the bake failed";
+  for (const std::string& name : names) {
+    EXPECT_EQ(ReadFileBytes(victims + "/" + name), "victim " + name) << name << " was written through a link";
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/" + name))) << name;
+  }
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
+  EXPECT_TRUE(manifest["complete"].get<bool>());
+  for (const auto& frame : manifest["frames"])
+    for (const auto& file : frame["files"])
+      EXPECT_EQ(ReadFileBytes(out + "/" + file["file"].get<std::string>()).size(), file["bytes"].get<uint64_t>());
+  fs::remove_all(root);
+}
+
+// A link at an output's own name is replaced (the rename), never written
+// through.
+TEST(SafeOutputs, LinkAtAnOutputNameIsReplacedNotFollowed) {
+  const std::string root = FreshTempDir("finallink");
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  std::ofstream(root + "/victim") << "victim";
+  fs::create_symlink(root + "/victim", out + "/sky_px.exr");
+  CommandRun run = RunSkybake("bake '" + Style() + "' --size 8 -q --force --out '" + out + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/sky_px.exr")));
   fs::remove_all(root);
 }
 
