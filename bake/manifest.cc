@@ -11,6 +11,7 @@
 
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
+#include "skybake/output_lock.h"
 
 namespace skybake {
 namespace {
@@ -443,11 +444,13 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
     }
   }
 
-  // Nothing overwritten by accident: the merged manifest and scene are new.
+  // What the merge writes, locked against any other live bake or merge
+  // writing it (OutputLock), then new unless --force.
+  std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
+  if (merged.gltf.enabled)
+    for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
+  const OutputLock lock = OutputLock::Claim(options.dir, outputs);
   if (!options.force) {
-    std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
-    if (merged.gltf.enabled)
-      for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
     for (const std::string& name : outputs)
       if (fs::exists(dir / name, ec))
         throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", (dir / name).string()));

@@ -22,6 +22,7 @@
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/manifest.h"
+#include "skybake/output_lock.h"
 #include "skybake/tonemap.h"
 
 namespace skybake {
@@ -330,6 +331,12 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   for (const FramePlan& plan : plans) CheckBudget(*plan.style, options);
   const std::vector<std::string> planned = PlannedFileNames(plans, part);
   auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
+  // The lock on the planned files, held to the end of the bake (any exit,
+  // kill -9 included, releases it): another live bake writing any of them
+  // into this folder stops this one here (exit 6); parts of one sequence,
+  // whose files differ, go ahead side by side.
+  std::filesystem::create_directories(options.out_dir);
+  const OutputLock lock = OutputLock::Claim(options.out_dir, planned);
   if (!options.force && !options.resume) {
     for (const std::string& name : planned) {
       std::error_code ec;

@@ -17,9 +17,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/output_lock.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -113,6 +115,7 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
   EXPECT_LT(partial["frames"].size(), 20u);
   size_t temporaries = 0;
   for (const std::string& name : after_kill) {
+    if (name.rfind(".skybake.lock.", 0) == 0) continue;  // the killed bake's lock claim, no longer held
     if (name[0] == '.') {
       ++temporaries;  // a hidden temporary of the killed process: never a real output name
       EXPECT_NE(name.find(".tmp"), std::string::npos) << name;
@@ -215,6 +218,162 @@ TEST(SafeOutputs, LinkAtAnOutputNameIsReplacedNotFollowed) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
   EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/sky_px.exr")));
+  fs::remove_all(root);
+}
+
+// The output lock (skybake/output_lock.h): claims that share a file name
+// exclude each other while held; disjoint claims coexist; a released or
+// dead claim frees its names.
+TEST(OutputLockTest, OverlappingClaimsAreRefusedDisjointOnesCoexist) {
+  const std::string dir = FreshTempDir("lockunit");
+  {
+    OutputLock a = OutputLock::Claim(dir, {"sky_px.0001.exr", "manifest.shard-0001-0002.json"});
+    OutputLock b = OutputLock::Claim(dir, {"sky_px.0003.exr", "manifest.shard-0003-0004.json"});
+    try {
+      OutputLock c = OutputLock::Claim(dir, {"sky_px.0004.exr", "sky_px.0001.exr"});
+      ADD_FAILURE() << "an overlapping claim was granted";
+    } catch (const OutputLockedError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(fmt::format("(pid {} on ", getpid())), std::string::npos) << what;
+      EXPECT_NE(what.find("which writes " + dir + "/sky_px.0001.exr too"), std::string::npos) << what;
+    }
+  }
+  // Both released: the names are free, and no lock file is left.
+  OutputLock again = OutputLock::Claim(dir, {"sky_px.0001.exr"});
+  EXPECT_EQ(FileNames(dir).size(), 1u) << "only the one live claim";
+  again = OutputLock();
+  EXPECT_TRUE(FileNames(dir).empty());
+  fs::remove_all(dir);
+}
+
+// Twenty frames of 64^3 take a few seconds: long enough to meet them.
+std::string SlowSequenceBake(const std::string& schedule, const std::string& out, const std::string& extra = "") {
+  return "bake '" + Style() + "' --schedule '" + schedule + "' --size 48 -q --out '" + out + "' " + extra;
+}
+
+// Waits until `dir` holds a lock claim (a bake got past its start).
+bool WaitForClaim(const std::string& dir, pid_t child) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const std::string& name : FileNames(dir))
+      if (name.rfind(".skybake.lock.", 0) == 0) return true;
+    if (waitpid(child, nullptr, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return false;
+}
+
+pid_t Spawn(const std::string& args) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/bash", "bash", "-c", (std::string("exec '") + SKYBAKE_BINARY + "' " + args + " >/dev/null 2>&1").c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+int WaitExit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Two bakes of the same files into one folder: the second, even with
+// --force, stops before any GPU work with exit 6 naming the first; the first
+// completes with every file matching its manifest.
+TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
+  const std::string root = FreshTempDir("lockbake");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  // A holder the test controls: this process claims one frame's file.
+  {
+    OutputLock held = OutputLock::Claim(out, {"sky_px.0007.exr"});
+    CommandRun refused = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
+    EXPECT_EQ(refused.exit_code, 6) << refused.output;
+    EXPECT_EQ(refused.output.rfind(fmt::format("skybake: error: {} is being written by another skybake (pid {} on ",
+                                               out, getpid()), 0), 0u) << refused.output;
+    EXPECT_NE(refused.output.find("which writes " + out + "/sky_px.0007.exr too: wait for it to end, or choose "
+                                  "another --out"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.find("skybake: device"), std::string::npos) << "no GPU work";
+    EXPECT_EQ(FileNames(out).size(), 1u) << "nothing written but the holder's claim";
+  }
+  // Two real bakes: the second overlaps the running first.
+  pid_t first = Spawn(SlowSequenceBake(schedule, out, "--force"));
+  ASSERT_TRUE(WaitForClaim(out, first)) << "the first bake never claimed its files";
+  CommandRun second = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
+  EXPECT_EQ(second.exit_code, 6) << second.output;
+  EXPECT_NE(second.output.find(fmt::format("(pid {} on ", first)), std::string::npos) << second.output;
+  EXPECT_NE(second.output.find(" bake "), std::string::npos) << "names the other's command: " << second.output;
+  ASSERT_EQ(WaitExit(first), 0);
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
+  EXPECT_TRUE(manifest["complete"].get<bool>());
+  for (const auto& frame : manifest["frames"])
+    for (const auto& file : frame["files"])
+      EXPECT_EQ(ReadFileBytes(out + "/" + file["file"].get<std::string>()).size(), file["bytes"].get<uint64_t>());
+  for (const std::string& name : FileNames(out)) EXPECT_NE(name[0], '.') << name << " left behind";
+  fs::remove_all(root);
+}
+
+// Shards of one sequence write into one folder at the same time; a part that
+// overlaps a running one is refused; the merge gives the unsharded bake.
+TEST(SafeOutputs, DisjointShardsShareAFolderOverlappingPartsAreRefused) {
+  const std::string root = FreshTempDir("lockshards");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  pid_t one = Spawn(SlowSequenceBake(schedule, out, "--shard 1/2"));
+  pid_t two = Spawn(SlowSequenceBake(schedule, out, "--shard 2/2"));
+  ASSERT_TRUE(WaitForClaim(out, one));
+  CommandRun overlapping = RunSkybake(SlowSequenceBake(schedule, out, "--frames 10:11 --force"));
+  EXPECT_EQ(overlapping.exit_code, 6) << overlapping.output;
+  EXPECT_NE(overlapping.output.find("is being written by another skybake (pid "), std::string::npos)
+      << overlapping.output;
+  EXPECT_EQ(WaitExit(one), 0);
+  EXPECT_EQ(WaitExit(two), 0);
+  CommandRun merged = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
+  fs::remove_all(root);
+}
+
+// kill -9 of a bake releases its lock (the kernel drops the flock): the
+// next bake into the folder proceeds and removes the dead claim.
+TEST(SafeOutputs, KilledBakesLockIsReleased) {
+  const std::string root = FreshTempDir("lockkill");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  pid_t first = Spawn(SlowSequenceBake(schedule, out));
+  ASSERT_TRUE(WaitForClaim(out, first));
+  ASSERT_EQ(kill(first, SIGKILL), 0);
+  EXPECT_EQ(WaitExit(first), -1);
+  CommandRun resumed = RunSkybake(SlowSequenceBake(schedule, out, "--resume"));
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+  for (const std::string& name : FileNames(out)) EXPECT_NE(name[0], '.') << name << " left behind";
+  fs::remove_all(root);
+}
+
+// merge-manifest takes the lock for what it writes: a live claim on
+// manifest.json (a whole bake running) refuses it, and it writes nothing.
+TEST(SafeOutputs, MergeTakesTheLockOnWhatItWrites) {
+  const std::string root = FreshTempDir("lockmerge");
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string out = root + "/out";
+  for (const char* shard : {"1/2", "2/2"}) {
+    CommandRun part = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out +
+                                 "' --shard " + shard);
+    ASSERT_EQ(part.exit_code, 0) << part.output;
+  }
+  {
+    OutputLock held = OutputLock::Claim(out, {"sky.glb"});
+    CommandRun refused = RunSkybake("merge-manifest '" + out + "'");
+    EXPECT_EQ(refused.exit_code, 6) << refused.output;
+    EXPECT_NE(refused.output.find("which writes " + out + "/sky.glb too"), std::string::npos) << refused.output;
+    EXPECT_FALSE(fs::exists(out + "/manifest.json"));
+  }
+  CommandRun merged = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
   fs::remove_all(root);
 }
 
