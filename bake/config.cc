@@ -85,15 +85,7 @@ int EditDistance(std::string_view a, std::string_view b) {
 
 // A name is safe as an output file name component: no separators, no "..",
 // no leading dot, printable ASCII.
-bool IsSafeFileName(const std::string& name) {
-  if (name.empty() || name.size() > 128 || name[0] == '.') return false;
-  for (char c : name) {
-    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-              c == '_' || c == '-' || c == '.' || c == '+';
-    if (!ok) return false;
-  }
-  return name.find("..") == std::string::npos;
-}
+bool IsSafeFileName(const std::string& name) { return IsPlainFileName(name); }
 
 // --------------------------------------------------------------- the schema
 
@@ -683,6 +675,16 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
 
 }  // namespace
 
+bool IsPlainFileName(const std::string& name) {
+  if (name.empty() || name.size() > 128 || name[0] == '.') return false;
+  for (char c : name) {
+    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+              c == '_' || c == '-' || c == '.' || c == '+';
+    if (!ok) return false;
+  }
+  return name.find("..") == std::string::npos;
+}
+
 std::string ConfigError::Format() const {
   std::string where = file;
   if (line > 0) where += fmt::format(":{}:{}", line, column);
@@ -823,6 +825,19 @@ ConfigResult LoadSkyStyle(const std::string& path, const std::vector<std::string
   std::stringstream text;
   text << in.rdbuf();
   return ParseSkyStyle(text.str(), path, overrides);
+}
+
+std::string EscapedText(std::string_view text) {
+  std::string out = "'";
+  for (char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c == '\\' || c == '\'') out += fmt::format("\\{}", ch);
+    else if (c == '\n') out += "\\n";
+    else if (c == '\t') out += "\\t";
+    else if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += ch;
+  }
+  return out + "'";
 }
 
 }  // namespace skybake

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -190,7 +191,7 @@ struct FrameNames {
 
 FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
   const OutputSettings& o = style.output;
-  const std::string number = number_in_name > 0 ? fmt::format(".{:04d}", number_in_name) : "";
+  const std::string number = FrameNumberSuffix(number_in_name);
   FrameNames names;
   if (o.faces)
     for (int face = 0; face < 6; ++face) names.faces.push_back(o.basename + "_" + o.face_names[face] + number + ".exr");
@@ -226,25 +227,48 @@ struct PreviousBake {
 PreviousBake ReadPreviousManifest(const std::string& path) {
   PreviousBake previous;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return previous;
+  const std::filesystem::file_status status = std::filesystem::symlink_status(path, ec);
+  if (!std::filesystem::exists(status)) return previous;
+  // What --resume cannot read is the folder's problem, not a write failure:
+  // exit 6, as for any file in the way, with the fix.
+  if (std::filesystem::is_directory(status))
+    throw OutputExistsError(fmt::format("{} is a directory, not a manifest, so --resume cannot tell which frames are "
+                                        "done: move it away, or pass --force instead to bake every frame again",
+                                        path));
+  if (!std::filesystem::is_regular_file(status))
+    throw OutputExistsError(fmt::format("{} is not a regular file (a link, a pipe or a device), so --resume does not "
+                                        "read it: move it away, or pass --force instead to bake every frame again",
+                                        path));
   std::ifstream in(path, std::ios::binary);
   json manifest = json::parse(in, nullptr, false);
   if (manifest.is_discarded() || !manifest.is_object())
-    throw OutputError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
-                                  "--force instead to bake every frame again", path));
+    throw OutputExistsError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
+                                        "--force instead to bake every frame again", path));
   previous.loaded = true;
-  previous.half_scale = manifest.value("half_scale", 0.0);
-  previous.exposure_ev100 = manifest.value("exposure_ev100", 0.0);
+  // A value of the wrong type matches no frame: those frames are baked again.
+  auto number = [&](const char* key) {
+    return manifest.contains(key) && manifest[key].is_number() ? manifest[key].get<double>() : std::nan("");
+  };
+  previous.half_scale = number("half_scale");
+  previous.exposure_ev100 = number("exposure_ev100");
   if (manifest.contains("frames") && manifest["frames"].is_array())
     for (const json& f : manifest["frames"])
-      if (f.is_object() && f.contains("frame") && f["frame"].is_number_integer())
+      if (f.is_object() && f.contains("frame") && f["frame"].is_number_integer() &&
+          f["frame"].get<int64_t>() >= 0 && f["frame"].get<int64_t>() <= std::numeric_limits<int>::max())
         previous.frames[f["frame"].get<int>()] = f;
   return previous;
 }
 
+// A string member, or "" when absent or not a string.
+std::string StringOf(const json& object, const char* key) {
+  return object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : std::string();
+}
+
 // The files of `frame` from the previous manifest when every one of them is
 // on disk with its recorded SHA-256 and the frame was baked with the same
-// style, exposure and half scale; otherwise nothing.
+// style, exposure and half scale; otherwise nothing. A frame of the same
+// style lists exactly the names and kinds this bake gives it: any other
+// name stops the bake (ManifestError, exit 8) before it is opened.
 std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous, const FramePlan& plan,
                                                     const std::string& out_dir, double half_scale,
                                                     double ev100) {
@@ -253,22 +277,40 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   auto it = previous.frames.find(plan.number);
   if (it == previous.frames.end()) return std::nullopt;
   const json& f = it->second;
-  if (f.value("style_sha256", std::string()) != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
+  if (StringOf(f, "style_sha256") != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
   if (!f.contains("files") || !f["files"].is_array()) return std::nullopt;
-  std::vector<std::string> expected = FrameFileNames(*plan.style, plan.number).All();
-  std::vector<BakedFile> files;
+  const FrameNames names = FrameFileNames(*plan.style, plan.number);
+  const std::vector<std::string> expected = names.All();
+  std::vector<std::string> kinds(names.faces.size(), "face");
+  if (!names.cube.empty()) kinds.push_back("cube");
+  if (!names.latlong.empty()) kinds.push_back("latlong");
+  if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
+  size_t index = 0;
   for (const json& entry : f["files"]) {
-    if (!entry.is_object()) return std::nullopt;
-    std::string name = entry.value("file", std::string());
-    if (files.size() >= expected.size() || name != expected[files.size()]) return std::nullopt;
-    std::string path = (std::filesystem::path(out_dir) / name).string();
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
-    std::string sha = Sha256OfFile(path);
-    if (sha != entry.value("sha256", std::string())) return std::nullopt;
-    files.push_back({path, entry.value("kind", std::string()), uint64_t(std::filesystem::file_size(path)), sha});
+    const std::string name = entry.is_object() ? StringOf(entry, "file") : std::string();
+    const std::string kind = entry.is_object() ? StringOf(entry, "kind") : std::string();
+    if (index >= expected.size() || name != expected[index] || kind != kinds[index])
+      throw ManifestError(fmt::format(
+          "the manifest in {} lists {} ({}) for frame {}, where this bake of the same style writes {}: the manifest "
+          "was edited or is not skybake's; nothing was read under that name. Pass --force instead of --resume to "
+          "bake every frame again",
+          out_dir, EscapedText(name), EscapedText(kind), plan.number,
+          index < expected.size() ? EscapedText(expected[index]) : "no more files"));
+    ++index;
   }
-  if (files.size() != expected.size()) return std::nullopt;
+  if (index != expected.size()) return std::nullopt;
+  std::vector<BakedFile> files;
+  index = 0;
+  for (const json& entry : f["files"]) {
+    std::string path = (std::filesystem::path(out_dir) / expected[index]).string();
+    std::error_code ec;
+    // A link is not followed: only a regular file of the folder is verified.
+    if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, ec))) return std::nullopt;
+    std::string sha = Sha256OfFile(path);
+    if (sha != StringOf(entry, "sha256")) return std::nullopt;
+    files.push_back({path, kinds[index], uint64_t(std::filesystem::file_size(path)), sha});
+    ++index;
+  }
   return files;
 }
 
@@ -451,9 +493,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   for (size_t i = 0; i < plans.size(); ++i) {
     const FramePlan& plan = plans[i];
     style_sha256.push_back(Sha256OfText(plan.style->resolved_toml));
-    sequence_identity += fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", plan.number,
-                                     plan.time ? plan.time->Iso8601() : "", plan.sun.x, plan.sun.y, plan.sun.z,
-                                     style_sha256.back());
+    sequence_identity +=
+        SequenceIdentityLine(plan.number, plan.time ? plan.time->Iso8601() : "", plan.sun, style_sha256.back());
     plan_of_frame[plan.number] = i;
   }
   auto manifest_of = [&]() {

@@ -377,6 +377,53 @@ TEST(SafeOutputs, MergeTakesTheLockOnWhatItWrites) {
   fs::remove_all(root);
 }
 
+// --resume reads manifest.json as input: a directory or non-JSON there is
+// the folder's problem (exit 6, with the fix), a value of the wrong type
+// only makes its frames bake again, and a name that is not the one this
+// bake gives the frame (same style) stops it (exit 8) before it is opened.
+TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
+  const std::string root = FreshTempDir("resumein");
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out + "'";
+  ASSERT_EQ(RunSkybake(bake).exit_code, 0);
+  const std::string manifest_path = out + "/manifest.json";
+  const std::string good = ReadFileBytes(manifest_path);
+
+  fs::remove(manifest_path);
+  fs::create_directory(manifest_path);
+  CommandRun directory = RunSkybake(bake + " --resume");
+  EXPECT_EQ(directory.exit_code, 6) << directory.output;
+  EXPECT_EQ(directory.output, "skybake: error: " + manifest_path + " is a directory, not a manifest, so --resume "
+                              "cannot tell which frames are done: move it away, or pass --force instead to bake every "
+                              "frame again\n");
+  fs::remove(manifest_path);
+
+  std::ofstream(manifest_path) << "not json";
+  CommandRun garbage = RunSkybake(bake + " --resume");
+  EXPECT_EQ(garbage.exit_code, 6) << garbage.output;
+  EXPECT_EQ(garbage.output, "skybake: error: " + manifest_path + " is not valid JSON, so --resume cannot tell which "
+                            "frames are done: pass --force instead to bake every frame again\n");
+
+  nlohmann::json m = nlohmann::json::parse(good);
+  m["half_scale"] = "one";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun typed = RunSkybake(bake + " --resume");
+  EXPECT_EQ(typed.exit_code, 0) << typed.output;
+  EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
+
+  m = nlohmann::json::parse(good);
+  m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun hostile = RunSkybake(bake + " --resume");
+  EXPECT_EQ(hostile.exit_code, 8) << hostile.output;
+  EXPECT_NE(hostile.output.find("lists '../../../etc/passwd' ('latlong') for frame 2, where this bake of the same "
+                                "style writes 'sky_latlong.0002.exr': the manifest was edited"),
+            std::string::npos)
+      << hostile.output;
+  fs::remove_all(root);
+}
+
 // A file-size limit (ulimit -f, in KiB) stands in for a full disk: write()
 // fails with EFBIG, as with ENOSPC.
 TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {

@@ -107,6 +107,16 @@ ConfigResult LoadSkyStyle(const std::string& path, const std::vector<std::string
 ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
                            const std::vector<std::string>& overrides = {});
 
+// The rule for every file name skybake writes into, or reads from, an output
+// folder (output.basename, output.face_names, names read from manifests):
+// 1 to 128 letters, digits, '_', '-', '.', '+', no "..", not starting with '.'.
+bool IsPlainFileName(const std::string& name);
+
+// `text` in single quotes for a message, with control characters, quotes
+// and backslashes escaped (\n, \t, \x1b, \'), so nothing read from a file
+// reaches the terminal raw.
+std::string EscapedText(std::string_view text);
+
 // Per-channel factor from spectral radiance to the chosen output units.
 Rgb OutputScale(OutputUnits units);
 
