@@ -7,9 +7,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cerrno>
+#include <cstring>
 #include <fstream>
+#include <optional>
 #include <set>
 #include <sstream>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -489,6 +496,7 @@ class StyleReader {
       if (dot == std::string_view::npos) break;
       prefix += std::string(rest.substr(0, dot));
       known_.insert(prefix);
+      tables_.insert(prefix);
       prefix += '.';
       rest.remove_prefix(dot + 1);
     }
@@ -504,6 +512,12 @@ class StyleReader {
         continue;
       }
       if (opaque_.count(path)) continue;
+      // A table replaced by a value (`--set sun=1`) would drop every key of
+      // it silently: refused.
+      if (tables_.count(path) && !node.is_table()) {
+        Error(&node, path, fmt::format("expected a table ([{}] with its keys), got {}", path, TypeName(node)));
+        continue;
+      }
       if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
     }
   }
@@ -558,6 +572,7 @@ class StyleReader {
   std::string file_;
   std::vector<ConfigError>& errors_;
   std::set<std::string> known_;
+  std::set<std::string> tables_;  // prefixes of known keys: tables
   std::set<std::string> opaque_;
 };
 
@@ -621,6 +636,68 @@ class StyleWriter {
   toml::table root_;
 };
 
+// --------------------------------------------------------------- input limits
+
+// The first place where `text` has a dotted key of more than kMaxKeyParts
+// parts (`a.b.c` is 3; a table header counts as a key), or nothing. The TOML
+// parser recurses once per part: 50,000 parts overflow its stack. A linear
+// scan that skips strings and comments; a float (`0.5`) is a 2-part chain,
+// a date has none.
+std::optional<toml::source_position> DeepKey(std::string_view text) {
+  uint32_t line = 1, column = 0;
+  size_t parts = 1;
+  bool in_chain = false;  // after a bare-key character or a quoted key
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    ++column;
+    if (c == '\n') {
+      ++line;
+      column = 0;
+      parts = 1;
+      in_chain = false;
+      continue;
+    }
+    if (c == '#') {  // a comment, to the end of the line
+      while (i + 1 < text.size() && text[i + 1] != '\n') ++i;
+      continue;
+    }
+    if (c == '"' || c == '\'') {  // a string: skipped, counts as one key part
+      const bool multi = text.compare(i, 3, std::string(3, c)) == 0;
+      const size_t open = multi ? 3 : 1;
+      size_t j = i + open;
+      for (; j < text.size(); ++j) {
+        if (c == '"' && text[j] == '\\') {
+          ++j;
+          continue;
+        }
+        if (text[j] == '\n') {
+          if (!multi) break;
+          ++line;
+          column = 0;
+        }
+        if (text[j] == c && (!multi || text.compare(j, 3, std::string(3, c)) == 0)) break;
+      }
+      const size_t end = std::min(text.size(), j + (multi ? 3 : 1));
+      column += uint32_t(end - i - 1);
+      i = end - 1;
+      in_chain = true;
+      continue;
+    }
+    const bool bare = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
+                      c == '-' || c == '+';
+    if (bare) {
+      in_chain = true;
+    } else if (c == '.' && in_chain) {
+      if (++parts > kMaxKeyParts) return toml::source_position{line, column};
+      in_chain = false;
+    } else if (c != ' ' && c != '\t' && c != '.') {
+      parts = 1;
+      in_chain = false;
+    }
+  }
+  return std::nullopt;
+}
+
 // --------------------------------------------------------------- overrides
 
 // Applies "a.b.c=value" on top of `root`. The value is TOML ("0.5", "[1,2,3]",
@@ -642,6 +719,10 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
   }
   std::string key = text.substr(0, eq);
   std::string value = text.substr(eq + 1);
+  if (DeepKey(value)) {
+    fail(fmt::format("the value nests more than {} dotted key parts: give a plain value", kMaxKeyParts));
+    return;
+  }
   toml::table parsed;
   try {
     parsed = toml::parse("v = " + value, name);
@@ -703,6 +784,10 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   ConfigResult result;
   result.style.source_path = name;
   toml::table root;
+  if (std::optional<ConfigError> deep = DeepKeyError(toml_text, name)) {
+    result.errors.push_back(*deep);
+    return result;
+  }
   try {
     root = toml::parse(toml_text, name);
   } catch (const toml::parse_error& e) {
@@ -811,20 +896,71 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   return result;
 }
 
+std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string& name) {
+  std::optional<toml::source_position> at = DeepKey(text);
+  if (!at) return std::nullopt;
+  ConfigError e;
+  e.file = name;
+  e.line = int(at->line);
+  e.column = int(at->column);
+  e.key = "(syntax)";
+  e.message = fmt::format("a dotted key or table name of more than {} parts: skybake's keys have at most 5, e.g. "
+                          "atmosphere.rayleigh.scale_height_km",
+                          kMaxKeyParts);
+  return e;
+}
+
+std::optional<ConfigError> ReadInputFile(const std::string& path, const char* what, std::string& text) {
+  ConfigError e;
+  e.file = path;
+  e.key = "(file)";
+  struct stat st {};
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    e.message = fmt::format("cannot open the {} file: check the path", what);
+    return e;
+  }
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    ::close(fd);
+    e.message = S_ISDIR(st.st_mode) ? fmt::format("is a directory: give a {} TOML file", what)
+                                    : fmt::format("is not a regular file (a device, a pipe or a socket): give a {} "
+                                                  "TOML file", what);
+    return e;
+  }
+  // Read up to the limit, whatever the size says (a file in /proc says 0).
+  text.clear();
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      e.message = fmt::format("cannot read the {} file: {}", what, std::strerror(errno));
+      ::close(fd);
+      return e;
+    }
+    if (n == 0) break;
+    text.append(buffer, size_t(n));
+    if (text.size() > kMaxInputBytes) {
+      ::close(fd);
+      e.message = fmt::format("is larger than {} MiB, the limit of a style or schedule file (a schedule of "
+                              "100,000 frames listed one by one is under 8 MiB): give a {} TOML file",
+                              kMaxInputBytes >> 20, what);
+      text.clear();
+      return e;
+    }
+  }
+  ::close(fd);
+  return std::nullopt;
+}
+
 ConfigResult LoadSkyStyle(const std::string& path, const std::vector<std::string>& overrides) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  std::string text;
+  if (std::optional<ConfigError> e = ReadInputFile(path, "style", text)) {
     ConfigResult result;
-    ConfigError e;
-    e.file = path;
-    e.key = "(file)";
-    e.message = "cannot open the style file: check the path";
-    result.errors.push_back(e);
+    result.errors.push_back(*e);
     return result;
   }
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseSkyStyle(text.str(), path, overrides);
+  return ParseSkyStyle(text, path, overrides);
 }
 
 std::string EscapedText(std::string_view text) {

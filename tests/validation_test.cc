@@ -27,6 +27,14 @@ struct BadInput {
 
 void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
 
+// A dotted key of 50,000 parts (100 KB): the TOML parser's recursion
+// overflowed the stack on it (SIGSEGV) before the input limits.
+const std::string kDeepKey = [] {
+  std::string text = "a";
+  for (int i = 0; i < 50000; ++i) text += ".a";
+  return text + " = 1\n";
+}();
+
 // clang-format off
 const BadInput kBadInputs[] = {
     {"UnknownKeyWithSuggestion", R"toml([sun]
@@ -355,6 +363,39 @@ set = { "sun.elevation_deg " = 5 }
 )toml", "", 3,
          "skybake: error: schedule.toml:5:32: schedule.frames[0].set.sun.elevation_deg : 'sun.elevation_deg ' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"DeepDottedKey", kDeepKey.c_str(), nullptr, "", 3,
+         "skybake: error: style.toml:1:128: (syntax): a dotted key or table name of more than 64 parts: skybake's keys have at most 5, e.g. atmosphere.rayleigh.scale_height_km\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"StyleIsADirectory", "DIR", nullptr, "", 3,
+         "skybake: error: style.toml: (file): is a directory: give a style TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"StyleIsADevice", "DEVZERO", nullptr, "", 3,
+         "skybake: error: style.toml: (file): is not a regular file (a device, a pipe or a socket): give a style TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleIsADirectory", "", "DIR", "", 3,
+         "skybake: error: schedule.toml: (file): is a directory: give a schedule TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetReplacesATableByANumber", "", nullptr, "--set sun=1", 3,
+         "skybake: error: --set sun=1:1:5: sun: expected a table ([sun] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetReplacesATableByAnArray", "", nullptr, "--set render=[]", 3,
+         "skybake: error: --set render=[]:1:5: render: expected a table ([render] with its keys), got an array\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetReplacesATable", "", R"toml([schedule]
+[[schedule.frames]]
+elevation_deg = 10
+azimuth_deg = 135
+set = { "sun" = 1 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:5:17: sun: frame 1: expected a table ([sun] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampReplacesATable", "", R"toml([schedule]
+sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
+[schedule.ramp]
+"atmosphere" = [0, 1]
+)toml", "", 3,
+         "skybake: error: schedule.toml:4:16: atmosphere: frame 1: expected a table ([atmosphere] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
@@ -368,10 +409,16 @@ class BadInputs : public ::testing::TestWithParam<BadInput> {};
 TEST_P(BadInputs, RefusedWithTheExactMessageAndExitCode) {
   const BadInput& c = GetParam();
   const std::string dir = testing::FreshTempDir(std::string("bad_") + c.name);
-  if (c.style) std::ofstream(dir + "/style.toml") << c.style;
+  // "DIR": a directory under the name; "DEVZERO": a link to /dev/zero.
+  auto place = [&](const char* text, const std::string& path) {
+    if (std::string(text) == "DIR") fs::create_directory(path);
+    else if (std::string(text) == "DEVZERO") fs::create_symlink("/dev/zero", path);
+    else if (std::string(text) != "MISSING") std::ofstream(path) << text;
+  };
+  if (c.style) place(c.style, dir + "/style.toml");
   std::string args = "style.toml";
   if (c.schedule) {
-    if (std::string(c.schedule) != "MISSING") std::ofstream(dir + "/schedule.toml") << c.schedule;
+    place(c.schedule, dir + "/schedule.toml");
     args += " --schedule schedule.toml";
   }
   args += std::string(" ") + c.args;

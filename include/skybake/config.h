@@ -6,6 +6,8 @@
 // reports all three, each with file:line:column and the key path.
 #pragma once
 
+#include <cstddef>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -116,6 +118,21 @@ bool IsPlainFileName(const std::string& name);
 // and backslashes escaped (\n, \t, \x1b, \'), so nothing read from a file
 // reaches the terminal raw.
 std::string EscapedText(std::string_view text);
+
+// Limits of a style or schedule file, checked before it is parsed: 16 MiB
+// (a schedule of the documented 100,000 frames listed one by one is under
+// 8 MiB) and dotted keys of at most 64 parts (skybake's have at most 5; the
+// TOML parser recurses once per part and 50,000 overflow its stack).
+inline constexpr size_t kMaxInputBytes = size_t(16) << 20;
+inline constexpr size_t kMaxKeyParts = 64;
+
+// Reads a style or schedule file (`what`: "style", "schedule") into `text`:
+// a regular file (not a directory, device or pipe) of at most
+// kMaxInputBytes; otherwise the error, at `(file)`.
+std::optional<ConfigError> ReadInputFile(const std::string& path, const char* what, std::string& text);
+
+// The error for a key of more than kMaxKeyParts parts in `text`, located.
+std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string& name);
 
 // Per-channel factor from spectral radiance to the chosen output units.
 Rgb OutputScale(OutputUnits units);
