@@ -11,6 +11,7 @@
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -274,6 +275,16 @@ int main(int argc, char** argv) {
   app.get_formatter()->column_width(34);
 
   BakeArgs args;
+  // A budget is a finite number above 0 (nan compares false with every
+  // bound and would switch the budget off).
+  const CLI::Validator finite_positive(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
+          return "expected a finite number above 0, got " + text;
+        return "";
+      },
+      "POSITIVE");
   auto add_style_options = [&](CLI::App* cmd) {
     cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
         ->required();
@@ -285,11 +296,11 @@ int main(int argc, char** argv) {
     cmd->add_option("--max-memory-mib", args.max_memory_mib,
                     "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(finite_positive);
     cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
                     "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(finite_positive);
   };
 
   CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "

@@ -469,6 +469,18 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
                            clock_hours(*f.time) - clock_hours(*frames[0].time);
     }
   }
+  // Clock times run forward: the glTF sun animation's keys (hours) must
+  // increase strictly, and a ramp by time needs an order.
+  if (schedule.clock_times) {
+    const char* list = s->get("times") ? "times" : "frames";
+    for (size_t i = 1; i < frames.size(); ++i) {
+      if (frames[i].hours_from_start > frames[i - 1].hours_from_start) continue;
+      r.Error(s->get(list), std::string("schedule.") + list,
+              fmt::format("frame {} ({}) is not after frame {} ({}): give clock times in increasing order, each "
+                          "once", i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
+      break;
+    }
+  }
   const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
   for (size_t i = 0; i < frames.size(); ++i) {
     if (schedule.clock_times && span_hours != 0.0)

@@ -396,6 +396,27 @@ sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
 )toml", "", 3,
          "skybake: error: schedule.toml:4:16: atmosphere: frame 1: expected a table ([atmosphere] with its keys), got an integer\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleClockTimesOutOfOrder", "", R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = [12:00:00, 09:00:00, 12:00:00]
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:9: schedule.times: frame 2 (2013-05-27T09:00:00-04:00) is not after frame 1 (2013-05-27T12:00:00-04:00): give clock times in increasing order, each once\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameTimesRepeat", "", R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+[[schedule.frames]]
+time = 09:00:00
+[[schedule.frames]]
+time = 09:00:00
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:1: schedule.frames: frame 2 (2013-05-27T09:00:00-04:00) is not after frame 1 (2013-05-27T09:00:00-04:00): give clock times in increasing order, each once\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
@@ -449,6 +470,21 @@ TEST(BadInputs, SizeOutsideTheCommandLineRangeIsAUsageError) {
     testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size " + size + " --out /nonexistent/x");
     EXPECT_EQ(run.exit_code, 2) << size << ": " << run.output;
     EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
+  }
+}
+
+// A budget of nan compared false with every estimate and switched the
+// check off; inf, 0 and negatives are no budget either.
+TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  for (const char* option : {"--max-memory-mib", "--max-frame-seconds"}) {
+    for (const char* value : {"nan", "inf", "-1", "0"}) {
+      testing::CommandRun run =
+          testing::RunSkybake("bake '" + style + "' " + option + " " + value + " --out /nonexistent/x");
+      EXPECT_EQ(run.exit_code, 2) << option << " " << value << ": " << run.output;
+      EXPECT_EQ(run.output.rfind(std::string(option) + ": expected a finite number above 0, got " + value, 0), 0u)
+          << run.output;
+    }
   }
 }
 
