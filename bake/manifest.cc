@@ -455,6 +455,8 @@ void WriteTimings(const BakeResult& result, const std::string& out_dir, double t
   }
   json timings = {{"out_dir", out_dir},
                   {"renderer_builds", result.renderer_builds},
+                  {"manifest_writes", result.manifest_writes},
+                  {"manifest_bytes_written", result.manifest_bytes_written},
                   {"total_s", total_seconds},
                   {"stages", stages},
                   {"frames", frames}};

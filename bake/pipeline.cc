@@ -528,6 +528,20 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     }
     return m;
   };
+  // A write costs time in proportion to the frames done, so rewriting the
+  // manifest after every frame grew as frames squared. It is rewritten after
+  // a frame when the frames done have grown by a tenth since its last write
+  // (so after each of the first twenty; the bytes written add up to about 11
+  // times the final manifest), or when kManifestSeconds have passed since
+  // the last write and at least kManifestSpacing times what it took (writes
+  // stay under a tenth of the bake). Both keep the cost linear; a killed
+  // bake loses at most the frames since the last write (--resume bakes them
+  // again).
+  constexpr double kManifestSpacing = 9.0;
+  constexpr double kManifestSeconds = 30.0;
+  Clock::time_point manifest_written = Clock::now();
+  double manifest_write_seconds = 0.0;
+  size_t manifest_frames = 0;  // frames in the last manifest written
   auto write_manifest = [&](const std::vector<BakedFile>& scene, bool complete) {
     Manifest m = manifest_of();
     for (const BakedFile& f : scene)
@@ -535,6 +549,20 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     m.complete = complete;
     result.manifest_path = path_of(manifest_name);
     WriteManifest(m, result.manifest_path);
+    ++result.manifest_writes;
+    std::error_code ec;
+    result.manifest_bytes_written += std::filesystem::file_size(result.manifest_path, ec);
+  };
+  auto write_progress_manifest = [&]() {
+    const size_t done = result.frames.size();
+    if (done - manifest_frames < std::max<size_t>(1, manifest_frames / 10) &&
+        SecondsSince(manifest_written) < std::max(kManifestSeconds, kManifestSpacing * manifest_write_seconds))
+      return;
+    const Clock::time_point start = Clock::now();
+    write_manifest({}, false);
+    manifest_frames = done;
+    manifest_written = Clock::now();
+    manifest_write_seconds = std::chrono::duration<double>(manifest_written - start).count();
   };
 
   // One frame's files, from its rendered views: one scale for every file
@@ -692,8 +720,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.write_seconds = w.write_seconds;
     for (const BakedFile& f : frame.files) result.files.push_back(f);
     result.frames.push_back(std::move(frame));
-    // The manifest after every frame: a killed bake leaves a valid record of the frames done.
-    write_manifest({}, false);
+    // The manifest as frames are done: a killed bake leaves a valid record of them.
+    write_progress_manifest();
   };
 
   for (size_t index = 0; index < plans.size(); ++index) {
@@ -766,7 +794,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       result.preview_ev100 = ev100.value_or(0.0);
       for (const BakedFile& f : frame.files) result.files.push_back(f);
       result.frames.push_back(std::move(frame));
-      write_manifest({}, false);
+      write_progress_manifest();
       continue;
     }
 
