@@ -238,6 +238,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.overrides = args.overrides;
   options.bake.vulkan.device_index = args.device;
   options.bake.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  options.bake.force = args.force;
   size_t done = 0;
   if (!args.quiet) {
     options.bake.progress = [&done, &styles](const StageReport& s) {
@@ -353,6 +354,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16));
   gallery->add_option("--set", args.overrides, "Override a key in every style (repeatable)");
   gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
+  gallery->add_flag("--force", args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
   gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
   gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
 

@@ -377,12 +377,32 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   // kill -9 included, releases it): another live bake writing any of them
   // into this folder stops this one here (exit 6); parts of one sequence,
   // whose files differ, go ahead side by side.
-  std::filesystem::create_directories(options.out_dir);
+  {
+    std::error_code ec;
+    const std::filesystem::file_status out = std::filesystem::status(options.out_dir, ec);
+    if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
+      throw OutputError(fmt::format("--out {} is not a folder: give a folder (it is created when missing)",
+                                    options.out_dir));
+    std::filesystem::create_directories(options.out_dir, ec);
+    if (ec)
+      throw OutputError(fmt::format("cannot create the output folder {}: {}: choose a writable --out folder",
+                                    options.out_dir, ec.message()));
+  }
   const OutputLock lock = OutputLock::Claim(options.out_dir, planned);
+  // What the renames at the end could not replace is found now, before any
+  // GPU work: a directory (or a pipe, a socket) under an output's name.
+  for (const std::string& name : planned) {
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::symlink_status(path_of(name), ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) && !std::filesystem::is_symlink(st))
+      throw OutputError(fmt::format("{} is {}: an output file cannot replace it; move it away, or choose another --out",
+                                    path_of(name), std::filesystem::is_directory(st) ? "a directory" : "not a regular file"));
+  }
   if (!options.force && !options.resume) {
     for (const std::string& name : planned) {
       std::error_code ec;
-      if (std::filesystem::exists(path_of(name), ec))
+      // A link (dangling or not) at the name is a file in the way too.
+      if (std::filesystem::exists(std::filesystem::symlink_status(path_of(name), ec)))
         throw OutputExistsError(fmt::format(
             "{} already exists: pass --force to overwrite the bake's files{}, or choose another --out",
             path_of(name), sequence ? ", --resume to finish an interrupted sequence" : ""));

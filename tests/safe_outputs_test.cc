@@ -424,6 +424,72 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   fs::remove_all(root);
 }
 
+// gallery: a second run stops at the existing sheet with a fix gallery
+// accepts (--force; it advised --force and then rejected it), a link at
+// gallery.png counts as a file and is replaced, never followed.
+TEST(SafeOutputs, GalleryNeedsForceAndNeverWritesThroughALink) {
+  const std::string root = FreshTempDir("gallery");
+  const std::string styles = root + "/styles";
+  fs::create_directories(styles);
+  for (const char* name : {"a", "b"})
+    fs::copy_file(testing::SourceDir() + "/configs/styles/" + (std::string(name) == "a" ? "ambiguous_yellow.toml" : "crystal_blue.toml"),
+                  styles + "/" + name + ".toml");
+  const std::string out = root + "/out";
+  const std::string gallery = "gallery '" + styles + "' --size 8 -q --out '" + out + "'";
+  CommandRun first = RunSkybake(gallery);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const std::string sheet = ReadFileBytes(out + "/gallery.png");
+  CommandRun again = RunSkybake(gallery);
+  EXPECT_EQ(again.exit_code, 6) << again.output;
+  EXPECT_EQ(again.output, "skybake: error: " + out + "/gallery.png already exists: pass --force to replace the "
+                          "gallery, or choose another --out\n");
+  fs::remove(out + "/gallery.png");
+  std::ofstream(root + "/victim") << "victim";
+  fs::create_symlink(root + "/victim", out + "/gallery.png");
+  CommandRun linked = RunSkybake(gallery);
+  EXPECT_EQ(linked.exit_code, 6) << "a link is a file in the way: " << linked.output;
+  CommandRun forced = RunSkybake(gallery + " --force");
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/gallery.png")));
+  EXPECT_EQ(ReadFileBytes(out + "/gallery.png"), sheet);
+  fs::remove_all(root);
+}
+
+// What would fail only at the end is found before any GPU work: an output
+// name that is a directory (even with --force: 7 files were replaced, then
+// exit 5), --out naming a regular file; a dangling link at an output name
+// is a file in the way (exists() followed it).
+TEST(SafeOutputs, OutputsThatCannotBeWrittenAreFoundBeforeRendering) {
+  const std::string root = FreshTempDir("beforegpu");
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --size 8 --out '" + out + "'";
+  ASSERT_EQ(RunSkybake(bake + " -q").exit_code, 0);
+  const std::string px = ReadFileBytes(out + "/sky_px.exr");
+  fs::remove(out + "/sky.glb");
+  fs::create_directory(out + "/sky.glb");
+  CommandRun directory = RunSkybake(bake + " --force");
+  EXPECT_EQ(directory.exit_code, 5) << directory.output;
+  EXPECT_EQ(directory.output, "skybake: error: " + out + "/sky.glb is a directory: an output file cannot replace "
+                              "it; move it away, or choose another --out\n");
+  EXPECT_EQ(ReadFileBytes(out + "/sky_px.exr"), px);
+  fs::remove(out + "/sky.glb");
+
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink(root + "/nowhere", out + "/sky_nz.exr");
+  CommandRun dangling = RunSkybake(bake + " -q");
+  EXPECT_EQ(dangling.exit_code, 6) << dangling.output;
+  EXPECT_NE(dangling.output.find(out + "/sky_nz.exr already exists"), std::string::npos) << dangling.output;
+
+  std::ofstream(root + "/file") << "x";
+  CommandRun file = RunSkybake("bake '" + Style() + "' --size 8 --out '" + root + "/file'");
+  EXPECT_EQ(file.exit_code, 5) << file.output;
+  EXPECT_EQ(file.output, "skybake: error: --out " + root + "/file is not a folder: give a folder (it is created when "
+                         "missing)\n");
+  fs::remove_all(root);
+}
+
 // A file-size limit (ulimit -f, in KiB) stands in for a full disk: write()
 // fails with EFBIG, as with ENOSPC.
 TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
