@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <fstream>
@@ -339,8 +340,11 @@ class StyleReader {
     const std::string& text = node->as_string()->get();
     if (!IsSafeFileName(text)) {
       Error(node, path,
-            fmt::format("'{}' is not a plain file name: use letters, digits, '_', '-', '.', '+', "
-                        "no '/' or '..', not starting with '.'", text));
+            text.size() > 128
+                ? fmt::format("a name of {} characters is longer than the 128 a plain file name may have", text.size())
+                : fmt::format("{} is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or "
+                              "'..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, "
+                              "...)", EscapedText(text)));
       return;
     }
     out = text;
@@ -719,6 +723,15 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
   }
   std::string key = text.substr(0, eq);
   std::string value = text.substr(eq + 1);
+  if (value.find_first_of("\n\r") != std::string::npos) {
+    fail("the value has a line break, and what follows it would be ignored: give one value per --set");
+    return;
+  }
+  if (key == "schedule" || key.rfind("schedule.", 0) == 0) {
+    fail("a schedule is not changed with --set (it would be ignored): edit the schedule file, or use its "
+         "[schedule.ramp] or a frame's set");
+    return;
+  }
   if (DeepKey(value)) {
     fail(fmt::format("the value nests more than {} dotted key parts: give a plain value", kMaxKeyParts));
     return;
@@ -739,6 +752,10 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
   size_t dot;
   while ((dot = path.find('.')) != std::string_view::npos) {
     std::string_view part = path.substr(0, dot);
+    if (part.empty()) {
+      fail("empty part in the key path (two dots, or a leading dot): e.g. --set sun.elevation_deg=10");
+      return;
+    }
     auto [it, inserted] = table->insert(part, toml::table{});
     if (!it->second.is_table()) {
       fail(fmt::format("'{}' is not a table", part));
@@ -757,7 +774,15 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
 }  // namespace
 
 bool IsPlainFileName(const std::string& name) {
-  if (name.empty() || name.size() > 128 || name[0] == '.') return false;
+  // Not `-x` (read as an option by tools given the file), nor a name Windows
+  // reserves (CON, NUL, COM1, ... with any extension) on a shared folder.
+  if (name.empty() || name.size() > 128 || name[0] == '.' || name[0] == '-') return false;
+  std::string stem = name.substr(0, name.find('.'));
+  for (char& c : stem) c = char(std::toupper(static_cast<unsigned char>(c)));
+  for (const char* reserved : {"CON", "PRN", "AUX", "NUL"})
+    if (stem == reserved) return false;
+  if (stem.size() == 4 && (stem.rfind("COM", 0) == 0 || stem.rfind("LPT", 0) == 0) && stem[3] >= '1' && stem[3] <= '9')
+    return false;
   for (char c : name) {
     bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
               c == '_' || c == '-' || c == '.' || c == '+';
@@ -865,15 +890,26 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   }
   // Every file of a bake has its own name: face names differ from each other
   // and from the cube strip's and latlong's suffixes.
+  // Compared without case: on a case-insensitive file system (macOS,
+  // Windows shares) "PX" and "px" are one file.
   const std::vector<std::string>& faces = result.style.output.face_names;
+  auto folded = [](std::string name) {
+    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return name;
+  };
   for (size_t i = 0; i < faces.size(); ++i) {
-    bool reserved = faces[i] == "cube" || faces[i] == "latlong";
-    bool repeated = std::find(faces.begin(), faces.begin() + i, faces[i]) != faces.begin() + i;
+    bool reserved = folded(faces[i]) == "cube" || folded(faces[i]) == "latlong";
+    size_t twin = 0;
+    while (twin < i && folded(faces[twin]) != folded(faces[i])) ++twin;
+    bool repeated = twin < i;
     if (reserved || repeated) {
       ConfigError e = locate("output.face_names");
       e.key = fmt::format("output.face_names[{}]", i);
       e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
-                           : fmt::format("'{}' is given twice: each face is its own file", faces[i]);
+                  : faces[twin] == faces[i]
+                      ? fmt::format("'{}' is given twice: each face is its own file", faces[i])
+                      : fmt::format("'{}' and '{}' differ only in case, one file on a case-insensitive file "
+                                    "system: each face is its own file", faces[twin], faces[i]);
       result.errors.push_back(e);
       break;
     }

@@ -38,8 +38,20 @@ namespace {
 
 using namespace skybake;
 
+// A message for the terminal: control characters read from a file or the
+// command line (an escape sequence, a newline in a key) shown as \xNN.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += ch;
+  }
+  return out;
+}
+
 void PrintErrors(const std::vector<ConfigError>& errors) {
-  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", e.Format().c_str());
+  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", Printable(e.Format()).c_str());
   std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
                errors.size() == 1 ? "" : "s");
 }
@@ -150,8 +162,20 @@ int RunBake(const BakeArgs& args, Mode mode) {
   }
   if (mode == Mode::kPlan || args.dry_run) {
     // The passes, LUTs and shader variant the bake would run, and why.
-    PassPlan plan = PlanPasses(schedule ? frame_styles : std::vector<SkyStyle>{config.style});
-    std::printf("%s", FormatPlan(plan, args.style_path + (schedule ? " with " + schedule_path : "")).c_str());
+    // The part that --frames / --shard select, when given.
+    std::vector<SkyStyle> planned;
+    if (schedule) {
+      for (size_t i = 0; i < frame_styles.size(); ++i)
+        if (!part || part->Contains(schedule->frames[i].number)) planned.push_back(frame_styles[i]);
+    } else {
+      planned.push_back(config.style);
+    }
+    PassPlan plan = PlanPasses(planned);
+    std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
+    if (part)
+      what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
+                          schedule->frames.back().number);
+    std::printf("%s", FormatPlan(plan, what).c_str());
     return kExitOk;
   }
   if (check_only) {
@@ -410,35 +434,35 @@ int main(int argc, char** argv) {
     }
     return RunBake(args, Mode::kBake);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitUsage;
   } catch (const ManifestError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitMerge;
   } catch (const ConfigFailure& e) {
     PrintErrors(e.errors);
     return kExitConfig;
   } catch (const VulkanUnavailable& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitVulkan;
   } catch (const VulkanError& e) {
-    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", Printable(e.what()).c_str());
     return kExitVulkan;
   } catch (const BudgetError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitBudget;
   } catch (const OutputExistsError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitExists;
   } catch (const OutputError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitOutput;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
                          "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
     return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitOutput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());

@@ -944,13 +944,20 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
 
 void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
   const ResourceEstimate e = EstimateResources(style);
-  if (e.memory_mib > options.max_memory_mib)
+  // Whole MiB, unless the two would then read the same ("1 MiB above 1 MiB").
+  auto pair = [](double need, double budget) {
+    const bool close = fmt::format("{:.0f}", need) == fmt::format("{:.0f}", budget);
+    return close ? std::pair{fmt::format("{:.3f}", need), fmt::format("{:.3f}", budget)}
+                 : std::pair{fmt::format("{:.0f}", need), fmt::format("{:.0f}", budget)};
+  };
+  if (e.memory_mib > options.max_memory_mib) {
+    const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
     throw BudgetError(fmt::format(
-        "the bake needs an estimated {:.0f} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
-        "of {:.0f} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
+        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
+        "of {} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
         "--max-memory-mib (README \"Limits\")",
-        e.memory_mib, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height,
-        options.max_memory_mib));
+        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, budget));
+  }
   if (e.seconds > options.max_frame_seconds)
     throw BudgetError(fmt::format(
         "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "

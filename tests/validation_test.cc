@@ -162,25 +162,25 @@ view_steps = 0
 basename = "../evil"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameAbsolute", R"toml([output]
 basename = "/tmp/evil"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '/tmp/evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '/tmp/evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameSubfolder", R"toml([output]
 basename = "a/b"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: 'a/b' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: 'a/b' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameHidden", R"toml([output]
 basename = ".sky"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '.sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '.sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"FaceNameTraversal", R"toml([output]
 face_names = ["px", "nx", "py", "ny", "pz", "../../nz"]
@@ -244,7 +244,7 @@ cube_size = 0
          "skybake: 1 error; nothing was baked\n"},
     {"SetTraversal", R"toml()toml",
      nullptr, "--set output.basename=../../etc/sky", 3,
-         "skybake: error: --set output.basename=../../etc/sky:1:5: output.basename: '../../etc/sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: --set output.basename=../../etc/sky:1:5: output.basename: '../../etc/sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"MissingStyleFile", nullptr,
      nullptr, "", 3,
@@ -332,7 +332,7 @@ elevation_deg = 10
 azimuth_deg = 135
 set = { "output.basename" = "../../evil" }
 )toml", "", 3,
-         "skybake: error: schedule.toml:5:29: output.basename: frame 1: '../../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: schedule.toml:5:29: output.basename: frame 1: '../../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"ScheduleRampPushesGOutOfRange", R"toml()toml",
      R"toml([schedule]
@@ -417,6 +417,38 @@ time = 09:00:00
 )toml", "", 3,
          "skybake: error: schedule.toml:6:1: schedule.frames: frame 2 (2013-05-27T09:00:00-04:00) is not after frame 1 (2013-05-27T09:00:00-04:00): give clock times in increasing order, each once\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"SetValueWithALineBreak", "", nullptr, "--set $'sun.elevation_deg=10\\nsun.azimuth_deg=5'", 3,
+         "skybake: error: --set: sun.elevation_deg: the value has a line break, and what follows it would be ignored: give one value per --set\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetScheduleKey", "", nullptr, "--set schedule.first_frame=5", 3,
+         "skybake: error: --set: schedule.first_frame: a schedule is not changed with --set (it would be ignored): edit the schedule file, or use its [schedule.ramp] or a frame's set\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetEmptyKeyPart", "", nullptr, "--set sun..elevation_deg=10", 3,
+         "skybake: error: --set: sun..elevation_deg: empty part in the key path (two dots, or a leading dot): e.g. --set sun.elevation_deg=10\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameLeadingDash", R"toml([output]
+basename = "-rf"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: '-rf' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameWindowsReserved", R"toml([output]
+basename = "nul"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: 'nul' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameTooLong", R"toml([output]
+basename = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: a name of 153 characters is longer than the 128 a plain file name may have\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNamesEqualUpToCase", R"toml([output]
+face_names = ["px", "PX", "py", "ny", "pz", "nz"]
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:14: output.face_names[1]: 'px' and 'PX' differ only in case, one file on a case-insensitive file system: each face is its own file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ControlCharacterInAKeyIsEscaped", "\"sun\\u001b[2J\" = 1\n", nullptr, "", 3,
+         "skybake: error: style.toml:1:1: sun\\x1b[2J: unknown key 'sun\\x1b[2J'\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
@@ -486,6 +518,34 @@ TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
           << run.output;
     }
   }
+}
+
+// An estimate just above the budget is shown with the digits that tell
+// them apart ("needs 3 MiB ... above the budget of 3 MiB" before).
+TEST(BadInputs, BudgetMessageTellsCloseNumbersApart) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  testing::CommandRun run = testing::RunSkybake("check '" + style + "' --set render.cube_size=64 --set "
+                                                "render.latlong_height=64 --max-memory-mib 3");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_NE(run.output.find("an estimated 3.031 MiB of memory per frame (cube 64, latlong 128x64), above the budget "
+                            "of 3.000 MiB"), std::string::npos) << run.output;
+}
+
+// --dry-run plans the part of the sequence that --frames / --shard select.
+TEST(BadInputs, DryRunPlansOnlyTheSelectedFrames) {
+  const std::string dir = testing::FreshTempDir("dryrun");
+  std::ofstream(dir + "/s.toml") << "[schedule]\nsun = { elevation_deg = [1, 2, 3, 4], azimuth_deg = 135 }\n";
+  const std::string bake = "bake '" + testing::SourceDir() + "/configs/default.toml' --schedule '" + dir +
+                           "/s.toml' --dry-run --out '" + dir + "/out'";
+  testing::CommandRun all = testing::RunSkybake(bake);
+  testing::CommandRun part = testing::RunSkybake(bake + " --frames 2:3");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  ASSERT_EQ(part.exit_code, 0) << part.output;
+  EXPECT_NE(all.output.find("4 frames"), std::string::npos) << all.output;
+  EXPECT_NE(part.output.find("2 frames"), std::string::npos) << part.output;
+  EXPECT_NE(part.output.find("(frames 2 to 3 of 1 to 4): 2 frames"), std::string::npos) << part.output;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  fs::remove_all(dir);
 }
 
 }  // namespace
