@@ -449,6 +449,14 @@ face_names = ["px", "PX", "py", "ny", "pz", "nz"]
     {"ControlCharacterInAKeyIsEscaped", "\"sun\\u001b[2J\" = 1\n", nullptr, "", 3,
          "skybake: error: style.toml:1:1: sun\\x1b[2J: unknown key 'sun\\x1b[2J'\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"SetNumberOutOfRange", "", nullptr, "--set sun.elevation_deg=1e400", 3,
+         "skybake: error: --set: sun.elevation_deg: 1e400 is not a number a double holds (at most about 1.8e308 in size): give a smaller value\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"LargeIntegerIsANumber", R"toml([sun]
+elevation_deg = 9007199254740993
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:17: sun.elevation_deg: 9007199254740992 is out of range [-90, 90]\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
