@@ -528,6 +528,20 @@ TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
   }
 }
 
+// A schedule ramp on a key given with --set silently won: now a warning at
+// the ramp's place (the bake goes on with the ramp's values).
+TEST(BadInputs, ScheduleRampOverASetKeyIsWarnedOf) {
+  const std::string dir = testing::FreshTempDir("rampset");
+  std::ofstream(dir + "/s.toml") << "[schedule]\nsun = { elevation_deg = [0, 10], azimuth_deg = 135 }\n"
+                                    "[schedule.ramp]\n\"atmosphere.mie.g\" = [0.7, 0.8]\n";
+  testing::CommandRun run = testing::RunSkybake("check '" + testing::SourceDir() + "/configs/default.toml' --schedule "
+                                                "s.toml --set atmosphere.mie.g=0.5", "cd '" + dir + "' &&");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("skybake: warning: s.toml:4:22: atmosphere.mie.g: the schedule sets this key per frame, "
+                            "so --set atmosphere.mie.g=0.5 has no effect on it\n"), std::string::npos) << run.output;
+  fs::remove_all(dir);
+}
+
 // An estimate just above the budget is shown with the digits that tell
 // them apart ("needs 3 MiB ... above the budget of 3 MiB" before).
 TEST(BadInputs, BudgetMessageTellsCloseNumbersApart) {
