@@ -1,6 +1,7 @@
 // Image-based lighting: the source mip chain on the CPU, the GGX and cosine
 // filtering on the Vulkan device (shaders/ibl_prefilter.comp), the files.
 #include "skybake/ibl.h"
+#include "skybake/manifest.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,10 +29,6 @@ std::vector<float> StackFaces(const CubeLevel& level) {
   stacked.reserve(size_t(level.size) * level.size * 4 * 6);
   for (const std::vector<float>& face : level.faces) stacked.insert(stacked.end(), face.begin(), face.end());
   return stacked;
-}
-
-std::string FrameSuffix(int number_in_name) {
-  return number_in_name > 0 ? fmt::format(".{:04d}", number_in_name) : "";
 }
 
 }  // namespace
@@ -531,7 +528,7 @@ std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name,
   std::vector<IblFileName> names;
   if (!s.Requested()) return names;
   const std::string base = style.output.basename;
-  const std::string number = FrameSuffix(number_in_name);
+  const std::string number = FrameNumberSuffix(number_in_name);
   if (s.exr) {
     if (s.specular)
       for (int level = 0; level < IblLevelCount(s); ++level)
