@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # A single-node Slurm cluster for tests, in one folder, run as root:
 #
-#   tests/slurm/cluster.sh start DIR   # munged, slurmctld and slurmd; waits until the node is idle
+#   tests/slurm/cluster.sh start DIR [OWNER_PID]
+#                                      # munged, slurmctld and slurmd; waits until the node is idle;
+#                                      # with OWNER_PID, a watchdog stops them once that process is gone,
+#                                      # even if it was killed (a test's time-out)
 #   tests/slurm/cluster.sh stop DIR    # stops the three daemons and waits until they are gone
 #   tests/slurm/cluster.sh logs DIR    # prints the daemons' logs
 #
@@ -17,10 +20,13 @@
 # slurmctld slurmd slurm-client munge (.ci/setup installs them).
 set -euo pipefail
 
-usage() { echo "usage: $0 start|stop|logs DIR" >&2; exit 2; }
-[ $# -eq 2 ] || usage
+usage() { echo "usage: $0 start DIR [OWNER_PID] | stop DIR | logs DIR" >&2; exit 2; }
+[ $# -eq 2 ] || { [ $# -eq 3 ] && [ "$1" = start ]; } || usage
 action=$1
-dir=$(mkdir -p "$2" && cd "$2" && pwd)
+[ "$action" = start ] && mkdir -p "$2"
+[ -d "$2" ] || exit 0   # stop or logs of a cluster whose folder is gone: nothing left
+dir=$(cd "$2" && pwd)
+owner=${3:-}
 conf=$dir/slurm.conf
 export SLURM_CONF=$conf
 
@@ -128,6 +134,13 @@ EOF
     print_logs >&2
     exit 1
   fi
+  if [ -n "$owner" ]; then
+    # Detached (its own session, not a child of the owner), so that killing
+    # the owner's process tree leaves it to clean up.
+    setsid bash -c 'while kill -0 "$1" 2>/dev/null; do sleep 1; done; exec bash "$2" stop "$3"' \
+      watchdog "$owner" "$0" "$dir" </dev/null >>"$dir/log/watchdog.log" 2>&1 &
+    echo $! > "$dir/run/watchdog.pid"
+  fi
   echo "cluster.sh: Slurm up in $dir ($node), SLURM_CONF=$conf"
   ;;
 stop)
@@ -140,6 +153,12 @@ stop)
   stop_daemon "$dir/run/slurmd.pid"
   stop_daemon "$dir/run/slurmctld.pid"
   stop_daemon "$dir/run/munged.pid"
+  if [ -s "$dir/run/watchdog.pid" ]; then
+    w=$(cat "$dir/run/watchdog.pid")
+    rm -f "$dir/run/watchdog.pid"
+    # The watchdog runs this stop itself: then it is this process.
+    [ "$w" = "$$" ] || [ "$w" = "$PPID" ] || kill "$w" 2>/dev/null || true
+  fi
   ;;
 logs) print_logs ;;
 *) usage ;;

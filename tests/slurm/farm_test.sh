@@ -138,7 +138,7 @@ sed 's/times = { start = 06:00:00, end = 20:30:00, step_minutes = 15 }/times = {
   "$SRC/configs/schedules/day.toml" > "$work/twelve.toml"
 grep -q "step_minutes = 75" "$work/twelve.toml" || fail "configs/schedules/day.toml has no 'times = ...' line to shorten"
 
-bash "$CLUSTER" start "$tmp/slurm" || fail "the Slurm cluster did not start"
+bash "$CLUSTER" start "$tmp/slurm" $$ || fail "the Slurm cluster did not start"
 export SLURM_CONF=$tmp/slurm/slurm.conf
 cd "$work" || fail "no $work"
 
