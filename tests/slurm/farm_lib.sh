@@ -13,7 +13,7 @@ TASKS=${SKYBAKE_FARM_TASKS:-3}
 SIZE=${SKYBAKE_FARM_SIZE:-32}
 TIMEOUT=${SKYBAKE_FARM_TIMEOUT:-300}
 TOTAL=${SKYBAKE_FARM_TOTAL_SECONDS:-720}
-FRAMES=12
+FRAMES=${SKYBAKE_FARM_FRAMES:-12}
 CLUSTER=$SRC/tests/slurm/cluster.sh
 
 tmp=$(mktemp -d /tmp/skybake-farm.XXXXXX)
@@ -85,7 +85,7 @@ adapt() {
   local text=$2
   text=$(replace_once "$text" /shared/day "$1" all) || exit 1
   case $text in *"--size 512"*) text=$(replace_once "$text" "--size 512" "--size $SIZE") ;; esac || exit 1
-  case $text in *configs/schedules/day.toml*) text=$(replace_once "$text" configs/schedules/day.toml twelve.toml) ;; esac || exit 1
+  case $text in *configs/schedules/day.toml*) text=$(replace_once "$text" configs/schedules/day.toml frames.toml) ;; esac || exit 1
   printf '%s\n' "$text"
 }
 batch_script() {  # $1 folder: the batch script of that case
@@ -101,10 +101,13 @@ batch_script() {  # $1 folder: the batch script of that case
 [ "$(id -u)" = 0 ] || fail "the Slurm daemons run as root here: run the test as root (as .ci/test does)"
 export PATH=$BUILD:$PATH SKYBAKE_VULKAN_VALIDATION=1
 ln -s "$SRC/configs" "$work/configs"
-# 12 frames of the README's day, 06:00 to 19:45 every 75 minutes.
-sed 's/times = { start = 06:00:00, end = 20:30:00, step_minutes = 15 }/times = { start = 06:00:00, end = 19:45:00, step_minutes = 75 }/' \
-  "$SRC/configs/schedules/day.toml" > "$work/twelve.toml"
-grep -q "step_minutes = 75" "$work/twelve.toml" || fail "configs/schedules/day.toml has no 'times = ...' line to shorten"
+# FRAMES frames of the README's day from 06:00, evenly spread over its 14.5 hours.
+step_min=$((870 / FRAMES))
+end_min=$((360 + (FRAMES - 1) * step_min))
+end=$(printf '%02d:%02d:00' $((end_min / 60)) $((end_min % 60)))
+sed "s/times = { start = 06:00:00, end = 20:30:00, step_minutes = 15 }/times = { start = 06:00:00, end = $end, step_minutes = $step_min }/" \
+  "$SRC/configs/schedules/day.toml" > "$work/frames.toml"
+grep -q "step_minutes = $step_min }" "$work/frames.toml" || fail "configs/schedules/day.toml has no 'times = ...' line to shorten"
 
 bash "$CLUSTER" start "$tmp/slurm" $$ || fail "the Slurm cluster did not start"
 export SLURM_CONF=$tmp/slurm/slurm.conf

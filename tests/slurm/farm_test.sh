@@ -7,8 +7,8 @@
 # The README's three code blocks (batch script, submission, retry) are
 # extracted from README.md and run with only these replacements, each of
 # which must match once: the shared folder /shared/day by a temporary one per
-# case, --size 512 by --size $SIZE, the 59-frame day schedule by a 12-frame
-# one, the 8 tasks by $TASKS, --cpus-per-task=4 by 1 (the node may have 2
+# case, --size 512 by --size $SIZE, the 59-frame day schedule by one of
+# $FRAMES frames, the 8 tasks by $TASKS, --cpus-per-task=4 by 1 (the node may have 2
 # CPUs) and the retried shard 5/8 by 2/$TASKS. Every bake runs under the
 # Khronos validation layer (SKYBAKE_VULKAN_VALIDATION=1, passed to the jobs
 # with the rest of the environment), so a validation message fails its job.
@@ -31,7 +31,8 @@
 #   E  task numbers 0 and above the count: exit code 2, the log says why, and
 #      nothing is written.
 #
-# SKYBAKE_FARM_TASKS (default 3), SKYBAKE_FARM_SIZE (default 32) and
+# SKYBAKE_FARM_TASKS (default 3), SKYBAKE_FARM_FRAMES (default 12, 4 or more
+# per task), SKYBAKE_FARM_SIZE (default 32),
 # SKYBAKE_FARM_TIMEOUT (seconds per wait, default 300) and
 # SKYBAKE_FARM_TOTAL_SECONDS (every wait ends by then, default 720) change the run.
 # On failure the temporary folder (job logs, daemon logs) is kept and the
