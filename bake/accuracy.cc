@@ -16,6 +16,7 @@
 
 #include "skybake/config.h"
 #include "skybake/envmap.h"
+#include "skybake/exr_io.h"
 #include "skybake/reference_model.h"
 #include "skybake/sky_renderer.h"
 #include "skybake/tonemap.h"
@@ -606,7 +607,7 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
     }
   }
   std::vector<double> kider_totals;
-  std::ofstream(options.out_dir + "/kider2014.csv") << "model,capture,rmse_mW_m2_sr_nm\n";
+  std::string kider_csv = "model,capture,rmse_mW_m2_sr_nm\n";
   for (const auto& [label, quality] : kider_models) {
     EffectSettings effects;
     effects.sun_disc = false;
@@ -638,12 +639,14 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
     double total = std::sqrt(sum_sq_rmse / std::max(count, 1));
     kider_totals.push_back(total);
     kider_rows.push_back(fmt::format("| {} | {} | {:.1f} |", label, count, total));
-    std::ofstream(options.out_dir + "/kider2014.csv", std::ios::app) << per_capture;
+    kider_csv += per_capture;
   }
+  // Every file through the one safe writer (exr_io.h): no link followed.
+  WriteFileAtomically(options.out_dir + "/kider2014.csv", kider_csv);
 
   // 5. Files: CSV, plot, markdown.
   {
-    std::ofstream csv(options.out_dir + "/accuracy.csv");
+    std::ostringstream csv;
     csv << "case,integrator,view_steps,light_steps,sky_view_lut,sun_elevation_deg,rmse_mW_m2_sr_nm,"
            "max_relative_error,max_delta_e76,ms_per_megapixel\n";
     for (const CaseResult& r : results)
@@ -653,19 +656,20 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
                                                               r.quality.sky_view_height)
                                                 : "no",
                          r.elevation, r.rmse_mw, r.max_relative, r.max_delta_e, r.ms_per_mp);
+    WriteFileAtomically(options.out_dir + "/accuracy.csv", csv.str());
   }
   {
-    std::ofstream data(options.out_dir + "/accuracy_plot.dat");
+    std::ostringstream data;
     for (const Summary& s : summaries)
       data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", s.ms_per_mp, std::max(s.day_error, 1e-7), s.pareto ? 1 : 0,
                           s.name);
-    std::ofstream front(options.out_dir + "/accuracy_front.dat");
+    std::ostringstream front;
     std::vector<const Summary*> sorted;
     for (const Summary& s : summaries)
       if (s.pareto) sorted.push_back(&s);
     std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->ms_per_mp < b->ms_per_mp; });
     for (const Summary* s : sorted) front << fmt::format("{:.6g} {:.6g}\n", s->ms_per_mp, std::max(s->day_error, 1e-7));
-    std::ofstream plot(options.out_dir + "/accuracy.gnuplot");
+    std::ostringstream plot;
     plot << "set terminal pngcairo size 1100,750 noenhanced\n"
          << "set output '" << options.out_dir << "/accuracy.png'\n"
          << "set logscale xy\nset grid\n"
@@ -676,6 +680,9 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
          << "plot '" << options.out_dir << "/accuracy_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
          << "     '" << options.out_dir << "/accuracy_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
          << "     '" << options.out_dir << "/accuracy_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
+    WriteFileAtomically(options.out_dir + "/accuracy_plot.dat", data.str());
+    WriteFileAtomically(options.out_dir + "/accuracy_front.dat", front.str());
+    WriteFileAtomically(options.out_dir + "/accuracy.gnuplot", plot.str());
   }
   std::string plot_status = "written";
   if (std::system(fmt::format("gnuplot '{}/accuracy.gnuplot' 2>/dev/null", options.out_dir).c_str()) != 0)
@@ -701,7 +708,7 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   md += "\n## Against the measured skies of Kider et al. 2014 (Bruneton's RMSE, 440/550/680 nm)\n\n| model | captures | RMSE mW/(m2 sr nm) |\n| --- | ---: | ---: |\n";
   for (const std::string& row : kider_rows) md += row + "\n";
   md += fmt::format("\nPlot {}: {}/accuracy.png\n", plot_status, options.out_dir);
-  std::ofstream(options.out_dir + "/accuracy_results.md") << md;
+  WriteFileAtomically(options.out_dir + "/accuracy_results.md", md);
   return md;
 }
 

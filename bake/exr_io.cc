@@ -4,6 +4,7 @@
 #include "oiio_module.h"
 
 #include <atomic>
+#include <chrono>
 #include <cerrno>
 #include <cfloat>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <dlfcn.h>
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -74,21 +76,41 @@ std::string WriteFix(int error) {
 
 std::string TemporaryPathFor(const std::string& path) {
   std::filesystem::path p(path);
+  // Unguessable: the pid (for the stale-temporary cleaner) and 64 random
+  // bits, so no one can plant a file or link at the name beforehand.
+  uint64_t random = 0;
+  if (::getrandom(&random, sizeof random, 0) != ssize_t(sizeof random)) {
+    static std::atomic<uint64_t> counter{0};
+    random = uint64_t(std::chrono::steady_clock::now().time_since_epoch().count()) * 0x9e3779b97f4a7c15ull ^
+             (counter++ << 1);
+  }
   // One fmt::format call: GCC 12's -Wrestrict misfires on `"." + std::string`.
-  std::string name = fmt::format(".{}.tmp{}", p.filename().string(), ::getpid());
+  std::string name = fmt::format(".{}.tmp{}.{:016x}", p.filename().string(), ::getpid(), random);
   return (p.parent_path() / name).string();
 }
 
+int CreateExclusiveFile(std::string& temporary, const std::string& path) {
+  // O_EXCL | O_NOFOLLOW: an existing file or link at the name is never
+  // opened (EEXIST, ELOOP), so a planted link cannot redirect the write.
+  for (int attempt = 0;; ++attempt) {
+    temporary = TemporaryPathFor(path);
+    int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd >= 0 || errno != EEXIST || attempt == 16) return fd;
+  }
+}
+
 void WriteFileAtomically(const std::string& path, std::string_view bytes) {
-  const std::string temporary = TemporaryPathFor(path);
+  std::string temporary;
+  bool created = false;
   auto fail = [&](const char* what, int error, int fd) {
     if (fd >= 0) ::close(fd);
-    ::unlink(temporary.c_str());
+    if (created) ::unlink(temporary.c_str());
     throw OutputError(fmt::format("cannot write {} ({} {}: {}){}", path, what, temporary, std::strerror(error),
                                   WriteFix(error)));
   };
-  int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  int fd = CreateExclusiveFile(temporary, path);
   if (fd < 0) fail("creating", errno, -1);
+  created = true;
   for (size_t done = 0; done < bytes.size();) {
     ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
     if (n < 0 && errno == EINTR) continue;
@@ -107,13 +129,20 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes) {
 }
 
 bool IsTemporaryOf(const std::string& file_name, const std::string& output_name, int* pid) {
+  // .NAME.tmpPID.RANDOM (TemporaryPathFor), or .NAME.tmpPID of earlier versions.
   const std::string prefix = "." + output_name + ".tmp";
   if (file_name.size() <= prefix.size() || file_name.compare(0, prefix.size(), prefix) != 0) return false;
   int value = 0;
-  for (size_t i = prefix.size(); i < file_name.size(); ++i) {
+  size_t i = prefix.size();
+  for (; i < file_name.size() && file_name[i] != '.'; ++i) {
     char c = file_name[i];
     if (c < '0' || c > '9' || value > 100000000) return false;
     value = value * 10 + (c - '0');
+  }
+  if (i == prefix.size()) return false;
+  if (i < file_name.size()) {
+    const std::string random = file_name.substr(i + 1);
+    if (random.size() != 16 || random.find_first_not_of("0123456789abcdef") != std::string::npos) return false;
   }
   if (pid) *pid = value;
   return true;
@@ -132,8 +161,10 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir, const st
     const std::string output = file.substr(1, tmp - 1);
     int pid = 0;
     if (!wanted.count(output) || !IsTemporaryOf(file, output, &pid)) continue;
-    // A live writer keeps its file; a dead one (killed) left it behind.
-    if (pid == ::getpid() || (pid > 0 && ::kill(pid, 0) == 0)) continue;
+    // A live writer keeps its file; a dead one (killed) left it behind. A
+    // link is never a temporary of skybake's (planted): removed, not followed.
+    const bool link = entry.is_symlink(ec);
+    if (!link && (pid == ::getpid() || (pid > 0 && ::kill(pid, 0) == 0))) continue;
     if (std::filesystem::remove(entry.path(), ec)) removed.push_back(entry.path().string());
   }
   return removed;

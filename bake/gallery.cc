@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "skybake/exr_io.h"
+#include "skybake/output_lock.h"
 #include "oiio_module.h"
 
 namespace skybake {
@@ -47,6 +48,15 @@ std::string DescribePrinciples(const SkyStyle& style) {
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
   GalleryResult result;
   std::filesystem::create_directories(options.out_dir);
+  // The sheet, like every style's files, is new unless --force; a link at
+  // its name counts as a file (it is replaced, never followed). Locked
+  // against another gallery writing it.
+  const std::string sheet_path = (std::filesystem::path(options.out_dir) / "gallery.png").string();
+  const OutputLock lock = OutputLock::Claim(options.out_dir, {"gallery.png"});
+  std::error_code ec;
+  if (!options.bake.force && std::filesystem::exists(std::filesystem::symlink_status(sheet_path, ec)))
+    throw OutputExistsError(fmt::format("{} already exists: pass --force to replace the gallery, or choose another --out",
+                                        sheet_path));
 
   // Bake each style's latlong preview only.
   for (const std::string& path : style_paths) {
@@ -88,7 +98,6 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
   int width = 0, height = 0;
   std::string error;
   if (!LoadOiioModule().compose_sheet(cells, layout, rgb, width, height, error)) throw OutputError(error);
-  std::string sheet_path = (std::filesystem::path(options.out_dir) / "gallery.png").string();
   WritePng(sheet_path, width, height, rgb);
   result.contact_sheet = sheet_path;
   return result;

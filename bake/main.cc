@@ -11,6 +11,7 @@
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -37,8 +38,20 @@ namespace {
 
 using namespace skybake;
 
+// A message for the terminal: control characters read from a file or the
+// command line (an escape sequence, a newline in a key) shown as \xNN.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += ch;
+  }
+  return out;
+}
+
 void PrintErrors(const std::vector<ConfigError>& errors) {
-  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", e.Format().c_str());
+  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", Printable(e.Format()).c_str());
   std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
                errors.size() == 1 ? "" : "s");
 }
@@ -149,8 +162,20 @@ int RunBake(const BakeArgs& args, Mode mode) {
   }
   if (mode == Mode::kPlan || args.dry_run) {
     // The passes, LUTs and shader variant the bake would run, and why.
-    PassPlan plan = PlanPasses(schedule ? frame_styles : std::vector<SkyStyle>{config.style});
-    std::printf("%s", FormatPlan(plan, args.style_path + (schedule ? " with " + schedule_path : "")).c_str());
+    // The part that --frames / --shard select, when given.
+    std::vector<SkyStyle> planned;
+    if (schedule) {
+      for (size_t i = 0; i < frame_styles.size(); ++i)
+        if (!part || part->Contains(schedule->frames[i].number)) planned.push_back(frame_styles[i]);
+    } else {
+      planned.push_back(config.style);
+    }
+    PassPlan plan = PlanPasses(planned);
+    std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
+    if (part)
+      what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
+                          schedule->frames.back().number);
+    std::printf("%s", FormatPlan(plan, what).c_str());
     return kExitOk;
   }
   if (check_only) {
@@ -237,6 +262,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.overrides = args.overrides;
   options.bake.vulkan.device_index = args.device;
   options.bake.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  options.bake.force = args.force;
   size_t done = 0;
   if (!args.quiet) {
     options.bake.progress = [&done, &styles](const StageReport& s) {
@@ -274,6 +300,16 @@ int main(int argc, char** argv) {
   app.get_formatter()->column_width(34);
 
   BakeArgs args;
+  // A budget is a finite number above 0 (nan compares false with every
+  // bound and would switch the budget off).
+  const CLI::Validator finite_positive(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
+          return "expected a finite number above 0, got " + text;
+        return "";
+      },
+      "POSITIVE");
   auto add_style_options = [&](CLI::App* cmd) {
     cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
         ->required();
@@ -285,11 +321,11 @@ int main(int argc, char** argv) {
     cmd->add_option("--max-memory-mib", args.max_memory_mib,
                     "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(finite_positive);
     cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
                     "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
         ->capture_default_str()
-        ->check(CLI::PositiveNumber);
+        ->check(finite_positive);
   };
 
   CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
@@ -342,6 +378,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 16));
   gallery->add_option("--set", args.overrides, "Override a key in every style (repeatable)");
   gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
+  gallery->add_flag("--force", args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
   gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
   gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
 
@@ -397,35 +434,35 @@ int main(int argc, char** argv) {
     }
     return RunBake(args, Mode::kBake);
   } catch (const UsageError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitUsage;
   } catch (const ManifestError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitMerge;
   } catch (const ConfigFailure& e) {
     PrintErrors(e.errors);
     return kExitConfig;
   } catch (const VulkanUnavailable& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitVulkan;
   } catch (const VulkanError& e) {
-    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", Printable(e.what()).c_str());
     return kExitVulkan;
   } catch (const BudgetError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitBudget;
   } catch (const OutputExistsError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitExists;
   } catch (const OutputError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitOutput;
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
                          "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
     return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", e.what());
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
     return kExitOutput;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());

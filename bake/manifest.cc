@@ -1,6 +1,9 @@
 #include "skybake/manifest.h"
 
 #include <algorithm>
+#include <cstring>
+#include <limits>
+#include <set>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -11,6 +14,7 @@
 
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
+#include "skybake/output_lock.h"
 
 namespace skybake {
 namespace {
@@ -113,6 +117,19 @@ class Reader {
       Fail(fmt::format("'{}' has the wrong type", key));
     }
   }
+  // An integer in [lo, hi] (a real, a string or a value out of range fails).
+  int64_t Integer(const json& object, const char* key, int64_t lo, int64_t hi) const {
+    const json& v = Get<json>(object, key);
+    if (v.is_number_unsigned()) {
+      if (v.get<uint64_t>() <= uint64_t(hi) && int64_t(v.get<uint64_t>()) >= lo) return int64_t(v.get<uint64_t>());
+    } else if (v.is_number_integer() && v.get<int64_t>() >= lo && v.get<int64_t>() <= hi) {
+      return v.get<int64_t>();
+    }
+    Fail(fmt::format("'{}' is {}, not an integer in [{}, {}]", key, v.dump(), lo, hi));
+  }
+  int Int(const json& object, const char* key) const {
+    return int(Integer(object, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+  }
   glm::dvec3 Vector(const json& object, const char* key) const {
     std::vector<double> v = Get<std::vector<double>>(object, key);
     if (v.size() != 3) Fail(fmt::format("'{}' is not 3 numbers", key));
@@ -134,7 +151,7 @@ class Reader {
   }
   FrameRange Range(const json& object, const char* key) const {
     const json& r = Get<json>(object, key);
-    FrameRange range{Get<int>(r, "first_frame"), Get<int>(r, "last_frame")};
+    FrameRange range{Int(r, "first_frame"), Int(r, "last_frame")};
     if (range.last < range.first) Fail(fmt::format("'{}' ends before it starts", key));
     return range;
   }
@@ -146,12 +163,16 @@ class Reader {
   std::string path_;
 };
 
+// The largest file a manifest may list: 2^53 bytes (8 PiB), the integers a
+// JSON number holds exactly in every reader.
+constexpr int64_t kMaxFileBytes = int64_t(1) << 53;
+
 std::vector<ManifestFile> FilesOf(const Reader& r, const json& array) {
   if (!array.is_array()) r.Fail("a file list is not an array");
   std::vector<ManifestFile> files;
   for (const json& f : array)
-    files.push_back({r.Get<std::string>(f, "file"), r.Get<std::string>(f, "kind"), r.Get<uint64_t>(f, "bytes"),
-                     r.Get<std::string>(f, "sha256")});
+    files.push_back({r.Get<std::string>(f, "file"), r.Get<std::string>(f, "kind"),
+                     uint64_t(r.Integer(f, "bytes", 0, kMaxFileBytes)), r.Get<std::string>(f, "sha256")});
   return files;
 }
 
@@ -178,7 +199,113 @@ json SharedPart(json manifest) {
   return manifest;
 }
 
+// A name read from a manifest that is not the one skybake gives: the
+// manifest was edited (or is hostile). Nothing is opened under it.
+[[noreturn]] void FailName(const std::string& path, const std::string& where, const std::string& name,
+                           const std::string& expected) {
+  throw ManifestError(fmt::format("{}: {}: {} is not {}: the manifest was edited or is not skybake's; nothing was "
+                                  "read under that name. Bake the part again (with --force) to rewrite it",
+                                  path, where, EscapedText(name), expected));
+}
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// Every name of a manifest is a plain file name and the one the bake gives
+// its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
+// BASE_latlong.NNNN.exr, BASE_latlong.NNNN.png, in that order, one BASE per
+// frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
+void CheckNames(const std::string& path, const Manifest& m) {
+  if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
+  if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
+    FailName(path, "gltf.texture.file", m.gltf.texture_file, "a plain file name of a PNG in the folder");
+  for (const ManifestFrame& f : m.frames) {
+    const std::string where = fmt::format("frame {}", f.number);
+    const std::string number = FrameNumberSuffix(f.number);
+    std::string base;
+    std::vector<std::string> faces;
+    int stage = 0;  // 0 faces, 1 cube, 2 latlong, 3 png, 4 done: the order files are written in
+    auto stem_of = [&](const ManifestFile& file, const char* ext, const char* what) {
+      const std::string tail = number + ext;
+      if (!IsPlainFileName(file.file) || !EndsWith(file.file, tail) || file.file.size() == tail.size())
+        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (...{})", what,
+                                                     f.number, tail));
+      return file.file.substr(0, file.file.size() - tail.size());
+    };
+    auto with_suffix = [&](const ManifestFile& file, const std::string& stem, const char* suffix, const char* what,
+                           int at) {
+      if (stage > at || !EndsWith(stem, suffix) || stem.size() == std::strlen(suffix))
+        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE{}{})", what,
+                                                     f.number, suffix, number));
+      const std::string b = stem.substr(0, stem.size() - std::strlen(suffix));
+      if (!base.empty() && b != base)
+        FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+      base = b;
+      stage = at + 1;
+    };
+    for (const ManifestFile& file : f.files) {
+      if (file.kind == "face") {
+        if (stage > 0 || faces.size() == 6)
+          FailName(path, where, file.file, "one of six face files listed before the frame's other files");
+        faces.push_back(stem_of(file, ".exr", "face"));
+      } else if (file.kind == "cube") {
+        with_suffix(file, stem_of(file, ".exr", "cube strip"), "_cube", "cube strip", 1);
+      } else if (file.kind == "latlong") {
+        with_suffix(file, stem_of(file, ".exr", "latlong"), "_latlong", "latlong", 2);
+      } else if (file.kind == "preview" || file.kind == "gltf_texture") {
+        with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 3);
+      } else {
+        FailName(path, where, file.kind, "a kind of file skybake writes (face, cube, latlong, preview, gltf_texture)");
+      }
+    }
+    if (!faces.empty() && faces.size() != 6)
+      FailName(path, where, faces.back(), "one of six face files (the frame lists " + std::to_string(faces.size()) + ")");
+    // The faces share the frame's basename (the other files', else the
+    // scene's name, else their common prefix) and differ from each other.
+    if (!faces.empty()) {
+      if (base.empty()) {
+        base = m.gltf.name;
+        for (const std::string& face : faces)
+          if (face.compare(0, base.size() + 1, base + "_") != 0) base.clear();
+        if (base.empty()) {
+          for (size_t cut = faces[0].rfind('_'); cut != std::string::npos && cut > 0 && base.empty();
+               cut = faces[0].rfind('_', cut - 1)) {
+            const std::string candidate = faces[0].substr(0, cut);
+            bool all = true;
+            for (const std::string& face : faces) all = all && face.compare(0, cut + 1, candidate + "_") == 0;
+            if (all) base = candidate;
+          }
+        }
+      }
+      std::set<std::string> names;
+      for (size_t i = 0; i < faces.size(); ++i) {
+        const std::string face = faces[i];
+        if (base.empty() || face.compare(0, base.size() + 1, base + "_") != 0 || face.size() == base.size() + 1 ||
+            !names.insert(face).second || face == base + "_cube" || face == base + "_latlong")
+          FailName(path, where, f.files[i].file,
+                   fmt::format("a face file skybake names for frame {} (BASE_FACE{}.exr, six different faces)",
+                               f.number, number));
+      }
+    }
+  }
+  static const std::map<std::string, std::string> kSceneExtension = {
+      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}};
+  for (const ManifestFile& file : m.scene) {
+    auto it = kSceneExtension.find(file.kind);
+    if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
+      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb)", m.gltf.name));
+  }
+}
+
 }  // namespace
+
+std::string FrameNumberSuffix(int number) { return number > 0 ? fmt::format(".{:04d}", number) : ""; }
+
+std::string SequenceIdentityLine(int number, const std::string& time_iso8601, const glm::dvec3& sun,
+                                 const std::string& style_sha256) {
+  return fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", number, time_iso8601, sun.x, sun.y, sun.z, style_sha256);
+}
 
 std::string ManifestFileName(const std::optional<FrameRange>& part) {
   return part ? fmt::format("manifest.shard-{:04d}-{:04d}.json", part->first, part->last) : "manifest.json";
@@ -222,7 +349,7 @@ Manifest ReadManifest(const std::string& path) {
   m.units = r.Get<std::string>(j, "units");
   m.exposure_ev100 = r.Get<double>(j, "exposure_ev100");
   m.exposure_source = r.Get<std::string>(j, "exposure_source");
-  m.texture_frame = r.Get<int>(j, "texture_frame");
+  m.texture_frame = r.Int(j, "texture_frame");
   m.half_scale = r.Get<double>(j, "half_scale");
   const json& gltf = r.Get<json>(j, "gltf");
   m.gltf.enabled = r.Get<bool>(gltf, "enabled");
@@ -230,19 +357,19 @@ Manifest ReadManifest(const std::string& path) {
   m.gltf.dome.dome = r.Get<std::string>(gltf, "dome") == "hemisphere" ? DomeShape::kHemisphere : DomeShape::kSphere;
   m.gltf.dome.radius_m = r.Get<double>(gltf, "radius_m");
   m.gltf.dome.flattening = r.Get<double>(gltf, "flattening");
-  m.gltf.dome.segments = r.Get<int>(gltf, "segments");
+  m.gltf.dome.segments = int(r.Integer(gltf, "segments", 3, 4096));
   m.gltf.dome.enabled = m.gltf.enabled;
   const json& texture = r.Get<json>(gltf, "texture");
   m.gltf.texture_file = r.Get<std::string>(texture, "file");
-  m.gltf.texture_width = r.Get<int>(texture, "width");
-  m.gltf.texture_height = r.Get<int>(texture, "height");
+  m.gltf.texture_width = int(r.Integer(texture, "width", 1, 16384));
+  m.gltf.texture_height = int(r.Integer(texture, "height", 1, 8192));
   if (j.contains("place"))
     m.place = GeoLocation{r.Get<double>(j["place"], "latitude_deg"), r.Get<double>(j["place"], "longitude_deg")};
   if (j.contains("sequence")) m.sequence = r.Range(j, "sequence");
   if (j.contains("part")) m.part = r.Range(j, "part");
   for (const json& f : r.Get<json>(j, "frames")) {
     ManifestFrame frame;
-    frame.number = r.Get<int>(f, "frame");
+    frame.number = r.Int(f, "frame");
     frame.style_sha256 = r.Get<std::string>(f, "style_sha256");
     if (f.contains("time") && !f["time"].is_null()) frame.time = r.Get<std::string>(f, "time");
     frame.hours_from_start = r.Get<double>(f, "hours_from_start");
@@ -260,6 +387,7 @@ Manifest ReadManifest(const std::string& path) {
   }
   m.complete = r.Get<bool>(j, "complete");
   m.scene = FilesOf(r, r.Get<json>(j, "scene"));
+  CheckNames(path, m);
   return m;
 }
 
@@ -327,6 +455,8 @@ void WriteTimings(const BakeResult& result, const std::string& out_dir, double t
   }
   json timings = {{"out_dir", out_dir},
                   {"renderer_builds", result.renderer_builds},
+                  {"manifest_writes", result.manifest_writes},
+                  {"manifest_bytes_written", result.manifest_bytes_written},
                   {"total_s", total_seconds},
                   {"stages", stages},
                   {"frames", frames}};
@@ -424,8 +554,14 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
   for (size_t i : order) {
     for (const ManifestFrame& f : parts[i].first.frames) {
       for (const ManifestFile& file : f.files) {
-        const fs::path path = dir / file.file;
-        if (!fs::is_regular_file(path, ec))
+        const fs::path path = dir / file.file;  // a plain name (ReadManifest): inside dir
+        // A link is not followed: only a regular file of the folder is read.
+        const fs::file_status status = fs::symlink_status(path, ec);
+        if (fs::exists(status) && !fs::is_regular_file(status))
+          throw ManifestError(fmt::format("{}, listed in {}, is not a regular file (links are not followed): put the "
+                                          "file itself in the folder",
+                                          path.string(), paths[i]));
+        if (!fs::is_regular_file(status))
           throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
                                           "{}, or bake them again with --frames {}:{} --resume",
                                           path.string(), paths[i], FrameRangeText(*parts[i].first.part),
@@ -443,11 +579,35 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
     }
   }
 
-  // Nothing overwritten by accident: the merged manifest and scene are new.
+  // The frames are the ones the parts say they baked: their numbers,
+  // times, suns and styles give the parts' sequence_sha256, and the scene's
+  // texture is the texture frame's PNG.
+  std::string identity;
+  std::string texture;
+  for (const ManifestFrame& f : merged.frames) {
+    identity += SequenceIdentityLine(f.number, f.time.value_or(""), f.sun_direction, f.style_sha256);
+    if (f.number == merged.texture_frame)
+      for (const ManifestFile& file : f.files)
+        if (file.kind == "preview" || file.kind == "gltf_texture") texture = file.file;
+  }
+  if (Sha256OfText(identity) != merged.sequence_sha256)
+    throw ManifestError(fmt::format("the frames of the shard manifests in {} (their numbers, times, suns and "
+                                    "style_sha256) do not give their sequence_sha256: a manifest was edited, or "
+                                    "the parts come from different bakes; bake the parts again with --force",
+                                    options.dir));
+  if (merged.gltf.enabled && texture != merged.gltf.texture_file)
+    throw ManifestError(fmt::format("gltf.texture.file {} of the shard manifests in {} is not the PNG of texture "
+                                    "frame {} ({}): a manifest was edited; bake the parts again with --force",
+                                    EscapedText(merged.gltf.texture_file), options.dir, merged.texture_frame,
+                                    texture.empty() ? "none" : EscapedText(texture)));
+
+  // What the merge writes, locked against any other live bake or merge
+  // writing it (OutputLock), then new unless --force.
+  std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
+  if (merged.gltf.enabled)
+    for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
+  const OutputLock lock = OutputLock::Claim(options.dir, outputs);
   if (!options.force) {
-    std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
-    if (merged.gltf.enabled)
-      for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
     for (const std::string& name : outputs)
       if (fs::exists(dir / name, ec))
         throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", (dir / name).string()));

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <filesystem>
 #include <fstream>
 #include <future>
@@ -22,6 +23,7 @@
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/manifest.h"
+#include "skybake/output_lock.h"
 #include "skybake/tonemap.h"
 
 namespace skybake {
@@ -189,7 +191,7 @@ struct FrameNames {
 
 FrameNames FrameFileNames(const SkyStyle& style, int number_in_name) {
   const OutputSettings& o = style.output;
-  const std::string number = number_in_name > 0 ? fmt::format(".{:04d}", number_in_name) : "";
+  const std::string number = FrameNumberSuffix(number_in_name);
   FrameNames names;
   if (o.faces)
     for (int face = 0; face < 6; ++face) names.faces.push_back(o.basename + "_" + o.face_names[face] + number + ".exr");
@@ -225,25 +227,48 @@ struct PreviousBake {
 PreviousBake ReadPreviousManifest(const std::string& path) {
   PreviousBake previous;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return previous;
+  const std::filesystem::file_status status = std::filesystem::symlink_status(path, ec);
+  if (!std::filesystem::exists(status)) return previous;
+  // What --resume cannot read is the folder's problem, not a write failure:
+  // exit 6, as for any file in the way, with the fix.
+  if (std::filesystem::is_directory(status))
+    throw OutputExistsError(fmt::format("{} is a directory, not a manifest, so --resume cannot tell which frames are "
+                                        "done: move it away, or pass --force instead to bake every frame again",
+                                        path));
+  if (!std::filesystem::is_regular_file(status))
+    throw OutputExistsError(fmt::format("{} is not a regular file (a link, a pipe or a device), so --resume does not "
+                                        "read it: move it away, or pass --force instead to bake every frame again",
+                                        path));
   std::ifstream in(path, std::ios::binary);
   json manifest = json::parse(in, nullptr, false);
   if (manifest.is_discarded() || !manifest.is_object())
-    throw OutputError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
-                                  "--force instead to bake every frame again", path));
+    throw OutputExistsError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
+                                        "--force instead to bake every frame again", path));
   previous.loaded = true;
-  previous.half_scale = manifest.value("half_scale", 0.0);
-  previous.exposure_ev100 = manifest.value("exposure_ev100", 0.0);
+  // A value of the wrong type matches no frame: those frames are baked again.
+  auto number = [&](const char* key) {
+    return manifest.contains(key) && manifest[key].is_number() ? manifest[key].get<double>() : std::nan("");
+  };
+  previous.half_scale = number("half_scale");
+  previous.exposure_ev100 = number("exposure_ev100");
   if (manifest.contains("frames") && manifest["frames"].is_array())
     for (const json& f : manifest["frames"])
-      if (f.is_object() && f.contains("frame") && f["frame"].is_number_integer())
+      if (f.is_object() && f.contains("frame") && f["frame"].is_number_integer() &&
+          f["frame"].get<int64_t>() >= 0 && f["frame"].get<int64_t>() <= std::numeric_limits<int>::max())
         previous.frames[f["frame"].get<int>()] = f;
   return previous;
 }
 
+// A string member, or "" when absent or not a string.
+std::string StringOf(const json& object, const char* key) {
+  return object.contains(key) && object[key].is_string() ? object[key].get<std::string>() : std::string();
+}
+
 // The files of `frame` from the previous manifest when every one of them is
 // on disk with its recorded SHA-256 and the frame was baked with the same
-// style, exposure and half scale; otherwise nothing.
+// style, exposure and half scale; otherwise nothing. A frame of the same
+// style lists exactly the names and kinds this bake gives it: any other
+// name stops the bake (ManifestError, exit 8) before it is opened.
 std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous, const FramePlan& plan,
                                                     const std::string& out_dir, double half_scale,
                                                     double ev100) {
@@ -252,22 +277,40 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   auto it = previous.frames.find(plan.number);
   if (it == previous.frames.end()) return std::nullopt;
   const json& f = it->second;
-  if (f.value("style_sha256", std::string()) != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
+  if (StringOf(f, "style_sha256") != Sha256OfText(plan.style->resolved_toml)) return std::nullopt;
   if (!f.contains("files") || !f["files"].is_array()) return std::nullopt;
-  std::vector<std::string> expected = FrameFileNames(*plan.style, plan.number).All();
-  std::vector<BakedFile> files;
+  const FrameNames names = FrameFileNames(*plan.style, plan.number);
+  const std::vector<std::string> expected = names.All();
+  std::vector<std::string> kinds(names.faces.size(), "face");
+  if (!names.cube.empty()) kinds.push_back("cube");
+  if (!names.latlong.empty()) kinds.push_back("latlong");
+  if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
+  size_t index = 0;
   for (const json& entry : f["files"]) {
-    if (!entry.is_object()) return std::nullopt;
-    std::string name = entry.value("file", std::string());
-    if (files.size() >= expected.size() || name != expected[files.size()]) return std::nullopt;
-    std::string path = (std::filesystem::path(out_dir) / name).string();
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(path, ec)) return std::nullopt;
-    std::string sha = Sha256OfFile(path);
-    if (sha != entry.value("sha256", std::string())) return std::nullopt;
-    files.push_back({path, entry.value("kind", std::string()), uint64_t(std::filesystem::file_size(path)), sha});
+    const std::string name = entry.is_object() ? StringOf(entry, "file") : std::string();
+    const std::string kind = entry.is_object() ? StringOf(entry, "kind") : std::string();
+    if (index >= expected.size() || name != expected[index] || kind != kinds[index])
+      throw ManifestError(fmt::format(
+          "the manifest in {} lists {} ({}) for frame {}, where this bake of the same style writes {}: the manifest "
+          "was edited or is not skybake's; nothing was read under that name. Pass --force instead of --resume to "
+          "bake every frame again",
+          out_dir, EscapedText(name), EscapedText(kind), plan.number,
+          index < expected.size() ? EscapedText(expected[index]) : "no more files"));
+    ++index;
   }
-  if (files.size() != expected.size()) return std::nullopt;
+  if (index != expected.size()) return std::nullopt;
+  std::vector<BakedFile> files;
+  index = 0;
+  for (const json& entry : f["files"]) {
+    std::string path = (std::filesystem::path(out_dir) / expected[index]).string();
+    std::error_code ec;
+    // A link is not followed: only a regular file of the folder is verified.
+    if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, ec))) return std::nullopt;
+    std::string sha = Sha256OfFile(path);
+    if (sha != StringOf(entry, "sha256")) return std::nullopt;
+    files.push_back({path, kinds[index], uint64_t(std::filesystem::file_size(path)), sha});
+    ++index;
+  }
   return files;
 }
 
@@ -330,10 +373,36 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   for (const FramePlan& plan : plans) CheckBudget(*plan.style, options);
   const std::vector<std::string> planned = PlannedFileNames(plans, part);
   auto path_of = [&](const std::string& name) { return (std::filesystem::path(options.out_dir) / name).string(); };
+  // The lock on the planned files, held to the end of the bake (any exit,
+  // kill -9 included, releases it): another live bake writing any of them
+  // into this folder stops this one here (exit 6); parts of one sequence,
+  // whose files differ, go ahead side by side.
+  {
+    std::error_code ec;
+    const std::filesystem::file_status out = std::filesystem::status(options.out_dir, ec);
+    if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
+      throw OutputError(fmt::format("--out {} is not a folder: give a folder (it is created when missing)",
+                                    options.out_dir));
+    std::filesystem::create_directories(options.out_dir, ec);
+    if (ec)
+      throw OutputError(fmt::format("cannot create the output folder {}: {}: choose a writable --out folder",
+                                    options.out_dir, ec.message()));
+  }
+  const OutputLock lock = OutputLock::Claim(options.out_dir, planned);
+  // What the renames at the end could not replace is found now, before any
+  // GPU work: a directory (or a pipe, a socket) under an output's name.
+  for (const std::string& name : planned) {
+    std::error_code ec;
+    const std::filesystem::file_status st = std::filesystem::symlink_status(path_of(name), ec);
+    if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) && !std::filesystem::is_symlink(st))
+      throw OutputError(fmt::format("{} is {}: an output file cannot replace it; move it away, or choose another --out",
+                                    path_of(name), std::filesystem::is_directory(st) ? "a directory" : "not a regular file"));
+  }
   if (!options.force && !options.resume) {
     for (const std::string& name : planned) {
       std::error_code ec;
-      if (std::filesystem::exists(path_of(name), ec))
+      // A link (dangling or not) at the name is a file in the way too.
+      if (std::filesystem::exists(std::filesystem::symlink_status(path_of(name), ec)))
         throw OutputExistsError(fmt::format(
             "{} already exists: pass --force to overwrite the bake's files{}, or choose another --out",
             path_of(name), sequence ? ", --resume to finish an interrupted sequence" : ""));
@@ -444,9 +513,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   for (size_t i = 0; i < plans.size(); ++i) {
     const FramePlan& plan = plans[i];
     style_sha256.push_back(Sha256OfText(plan.style->resolved_toml));
-    sequence_identity += fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", plan.number,
-                                     plan.time ? plan.time->Iso8601() : "", plan.sun.x, plan.sun.y, plan.sun.z,
-                                     style_sha256.back());
+    sequence_identity +=
+        SequenceIdentityLine(plan.number, plan.time ? plan.time->Iso8601() : "", plan.sun, style_sha256.back());
     plan_of_frame[plan.number] = i;
   }
   auto manifest_of = [&]() {
@@ -480,6 +548,20 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     }
     return m;
   };
+  // A write costs time in proportion to the frames done, so rewriting the
+  // manifest after every frame grew as frames squared. It is rewritten after
+  // a frame when the frames done have grown by a tenth since its last write
+  // (so after each of the first twenty; the bytes written add up to about 11
+  // times the final manifest), or when kManifestSeconds have passed since
+  // the last write and at least kManifestSpacing times what it took (writes
+  // stay under a tenth of the bake). Both keep the cost linear; a killed
+  // bake loses at most the frames since the last write (--resume bakes them
+  // again).
+  constexpr double kManifestSpacing = 9.0;
+  constexpr double kManifestSeconds = 30.0;
+  Clock::time_point manifest_written = Clock::now();
+  double manifest_write_seconds = 0.0;
+  size_t manifest_frames = 0;  // frames in the last manifest written
   auto write_manifest = [&](const std::vector<BakedFile>& scene, bool complete) {
     Manifest m = manifest_of();
     for (const BakedFile& f : scene)
@@ -487,6 +569,20 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     m.complete = complete;
     result.manifest_path = path_of(manifest_name);
     WriteManifest(m, result.manifest_path);
+    ++result.manifest_writes;
+    std::error_code ec;
+    result.manifest_bytes_written += std::filesystem::file_size(result.manifest_path, ec);
+  };
+  auto write_progress_manifest = [&]() {
+    const size_t done = result.frames.size();
+    if (done - manifest_frames < std::max<size_t>(1, manifest_frames / 10) &&
+        SecondsSince(manifest_written) < std::max(kManifestSeconds, kManifestSpacing * manifest_write_seconds))
+      return;
+    const Clock::time_point start = Clock::now();
+    write_manifest({}, false);
+    manifest_frames = done;
+    manifest_written = Clock::now();
+    manifest_write_seconds = std::chrono::duration<double>(manifest_written - start).count();
   };
 
   // One frame's files, from its rendered views: one scale for every file
@@ -644,8 +740,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     frame.write_seconds = w.write_seconds;
     for (const BakedFile& f : frame.files) result.files.push_back(f);
     result.frames.push_back(std::move(frame));
-    // The manifest after every frame: a killed bake leaves a valid record of the frames done.
-    write_manifest({}, false);
+    // The manifest as frames are done: a killed bake leaves a valid record of them.
+    write_progress_manifest();
   };
 
   for (size_t index = 0; index < plans.size(); ++index) {
@@ -718,7 +814,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       result.preview_ev100 = ev100.value_or(0.0);
       for (const BakedFile& f : frame.files) result.files.push_back(f);
       result.frames.push_back(std::move(frame));
-      write_manifest({}, false);
+      write_progress_manifest();
       continue;
     }
 
@@ -848,13 +944,20 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
 
 void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
   const ResourceEstimate e = EstimateResources(style);
-  if (e.memory_mib > options.max_memory_mib)
+  // Whole MiB, unless the two would then read the same ("1 MiB above 1 MiB").
+  auto pair = [](double need, double budget) {
+    const bool close = fmt::format("{:.0f}", need) == fmt::format("{:.0f}", budget);
+    return close ? std::pair{fmt::format("{:.3f}", need), fmt::format("{:.3f}", budget)}
+                 : std::pair{fmt::format("{:.0f}", need), fmt::format("{:.0f}", budget)};
+  };
+  if (e.memory_mib > options.max_memory_mib) {
+    const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
     throw BudgetError(fmt::format(
-        "the bake needs an estimated {:.0f} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
-        "of {:.0f} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
+        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
+        "of {} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
         "--max-memory-mib (README \"Limits\")",
-        e.memory_mib, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height,
-        options.max_memory_mib));
+        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, budget));
+  }
   if (e.seconds > options.max_frame_seconds)
     throw BudgetError(fmt::format(
         "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "

@@ -230,6 +230,10 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
   Schedule& schedule = result.schedule;
   schedule.source_path = name;
   toml::table root;
+  if (std::optional<ConfigError> deep = DeepKeyError(toml_text, name)) {
+    result.errors.push_back(*deep);
+    return result;
+  }
   try {
     root = toml::parse(toml_text, name);
   } catch (const toml::parse_error& e) {
@@ -465,6 +469,18 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
                            clock_hours(*f.time) - clock_hours(*frames[0].time);
     }
   }
+  // Clock times run forward: the glTF sun animation's keys (hours) must
+  // increase strictly, and a ramp by time needs an order.
+  if (schedule.clock_times) {
+    const char* list = s->get("times") ? "times" : "frames";
+    for (size_t i = 1; i < frames.size(); ++i) {
+      if (frames[i].hours_from_start > frames[i - 1].hours_from_start) continue;
+      r.Error(s->get(list), std::string("schedule.") + list,
+              fmt::format("frame {} ({}) is not after frame {} ({}): give clock times in increasing order, each "
+                          "once", i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
+      break;
+    }
+  }
   const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
   for (size_t i = 0; i < frames.size(); ++i) {
     if (schedule.clock_times && span_hours != 0.0)
@@ -513,8 +529,10 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
 }
 
 bool FileHasSchedule(const std::string& path) {
+  std::string text;
+  if (ReadInputFile(path, "style", text) || DeepKeyError(text, path)) return false;  // LoadSkyStyle reports it
   try {
-    toml::table root = toml::parse_file(path);
+    toml::table root = toml::parse(text, path);
     return root.contains("schedule");
   } catch (const toml::parse_error&) {
     return false;  // LoadSkyStyle reports the syntax error
@@ -522,19 +540,13 @@ bool FileHasSchedule(const std::string& path) {
 }
 
 ScheduleResult LoadSchedule(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  std::string text;
+  if (std::optional<ConfigError> e = ReadInputFile(path, "schedule", text)) {
     ScheduleResult result;
-    ConfigError e;
-    e.file = path;
-    e.key = "(file)";
-    e.message = "cannot open the schedule file: check the path";
-    result.errors.push_back(e);
+    result.errors.push_back(*e);
     return result;
   }
-  std::stringstream text;
-  text << in.rdbuf();
-  return ParseSchedule(text.str(), path);
+  return ParseSchedule(text, path);
 }
 
 std::vector<FrameOverride> FrameStyleOverrides(const Schedule& schedule, const ScheduleFrame& frame,
@@ -599,15 +611,17 @@ FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<
     result.errors = base.errors;
     return result;
   }
-  std::ifstream in(style_path, std::ios::binary);
-  std::stringstream text;
-  text << in.rdbuf();
+  std::string text;
+  if (std::optional<ConfigError> e = ReadInputFile(style_path, "style", text)) {
+    result.errors.push_back(*e);
+    return result;
+  }
   for (const ScheduleFrame& frame : schedule.frames) {
     std::vector<ConfigError> errors;
     std::vector<FrameOverride> frame_overrides = FrameStyleOverrides(schedule, frame, base.style, errors);
     std::vector<std::string> all = overrides;
     for (const FrameOverride& o : frame_overrides) all.push_back(o.Assignment());
-    ConfigResult styled = errors.empty() ? ParseSkyStyle(text.str(), style_path, all) : ConfigResult{};
+    ConfigResult styled = errors.empty() ? ParseSkyStyle(text, style_path, all) : ConfigResult{};
     for (ConfigError e : styled.errors) {
       // Errors from the frame's assignments point back into the schedule.
       for (const FrameOverride& o : frame_overrides) {

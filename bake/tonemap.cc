@@ -17,9 +17,14 @@ double SrgbEncode(double v) {
 
 double ExposureFromEv100(double ev100) { return 1.0 / (1.2 * std::exp2(ev100)); }
 
-double AutoEv100(const std::vector<float>& rgba, int width, int height) {
+namespace {
+
+// EV100 that maps the log-average luminance of rows [y0, y1) of a latlong
+// to the photographic mid grey 0.18; texels brighter than 1e4 times the
+// median (the sun disc) are left out of the average.
+double MeteredEv100(const std::vector<float>& rgba, int width, int y0, int y1) {
   std::vector<double> luminance;
-  for (int y = 0; y < height / 2; ++y) {
+  for (int y = y0; y < y1; ++y) {
     for (int x = 0; x < width; ++x) {
       const float* p = &rgba[(size_t(y) * width + x) * 4];
       // Rec.709 luminance weights.
@@ -40,6 +45,23 @@ double AutoEv100(const std::vector<float>& rgba, int width, int height) {
   double average = std::exp(sum_log / double(std::max<size_t>(count, 1)));
   // exposure * average = 0.18  =>  1 / (1.2 * 2^ev) = 0.18 / average
   return std::log2(average / (0.18 * 1.2));
+}
+
+// How far above mid grey the lower hemisphere may be exposed: 1 stop (0.36,
+// which ACES maps to 0.50, sRGB 0.74), so that it is never near white.
+constexpr double kLowerHemisphereStops = 1.0;
+
+}  // namespace
+
+double AutoEv100(const std::vector<float>& rgba, int width, int height) {
+  const double sky = MeteredEv100(rgba, width, 0, height / 2);
+  if (height / 2 == 0) return sky;
+  // What the image shows below the horizon: from high altitude the sky above
+  // is near black and the lit planet fills the lower half, which the sky's
+  // exposure would make white. At ground level the ground is at most about
+  // as bright as the sky and the sky decides alone.
+  const double lower = MeteredEv100(rgba, width, height / 2, height) - kLowerHemisphereStops;
+  return std::max(sky, lower);
 }
 
 std::vector<uint8_t> TonemapToSrgb8(const std::vector<float>& rgba, int width, int height,

@@ -292,5 +292,23 @@ TEST(TonemapTest, AcesAndSrgbKnownValues) {
   EXPECT_NEAR(5000.0 * ExposureFromEv100(ev), 0.18, 1e-9);
 }
 
+// Auto exposure meters what the image shows: a near-black sky over a lit
+// planet (a view from 80 km) exposes the lower half at most 1 stop above mid
+// grey, not white (the upper half alone gave EV100 -1.2 and a white planet);
+// a ground darker than the sky leaves the sky's exposure as it was.
+TEST(TonemapTest, AutoExposureNeverWhitensTheLowerHemisphere) {
+  auto image = [](float upper, float lower) {
+    std::vector<float> rgba(64 * 32 * 4);
+    for (size_t i = 0; i < 64 * 32; ++i)
+      for (int c = 0; c < 3; ++c) rgba[4 * i + c] = i < 64 * 16 ? upper : lower;
+    return rgba;
+  };
+  const double space = AutoEv100(image(0.05f, 3000.0f), 64, 32);
+  EXPECT_NEAR(3000.0 * ExposureFromEv100(space), 0.36, 1e-9);
+  EXPECT_LT(AcesFilmic(3000.0 * ExposureFromEv100(space)), 0.51);
+  const double ground = AutoEv100(image(5000.0f, 1500.0f), 64, 32);
+  EXPECT_NEAR(5000.0 * ExposureFromEv100(ground), 0.18, 1e-9) << "the sky decides, as before";
+}
+
 }  // namespace
 }  // namespace skybake

@@ -11,14 +11,17 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/output_lock.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -112,6 +115,7 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
   EXPECT_LT(partial["frames"].size(), 20u);
   size_t temporaries = 0;
   for (const std::string& name : after_kill) {
+    if (name.rfind(".skybake.lock.", 0) == 0) continue;  // the killed bake's lock claim, no longer held
     if (name[0] == '.') {
       ++temporaries;  // a hidden temporary of the killed process: never a real output name
       EXPECT_NE(name.find(".tmp"), std::string::npos) << name;
@@ -152,6 +156,337 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
     ++rendered;
   EXPECT_EQ(rendered, 20u) << changed.output;
   EXPECT_NE(ReadFileBytes(killed + "/sky_px.0001.exr"), ReadFileBytes(root + "/whole/out/sky_px.0001.exr"));
+  fs::remove_all(root);
+}
+
+// A hostile folder: links planted at every temporary name a bake used to
+// pick (`.NAME.tmpPID`, the pid known once the process starts: here the
+// child plants them before it execs skybake, keeping its pid), pointing at
+// files elsewhere. Temporaries are created with O_EXCL | O_NOFOLLOW under
+// unguessable names, so every victim keeps its bytes and every output is
+// the bake's own.
+TEST(SafeOutputs, PlantedTemporaryLinksAreNeverFollowed) {
+  const std::string root = FreshTempDir("planted");
+  const std::string out = root + "/out";
+  const std::string victims = root + "/victims";
+  fs::create_directories(out);
+  fs::create_directories(victims);
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  std::vector<std::string> names = {"manifest.json", "timings.json", "sky.gltf", "sky.bin", "sky.glb"};
+  for (const char* frame : {"0001", "0002"}) {
+    for (const char* face : {"px", "nx", "py", "ny", "pz", "nz", "cube", "latlong"})
+      names.push_back(std::string("sky_") + face + "." + frame + ".exr");
+    names.push_back(std::string("sky_latlong.") + frame + ".png");
+  }
+  pid_t pid = fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    for (const std::string& name : names) {
+      const std::string victim = victims + "/" + name;
+      std::ofstream(victim) << "victim " << name;
+      if (symlink(victim.c_str(), (out + "/." + name + ".tmp" + std::to_string(getpid())).c_str()) != 0) _exit(126);
+    }
+    execl(SKYBAKE_BINARY, "skybake", "bake", Style().c_str(), "--schedule", schedule.c_str(), "--size", "8", "-q",
+          "--out", out.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status)) << "the bake crashed";
+  ASSERT_EQ(WEXITSTATUS(status), 0) << "planting failed (126) or the bake failed";
+  for (const std::string& name : names) {
+    EXPECT_EQ(ReadFileBytes(victims + "/" + name), "victim " + name) << name << " was written through a link";
+    EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/" + name))) << name;
+  }
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
+  EXPECT_TRUE(manifest["complete"].get<bool>());
+  for (const auto& frame : manifest["frames"])
+    for (const auto& file : frame["files"])
+      EXPECT_EQ(ReadFileBytes(out + "/" + file["file"].get<std::string>()).size(), file["bytes"].get<uint64_t>());
+  fs::remove_all(root);
+}
+
+// A link at an output's own name is replaced (the rename), never written
+// through.
+TEST(SafeOutputs, LinkAtAnOutputNameIsReplacedNotFollowed) {
+  const std::string root = FreshTempDir("finallink");
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  std::ofstream(root + "/victim") << "victim";
+  fs::create_symlink(root + "/victim", out + "/sky_px.exr");
+  CommandRun run = RunSkybake("bake '" + Style() + "' --size 8 -q --force --out '" + out + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/sky_px.exr")));
+  fs::remove_all(root);
+}
+
+// The output lock (skybake/output_lock.h): claims that share a file name
+// exclude each other while held; disjoint claims coexist; a released or
+// dead claim frees its names.
+TEST(OutputLockTest, OverlappingClaimsAreRefusedDisjointOnesCoexist) {
+  const std::string dir = FreshTempDir("lockunit");
+  {
+    OutputLock a = OutputLock::Claim(dir, {"sky_px.0001.exr", "manifest.shard-0001-0002.json"});
+    OutputLock b = OutputLock::Claim(dir, {"sky_px.0003.exr", "manifest.shard-0003-0004.json"});
+    try {
+      OutputLock c = OutputLock::Claim(dir, {"sky_px.0004.exr", "sky_px.0001.exr"});
+      ADD_FAILURE() << "an overlapping claim was granted";
+    } catch (const OutputLockedError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(fmt::format("(pid {} on ", getpid())), std::string::npos) << what;
+      EXPECT_NE(what.find("which writes " + dir + "/sky_px.0001.exr too"), std::string::npos) << what;
+    }
+  }
+  // Both released: the names are free, and no lock file is left.
+  OutputLock again = OutputLock::Claim(dir, {"sky_px.0001.exr"});
+  EXPECT_EQ(FileNames(dir).size(), 1u) << "only the one live claim";
+  again = OutputLock();
+  EXPECT_TRUE(FileNames(dir).empty());
+  fs::remove_all(dir);
+}
+
+// Twenty frames of 64^3 take a few seconds: long enough to meet them.
+std::string SlowSequenceBake(const std::string& schedule, const std::string& out, const std::string& extra = "") {
+  return "bake '" + Style() + "' --schedule '" + schedule + "' --size 48 -q --out '" + out + "' " + extra;
+}
+
+// Waits until `dir` holds a lock claim (a bake got past its start).
+bool WaitForClaim(const std::string& dir, pid_t child) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
+  while (std::chrono::steady_clock::now() < deadline) {
+    for (const std::string& name : FileNames(dir))
+      if (name.rfind(".skybake.lock.", 0) == 0) return true;
+    if (waitpid(child, nullptr, WNOHANG) == child) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  return false;
+}
+
+pid_t Spawn(const std::string& args) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    execl("/bin/bash", "bash", "-c", (std::string("exec '") + SKYBAKE_BINARY + "' " + args + " >/dev/null 2>&1").c_str(),
+          static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+int WaitExit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Two bakes of the same files into one folder: the second, even with
+// --force, stops before any GPU work with exit 6 naming the first; the first
+// completes with every file matching its manifest.
+TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
+  const std::string root = FreshTempDir("lockbake");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  // A holder the test controls: this process claims one frame's file.
+  {
+    OutputLock held = OutputLock::Claim(out, {"sky_px.0007.exr"});
+    CommandRun refused = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
+    EXPECT_EQ(refused.exit_code, 6) << refused.output;
+    EXPECT_EQ(refused.output.rfind(fmt::format("skybake: error: {} is being written by another skybake (pid {} on ",
+                                               out, getpid()), 0), 0u) << refused.output;
+    EXPECT_NE(refused.output.find("which writes " + out + "/sky_px.0007.exr too: wait for it to end, or choose "
+                                  "another --out"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.find("skybake: device"), std::string::npos) << "no GPU work";
+    EXPECT_EQ(FileNames(out).size(), 1u) << "nothing written but the holder's claim";
+  }
+  // Two real bakes: the second overlaps the running first.
+  pid_t first = Spawn(SlowSequenceBake(schedule, out, "--force"));
+  ASSERT_TRUE(WaitForClaim(out, first)) << "the first bake never claimed its files";
+  CommandRun second = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
+  EXPECT_EQ(second.exit_code, 6) << second.output;
+  EXPECT_NE(second.output.find(fmt::format("(pid {} on ", first)), std::string::npos) << second.output;
+  EXPECT_NE(second.output.find(" bake "), std::string::npos) << "names the other's command: " << second.output;
+  ASSERT_EQ(WaitExit(first), 0);
+  nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
+  EXPECT_TRUE(manifest["complete"].get<bool>());
+  for (const auto& frame : manifest["frames"])
+    for (const auto& file : frame["files"])
+      EXPECT_EQ(ReadFileBytes(out + "/" + file["file"].get<std::string>()).size(), file["bytes"].get<uint64_t>());
+  for (const std::string& name : FileNames(out)) EXPECT_NE(name[0], '.') << name << " left behind";
+  fs::remove_all(root);
+}
+
+// Shards of one sequence write into one folder at the same time; a part that
+// overlaps a running one is refused; the merge gives the unsharded bake.
+TEST(SafeOutputs, DisjointShardsShareAFolderOverlappingPartsAreRefused) {
+  const std::string root = FreshTempDir("lockshards");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  pid_t one = Spawn(SlowSequenceBake(schedule, out, "--shard 1/2"));
+  pid_t two = Spawn(SlowSequenceBake(schedule, out, "--shard 2/2"));
+  ASSERT_TRUE(WaitForClaim(out, one));
+  CommandRun overlapping = RunSkybake(SlowSequenceBake(schedule, out, "--frames 10:11 --force"));
+  EXPECT_EQ(overlapping.exit_code, 6) << overlapping.output;
+  EXPECT_NE(overlapping.output.find("is being written by another skybake (pid "), std::string::npos)
+      << overlapping.output;
+  EXPECT_EQ(WaitExit(one), 0);
+  EXPECT_EQ(WaitExit(two), 0);
+  CommandRun merged = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
+  fs::remove_all(root);
+}
+
+// kill -9 of a bake releases its lock (the kernel drops the flock): the
+// next bake into the folder proceeds and removes the dead claim.
+TEST(SafeOutputs, KilledBakesLockIsReleased) {
+  const std::string root = FreshTempDir("lockkill");
+  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
+  const std::string out = root + "/out";
+  fs::create_directories(out);
+  pid_t first = Spawn(SlowSequenceBake(schedule, out));
+  ASSERT_TRUE(WaitForClaim(out, first));
+  ASSERT_EQ(kill(first, SIGKILL), 0);
+  EXPECT_EQ(WaitExit(first), -1);
+  CommandRun resumed = RunSkybake(SlowSequenceBake(schedule, out, "--resume"));
+  EXPECT_EQ(resumed.exit_code, 0) << resumed.output;
+  for (const std::string& name : FileNames(out)) EXPECT_NE(name[0], '.') << name << " left behind";
+  fs::remove_all(root);
+}
+
+// merge-manifest takes the lock for what it writes: a live claim on
+// manifest.json (a whole bake running) refuses it, and it writes nothing.
+TEST(SafeOutputs, MergeTakesTheLockOnWhatItWrites) {
+  const std::string root = FreshTempDir("lockmerge");
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string out = root + "/out";
+  for (const char* shard : {"1/2", "2/2"}) {
+    CommandRun part = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out +
+                                 "' --shard " + shard);
+    ASSERT_EQ(part.exit_code, 0) << part.output;
+  }
+  {
+    OutputLock held = OutputLock::Claim(out, {"sky.glb"});
+    CommandRun refused = RunSkybake("merge-manifest '" + out + "'");
+    EXPECT_EQ(refused.exit_code, 6) << refused.output;
+    EXPECT_NE(refused.output.find("which writes " + out + "/sky.glb too"), std::string::npos) << refused.output;
+    EXPECT_FALSE(fs::exists(out + "/manifest.json"));
+  }
+  CommandRun merged = RunSkybake("merge-manifest '" + out + "'");
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
+  fs::remove_all(root);
+}
+
+// --resume reads manifest.json as input: a directory or non-JSON there is
+// the folder's problem (exit 6, with the fix), a value of the wrong type
+// only makes its frames bake again, and a name that is not the one this
+// bake gives the frame (same style) stops it (exit 8) before it is opened.
+TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
+  const std::string root = FreshTempDir("resumein");
+  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out + "'";
+  ASSERT_EQ(RunSkybake(bake).exit_code, 0);
+  const std::string manifest_path = out + "/manifest.json";
+  const std::string good = ReadFileBytes(manifest_path);
+
+  fs::remove(manifest_path);
+  fs::create_directory(manifest_path);
+  CommandRun directory = RunSkybake(bake + " --resume");
+  EXPECT_EQ(directory.exit_code, 6) << directory.output;
+  EXPECT_EQ(directory.output, "skybake: error: " + manifest_path + " is a directory, not a manifest, so --resume "
+                              "cannot tell which frames are done: move it away, or pass --force instead to bake every "
+                              "frame again\n");
+  fs::remove(manifest_path);
+
+  std::ofstream(manifest_path) << "not json";
+  CommandRun garbage = RunSkybake(bake + " --resume");
+  EXPECT_EQ(garbage.exit_code, 6) << garbage.output;
+  EXPECT_EQ(garbage.output, "skybake: error: " + manifest_path + " is not valid JSON, so --resume cannot tell which "
+                            "frames are done: pass --force instead to bake every frame again\n");
+
+  nlohmann::json m = nlohmann::json::parse(good);
+  m["half_scale"] = "one";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun typed = RunSkybake(bake + " --resume");
+  EXPECT_EQ(typed.exit_code, 0) << typed.output;
+  EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
+
+  m = nlohmann::json::parse(good);
+  m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun hostile = RunSkybake(bake + " --resume");
+  EXPECT_EQ(hostile.exit_code, 8) << hostile.output;
+  EXPECT_NE(hostile.output.find("lists '../../../etc/passwd' ('latlong') for frame 2, where this bake of the same "
+                                "style writes 'sky_latlong.0002.exr': the manifest was edited"),
+            std::string::npos)
+      << hostile.output;
+  fs::remove_all(root);
+}
+
+// gallery: a second run stops at the existing sheet with a fix gallery
+// accepts (--force; it advised --force and then rejected it), a link at
+// gallery.png counts as a file and is replaced, never followed.
+TEST(SafeOutputs, GalleryNeedsForceAndNeverWritesThroughALink) {
+  const std::string root = FreshTempDir("gallery");
+  const std::string styles = root + "/styles";
+  fs::create_directories(styles);
+  for (const char* name : {"a", "b"})
+    fs::copy_file(testing::SourceDir() + "/configs/styles/" + (std::string(name) == "a" ? "ambiguous_yellow.toml" : "crystal_blue.toml"),
+                  styles + "/" + name + ".toml");
+  const std::string out = root + "/out";
+  const std::string gallery = "gallery '" + styles + "' --size 8 -q --out '" + out + "'";
+  CommandRun first = RunSkybake(gallery);
+  ASSERT_EQ(first.exit_code, 0) << first.output;
+  const std::string sheet = ReadFileBytes(out + "/gallery.png");
+  CommandRun again = RunSkybake(gallery);
+  EXPECT_EQ(again.exit_code, 6) << again.output;
+  EXPECT_EQ(again.output, "skybake: error: " + out + "/gallery.png already exists: pass --force to replace the "
+                          "gallery, or choose another --out\n");
+  fs::remove(out + "/gallery.png");
+  std::ofstream(root + "/victim") << "victim";
+  fs::create_symlink(root + "/victim", out + "/gallery.png");
+  CommandRun linked = RunSkybake(gallery);
+  EXPECT_EQ(linked.exit_code, 6) << "a link is a file in the way: " << linked.output;
+  CommandRun forced = RunSkybake(gallery + " --force");
+  ASSERT_EQ(forced.exit_code, 0) << forced.output;
+  EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
+  EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/gallery.png")));
+  EXPECT_EQ(ReadFileBytes(out + "/gallery.png"), sheet);
+  fs::remove_all(root);
+}
+
+// What would fail only at the end is found before any GPU work: an output
+// name that is a directory (even with --force: 7 files were replaced, then
+// exit 5), --out naming a regular file; a dangling link at an output name
+// is a file in the way (exists() followed it).
+TEST(SafeOutputs, OutputsThatCannotBeWrittenAreFoundBeforeRendering) {
+  const std::string root = FreshTempDir("beforegpu");
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --size 8 --out '" + out + "'";
+  ASSERT_EQ(RunSkybake(bake + " -q").exit_code, 0);
+  const std::string px = ReadFileBytes(out + "/sky_px.exr");
+  fs::remove(out + "/sky.glb");
+  fs::create_directory(out + "/sky.glb");
+  CommandRun directory = RunSkybake(bake + " --force");
+  EXPECT_EQ(directory.exit_code, 5) << directory.output;
+  EXPECT_EQ(directory.output, "skybake: error: " + out + "/sky.glb is a directory: an output file cannot replace "
+                              "it; move it away, or choose another --out\n");
+  EXPECT_EQ(ReadFileBytes(out + "/sky_px.exr"), px);
+  fs::remove(out + "/sky.glb");
+
+  fs::remove_all(out);
+  fs::create_directories(out);
+  fs::create_symlink(root + "/nowhere", out + "/sky_nz.exr");
+  CommandRun dangling = RunSkybake(bake + " -q");
+  EXPECT_EQ(dangling.exit_code, 6) << dangling.output;
+  EXPECT_NE(dangling.output.find(out + "/sky_nz.exr already exists"), std::string::npos) << dangling.output;
+
+  std::ofstream(root + "/file") << "x";
+  CommandRun file = RunSkybake("bake '" + Style() + "' --size 8 --out '" + root + "/file'");
+  EXPECT_EQ(file.exit_code, 5) << file.output;
+  EXPECT_EQ(file.output, "skybake: error: --out " + root + "/file is not a folder: give a folder (it is created when "
+                         "missing)\n");
   fs::remove_all(root);
 }
 

@@ -352,5 +352,24 @@ TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact)
   fs::remove_all(options.out_dir);
 }
 
+// A long sequence's progress manifests cost in proportion to its frames:
+// rewritten after every frame, their bytes grew as frames squared (100
+// frames wrote about 50 times the final manifest); now after frames 1 to 20
+// and then whenever the frames done have grown by a tenth (or every 30 s).
+TEST(SequenceCost, ProgressManifestsAddUpToAFewFinalManifests) {
+  const std::string root = testing::FreshTempDir("manifestcost");
+  const std::string schedule = root + "/hundred.toml";
+  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = { start = 0, end = 49.5, step = 0.5 }, azimuth_deg = 135 }\n";
+  testing::CommandRun run = testing::RunSkybake("bake '" + testing::SourceDir() + "/configs/default.toml' --schedule '" +
+                                                schedule + "' --size 1 -q --out '" + root + "/out'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  nlohmann::json timings = nlohmann::json::parse(std::ifstream(root + "/out/timings.json"));
+  const double seconds = timings["total_s"].get<double>();
+  const uint64_t final_bytes = std::filesystem::file_size(root + "/out/manifest.json");
+  EXPECT_LE(timings["manifest_writes"].get<int>(), 40 + int(seconds / 30.0)) << "100 before";
+  EXPECT_LE(timings["manifest_bytes_written"].get<uint64_t>(), (14 + uint64_t(seconds / 30.0)) * final_bytes) << "about 50 times before";
+  std::filesystem::remove_all(root);
+}
+
 }  // namespace
 }  // namespace skybake

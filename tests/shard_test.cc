@@ -4,6 +4,7 @@
 // manifests into the unsharded bake's manifest.json and glTF scene byte for
 // byte, and bad values or missing parts are refused with the fix.
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -198,6 +199,110 @@ TEST_F(Shard, MergeRefusesMissingFramesAndPartsOfAnotherBake) {
   EXPECT_NE(gone.output.find("sky_nz.0015.exr, listed in " + out + "/manifest.shard-0015-0016.json, is missing"),
             std::string::npos)
       << gone.output;
+}
+
+// Hostile or edited shard manifests: every name read from a part must be a
+// plain file name and the one the bake gives that frame and kind, the
+// frames must give the parts' sequence_sha256, sizes must be integers in
+// range; anything else is exit 8, before any file under such a name is
+// opened (no size of a file outside the folder is ever shown) and with
+// nothing written.
+TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
+  const std::string root = FreshTempDir("hostile");
+  const std::string schedule = root + "/two.toml";
+  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n";
+  const std::string parts = root + "/parts";
+  for (const char* shard : {"1/2", "2/2"}) {
+    CommandRun run = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + parts +
+                                "' --shard " + shard);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  std::ofstream(root + "/secret.png") << "secret";
+  using Edit = std::function<void(nlohmann::json&)>;
+  struct Case {
+    const char* name;
+    const char* part;  // the manifest edited
+    Edit edit;
+    std::string message;  // expected in the output
+  };
+  auto file = [](int n) { return [n](nlohmann::json& m) -> nlohmann::json& { return m["frames"][0]["files"][n]["file"]; }; };
+  const std::vector<Case> cases = {
+      {"gltf name escapes", "0001-0001", [](nlohmann::json& m) { m["gltf"]["name"] = "../evil"; },
+       "gltf.name: '../evil' is not a plain file name"},
+      {"gltf name absolute", "0001-0001", [](nlohmann::json& m) { m["gltf"]["name"] = "/tmp/evil"; },
+       "gltf.name: '/tmp/evil' is not a plain file name"},
+      {"texture escapes", "0002-0002", [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "../secret.png"; },
+       "gltf.texture.file: '../secret.png' is not a plain file name of a PNG in the folder"},
+      {"frame file escapes", "0001-0001", [&](nlohmann::json& m) { file(0)(m) = "../../../etc/passwd"; },
+       "frame 1: '../../../etc/passwd' is not the face file skybake names for frame 1 (....0001.exr)"},
+      {"frame file absolute", "0001-0001", [&](nlohmann::json& m) { file(6)(m) = "/etc/passwd"; },
+       "frame 1: '/etc/passwd' is not the cube strip file skybake names for frame 1"},
+      {"frame file in a sub-folder", "0001-0001", [&](nlohmann::json& m) { file(7)(m) = "sub/sky_latlong.0001.exr"; },
+       "frame 1: 'sub/sky_latlong.0001.exr' is not the latlong file skybake names for frame 1"},
+      {"frame file with a newline", "0001-0001", [&](nlohmann::json& m) { file(1)(m) = "sky_nx.0001.exr\nX"; },
+       "frame 1: 'sky_nx.0001.exr\\nX' is not the face file skybake names for frame 1"},
+      {"another frame's file", "0001-0001", [&](nlohmann::json& m) { file(7)(m) = "sky_latlong.0002.exr"; },
+       "frame 1: 'sky_latlong.0002.exr' is not the latlong file skybake names for frame 1 (....0001.exr)"},
+      {"kind swapped", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][6]["kind"] = "latlong"; },
+       "frame 1: 'sky_cube.0001.exr' is not the latlong file skybake names for frame 1 (BASE_latlong.0001)"},
+      {"unknown kind", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][6]["kind"] = "secret"; },
+       "frame 1: 'secret' is not a kind of file skybake writes"},
+      {"negative size", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][0]["bytes"] = -1; },
+       "'bytes' is -1, not an integer in [0, 9007199254740992]"},
+      {"fractional size", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][0]["bytes"] = 1.5; },
+       "'bytes' is 1.5, not an integer in [0, 9007199254740992]"},
+      {"huge frame number", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["frame"] = 4294967297.0; },
+       "'frame' is 4294967297.0, not an integer"},
+      {"edited style hash", "0001-0001",
+       [](nlohmann::json& m) { m["frames"][0]["style_sha256"] = std::string(64, '0'); },
+       "do not give their sequence_sha256: a manifest was edited"},
+      {"edited sun", "0002-0002",
+       [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][1] = 0.5; },
+       "do not give their sequence_sha256"},
+      {"texture of another frame", "0001-0001",
+       [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "sky_latlong.0001.png"; },
+       "gltf.texture.file 'sky_latlong.0001.png' of the shard manifests in "},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string dir = root + "/case";
+    fs::remove_all(dir);
+    fs::copy(parts, dir);
+    // Both parts share the sequence-wide entries: edit those in both.
+    for (const char* part : {"0001-0001", "0002-0002"}) {
+      const std::string path = dir + "/manifest.shard-" + part + ".json";
+      nlohmann::json m = nlohmann::json::parse(std::ifstream(path));
+      const bool shared = std::string(c.name).rfind("gltf", 0) == 0 || std::string(c.name).rfind("texture", 0) == 0;
+      if (shared || std::string(part) == c.part) c.edit(m);
+      std::ofstream(path) << m.dump(2);
+    }
+    const std::set<std::string> before = FileNames(dir);
+    CommandRun run = RunSkybake("merge-manifest --force '" + dir + "'");
+    EXPECT_EQ(run.exit_code, 8) << run.output;
+    EXPECT_NE(run.output.find(c.message), std::string::npos) << run.output;
+    EXPECT_EQ(run.output.find("bytes, listed with"), std::string::npos) << "no size shown: " << run.output;
+    EXPECT_EQ(FileNames(dir), before) << "nothing written";
+    EXPECT_FALSE(fs::exists(root + "/evil.gltf"));
+    EXPECT_FALSE(fs::exists("/tmp/evil.glb"));
+  }
+  // A listed file replaced by a link (to a copy of itself) is not followed.
+  {
+    const std::string dir = root + "/case";
+    fs::remove_all(dir);
+    fs::copy(parts, dir);
+    fs::rename(dir + "/sky_latlong.0002.png", root + "/moved.png");
+    fs::create_symlink(root + "/moved.png", dir + "/sky_latlong.0002.png");
+    CommandRun run = RunSkybake("merge-manifest --sizes-only '" + dir + "'");
+    EXPECT_EQ(run.exit_code, 8) << run.output;
+    EXPECT_NE(run.output.find("sky_latlong.0002.png, listed in " + dir +
+                              "/manifest.shard-0002-0002.json, is not a regular file (links are not followed)"),
+              std::string::npos)
+        << run.output;
+  }
+  // The untouched parts merge.
+  CommandRun merged = RunSkybake("merge-manifest '" + parts + "'");
+  EXPECT_EQ(merged.exit_code, 0) << merged.output;
+  fs::remove_all(root);
 }
 
 TEST_F(Shard, BadFramesAndShardsAreUsageErrorsBeforeAnyGpuWork) {

@@ -27,6 +27,14 @@ struct BadInput {
 
 void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
 
+// A dotted key of 50,000 parts (100 KB): the TOML parser's recursion
+// overflowed the stack on it (SIGSEGV) before the input limits.
+const std::string kDeepKey = [] {
+  std::string text = "a";
+  for (int i = 0; i < 50000; ++i) text += ".a";
+  return text + " = 1\n";
+}();
+
 // clang-format off
 const BadInput kBadInputs[] = {
     {"UnknownKeyWithSuggestion", R"toml([sun]
@@ -154,25 +162,25 @@ view_steps = 0
 basename = "../evil"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameAbsolute", R"toml([output]
 basename = "/tmp/evil"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '/tmp/evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '/tmp/evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameSubfolder", R"toml([output]
 basename = "a/b"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: 'a/b' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: 'a/b' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"BasenameHidden", R"toml([output]
 basename = ".sky"
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:12: output.basename: '.sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: style.toml:2:12: output.basename: '.sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"FaceNameTraversal", R"toml([output]
 face_names = ["px", "nx", "py", "ny", "pz", "../../nz"]
@@ -236,7 +244,7 @@ cube_size = 0
          "skybake: 1 error; nothing was baked\n"},
     {"SetTraversal", R"toml()toml",
      nullptr, "--set output.basename=../../etc/sky", 3,
-         "skybake: error: --set output.basename=../../etc/sky:1:5: output.basename: '../../etc/sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: --set output.basename=../../etc/sky:1:5: output.basename: '../../etc/sky' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"MissingStyleFile", nullptr,
      nullptr, "", 3,
@@ -324,7 +332,7 @@ elevation_deg = 10
 azimuth_deg = 135
 set = { "output.basename" = "../../evil" }
 )toml", "", 3,
-         "skybake: error: schedule.toml:5:29: output.basename: frame 1: '../../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.'\n"
+         "skybake: error: schedule.toml:5:29: output.basename: frame 1: '../../evil' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
          "skybake: 1 error; nothing was baked\n"},
     {"ScheduleRampPushesGOutOfRange", R"toml()toml",
      R"toml([schedule]
@@ -355,6 +363,92 @@ set = { "sun.elevation_deg " = 5 }
 )toml", "", 3,
          "skybake: error: schedule.toml:5:32: schedule.frames[0].set.sun.elevation_deg : 'sun.elevation_deg ' is not a style key: use a dotted key such as \"atmosphere.mie.g\"\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"DeepDottedKey", kDeepKey.c_str(), nullptr, "", 3,
+         "skybake: error: style.toml:1:128: (syntax): a dotted key or table name of more than 64 parts: skybake's keys have at most 5, e.g. atmosphere.rayleigh.scale_height_km\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"StyleIsADirectory", "DIR", nullptr, "", 3,
+         "skybake: error: style.toml: (file): is a directory: give a style TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"StyleIsADevice", "DEVZERO", nullptr, "", 3,
+         "skybake: error: style.toml: (file): is not a regular file (a device, a pipe or a socket): give a style TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleIsADirectory", "", "DIR", "", 3,
+         "skybake: error: schedule.toml: (file): is a directory: give a schedule TOML file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetReplacesATableByANumber", "", nullptr, "--set sun=1", 3,
+         "skybake: error: --set sun=1:1:5: sun: expected a table ([sun] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetReplacesATableByAnArray", "", nullptr, "--set render=[]", 3,
+         "skybake: error: --set render=[]:1:5: render: expected a table ([render] with its keys), got an array\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetReplacesATable", "", R"toml([schedule]
+[[schedule.frames]]
+elevation_deg = 10
+azimuth_deg = 135
+set = { "sun" = 1 }
+)toml", "", 3,
+         "skybake: error: schedule.toml:5:17: sun: frame 1: expected a table ([sun] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampReplacesATable", "", R"toml([schedule]
+sun = { elevation_deg = [0, 10], azimuth_deg = 135 }
+[schedule.ramp]
+"atmosphere" = [0, 1]
+)toml", "", 3,
+         "skybake: error: schedule.toml:4:16: atmosphere: frame 1: expected a table ([atmosphere] with its keys), got an integer\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleClockTimesOutOfOrder", "", R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+times = [12:00:00, 09:00:00, 12:00:00]
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:9: schedule.times: frame 2 (2013-05-27T09:00:00-04:00) is not after frame 1 (2013-05-27T12:00:00-04:00): give clock times in increasing order, each once\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameTimesRepeat", "", R"toml([schedule]
+date = 2013-05-27
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4.0
+[[schedule.frames]]
+time = 09:00:00
+[[schedule.frames]]
+time = 09:00:00
+)toml", "", 3,
+         "skybake: error: schedule.toml:6:1: schedule.frames: frame 2 (2013-05-27T09:00:00-04:00) is not after frame 1 (2013-05-27T09:00:00-04:00): give clock times in increasing order, each once\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetValueWithALineBreak", "", nullptr, "--set $'sun.elevation_deg=10\\nsun.azimuth_deg=5'", 3,
+         "skybake: error: --set: sun.elevation_deg: the value has a line break, and what follows it would be ignored: give one value per --set\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetScheduleKey", "", nullptr, "--set schedule.first_frame=5", 3,
+         "skybake: error: --set: schedule.first_frame: a schedule is not changed with --set (it would be ignored): edit the schedule file, or use its [schedule.ramp] or a frame's set\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetEmptyKeyPart", "", nullptr, "--set sun..elevation_deg=10", 3,
+         "skybake: error: --set: sun..elevation_deg: empty part in the key path (two dots, or a leading dot): e.g. --set sun.elevation_deg=10\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameLeadingDash", R"toml([output]
+basename = "-rf"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: '-rf' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameWindowsReserved", R"toml([output]
+basename = "nul"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: 'nul' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"BasenameTooLong", R"toml([output]
+basename = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa"
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: a name of 153 characters is longer than the 128 a plain file name may have\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNamesEqualUpToCase", R"toml([output]
+face_names = ["px", "PX", "py", "ny", "pz", "nz"]
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:14: output.face_names[1]: 'px' and 'PX' differ only in case, one file on a case-insensitive file system: each face is its own file\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ControlCharacterInAKeyIsEscaped", "\"sun\\u001b[2J\" = 1\n", nullptr, "", 3,
+         "skybake: error: style.toml:1:1: sun\\x1b[2J: unknown key 'sun\\x1b[2J'\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
@@ -368,10 +462,16 @@ class BadInputs : public ::testing::TestWithParam<BadInput> {};
 TEST_P(BadInputs, RefusedWithTheExactMessageAndExitCode) {
   const BadInput& c = GetParam();
   const std::string dir = testing::FreshTempDir(std::string("bad_") + c.name);
-  if (c.style) std::ofstream(dir + "/style.toml") << c.style;
+  // "DIR": a directory under the name; "DEVZERO": a link to /dev/zero.
+  auto place = [&](const char* text, const std::string& path) {
+    if (std::string(text) == "DIR") fs::create_directory(path);
+    else if (std::string(text) == "DEVZERO") fs::create_symlink("/dev/zero", path);
+    else if (std::string(text) != "MISSING") std::ofstream(path) << text;
+  };
+  if (c.style) place(c.style, dir + "/style.toml");
   std::string args = "style.toml";
   if (c.schedule) {
-    if (std::string(c.schedule) != "MISSING") std::ofstream(dir + "/schedule.toml") << c.schedule;
+    place(c.schedule, dir + "/schedule.toml");
     args += " --schedule schedule.toml";
   }
   args += std::string(" ") + c.args;
@@ -403,6 +503,49 @@ TEST(BadInputs, SizeOutsideTheCommandLineRangeIsAUsageError) {
     EXPECT_EQ(run.exit_code, 2) << size << ": " << run.output;
     EXPECT_NE(run.output.find("--size"), std::string::npos) << run.output;
   }
+}
+
+// A budget of nan compared false with every estimate and switched the
+// check off; inf, 0 and negatives are no budget either.
+TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  for (const char* option : {"--max-memory-mib", "--max-frame-seconds"}) {
+    for (const char* value : {"nan", "inf", "-1", "0"}) {
+      testing::CommandRun run =
+          testing::RunSkybake("bake '" + style + "' " + option + " " + value + " --out /nonexistent/x");
+      EXPECT_EQ(run.exit_code, 2) << option << " " << value << ": " << run.output;
+      EXPECT_EQ(run.output.rfind(std::string(option) + ": expected a finite number above 0, got " + value, 0), 0u)
+          << run.output;
+    }
+  }
+}
+
+// An estimate just above the budget is shown with the digits that tell
+// them apart ("needs 3 MiB ... above the budget of 3 MiB" before).
+TEST(BadInputs, BudgetMessageTellsCloseNumbersApart) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  testing::CommandRun run = testing::RunSkybake("check '" + style + "' --set render.cube_size=64 --set "
+                                                "render.latlong_height=64 --max-memory-mib 3");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_NE(run.output.find("an estimated 3.031 MiB of memory per frame (cube 64, latlong 128x64), above the budget "
+                            "of 3.000 MiB"), std::string::npos) << run.output;
+}
+
+// --dry-run plans the part of the sequence that --frames / --shard select.
+TEST(BadInputs, DryRunPlansOnlyTheSelectedFrames) {
+  const std::string dir = testing::FreshTempDir("dryrun");
+  std::ofstream(dir + "/s.toml") << "[schedule]\nsun = { elevation_deg = [1, 2, 3, 4], azimuth_deg = 135 }\n";
+  const std::string bake = "bake '" + testing::SourceDir() + "/configs/default.toml' --schedule '" + dir +
+                           "/s.toml' --dry-run --out '" + dir + "/out'";
+  testing::CommandRun all = testing::RunSkybake(bake);
+  testing::CommandRun part = testing::RunSkybake(bake + " --frames 2:3");
+  ASSERT_EQ(all.exit_code, 0) << all.output;
+  ASSERT_EQ(part.exit_code, 0) << part.output;
+  EXPECT_NE(all.output.find("4 frames"), std::string::npos) << all.output;
+  EXPECT_NE(part.output.find("2 frames"), std::string::npos) << part.output;
+  EXPECT_NE(part.output.find("(frames 2 to 3 of 1 to 4): 2 frames"), std::string::npos) << part.output;
+  EXPECT_FALSE(fs::exists(dir + "/out"));
+  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -83,15 +83,27 @@ void SetExrThreads(int threads);
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 
 // Writes `bytes` to a temporary file beside `path`, syncs it and renames it
-// over `path`. On any failure the temporary is removed and OutputError names
-// the file, the system error and the fix (a full disk, a file-size limit).
+// over `path`. The one way skybake writes a file: the temporary has an
+// unguessable name and is created with O_CREAT | O_EXCL | O_NOFOLLOW, so an
+// existing file or a planted link is never opened or followed, and the
+// rename replaces a link at `path` rather than writing through it. On any
+// failure the temporary is removed and OutputError names the file, the
+// system error and the fix (a full disk, a file-size limit).
 void WriteFileAtomically(const std::string& path, std::string_view bytes);
 
 // Removes hidden temporaries (TemporaryPathFor) of the given file names in
-// `dir` left by processes that no longer run (a killed bake); returns them.
+// `dir` left by processes that no longer run (a killed bake), and links at
+// such names (never skybake's); returns them.
 std::vector<std::string> RemoveStaleTemporaries(const std::string& dir, const std::vector<std::string>& names);
 
-// Temporary name beside `path` for a write in progress (hidden, pid-tagged).
+// Temporary name beside `path` for a write in progress: hidden, tagged with
+// the pid (for RemoveStaleTemporaries) and 64 random bits,
+// `.sky_px.exr.tmp1234.0123456789abcdef`.
 std::string TemporaryPathFor(const std::string& path);
+
+// Creates a new file at a fresh TemporaryPathFor(path) (set in `temporary`)
+// with O_CREAT | O_EXCL | O_NOFOLLOW, for writing; returns its descriptor,
+// or -1 with errno set.
+int CreateExclusiveFile(std::string& temporary, const std::string& path);
 
 }  // namespace skybake

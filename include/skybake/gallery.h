@@ -21,7 +21,7 @@ struct GalleryOptions {
   int latlong_height = 192;             // each style's latlong is 2H x H
   int columns = 2;
   std::vector<std::string> overrides;   // --set, applied to every style
-  BakeOptions bake;                     // device, validation, progress
+  BakeOptions bake;                     // device, validation, progress; bake.force replaces a previous gallery
 };
 
 struct GalleryEntry {

@@ -94,6 +94,16 @@ struct Manifest {
 std::string ManifestFileName(const std::optional<FrameRange>& part);
 std::string TimingsFileName(const std::optional<FrameRange>& part);
 
+// ".0012" for frame 12 in file names (at least four digits), "" for 0 (a
+// single bake).
+std::string FrameNumberSuffix(int number);
+
+// One frame's line of the text whose SHA-256 is a manifest's
+// sequence_sha256: number, ISO 8601 time ("" without), sun direction,
+// style_sha256.
+std::string SequenceIdentityLine(int number, const std::string& time_iso8601, const glm::dvec3& sun,
+                                 const std::string& style_sha256);
+
 // The manifest's frame record of a baked frame (files by name, not path).
 ManifestFrame ManifestFrameOf(const FrameResult& frame);
 
@@ -101,7 +111,11 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame);
 void WriteManifest(const Manifest& manifest, const std::string& path);
 
 // Reads a manifest written by WriteManifest. Throws ManifestError naming the
-// file and the entry that is missing or malformed.
+// file and the entry that is missing, malformed (a `bytes` that is not an
+// integer in [0, 2^53], a frame number that is not an int) or a name that
+// is not the one skybake gives that frame and kind (a plain file name,
+// BASE_FACE.NNNN.exr, BASE_cube.NNNN.exr, BASE_latlong.NNNN.exr,
+// BASE_latlong.NNNN.png in that order; the scene NAME.gltf/.bin/.glb).
 Manifest ReadManifest(const std::string& path);
 
 // How a whole bake ends, and a merge: writes the glTF scene (when

@@ -118,6 +118,8 @@ struct BakeResult {
   std::string manifest_path;
   int renderer_builds = 0;  // SkyRenderer constructions (new shader variants or LUT sizes)
   int atmosphere_updates = 0;  // atmosphere changes served by the same pipelines (new uniforms and LUTs)
+  int manifest_writes = 0;     // progress manifests written during the bake (the final one apart)
+  uint64_t manifest_bytes_written = 0;  // their bytes: linear in the frames, not quadratic
   std::vector<std::string> removed_temporaries;  // left by a killed bake, removed before baking
 };
 

@@ -19,9 +19,11 @@ double SrgbEncode(double linear);
 double ExposureFromEv100(double ev100);
 
 // EV100 that maps the log-average luminance of the upper hemisphere of a
-// latlong RGBA image (rows from the top; the lower half is ignored) to the
-// photographic mid grey 0.18 after exposure. Texels brighter than 1e4 times
-// the median (the sun disc) are left out of the average.
+// latlong RGBA image (rows from the top) to the photographic mid grey 0.18
+// after exposure, or a darker one when the lower hemisphere would then be
+// exposed more than 1 stop above mid grey (a view from high altitude: the
+// lit planet below a near-black sky). Texels brighter than 1e4 times the
+// median (the sun disc) are left out of each average.
 double AutoEv100(const std::vector<float>& latlong_rgba, int width, int height);
 
 // Exposes, tone maps and encodes an RGBA float image to 8-bit sRGB RGB.
