@@ -156,7 +156,7 @@ wait_first_frame() {
     sleep 0.02
   done
 }
-# Folder $1 holds the reference's files byte for byte, plus the parts' manifests and timings.
+# Folder $1 holds the reference's files byte for byte, plus the parts' manifests and timings, and nothing else.
 expect_identical() {
   local f n=0
   for f in $(ls "$tmp/ref"); do
@@ -169,6 +169,8 @@ expect_identical() {
     [ -e "$tmp/ref/$f" ] || fail "$1/$f is not in the unsharded bake"
   done
   [ "$(ls "$1" | grep -c '^manifest\.shard-')" = "$TASKS" ] || fail "$1 does not hold $TASKS shard manifests"
+  # Nor hidden files: the lock's claims are gone once every writer ended.
+  [ -z "$(ls -A "$1" | grep '^\.')" ] || fail "$1 holds hidden files after the merge: $(ls -A "$1" | grep '^\.' | tr '\n' ' ')"
   step "$1: $n files byte-identical to the unsharded bake ($n_exr EXRs, $n_png PNGs, manifest.json, glTF scene)"
 }
 # Submits the README's submission block for the case folder $1; sets JOB and MERGE.

@@ -9,7 +9,8 @@
 #    (SIGSTOP) after its first frame, so each still holds its part's lock;
 #    the same array and merge are submitted again into the same folder:
 #    every task of the second exits with code 6 before any GPU work, its log
-#    saying that the part is locked and naming a process of the first; no file
+#    naming the first array's task of the same part (pid, command) as the
+#    folder's writer; no file
 #    of the first changed; the second's merge is held
 #    (DependencyNeverSatisfied) and cancelled; the first, resumed (SIGCONT),
 #    completes, and its merge is byte-identical to an unsharded bake.
@@ -43,7 +44,8 @@ for i in $(seq 1 "$TASKS"); do
   log=slurm-${SECOND_JOB}_$i.out
   [ "$(job_field "${SECOND_JOB}_$i" ExitCode)" = 6:0 ] ||
     fail "F: the second array's task $i exit code is $(job_field "${SECOND_JOB}_$i" ExitCode), expected 6:0: $(cat "$log")"
-  grep -qi "error:.*lock" "$log" || fail "F: the second array's task $i log does not say the part is locked: $(cat "$log")"
+  grep -qF "error: $tmp/f is being written by another skybake (pid " "$log" && grep -qF -- "--shard $i/$TASKS), which writes" "$log" ||
+    fail "F: the second array's task $i log does not name the first array's task $i as the folder's writer: $(cat "$log")"
   named=0
   for pid in $first_pids; do grep -qw "$pid" "$log" && named=1; done
   [ "$named" = 1 ] || fail "F: the second array's task $i log names no process of the first ($first_pids): $(cat "$log")"
