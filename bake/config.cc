@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <optional>
+#include <regex>
 #include <set>
 #include <sstream>
 
@@ -216,6 +217,9 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     std::optional<double> value = node->value<double>();  // accepts integers too
+    // An integer beyond 2^53 is still a number (toml++ refuses the inexact
+    // conversion): the nearest double.
+    if (!value && node->is_integer()) value = double(node->as_integer()->get());
     if (!value || node->is_boolean()) {
       Error(node, path, fmt::format("expected a number, got {}", TypeName(*node)));
       return;
@@ -739,7 +743,15 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
   toml::table parsed;
   try {
     parsed = toml::parse("v = " + value, name);
-  } catch (const toml::parse_error&) {
+  } catch (const toml::parse_error& e) {
+    // A number TOML cannot hold (1e400) is not a bare word.
+    static const std::regex kNumber(R"([+-]?[0-9][0-9_]*(\.[0-9_]+)?([eE][+-]?[0-9_]+)?)");
+    if (std::regex_match(value, kNumber)) {
+      (void)e;
+      fail(fmt::format("{} is not a number a double holds (at most about 1.8e308 in size): give a smaller value",
+                       value));
+      return;
+    }
     try {
       parsed = toml::parse("v = \"" + value + "\"", name);
     } catch (const toml::parse_error& e) {

@@ -129,6 +129,8 @@ int RunBake(const BakeArgs& args, Mode mode) {
       return kExitConfig;
     }
     FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
+    for (const ConfigError& w : styles.warnings)
+      std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
     if (!styles.ok()) {
       PrintErrors(styles.errors);
       return kExitConfig;

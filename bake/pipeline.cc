@@ -392,6 +392,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   // What the renames at the end could not replace is found now, before any
   // GPU work: a directory (or a pipe, a socket) under an output's name.
   for (const std::string& name : planned) {
+    if (options.resume && name == manifest_name) continue;  // read first: ReadPreviousManifest says what is wrong
     std::error_code ec;
     const std::filesystem::file_status st = std::filesystem::symlink_status(path_of(name), ec);
     if (std::filesystem::exists(st) && !std::filesystem::is_regular_file(st) && !std::filesystem::is_symlink(st))

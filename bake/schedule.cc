@@ -1,6 +1,7 @@
 // Reading schedules and resolving each frame's style.
 #include "skybake/schedule.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <set>
@@ -619,6 +620,18 @@ FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<
   for (const ScheduleFrame& frame : schedule.frames) {
     std::vector<ConfigError> errors;
     std::vector<FrameOverride> frame_overrides = FrameStyleOverrides(schedule, frame, base.style, errors);
+    for (const FrameOverride& o : frame_overrides) {
+      for (const std::string& set : overrides) {
+        if (set.compare(0, o.key.size() + 1, o.key + "=") != 0) continue;
+        if (std::any_of(result.warnings.begin(), result.warnings.end(),
+                        [&](const ConfigError& w) { return w.key == o.key; }))
+          continue;
+        ConfigError w = o.origin;
+        w.key = o.key;
+        w.message = fmt::format("the schedule sets this key per frame, so --set {} has no effect on it", set);
+        result.warnings.push_back(w);
+      }
+    }
     std::vector<std::string> all = overrides;
     for (const FrameOverride& o : frame_overrides) all.push_back(o.Assignment());
     ConfigResult styled = errors.empty() ? ParseSkyStyle(text, style_path, all) : ConfigResult{};

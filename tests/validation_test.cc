@@ -449,6 +449,14 @@ face_names = ["px", "PX", "py", "ny", "pz", "nz"]
     {"ControlCharacterInAKeyIsEscaped", "\"sun\\u001b[2J\" = 1\n", nullptr, "", 3,
          "skybake: error: style.toml:1:1: sun\\x1b[2J: unknown key 'sun\\x1b[2J'\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"SetNumberOutOfRange", "", nullptr, "--set sun.elevation_deg=1e400", 3,
+         "skybake: error: --set: sun.elevation_deg: 1e400 is not a number a double holds (at most about 1.8e308 in size): give a smaller value\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"LargeIntegerIsANumber", R"toml([sun]
+elevation_deg = 9007199254740993
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:17: sun.elevation_deg: 9007199254740992 is out of range [-90, 90]\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"EmptyKey", R"toml("" = 0.007
 )toml",
      nullptr, "", 3,
@@ -518,6 +526,20 @@ TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
           << run.output;
     }
   }
+}
+
+// A schedule ramp on a key given with --set silently won: now a warning at
+// the ramp's place (the bake goes on with the ramp's values).
+TEST(BadInputs, ScheduleRampOverASetKeyIsWarnedOf) {
+  const std::string dir = testing::FreshTempDir("rampset");
+  std::ofstream(dir + "/s.toml") << "[schedule]\nsun = { elevation_deg = [0, 10], azimuth_deg = 135 }\n"
+                                    "[schedule.ramp]\n\"atmosphere.mie.g\" = [0.7, 0.8]\n";
+  testing::CommandRun run = testing::RunSkybake("check '" + testing::SourceDir() + "/configs/default.toml' --schedule "
+                                                "s.toml --set atmosphere.mie.g=0.5", "cd '" + dir + "' &&");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("skybake: warning: s.toml:4:22: atmosphere.mie.g: the schedule sets this key per frame, "
+                            "so --set atmosphere.mie.g=0.5 has no effect on it\n"), std::string::npos) << run.output;
+  fs::remove_all(dir);
 }
 
 // An estimate just above the budget is shown with the digits that tell

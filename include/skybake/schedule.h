@@ -96,6 +96,10 @@ std::vector<FrameOverride> FrameStyleOverrides(const Schedule& schedule, const S
 struct FrameStyles {
   std::vector<SkyStyle> styles;  // one per frame
   std::vector<ConfigError> errors;
+  // Keys set by --set that the schedule sets again per frame (a ramp, a
+  // rate, a frame's set): the schedule's value wins, which is said, once
+  // per key, at the schedule's place.
+  std::vector<ConfigError> warnings;
   bool ok() const { return errors.empty(); }
 };
 FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<std::string>& overrides,
