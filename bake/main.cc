@@ -103,6 +103,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
     PrintErrors(config.errors);
     return kExitConfig;
   }
+  for (const ConfigError& w : config.warnings) std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
   // A schedule (its own file, or inline in the style) makes a sequence: every
   // frame's style is resolved and checked before any GPU work.
   std::string schedule_path = args.schedule_path;
