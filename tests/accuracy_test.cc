@@ -88,9 +88,10 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
 // sky-view LUT was weakest: the Earth's shadow and the band above it, 90 to
 // 180 deg from the sun and up to 10 deg above the horizon. GPU (both paths)
 // against the converged reference. The bounds are the measured errors of
-// this build with a margin of 10% (docs/accuracy.md, "Twilight"): the linear
-// mix of the sky-view LUT gave 2.9e-1 for production here, the logarithmic
-// mix 9.0e-2; production's 1% budget needs 576 rows (1.0e-2, measured).
+// this build with a margin of 10% (docs/accuracy.md, "Twilight"), draft's
+// its 5% budget: the linear mix of the sky-view LUT gave 2.9e-1 for
+// production here, the logarithmic mix 9.0e-2; production's 1% budget needs
+// 576 rows (1.0e-2, measured); draft's 216 rows give 4.6e-2.
 TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
   AtmosphereParams a;
   EffectSettings single;
@@ -109,7 +110,7 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
     const char* preset;
     double max_relative;
   };
-  for (const Bound& b : {Bound{"draft", 0.19}, Bound{"production", 0.099}, Bound{"reference", 5.0e-3}}) {
+  for (const Bound& b : {Bound{"draft", 0.05}, Bound{"production", 0.099}, Bound{"reference", 5.0e-3}}) {
     SkyRenderer renderer(testing::Vulkan(), a, QualityPreset(b.preset), single, {1, 1, 1});
     std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
     double worst = 0.0, max_value = 0.0;
