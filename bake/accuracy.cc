@@ -343,7 +343,7 @@ std::vector<StudyCase> StudyCases(bool quick) {
   // The sky-view LUT: its resolution against its steps per texel (a frame
   // of a time-lapse pays for one LUT, whatever its output size).
   for (auto [w, h] : quick ? std::vector<std::pair<int, int>>{{192, 108}}
-                           : std::vector<std::pair<int, int>>{{192, 108}, {256, 144}, {320, 180}, {384, 216}})
+                           : std::vector<std::pair<int, int>>{{192, 108}, {192, 216}, {256, 144}, {320, 180}, {384, 216}})
     for (int v : quick ? std::vector<int>{48} : std::vector<int>{24, 32, 48})
       cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0, true, w, h, STEPS_QUADRATIC));
   if (!quick) cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, 768, 432, STEPS_QUADRATIC));
