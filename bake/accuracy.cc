@@ -344,7 +344,7 @@ std::vector<StudyCase> StudyCases(bool quick) {
   // The sky-view LUT: its resolution against its steps per texel (a frame
   // of a time-lapse pays for one LUT, whatever its output size).
   for (auto [w, h] : quick ? std::vector<std::pair<int, int>>{{192, 108}}
-                           : std::vector<std::pair<int, int>>{{192, 108}, {256, 144}, {320, 180}, {384, 216}})
+                           : std::vector<std::pair<int, int>>{{192, 108}, {192, 216}, {256, 144}, {320, 180}, {384, 216}})
     for (int v : quick ? std::vector<int>{48} : std::vector<int>{24, 32, 48})
       cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0, true, w, h, STEPS_QUADRATIC));
   if (!quick) cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, 768, 432, STEPS_QUADRATIC));
@@ -445,12 +445,17 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
     if (options.progress) options.progress(text);
   };
   std::filesystem::create_directories(options.out_dir);
-  const AtmosphereParams atmosphere;  // Earth defaults, spectral units
+  AtmosphereParams atmosphere;  // Earth defaults, spectral units
+  atmosphere.observer_altitude_m = options.observer_altitude_m;
   EffectSettings single;              // the integral under study: single scattering
   single.multiple_scattering = false;
   single.sun_disc = false;
   single.ground = false;
-  const std::vector<double> elevations = {90.0, 45.0, 10.0, 3.0, 0.0, -6.0};
+  // By day (3..90 deg, the presets' front) and at twilight (1 .. -10 deg),
+  // where the Earth's shadow crosses the low sky.
+  const std::vector<double> elevations = options.quick ? std::vector<double>{90.0, 45.0, 10.0, 3.0, 0.0, -3.0}
+                                                       : std::vector<double>{90.0, 45.0, 10.0, 3.0, 1.0, 0.0,
+                                                                             -1.0, -3.0, -6.0, -10.0};
   const std::vector<glm::dvec3> dirs = StudyDirections(options.quick);
   std::vector<StudyCase> cases = StudyCases(options.quick);
   if (!options.only.empty())
@@ -689,8 +694,9 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
     plot_status = "not written (gnuplot missing: apt-get install gnuplot-nox)";
 
   std::string md;
-  md += "## Cases (worst over sun elevations 90, 45, 10, 3 deg; all six in accuracy.csv)\n\n";
-  md += "| case | ms per megapixel | max relative error | max Delta-E76 | worst incl. 0 and -6 deg | Pareto |\n";
+  md += fmt::format("## Cases (observer at {} m; worst over sun elevations 3..90 deg; every elevation in accuracy.csv)\n\n",
+                    options.observer_altitude_m);
+  md += "| case | ms per megapixel | max relative error | max Delta-E76 | worst incl. twilight (sun 1 .. -10 deg) | Pareto |\n";
   md += "| --- | ---: | ---: | ---: | ---: | :---: |\n";
   for (const Summary& s : summaries)
     md += fmt::format("| {} | {:.1f} | {:.2e} | {:.3f} | {:.2e} | {} |\n", s.name, s.ms_per_mp, s.day_error,

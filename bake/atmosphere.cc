@@ -15,7 +15,8 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 
 // Each preset is the cheapest case of the accuracy study's Pareto front that
 // meets its bound (docs/accuracy.md, `skybake accuracy`):
-//   draft       analytic 24 quadratic steps, sky-view LUT 192 x 108   1.57e-2
+//   draft       analytic 24 quadratic steps, sky-view LUT 192 x 216   7.4e-3
+//               (216 rows, not 108: within 5% at sun -6..90 deg, docs/accuracy.md "Twilight")
 //   production  analytic 32 quadratic steps, sky-view LUT 256 x 144   8.59e-3
 //   reference   Simpson 64 quadratic steps per texel, transmittance
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
@@ -23,7 +24,7 @@ QualitySettings QualityPreset(const std::string& name) {
   QualitySettings q;  // production
   if (name == "draft") {
     q.sky_view_width = 192;
-    q.sky_view_height = 108;
+    q.sky_view_height = 216;
     q.view_steps = 24;
   } else if (name == "reference") {
     q.sky_view_lut = false;

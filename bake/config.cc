@@ -647,9 +647,13 @@ class StyleReader {
     WalkUnknown(root_, "");
   }
 
+  // Whether the file (or an override) gives the key explicitly.
+  bool Given(const std::string& path) const { return given_.count(path) > 0; }
+
  private:
   const toml::node* Find(const char* path) {
     known_.insert(path);
+    if (root_.at_path(path).node()) given_.insert(path);
     std::string prefix;
     for (std::string_view rest = path; !rest.empty();) {  // parent tables are known too
       size_t dot = rest.find('.');
@@ -733,6 +737,7 @@ class StyleReader {
   std::vector<ConfigError>& errors_;
   std::set<std::string> known_;
   std::set<std::string> tables_;  // prefixes of known keys: tables
+  std::set<std::string> given_;
   std::set<std::string> opaque_;
 };
 
@@ -887,6 +892,36 @@ std::optional<toml::source_position> DeepKey(std::string_view text) {
     }
   }
   return std::nullopt;
+// The [quality] keys in which the presets differ, in key order: every preset
+// sets all of them, so a style that gives each one explicitly resolves to the
+// same quality whichever preset it names.
+std::vector<std::string> PresetKeys() {
+  std::vector<toml::table> presets;
+  for (const std::string& name : QualityPresetNames()) {
+    SkyStyle style;
+    style.quality = QualityPreset(name);
+    StyleWriter writer;
+    VisitStyle(style, writer);
+    presets.push_back(*writer.table().get_as<toml::table>("quality"));
+  }
+  auto text = [](const toml::table& quality, std::string_view key) {
+    toml::table one;
+    one.insert(key, *quality.get(key));
+    std::ostringstream out;
+    out << one;
+    return out.str();
+  };
+  std::vector<std::string> keys;
+  for (const auto& [key, node] : presets[0]) {
+    if (key.str() == "preset") continue;
+    for (size_t i = 1; i < presets.size(); ++i) {
+      if (text(presets[i], key.str()) != text(presets[0], key.str())) {
+        keys.push_back("quality." + std::string(key.str()));
+        break;
+      }
+    }
+  }
+  return keys;
 }
 
 // --------------------------------------------------------------- overrides
@@ -1161,6 +1196,20 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       ConfigError e = locate("ibl.ktx2_zstd_level");
       e.message = "zstd supercompression applies to KTX2 files: set ibl.ktx2 = true or ibl.ktx2_zstd_level = 0";
       result.errors.push_back(e);
+    }
+  }
+  // A preset that every explicit key overrides changes nothing: say so.
+  if (reader.Given("quality.preset")) {
+    std::vector<std::string> keys = PresetKeys();
+    bool all_given = std::all_of(keys.begin(), keys.end(), [&](const std::string& k) { return reader.Given(k); });
+    if (all_given) {
+      ConfigError w = locate("quality.preset");
+      std::string list;
+      for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
+      w.message = fmt::format("preset '{}' changes nothing: every key it sets is given explicitly ({}), and "
+                              "explicit keys refine the preset; remove or comment out those keys to use it",
+                              result.style.quality_preset, list);
+      result.warnings.push_back(w);
     }
   }
   if (!result.ok()) return result;

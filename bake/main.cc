@@ -116,6 +116,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
     PrintErrors(config.errors);
     return kExitConfig;
   }
+  for (const ConfigError& w : config.warnings) std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
   // A schedule (its own file, or inline in the style) makes a sequence: every
   // frame's style is resolved and checked before any GPU work.
   std::string schedule_path = args.schedule_path;
@@ -405,6 +406,9 @@ int main(int argc, char** argv) {
   accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
   accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
   accuracy->add_option("--only", study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
+  accuracy->add_option("--observer-altitude-m", study.observer_altitude_m, "Observer altitude of the study (m)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
 
   // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
   // like a full disk, instead of killing the process mid-file.

@@ -793,9 +793,19 @@ vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azim
   int x0 = int(min(floor(x), Real(atm.sky_view_width - 2)));
   Real fx = x - Real(x0);
   int x1 = x0 + 1;
-  vec3 a = mix(SkyViewLutTexel(x0, y0), SkyViewLutTexel(x1, y0), fx);
-  vec3 b = mix(SkyViewLutTexel(x0, y1), SkyViewLutTexel(x1, y1), fx);
-  return mix(a, b, fy);
+  vec3 t00 = SkyViewLutTexel(x0, y0), t10 = SkyViewLutTexel(x1, y0);
+  vec3 t01 = SkyViewLutTexel(x0, y1), t11 = SkyViewLutTexel(x1, y1);
+  // In the logarithm of the radiance where all four are positive: across
+  // the Earth's shadow at twilight the sky dims by orders of magnitude within
+  // a few texels, nearly exponentially, which a linear mix overestimates by
+  // tens of percent (docs/accuracy.md, "Twilight"); where a texel is black
+  // or nearly (below 1e-30: night, float32 denormals) the mix stays linear.
+  vec3 linear = mix(mix(t00, t10, fx), mix(t01, t11, fx), fy);
+  vec3 lowest = min(min(t00, t10), min(t01, t11));
+  vec3 floor_value = vec3(1e-30);
+  vec3 logarithmic = exp2(mix(mix(log2(max(t00, floor_value)), log2(max(t10, floor_value)), fx),
+                              mix(log2(max(t01, floor_value)), log2(max(t11, floor_value)), fx), fy));
+  return mix(linear, logarithmic, vec3(greaterThan(lowest, floor_value)));
 }
 
 // The solar disc seen along `view`, per unit solar irradiance, through the

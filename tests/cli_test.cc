@@ -133,6 +133,27 @@ TEST(CliTest, CheckValidatesOnly) {
   EXPECT_EQ(bad.exit_code, 3) << bad.output;
 }
 
+// A preset that the explicit keys override entirely is baked as written, with
+// a warning from check and from bake (the default template gives none).
+TEST(CliTest, PresetOverriddenByEveryKeyWarns) {
+  CommandRun plain = Skybake("check " + Style() + " --set quality.preset=reference");
+  EXPECT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_EQ(plain.output.find("warning"), std::string::npos) << plain.output;
+  std::string keys;
+  for (const char* k : {"integrator=analytic", "sky_view_lut=true", "sky_view_lut_width=256", "sky_view_lut_height=144",
+                        "view_steps=32", "transmittance_steps=256", "transmittance_lut_width=256",
+                        "transmittance_lut_height=64"})
+    keys += std::string(" --set quality.") + k;
+  for (const char* command : {"check", "bake --dry-run"}) {
+    CommandRun run = Skybake(std::string(command) + " " + Style() + " --set quality.preset=reference" + keys);
+    EXPECT_EQ(run.exit_code, 0) << run.output;
+    EXPECT_NE(run.output.find("skybake: warning: --set quality.preset=reference:1:5: quality.preset: preset "
+                              "'reference' changes nothing"),
+              std::string::npos)
+        << command << ": " << run.output;
+  }
+}
+
 TEST(CliTest, MissingVulkanDriverNamesThePackage) {
   CommandRun run = Skybake("bake " + Style() + " --size 4 --out " + FreshDir("nodriver"),
                     "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");

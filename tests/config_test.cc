@@ -1,5 +1,8 @@
 // Sky style parsing: defaults, overrides, and user errors that name the
 // place (file:line:column, key path) and the fix, all reported at once.
+#include <cctype>
+#include <sstream>
+
 #include <gtest/gtest.h>
 
 #include "skybake/config.h"
@@ -136,6 +139,97 @@ TEST(ConfigTest, MissingFileIsReported) {
   ConfigResult r = LoadSkyStyle("/nonexistent/style.toml");
   ASSERT_EQ(r.errors.size(), 1u);
   EXPECT_EQ(r.errors[0].Format(), "/nonexistent/style.toml: (file): cannot open the style file: check the path");
+}
+
+// configs/default.toml is the template the README says to copy: naming a
+// preset there, or with --set on it, must give that preset's settings.
+TEST(ConfigTest, PresetInTheDefaultTemplateTakesEffect) {
+  const std::string path = testing::SourceDir() + "/configs/default.toml";
+  const QualitySettings reference = QualityPreset("reference"), draft = QualityPreset("draft");
+  ConfigResult set = LoadSkyStyle(path, {"quality.preset=\"reference\""});
+  ASSERT_TRUE(set.ok()) << ::testing::PrintToString(Messages(set));
+  EXPECT_TRUE(set.warnings.empty());
+  EXPECT_FALSE(set.style.quality.sky_view_lut);
+  EXPECT_EQ(set.style.quality.integrator, reference.integrator);
+  EXPECT_EQ(set.style.quality.view_steps, reference.view_steps);
+  EXPECT_EQ(set.style.quality.transmittance_width, reference.transmittance_width);
+  EXPECT_EQ(set.style.quality.transmittance_steps, reference.transmittance_steps);
+
+  // The copied file with its preset line edited.
+  std::string text = testing::ReadFileBytes(path);
+  const std::string line = "preset = \"production\"";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.replace(text.find(line), line.size(), "preset = \"draft\"");
+  ConfigResult edited = ParseSkyStyle(text, "copy.toml");
+  ASSERT_TRUE(edited.ok()) << ::testing::PrintToString(Messages(edited));
+  EXPECT_TRUE(edited.warnings.empty());
+  EXPECT_EQ(edited.style.quality.sky_view_width, draft.sky_view_width);
+  EXPECT_EQ(edited.style.quality.sky_view_height, draft.sky_view_height);
+  EXPECT_EQ(edited.style.quality.view_steps, draft.view_steps);
+
+  // As shipped it is the production preset, without a warning, and the values
+  // its comments show are production's: uncommented, they resolve the same.
+  ConfigResult shipped = LoadSkyStyle(path);
+  ASSERT_TRUE(shipped.ok());
+  EXPECT_TRUE(shipped.warnings.empty());
+  std::string original = testing::ReadFileBytes(path), uncommented;
+  size_t begin = original.find("[quality]\n"), end = original.find("\n[", begin + 1);
+  ASSERT_NE(end, std::string::npos);
+  std::istringstream lines(original.substr(begin, end - begin));
+  int keys = 0;
+  for (std::string l; std::getline(lines, l);) {
+    if (l.rfind("# ", 0) == 0 && l.size() > 2 && std::islower(static_cast<unsigned char>(l[2])) &&
+        l.find(" = ") != std::string::npos && l.find(' ', 2) == l.find(" = ")) {
+      l = l.substr(2);
+      ++keys;
+    }
+    uncommented += l + "\n";
+  }
+  EXPECT_EQ(keys, 13);
+  ConfigResult spelled = ParseSkyStyle(original.substr(0, begin) + uncommented + original.substr(end), "spelled.toml");
+  ASSERT_TRUE(spelled.ok()) << ::testing::PrintToString(Messages(spelled));
+  EXPECT_EQ(spelled.style.resolved_toml, shipped.style.resolved_toml);
+  EXPECT_EQ(spelled.warnings.size(), 1u);  // every key given: the preset changes nothing
+}
+
+// Explicit [quality] keys refine the preset; when they give every key in which
+// the presets differ, the preset changes nothing, and the style says so.
+TEST(ConfigTest, PresetOverriddenByEveryKeyWarns) {
+  const std::string all_keys =
+      "[quality]\npreset = \"reference\"\nintegrator = \"analytic\"\nsky_view_lut = true\n"
+      "sky_view_lut_width = 256\nsky_view_lut_height = 144\nview_steps = 32\ntransmittance_steps = 256\n"
+      "transmittance_lut_width = 256\ntransmittance_lut_height = 64\n";
+  ConfigResult r = ParseSkyStyle(all_keys, "q.toml");
+  ASSERT_TRUE(r.ok()) << ::testing::PrintToString(Messages(r));
+  ASSERT_EQ(r.warnings.size(), 1u);
+  EXPECT_EQ(r.warnings[0].Format(),
+            "q.toml:2:10: quality.preset: preset 'reference' changes nothing: every key it sets is given "
+            "explicitly (quality.integrator, quality.sky_view_lut, quality.sky_view_lut_height, "
+            "quality.sky_view_lut_width, quality.transmittance_lut_height, quality.transmittance_lut_width, "
+            "quality.transmittance_steps, quality.view_steps), and explicit keys refine the preset; remove or "
+            "comment out those keys to use it");
+  EXPECT_TRUE(r.style.quality.sky_view_lut);  // the explicit keys still win
+  EXPECT_EQ(r.style.quality.view_steps, 32);
+
+  // The same through --set on a file that gives every key.
+  ConfigResult set = ParseSkyStyle(all_keys, "q.toml", {"quality.preset=draft"});
+  ASSERT_EQ(set.warnings.size(), 1u);
+  EXPECT_EQ(set.warnings[0].file, "--set quality.preset=draft");
+
+  // One key left to the preset: it has an effect, no warning.
+  std::string missing = all_keys;
+  missing.erase(missing.find("view_steps = 32\n"), std::string("view_steps = 32\n").size());
+  ConfigResult partial = ParseSkyStyle(missing, "q.toml");
+  ASSERT_TRUE(partial.ok());
+  EXPECT_TRUE(partial.warnings.empty());
+  EXPECT_EQ(partial.style.quality.view_steps, QualityPreset("reference").view_steps);
+
+  // No preset named: nothing to warn about.
+  std::string unnamed = all_keys;
+  unnamed.erase(unnamed.find("preset = \"reference\"\n"), std::string("preset = \"reference\"\n").size());
+  ConfigResult none = ParseSkyStyle(unnamed, "q.toml");
+  ASSERT_TRUE(none.ok());
+  EXPECT_TRUE(none.warnings.empty());
 }
 
 }  // namespace

@@ -41,6 +41,7 @@ struct AccuracyStudyOptions {
   std::string out_dir = "docs";   // accuracy.md, accuracy.csv, accuracy.png, kider2014.csv
   std::string shared_dir = "../shared";
   bool quick = false;             // fewer cases and directions (for tests)
+  double observer_altitude_m = 0.0;  // the study's observer (0 m and 8000 m in docs/accuracy.md)
   std::string only;               // when set, only the cases whose name contains it
   std::function<void(const std::string&)> progress;
 };

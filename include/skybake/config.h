@@ -125,6 +125,9 @@ struct ConfigError {
 struct ConfigResult {
   SkyStyle style;
   std::vector<ConfigError> errors;
+  // Not errors: the style bakes, but likely not as meant (a quality preset
+  // whose every key is given explicitly, so it changes nothing).
+  std::vector<ConfigError> warnings;
   bool ok() const { return errors.empty(); }
 };
 
