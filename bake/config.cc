@@ -892,6 +892,8 @@ std::optional<toml::source_position> DeepKey(std::string_view text) {
     }
   }
   return std::nullopt;
+}
+
 // The [quality] keys in which the presets differ, in key order: every preset
 // sets all of them, so a style that gives each one explicitly resolves to the
 // same quality whichever preset it names.
