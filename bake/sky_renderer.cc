@@ -89,18 +89,9 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
-  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-  set_info.bindingCount = kBindingCount;
-  set_info.pBindings = bindings;
-  VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &set_layout_));
-
-  VkPushConstantRange push_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::SkyPush)};
-  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
-  layout_info.setLayoutCount = 1;
-  layout_info.pSetLayouts = &set_layout_;
-  layout_info.pushConstantRangeCount = 1;
-  layout_info.pPushConstantRanges = &push_range;
-  VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &pipeline_layout_));
+  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(gpu::SkyPush));
+  set_layout_ = layouts.set;
+  pipeline_layout_ = layouts.pipeline;
 
   VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
                                         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 3}};

@@ -352,4 +352,21 @@ uint32_t VulkanContext::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags
   return uint32_t(fallback);
 }
 
+ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayoutBinding* bindings,
+                                    uint32_t binding_count, uint32_t push_bytes) {
+  ComputeLayouts layouts;
+  VkDescriptorSetLayoutCreateInfo set_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  set_info.bindingCount = binding_count;
+  set_info.pBindings = bindings;
+  VK_CHECK(vkCreateDescriptorSetLayout(device, &set_info, nullptr, &layouts.set));
+  VkPushConstantRange push_range{VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes};
+  VkPipelineLayoutCreateInfo layout_info{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  layout_info.setLayoutCount = 1;
+  layout_info.pSetLayouts = &layouts.set;
+  layout_info.pushConstantRangeCount = 1;
+  layout_info.pPushConstantRanges = &push_range;
+  VK_CHECK(vkCreatePipelineLayout(device, &layout_info, nullptr, &layouts.pipeline));
+  return layouts;
+}
+
 }  // namespace skybake

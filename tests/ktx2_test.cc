@@ -24,18 +24,10 @@
 namespace skybake {
 namespace {
 
+using testing::RunCommand;
+
 using nlohmann::json;
 
-std::pair<int, std::string> RunCommand(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  int status = pclose(pipe);
-  return {WEXITSTATUS(status), output};
-}
 
 // Decoders written from the Vulkan specification, independently of the encoder.
 float DecodeUnsignedFloat(uint32_t bits, int mantissa_bits) {

@@ -25,6 +25,8 @@
 namespace skybake {
 namespace {
 
+using testing::RunCommand;
+
 namespace fs = std::filesystem;
 using nlohmann::json;
 
@@ -40,17 +42,6 @@ times = { start = 06:00:00, end = 11:45:00, step_minutes = 15 }
 // Small and quick: 16^3 cube faces, a 32 x 16 latlong.
 const std::vector<std::string> kSmall = {"render.cube_size=16", "render.latlong_height=16", "gltf.segments=32"};
 
-// Runs a shell command; returns its exit status and stdout.
-std::pair<int, std::string> RunCommand(const std::string& command) {
-  std::string output;
-  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
-  if (!pipe) return {-1, "popen failed"};
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
-  int status = pclose(pipe);
-  return {WEXITSTATUS(status), output};
-}
 
 std::string ViewerDir() { return testing::SourceDir() + "/tests/viewer"; }
 

@@ -68,6 +68,17 @@ CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix) 
   return run;
 }
 
+std::pair<int, std::string> RunCommand(const std::string& command) {
+  std::string output;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return {-1, "popen failed"};
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) output.append(buffer.data(), n);
+  int status = pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
+}
+
 std::string FreshTempDir(const std::string& name) {
   auto dir = std::filesystem::temp_directory_path() / ("skybake_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

@@ -6,6 +6,7 @@
 #include <memory>
 #include <set>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +38,9 @@ struct CommandRun {
   std::string output;  // stdout and stderr together
 };
 CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix = "");
+
+// Any shell command: its exit status and its stdout and stderr together.
+std::pair<int, std::string> RunCommand(const std::string& command);
 
 // A new, empty folder under the temporary directory, unique to this process.
 std::string FreshTempDir(const std::string& name);

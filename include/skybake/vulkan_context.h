@@ -83,6 +83,15 @@ std::string SoftwareDriverSelection(const DriverEnvironment& environment);
 std::string SelectSoftwareDriversWithoutGpu();
 const std::string& DriverSelection();
 
+// The layouts of a compute pipeline with one descriptor set of `bindings`
+// and one push-constant block of `push_bytes` bytes; the caller destroys both.
+struct ComputeLayouts {
+  VkDescriptorSetLayout set = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline = VK_NULL_HANDLE;
+};
+ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayoutBinding* bindings,
+                                    uint32_t binding_count, uint32_t push_bytes);
+
 struct VulkanOptions {
   int device_index = -1;      // -1: choose the best usable device
   bool validation = false;    // load VK_LAYER_KHRONOS_validation
