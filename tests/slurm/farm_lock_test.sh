@@ -6,7 +6,7 @@
 #   bash tests/slurm/farm_lock_test.sh BUILD_DIR      # ctest: slurm_farm_lock
 #
 # F  the README's array (3 tasks) into one folder; every task is stopped
-#    (SIGSTOP) after its first frame, so each still holds its part's lock;
+#    (SIGSTOP) as soon as it holds its part's lock, before its first frame;
 #    the same array and merge are submitted again into the same folder:
 #    every task of the second exits with code 6 before any GPU work, its log
 #    naming the first array's task of the same part (pid, command) as the
@@ -19,12 +19,26 @@
 TEST_NAME=slurm_farm_lock
 source "$(dirname "$0")/farm_lib.sh"
 
-step "F: the README's array, every task stopped after its first frame"
+step "F: the README's array, every task stopped once it holds its part's lock"
 submit "$tmp/f"
 FIRST_JOB=$JOB FIRST_MERGE=$MERGE
-for i in $(seq 1 "$TASKS"); do
-  wait_first_frame "$tmp/f/manifest.shard-$(shard_first "$i")-$(shard_last "$i").json"
-  scancel --full --signal=STOP "${FIRST_JOB}_$i"
+# Every task is watched at once and stopped as soon as its claim (the lock
+# file naming its part's manifest) is in the folder: that is before its
+# device, pipelines and first frame, so no task can finish first, however
+# fast the machine. (Waiting for the tasks one after another let a later
+# task finish all its frames on a quiet machine.)
+declare -A held=()
+deadline=$(deadline_in)
+while [ "${#held[@]}" -lt "$TASKS" ]; do
+  for i in $(seq 1 "$TASKS"); do
+    [ -z "${held[$i]:-}" ] || continue
+    if grep -qsF "manifest.shard-$(shard_first "$i")-$(shard_last "$i").json" "$tmp/f"/.skybake.lock.*; then
+      scancel --full --signal=STOP "${FIRST_JOB}_$i"
+      held[$i]=1
+    fi
+  done
+  [ "$(date +%s)" -lt "$deadline" ] || fail "F: only ${#held[@]} of $TASKS tasks claimed their part within $TIMEOUT s"
+  sleep 0.01
 done
 sleep 0.5
 for i in $(seq 1 "$TASKS"); do
