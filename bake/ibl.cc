@@ -163,12 +163,7 @@ IblBaker::IblBaker(VulkanContext& context) : context_(context) {
     pool_info.queueFamilyIndex = context_.queue_family();
     VK_CHECK(vkCreateCommandPool(device, &pool_info, nullptr, &command_pool_));
 
-    uint32_t family_count = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, nullptr);
-    std::vector<VkQueueFamilyProperties> families(family_count);
-    vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, families.data());
-    timestamps_ = families[context_.queue_family()].timestampValidBits > 0 &&
-                  context_.properties().limits.timestampPeriod > 0.0f;
+    timestamps_ = context_.SupportsTimestamps();
     if (timestamps_) {
       VkQueryPoolCreateInfo query_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
       query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;

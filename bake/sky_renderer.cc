@@ -183,12 +183,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_));
 
-  uint32_t family_count = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, nullptr);
-  std::vector<VkQueueFamilyProperties> families(family_count);
-  vkGetPhysicalDeviceQueueFamilyProperties(context_.physical_device(), &family_count, families.data());
-  timestamps_supported_ = families[context_.queue_family()].timestampValidBits > 0 &&
-                          context_.properties().limits.timestampPeriod > 0.0f;
+  timestamps_supported_ = context_.SupportsTimestamps();
 }
 
 bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas) {

@@ -352,6 +352,14 @@ uint32_t VulkanContext::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags
   return uint32_t(fallback);
 }
 
+bool VulkanContext::SupportsTimestamps() const {
+  uint32_t family_count = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, nullptr);
+  std::vector<VkQueueFamilyProperties> families(family_count);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_device_, &family_count, families.data());
+  return families[queue_family_].timestampValidBits > 0 && properties_.limits.timestampPeriod > 0.0f;
+}
+
 ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayoutBinding* bindings,
                                     uint32_t binding_count, uint32_t push_bytes) {
   ComputeLayouts layouts;

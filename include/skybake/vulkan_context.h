@@ -115,6 +115,10 @@ class VulkanContext {
   const DeviceInfo& device_info() const { return device_info_; }
   const VkPhysicalDeviceProperties& properties() const { return properties_; }
 
+  // Whether the queue's commands can be timed (timestamp queries with a
+  // known period): GPU pass times are reported only then.
+  bool SupportsTimestamps() const;
+
   // Number of validation messages (warnings and errors) seen so far.
   int validation_message_count() const { return validation_messages_; }
   const std::vector<std::string>& validation_messages() const { return messages_; }
