@@ -8,7 +8,6 @@
 #include <fmt/format.h>
 
 #include "skybake/aoas.h"
-#include "skybake/pipeline.h"
 #include "skybake/sky_renderer.h"
 
 namespace skybake {
@@ -47,6 +46,25 @@ SkyStyle PrunedStyle(const SkyStyle& style) {
 
 bool NeedsSkyViewLut(const SkyStyle& style) {
   return style.quality.sky_view_lut && !style.aoas.skydome.enabled;
+}
+
+bool RendersLatlong(const SkyStyle& style) {
+  return style.output.latlong || WritesLatlongPng(style);
+}
+
+bool WritesLatlongPng(const SkyStyle& style) { return style.output.preview || style.gltf.enabled; }
+
+std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
+  std::vector<ViewRequest> views;
+  const int n = style.render.cube_size;
+  if (style.output.faces)
+    for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+  if (style.output.cube_strip) views.push_back({MAPPING_CUBE_STRIP, n, 6 * n, 0});
+  if (RendersLatlong(style)) {
+    const int h = style.render.latlong_height;
+    views.push_back({MAPPING_LATLONG, 2 * h, h, 0});
+  }
+  return views;
 }
 
 PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {

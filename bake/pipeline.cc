@@ -215,7 +215,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
     for (int face = 0; face < 6; ++face) names.faces.push_back(o.basename + "_" + o.face_names[face] + number + ".exr");
   if (o.cube_strip) names.cube = o.basename + "_cube" + number + ".exr";
   if (o.latlong) names.latlong = o.basename + "_latlong" + number + ".exr";
-  if (o.preview || style.gltf.enabled) names.png = o.basename + "_latlong" + number + ".png";
+  if (WritesLatlongPng(style)) names.png = o.basename + "_latlong" + number + ".png";
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
   return names;
@@ -488,7 +488,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   double half_scale = 1.0;
   // Only previews and the glTF texture are exposed.
   const bool exposed = std::any_of(plans.begin(), plans.end(), [](const FramePlan& p) {
-    return p.style->output.preview || p.style->gltf.enabled;
+    return WritesLatlongPng(*p.style);
   });
   if (sequence) {
     const FramePlan& ref = plans[reference];
@@ -733,7 +733,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
     // Preview (and glTF texture): exposure, ACES, sRGB; one exposure for a sequence.
     w.ev100 = job.ev100;
-    if (latlong && (style.output.preview || style.gltf.enabled)) {
+    if (latlong && WritesLatlongPng(style)) {
       Clock::time_point preview_start = Clock::now();
       std::vector<float> display = DisplayLuminance(latlong->data(), latlong->texels(), style.output.units);
       if (!w.ev100) {
@@ -811,11 +811,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     // Render: every view of the frame in one submission, then the SH views.
     Clock::time_point render_start = Clock::now();
     SkyRenderer& renderer = renderers.Main(style, CloudTimeOf(plan));
-    std::vector<ViewRequest> views = PlanViews(style);
-    if (style.gltf.enabled && !style.output.latlong && !style.output.preview) {
-      const int h = style.render.latlong_height;
-      views.push_back({MAPPING_LATLONG, 2 * h, h, 0});  // the glTF texture needs the latlong
-    }
+    const std::vector<ViewRequest> views = PlanViews(style);
     RenderedViews rendered;
     if (!verified) {
       // In place: the writer thread reads the texels where the device wrote
@@ -985,10 +981,8 @@ std::string Sha256OfText(std::string_view text) {
 constexpr double kLavapipeSamplesPerSecond = 1.2e7;
 
 ResourceEstimate EstimateResources(const SkyStyle& style) {
-  std::vector<ViewRequest> views = PlanViews(style);
+  const std::vector<ViewRequest> views = PlanViews(style);
   const double latlong = 2.0 * style.render.latlong_height * double(style.render.latlong_height);
-  if (style.gltf.enabled && !style.output.latlong && !style.output.preview)
-    views.push_back({MAPPING_LATLONG, 2 * style.render.latlong_height, style.render.latlong_height, 0});
   double texels = 0.0, largest = 0.0;
   for (const ViewRequest& v : views) {
     texels += double(v.width) * v.height;
@@ -1002,7 +996,7 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   ResourceEstimate e;
   // Device output buffer and its host copy (RGBA float each), the largest
   // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG.
-  const bool preview = style.output.preview || style.gltf.enabled;
+  const bool preview = WritesLatlongPng(style);
   const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
   e.memory_mib = bytes / (1024.0 * 1024.0);
   // Samples: the pass plan's count for one frame (each ray-marched texel
@@ -1035,19 +1029,6 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
         "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
         "--max-frame-seconds (README \"Limits\")",
         e.samples, e.seconds, options.max_frame_seconds));
-}
-
-std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
-  std::vector<ViewRequest> views;
-  const int n = style.render.cube_size;
-  if (style.output.faces)
-    for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
-  if (style.output.cube_strip) views.push_back({MAPPING_CUBE_STRIP, n, 6 * n, 0});
-  if (style.output.latlong || style.output.preview) {
-    const int h = style.render.latlong_height;
-    views.push_back({MAPPING_LATLONG, 2 * h, h, 0});
-  }
-  return views;
 }
 
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options) {

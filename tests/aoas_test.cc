@@ -22,6 +22,7 @@
 #include "skybake/config.h"
 #include "skybake/envmap.h"
 #include "skybake/gallery.h"
+#include "skybake/pass_plan.h"
 #include "skybake/pipeline.h"
 #include "skybake/reference_model.h"
 #include "skybake/schedule.h"

@@ -23,6 +23,7 @@
 
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
+#include "skybake/pass_plan.h"
 #include "skybake/pipeline.h"
 #include "skybake/sky_renderer.h"
 #include "skybake/vulkan_context.h"

@@ -11,6 +11,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/pass_plan.h"
+#include "skybake/pipeline.h"
 #include "skybake/sky_renderer.h"
 #include "test_support.h"
 
@@ -59,6 +60,42 @@ TEST(PassPlanTest, DefaultStyleRunsEveryPhysicalPass) {
   EXPECT_NE(plan.variant.find("sky_render from the built-in sky-view variant"), std::string::npos) << plan.variant;
   EXPECT_NE(plan.variant.find("LUT shaders from the built-in analytic variants"), std::string::npos) << plan.variant;
   EXPECT_NE(plan.variant.find("sun disc: compiled out of sky_render"), std::string::npos) << plan.variant;
+}
+
+// A glTF-only bake (no latlong EXR, no preview) still renders the latlong:
+// the scene's texture is its tone-mapped PNG. The plan, its estimate and the
+// renderer read the same view list, so the plan shows the pass and the
+// estimate counts its texels, as for a bake that also writes the latlong EXR.
+TEST(PassPlanTest, GltfOnlyBakePlansTheLatlongItsTextureNeeds) {
+  const std::string outputs = "[output]\nfaces = true\ncube_strip = false\npreview = false\n";
+  const SkyStyle gltf_only = Style(outputs + "latlong = false\n[gltf]\nenabled = true\n");
+  const SkyStyle with_exr = Style(outputs + "latlong = true\n[gltf]\nenabled = true\n");
+  const SkyStyle neither = Style(outputs + "latlong = false\n[gltf]\nenabled = false\n");
+  const std::vector<std::string> names = PassNames(PlanPasses({gltf_only}));
+  EXPECT_NE(std::find(names.begin(), names.end(), "render latlong"), names.end());
+  const std::vector<std::string> none = PassNames(PlanPasses({neither}));
+  EXPECT_EQ(std::find(none.begin(), none.end(), "render latlong"), none.end());
+
+  const std::vector<ViewRequest> views = PlanViews(gltf_only);
+  ASSERT_EQ(views.size(), 7u);
+  EXPECT_EQ(views.back().mapping, int(MAPPING_LATLONG));
+  EXPECT_EQ(views.back().width, 2 * gltf_only.render.latlong_height);
+  EXPECT_EQ(views.back().height, gltf_only.render.latlong_height);
+  EXPECT_TRUE(WritesLatlongPng(gltf_only));
+  EXPECT_FALSE(RendersLatlong(neither));
+
+  // The estimate: the latlong's samples, as many as with the EXR asked for.
+  EXPECT_EQ(PlanPasses({gltf_only}).total_samples, PlanPasses({with_exr}).total_samples);
+  EXPECT_EQ(EstimateResources(gltf_only).samples, EstimateResources(with_exr).samples);
+  EXPECT_GT(EstimateResources(gltf_only).samples, EstimateResources(neither).samples);
+  EXPECT_GT(EstimateResources(gltf_only).memory_mib, EstimateResources(neither).memory_mib);
+
+  // skybake plan, as a user runs it.
+  const testing::CommandRun run = testing::RunSkybake(
+      "plan " + testing::SourceDir() +
+      "/configs/default.toml --set output.latlong=false --set output.preview=false --set gltf.enabled=true");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("render latlong"), std::string::npos) << run.output;
 }
 
 // The disc has a pass of its own only where nothing acts on it after it is

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "skybake/config.h"
+#include "skybake/sky_renderer.h"
 
 namespace skybake {
 
@@ -46,6 +47,21 @@ SkyStyle PrunedStyle(const SkyStyle& style);
 // Whether the per-frame sky-view LUT is read (not with the skydome, which
 // moves the observer and so ray-marches).
 bool NeedsSkyViewLut(const SkyStyle& style);
+
+// Whether a frame renders the latlong: for its EXR, its PNG preview, or the
+// glTF scene's texture (the tone-mapped latlong PNG). The one place of the
+// rule "the glTF texture needs a latlong".
+bool RendersLatlong(const SkyStyle& style);
+
+// Whether a frame writes the tone-mapped latlong PNG: the preview, which is
+// also the glTF scene's texture.
+bool WritesLatlongPng(const SkyStyle& style);
+
+// The views one frame renders, in order: six Vulkan faces, the cube strip,
+// the latlong (each only when enabled in `output`; the latlong also for the
+// glTF texture, RendersLatlong). The planner, the resource estimate, the
+// device-limit check and the renderer all read this list.
+std::vector<ViewRequest> PlanViews(const SkyStyle& style);
 
 PassPlan PlanPasses(const std::vector<SkyStyle>& frames);
 

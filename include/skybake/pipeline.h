@@ -153,8 +153,4 @@ void KeepFrameMemoryInHeap();
 std::string Sha256OfFile(const std::string& path);
 std::string Sha256OfText(std::string_view text);
 
-// The views one bake renders, in order: six Vulkan faces, the cube strip,
-// the latlong (each only when enabled in `output`).
-std::vector<ViewRequest> PlanViews(const SkyStyle& style);
-
 }  // namespace skybake
