@@ -2,7 +2,7 @@
 // (AOAS; Shen, Mallett, Shkurko, Eurographics 2019 short paper), written once
 // in the common GLSL/C++ subset (see glsl_prelude.glsl) on top of the
 // physical atmosphere of atmosphere.glsl. The compute shaders include it with
-// Real = float; the CPU reference (bake/reference_model.cc) with Real = double.
+// Real = float; the CPU reference (bake/tools/reference/reference_model.cc) with Real = double.
 //
 // Spaces (paper section 3.2, fig. 3):
 //   - skydome space: the model space of the single atmosphere skydome, centred

@@ -1,6 +1,6 @@
 // The physical atmosphere, written once in the common GLSL/C++ subset (see
 // glsl_prelude.glsl). The compute shaders include it with Real = float; the
-// CPU reference (bake/reference_model.cc) includes it with Real = double.
+// CPU reference (bake/tools/reference/reference_model.cc) includes it with Real = double.
 //
 // Model: Hillaire 2020, "A Scalable and Production Ready Sky and Atmosphere
 // Rendering Technique" (EGSR 2020), with the LUT parametrisation of Bruneton

@@ -1,4 +1,4 @@
-// Volumetric cloud layers (include/skybake/clouds.h, docs/clouds.md), after
+// Volumetric cloud layers (include/skybake/model/clouds.h, docs/clouds.md), after
 // common.glsl: the noise volumes, the density, the aerial-perspective and
 // ambient tables, and the ray march that composites the clouds over the sky
 // the sky pass wrote.

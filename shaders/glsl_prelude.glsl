@@ -1,6 +1,6 @@
 // GLSL side of the common GLSL/C++ subset used by the shared physics files
 // (atmosphere.glsl, envmap.glsl). The C++ side of the same subset is
-// bake/glsl_compat.h, which defines the same names with double precision.
+// include/skybake/model/glsl_compat.h, which defines the same names with double precision.
 //
 // Rules of the subset:
 //   - scalars are `Real`, vectors are vec2/vec3/vec4 of Real;

@@ -84,7 +84,7 @@ vec3 PrefilterGgx(samplerCube source, vec3 n, float alpha, uint samples, int fac
 // The Sun as a point source of irradiance E (at normal incidence) in
 // direction s, through the same kernel as PrefilterGgx: E (n.s) D(h) / 4 / W,
 // W the kernel's normalization (the integral of (n.l) D(h) / 4 over n.l > 0,
-// IblSunKernelNormalization in bake/ibl.cc). The kernel depends on n.s only
+// IblSunKernelNormalization in bake/gpu/ibl.cc). The kernel depends on n.s only
 // and integrates to 1 over l, so it also integrates to 1 over n: the Sun's
 // energy is kept, not clamped. Valid while the lobe is much wider than the
 // disc (0.0047 rad): alpha >= 0.01 from the chain's second level on.

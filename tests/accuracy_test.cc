@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
-#include "skybake/accuracy.h"
-#include "skybake/reference_model.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/tools/accuracy.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {

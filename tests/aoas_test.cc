@@ -18,15 +18,15 @@
 
 #include <glm/glm.hpp>
 
-#include "skybake/aoas.h"
-#include "skybake/config.h"
-#include "skybake/envmap.h"
-#include "skybake/gallery.h"
-#include "skybake/pass_plan.h"
-#include "skybake/pipeline.h"
-#include "skybake/reference_model.h"
-#include "skybake/schedule.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/model/aoas.h"
+#include "skybake/input/config.h"
+#include "skybake/model/envmap.h"
+#include "skybake/pipeline/gallery.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/input/schedule.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -35,7 +35,7 @@ namespace skybake {
 // need (the LUTs are never read by these functions).
 namespace f64 {
 #define SKYBAKE_REAL double
-#include "glsl_compat.h"
+#include "skybake/model/glsl_compat.h"
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }

@@ -11,8 +11,8 @@
 
 #include <glm/glm.hpp>
 
-#include "skybake/config.h"
-#include "skybake/reference_model.h"
+#include "skybake/input/config.h"
+#include "skybake/tools/reference_model.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -21,7 +21,7 @@ namespace skybake {
 // are never reached by the geometry functions tested with these copies.
 namespace f64 {
 #define SKYBAKE_REAL double
-#include "glsl_compat.h"
+#include "skybake/model/glsl_compat.h"
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
@@ -31,7 +31,7 @@ vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #undef SKYBAKE_ATMOSPHERE_GLSL
 namespace f32 {
 #define SKYBAKE_REAL float
-#include "glsl_compat.h"
+#include "skybake/model/glsl_compat.h"
 #undef SKYBAKE_REAL
 vec3 TransmittanceLutTexel(int, int) { return vec3(1.0f); }
 vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0f); }

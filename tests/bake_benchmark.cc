@@ -8,8 +8,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "skybake/config.h"
-#include "skybake/pipeline.h"
+#include "skybake/input/config.h"
+#include "skybake/pipeline/pipeline.h"
 
 namespace {
 

@@ -15,13 +15,13 @@
 #include <OpenImageIO/imageio.h>
 #include <glm/glm.hpp>
 
-#include "skybake/clouds.h"
-#include "skybake/config.h"
-#include "skybake/envmap.h"
-#include "skybake/pass_plan.h"
-#include "skybake/pipeline.h"
-#include "skybake/reference_model.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/model/clouds.h"
+#include "skybake/input/config.h"
+#include "skybake/model/envmap.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {

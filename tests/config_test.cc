@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "skybake/config.h"
+#include "skybake/input/config.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -10,11 +10,11 @@
 
 #include <benchmark/benchmark.h>
 
-#include "skybake/aoas.h"
-#include "skybake/config.h"
-#include "skybake/pass_plan.h"
-#include "skybake/sky_renderer.h"
-#include "skybake/vulkan_context.h"
+#include "skybake/model/aoas.h"
+#include "skybake/input/config.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/gpu/sky_renderer.h"
+#include "skybake/gpu/vulkan_context.h"
 
 namespace {
 

@@ -6,9 +6,9 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
-#include "skybake/envmap.h"
-#include "skybake/reference_model.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/model/envmap.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {

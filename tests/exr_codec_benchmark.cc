@@ -21,12 +21,12 @@
 #include <benchmark/benchmark.h>
 #include <fmt/format.h>
 
-#include "skybake/config.h"
-#include "skybake/exr_io.h"
-#include "skybake/pass_plan.h"
-#include "skybake/pipeline.h"
-#include "skybake/sky_renderer.h"
-#include "skybake/vulkan_context.h"
+#include "skybake/input/config.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/gpu/sky_renderer.h"
+#include "skybake/gpu/vulkan_context.h"
 
 namespace {
 

@@ -16,8 +16,8 @@
 #include <OpenEXR/ImfStringAttribute.h>
 #include <OpenImageIO/imageio.h>
 
-#include "skybake/exr_io.h"
-#include "skybake/tonemap.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/model/tonemap.h"
 
 namespace skybake {
 namespace {

@@ -7,7 +7,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include <OpenEXR/ImfEnvmap.h>
 
-#include "skybake/gltf_scene.h"
+#include "skybake/output/gltf_scene.h"
 
 namespace skybake {
 namespace {

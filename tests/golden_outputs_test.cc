@@ -19,7 +19,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
-#include "skybake/pipeline.h"
+#include "skybake/pipeline/pipeline.h"
 #include "test_support.h"
 
 namespace skybake {

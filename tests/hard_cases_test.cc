@@ -12,9 +12,10 @@
 #include <glm/glm.hpp>
 #include <OpenImageIO/imageio.h>
 
-#include "skybake/exr_io.h"
-#include "skybake/reference_model.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/input/style.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {

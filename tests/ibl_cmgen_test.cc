@@ -30,8 +30,8 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
-#include "skybake/envmap.h"
-#include "skybake/ibl.h"
+#include "skybake/model/envmap.h"
+#include "skybake/gpu/ibl.h"
 #include "test_support.h"
 
 namespace skybake {

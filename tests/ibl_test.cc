@@ -15,9 +15,9 @@
 #include <fmt/format.h>
 #include <glm/glm.hpp>
 
-#include "skybake/envmap.h"
-#include "skybake/ibl.h"
-#include "skybake/sh.h"
+#include "skybake/model/envmap.h"
+#include "skybake/gpu/ibl.h"
+#include "skybake/model/sh.h"
 #include "test_support.h"
 
 namespace skybake {

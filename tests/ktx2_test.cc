@@ -17,8 +17,8 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "skybake/exr_io.h"
-#include "skybake/ktx2.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/output/ktx2.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -9,10 +9,10 @@
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
-#include "skybake/aoas.h"
-#include "skybake/pass_plan.h"
-#include "skybake/pipeline.h"
-#include "skybake/sky_renderer.h"
+#include "skybake/model/aoas.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/gpu/sky_renderer.h"
 #include "test_support.h"
 
 namespace skybake {

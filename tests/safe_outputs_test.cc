@@ -21,7 +21,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "skybake/output_lock.h"
+#include "skybake/output/output_lock.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "skybake/schedule.h"
-#include "skybake/solar_position.h"
+#include "skybake/input/schedule.h"
+#include "skybake/model/solar_position.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -18,8 +18,8 @@
 #include <nlohmann/json.hpp>
 #include <OpenImageIO/imageio.h>
 
-#include "skybake/pipeline.h"
-#include "skybake/schedule.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/input/schedule.h"
 #include "test_support.h"
 
 namespace skybake {

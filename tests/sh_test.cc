@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
-#include "skybake/envmap.h"
-#include "skybake/sh.h"
+#include "skybake/model/envmap.h"
+#include "skybake/model/sh.h"
 
 namespace skybake {
 namespace {

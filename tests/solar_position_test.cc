@@ -27,7 +27,7 @@
 #include <gtest/gtest.h>
 #include <glm/geometric.hpp>
 
-#include "skybake/solar_position.h"
+#include "skybake/model/solar_position.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "skybake/vulkan_context.h"
+#include "skybake/gpu/vulkan_context.h"
 
 namespace skybake::testing {
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "skybake/vulkan_context.h"
+#include "skybake/gpu/vulkan_context.h"
 #include "test_support.h"
 
 namespace skybake {

@@ -121,7 +121,7 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
   ivec4 rect;          // sun-disc pass: texels [x, z) x [y, w) of the view
 };
 
-// Volumetric cloud layers (include/skybake/clouds.h, shaders/clouds.glsl).
+// Volumetric cloud layers (include/skybake/model/clouds.h, shaders/clouds.glsl).
 // Lengths in km, extinction in km^-1; world x, z as in the sky's frame.
 #define CLOUD_MAX_LAYERS 4
 // What one dispatch of cloud_lut.comp computes (SkyPush.view.x).
@@ -156,7 +156,7 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
 };
 
 
-// --- Image-based lighting (shaders/ibl_prefilter.comp, bake/ibl.cc)
+// --- Image-based lighting (shaders/ibl_prefilter.comp, bake/gpu/ibl.cc)
 #define IBL_BINDING_SOURCE 0  // samplerCube: the sky without the Sun, RGBA float, its box-filtered mips
 #define IBL_BINDING_OUTPUT 1  // storage vec4[]: the filtered texels, level after level
 #define IBL_MODE_SPECULAR 0    // GGX-prefiltered radiance of one mip level (split sum, N = V = R)

@@ -14,8 +14,8 @@
 #include <string_view>
 #include <vector>
 
-#include "skybake/config.h"
-#include "skybake/schedule.h"
+#include "skybake/input/config.h"
+#include "skybake/input/schedule.h"
 
 namespace skybake::fuzz {
 

@@ -2,7 +2,7 @@
 // image is reported as unreadable, so the parser's error path for it runs.
 #include <stdexcept>
 
-#include "skybake/clouds.h"
+#include "skybake/model/clouds.h"
 
 namespace skybake {
 

@@ -1,0 +1,54 @@
+// Loading libskybake_oiio.so (oiio_module.h) on first use: from
+// $SKYBAKE_MODULE_DIR, beside the executable, the build tree's top folder, or
+// the folder it was built in.
+#include <dlfcn.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "skybake/base/errors.h"
+#include "skybake/base/oiio_module.h"
+
+namespace skybake {
+
+const OiioModule& LoadOiioModule() {
+  static std::mutex mutex;
+  static const OiioModule* module = nullptr;
+  std::lock_guard<std::mutex> lock(mutex);
+  if (module) return *module;
+  std::vector<std::filesystem::path> dirs;
+  if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) dirs.emplace_back(dir);
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    dirs.push_back(exe.parent_path());
+    dirs.push_back(exe.parent_path().parent_path());  // tests/ of the build tree
+  }
+  dirs.emplace_back(SKYBAKE_MODULE_BUILD_DIR);
+  std::string tried;
+  for (const std::filesystem::path& dir : dirs) {
+    const std::string path = (dir / "libskybake_oiio.so").string();
+    void* handle = ::dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (!handle) {
+      tried += fmt::format("\n  {}: {}", path, ::dlerror());
+      continue;
+    }
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module"));
+    if (!entry) {
+      tried += fmt::format("\n  {}: no skybake_oiio_module", path);
+      continue;
+    }
+    module = entry();
+    return *module;
+  }
+  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (PNG previews, glTF "
+                                "textures, galleries): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
+                                "holding it; tried:{}", tried));
+}
+
+}  // namespace skybake

@@ -1,0 +1,477 @@
+// skybake: bakes physical, art-directable skies into HDR environment maps.
+//
+//   skybake bake <style.toml> [--schedule day.toml] [--out DIR] [--size N] [--set key=value ...]
+//                [--force | --resume] [--max-memory-mib M] [--max-frame-seconds S]
+//                [--frames FIRST:LAST] [--shard I/N]
+//   skybake merge-manifest DIR [--force] [--sizes-only]
+//   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
+//   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
+//   skybake devices
+//
+// main reads as the pipeline: parse, validate, bake (device, pipelines,
+// LUTs, render, files, preview), report.
+
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "skybake/tools/accuracy.h"
+#include "skybake/input/config.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/pipeline/gallery.h"
+#include "skybake/output/manifest.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/input/schedule.h"
+#include "skybake/input/shard.h"
+#include "skybake/gpu/vulkan_context.h"
+
+namespace {
+
+using namespace skybake;
+
+// A message for the terminal: control characters read from a file or the
+// command line (an escape sequence, a newline in a key) shown as \xNN.
+std::string Printable(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
+    else out += ch;
+  }
+  return out;
+}
+
+void PrintErrors(const std::vector<ConfigError>& errors) {
+  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", Printable(e.Format()).c_str());
+  std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
+               errors.size() == 1 ? "" : "s");
+}
+
+bool EnvFlag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && *v && std::string(v) != "0";
+}
+
+int RunDevices() {
+  std::vector<DeviceInfo> devices = VulkanContext::ListDevices();
+  if (devices.empty()) {
+    std::fprintf(stderr,
+                 "skybake: error: no Vulkan device found; on Debian 'apt-get install libvulkan1 "
+                 "mesa-vulkan-drivers'\n");
+    return kExitVulkan;
+  }
+  for (const DeviceInfo& d : devices) {
+    std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(),
+                d.api_version.c_str(), d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
+  }
+  if (!DriverSelection().empty())
+    std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
+                "every installed driver)\n");
+  return kExitOk;
+}
+
+struct BakeArgs {
+  std::string style_path;
+  std::string out_dir = "out";
+  std::string schedule_path;  // empty: the style's inline [schedule], if any
+  int size = 0;
+  int device = -1;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  bool validation = false;
+  bool force = false;
+  bool resume = false;
+  double max_memory_mib = 4096.0;
+  double max_frame_seconds = 3600.0;
+  bool dry_run = false;  // print the plan instead of baking
+  std::string frames;    // --frames FIRST:LAST, empty: every frame
+  std::string shard;     // --shard I/N, empty: no split
+};
+
+enum class Mode { kBake, kCheck, kPlan };
+
+int RunBake(const BakeArgs& args, Mode mode) {
+  const bool check_only = mode == Mode::kCheck;
+  // Parse and validate: every error at once, before any GPU work.
+  std::optional<FrameRange> frames;
+  std::optional<ShardSpec> shard;
+  if (!args.frames.empty()) frames = ParseFrameRange(args.frames);
+  if (!args.shard.empty()) shard = ParseShard(args.shard);
+  std::vector<std::string> overrides = args.overrides;
+  if (args.size > 0) {
+    overrides.push_back(fmt::format("render.cube_size={}", args.size));
+    overrides.push_back(fmt::format("render.latlong_height={}", args.size));
+  }
+  ConfigResult config = LoadSkyStyle(args.style_path, overrides);
+  if (!config.ok()) {
+    PrintErrors(config.errors);
+    return kExitConfig;
+  }
+  for (const ConfigError& w : config.warnings) std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
+  // A schedule (its own file, or inline in the style) makes a sequence: every
+  // frame's style is resolved and checked before any GPU work.
+  std::string schedule_path = args.schedule_path;
+  if (schedule_path.empty() && FileHasSchedule(args.style_path)) schedule_path = args.style_path;
+  std::optional<Schedule> schedule;
+  std::vector<SkyStyle> frame_styles;
+  if (!schedule_path.empty()) {
+    ScheduleResult loaded = LoadSchedule(schedule_path);
+    if (!loaded.ok()) {
+      PrintErrors(loaded.errors);
+      return kExitConfig;
+    }
+    FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
+    for (const ConfigError& w : styles.warnings)
+      std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
+    if (!styles.ok()) {
+      PrintErrors(styles.errors);
+      return kExitConfig;
+    }
+    schedule = std::move(loaded.schedule);
+    frame_styles = std::move(styles.styles);
+  }
+  // Budget: every frame's memory and time estimate, before any GPU work.
+  BakeOptions options;
+  options.max_memory_mib = args.max_memory_mib;
+  options.max_frame_seconds = args.max_frame_seconds;
+  ResourceEstimate largest;
+  for (const SkyStyle& style : schedule ? frame_styles : std::vector<SkyStyle>{config.style}) {
+    CheckBudget(style, options);
+    ResourceEstimate e = EstimateResources(style);
+    if (e.memory_mib > largest.memory_mib) largest.memory_mib = e.memory_mib;
+    if (e.seconds > largest.seconds) largest.seconds = e.seconds;
+  }
+  // Shard: the part of the sequence this run bakes (README "Scale-out").
+  std::optional<FrameRange> part;
+  if (frames || shard) {
+    if (!schedule)
+      throw UsageError("--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
+                       "[schedule])");
+    part = SelectFrames(*schedule, frames, shard);
+  }
+  if (args.resume && !schedule) {
+    std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
+                         "an inline [schedule]), or use --force to bake a single style again\n");
+    return kExitUsage;
+  }
+  if (mode == Mode::kPlan || args.dry_run) {
+    // The passes, LUTs and shader variant the bake would run, and why.
+    // The part that --frames / --shard select, when given.
+    std::vector<SkyStyle> planned;
+    if (schedule) {
+      for (size_t i = 0; i < frame_styles.size(); ++i)
+        if (!part || part->Contains(schedule->frames[i].number)) planned.push_back(frame_styles[i]);
+    } else {
+      planned.push_back(config.style);
+    }
+    PassPlan plan = PlanPasses(planned);
+    std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
+    if (part)
+      what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
+                          schedule->frames.back().number);
+    std::printf("%s", FormatPlan(plan, what).c_str());
+    return kExitOk;
+  }
+  if (check_only) {
+    std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
+                largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
+    if (schedule)
+      std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), schedule_path.c_str(),
+                  schedule->frames.size());
+    else
+      std::printf("%s: ok\n", args.style_path.c_str());
+    return kExitOk;
+  }
+
+  // Bake: device, pipelines, LUTs, render, files, preview.
+  options.out_dir = args.out_dir;
+  options.force = args.force;
+  options.resume = args.resume;
+  options.frames = part;
+  options.vulkan.device_index = args.device;
+  options.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  if (!args.quiet) {
+    options.progress = [](const StageReport& s) {
+      std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
+    };
+  }
+  BakeResult result = schedule ? BakeSequence(frame_styles, *schedule, options) : BakeStyle(config.style, options);
+
+  // Report: the files, then anything the validation layer said.
+  for (const BakedFile& f : result.files)
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+  if (result.half_scale != 1.0)
+    std::fprintf(stderr,
+                 "skybake: warning: values exceeded half range; every EXR was scaled by %.9g "
+                 "(recorded as skybake:scale and whiteLuminance)\n",
+                 result.half_scale);
+  if (result.validation_messages > 0) {
+    std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d message%s\n",
+                 result.validation_messages, result.validation_messages == 1 ? "" : "s");
+    return kExitVulkan;
+  }
+  return kExitOk;
+}
+
+int RunMergeManifest(const MergeOptions& options) {
+  // Check every part, then write the scene and manifest.json.
+  MergeResult result = MergeShardManifests(options);
+  for (const std::string& part : result.parts) std::printf("part      %s\n", part.c_str());
+  for (const BakedFile& f : result.scene_files)
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+  std::printf("manifest  %s  %d frames from %zu part%s\n", result.manifest_path.c_str(), result.frames,
+              result.parts.size(), result.parts.size() == 1 ? "" : "s");
+  return kExitOk;
+}
+
+struct GalleryArgs {
+  std::string styles_dir = "configs/styles";
+  std::string out_dir = "out/gallery";
+  int size = 192;
+  int columns = 2;
+};
+
+int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
+  // Parse and validate every style first: nothing is baked if one is wrong.
+  std::vector<std::string> styles = StyleFilesIn(gallery.styles_dir);
+  if (styles.empty()) {
+    std::fprintf(stderr, "skybake: error: no .toml styles in %s\n", gallery.styles_dir.c_str());
+    return kExitUsage;
+  }
+  std::vector<ConfigError> errors;
+  for (const std::string& path : styles) {
+    ConfigResult config = LoadSkyStyle(path, args.overrides);
+    errors.insert(errors.end(), config.errors.begin(), config.errors.end());
+  }
+  if (!errors.empty()) {
+    PrintErrors(errors);
+    return kExitConfig;
+  }
+
+  // Bake each style's preview, then lay out the labelled contact sheet.
+  GalleryOptions options;
+  options.out_dir = gallery.out_dir;
+  options.latlong_height = gallery.size;
+  options.columns = gallery.columns;
+  options.overrides = args.overrides;
+  options.bake.vulkan.device_index = args.device;
+  options.bake.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  options.bake.force = args.force;
+  size_t done = 0;
+  if (!args.quiet) {
+    options.bake.progress = [&done, &styles](const StageReport& s) {
+      if (s.name != "preview") return;
+      std::fprintf(stderr, "skybake: gallery %zu/%zu %s (%s)\n", done + 1, styles.size(),
+                   styles[done].c_str(), s.detail.c_str());
+      ++done;
+    };
+  }
+  GalleryResult result = BakeGallery(styles, options);
+
+  // Report: every style with its principles, then the sheet.
+  for (const GalleryEntry& e : result.entries)
+    std::printf("style    %-24s %s\n", e.name.c_str(), e.principles.c_str());
+  std::printf("gallery  %s\n", result.contact_sheet.c_str());
+  if (result.validation_messages > 0) {
+    std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d messages\n",
+                 result.validation_messages);
+    return kExitVulkan;
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  KeepFrameMemoryInHeap();
+  CLI::App app{"skybake " SKYBAKE_VERSION
+               ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
+               "into OpenEXR environment maps with Vulkan compute.\n"
+               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
+               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
+               "manifests that do not merge."};
+  app.require_subcommand(1);
+  app.get_formatter()->column_width(34);
+
+  BakeArgs args;
+  // A budget is a finite number above 0 (nan compares false with every
+  // bound and would switch the budget off).
+  const CLI::Validator finite_positive(
+      [](std::string& text) -> std::string {
+        double value = 0.0;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
+          return "expected a finite number above 0, got " + text;
+        return "";
+      },
+      "POSITIVE");
+  auto add_style_options = [&](CLI::App* cmd) {
+    cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
+        ->required();
+    cmd->add_option("--set", args.overrides,
+                    "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
+    cmd->add_option("--schedule", args.schedule_path,
+                    "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
+                    "[schedule], if it has one)");
+    cmd->add_option("--max-memory-mib", args.max_memory_mib,
+                    "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
+        ->capture_default_str()
+        ->check(finite_positive);
+    cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
+                    "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
+        ->capture_default_str()
+        ->check(finite_positive);
+  };
+
+  CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
+      "preview, a glTF scene and manifest.json");
+  add_style_options(bake);
+  bake->add_option("--out", args.out_dir, "Output folder")->capture_default_str();
+  bake->add_option("--size", args.size,
+                   "Cube face size N; also sets the latlong to 2N x N (default: the style's, 512)")
+      ->check(CLI::Range(1, 8192));
+  bake->add_option("--device", args.device, "Vulkan device index from 'skybake devices' (default: best)");
+  CLI::Option* force = bake->add_flag(
+      "--force", args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
+  bake->add_flag("--resume", args.resume,
+                 "Sequence: keep the frames whose files match their checksums in the manifest in --out (manifest.json, or "
+                 "the shard's), bake the rest")
+      ->excludes(force);
+  bake->add_option("--frames", args.frames,
+                   "Sequence: bake only frames FIRST to LAST (inclusive), numbered as in file names (from "
+                   "schedule.first_frame); writes manifest.shard-FIRST-LAST.json, no scene")
+      ->type_name("FIRST:LAST");
+  bake->add_option("--shard", args.shard,
+                   "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
+                   "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
+      ->type_name("I/N");
+  bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
+  bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
+  bake->add_flag("--vulkan-validation", args.validation,
+                 "Load the Khronos validation layer; any message fails the bake (also "
+                 "SKYBAKE_VULKAN_VALIDATION=1)");
+
+  CLI::App* check = app.add_subcommand("check", "Validate a style without baking");
+  add_style_options(check);
+
+  CLI::App* plan = app.add_subcommand(
+      "plan", "Print the passes, LUT sizes, shader variant, estimated work and reuse of a bake, and why each "
+              "effect is on (also: bake --dry-run)");
+  add_style_options(plan);
+
+  GalleryArgs gallery_args;
+  CLI::App* gallery = app.add_subcommand(
+      "gallery", "Bake every style of a folder and write one labelled contact sheet (gallery.png)");
+  gallery->add_option("styles", gallery_args.styles_dir, "Folder of style TOML files")
+      ->capture_default_str();
+  gallery->add_option("--out", gallery_args.out_dir, "Output folder")->capture_default_str();
+  gallery->add_option("--size", gallery_args.size, "Latlong height H of each style (2H x H)")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 2048));
+  gallery->add_option("--columns", gallery_args.columns, "Tiles per row")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  gallery->add_option("--set", args.overrides, "Override a key in every style (repeatable)");
+  gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
+  gallery->add_flag("--force", args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
+  gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
+  gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
+
+  MergeOptions merge_options;
+  bool sizes_only = false;
+  CLI::App* merge = app.add_subcommand(
+      "merge-manifest",
+      "Join the shard manifests (manifest.shard-FIRST-LAST.json, from bake --shard or --frames) of a folder into "
+      "manifest.json and write the glTF scene, equal to an unsharded bake's; checks that the parts are of one "
+      "bake, cover every frame once, and that every listed file is there with its SHA-256");
+  merge->add_option("dir", merge_options.dir, "Folder holding every part's files and shard manifest")->required();
+  merge->add_flag("--force", merge_options.force, "Replace an existing manifest.json and glTF scene");
+  merge->add_flag("--sizes-only", sizes_only, "Check listed files by size only, without reading them for SHA-256");
+
+  CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
+
+  AccuracyStudyOptions study;
+  CLI::App* accuracy = app.add_subcommand(
+      "accuracy", "Run the accuracy-versus-time study of every integrator and write its tables and plot");
+  accuracy->add_option("--out", study.out_dir, "Folder for accuracy_results.md, accuracy.csv, accuracy.png")
+      ->capture_default_str();
+  accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
+  accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
+  accuracy->add_option("--only", study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
+  accuracy->add_option("--observer-altitude-m", study.observer_altitude_m, "Observer altitude of the study (m)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1e6));
+
+  // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
+  // like a full disk, instead of killing the process mid-file.
+  std::signal(SIGXFSZ, SIG_IGN);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+
+  // Single-threaded still: the only point where the environment may change.
+  SelectSoftwareDriversWithoutGpu();
+  try {
+    if (devices->parsed()) return RunDevices();
+    if (accuracy->parsed()) {
+      study.progress = [](const std::string& line) { std::fprintf(stderr, "skybake: %s\n", line.c_str()); };
+      std::string report = RunAccuracyStudy(study);
+      std::printf("%s", report.c_str());
+      return kExitOk;
+    }
+    if (check->parsed()) return RunBake(args, Mode::kCheck);
+    if (plan->parsed()) return RunBake(args, Mode::kPlan);
+    if (gallery->parsed()) return RunGallery(gallery_args, args);
+    if (merge->parsed()) {
+      merge_options.verify_checksums = !sizes_only;
+      return RunMergeManifest(merge_options);
+    }
+    return RunBake(args, Mode::kBake);
+  } catch (const UsageError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitUsage;
+  } catch (const ManifestError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitMerge;
+  } catch (const ConfigFailure& e) {
+    PrintErrors(e.errors);
+    return kExitConfig;
+  } catch (const VulkanUnavailable& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitVulkan;
+  } catch (const VulkanError& e) {
+    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", Printable(e.what()).c_str());
+    return kExitVulkan;
+  } catch (const BudgetError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitBudget;
+  } catch (const OutputExistsError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitExists;
+  } catch (const OutputError& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitOutput;
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
+                         "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
+    return kExitBudget;
+  } catch (const std::filesystem::filesystem_error& e) {
+    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    return kExitOutput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());
+    return kExitInternal;
+  }
+}

@@ -1,0 +1,845 @@
+#include "skybake/gpu/sky_renderer.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <future>
+
+#include <glm/geometric.hpp>
+#include <sys/mman.h>
+
+#include "shaders/kCloudLutSpv.spv.h"
+#include "shaders/kCloudRenderSpv.spv.h"
+#include "shaders/kMultiscatteringLutSpv.spv.h"
+#include "shaders/kSkyRenderSpv.spv.h"
+#include "shaders/kSkyviewLutSpv.spv.h"
+#include "shaders/kTransmittanceLutSpv.spv.h"
+#include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
+#include "shaders/kSkyRenderSkyViewSpv.spv.h"
+#include "shaders/kSkyRenderSunDiscPassSpv.spv.h"
+#include "shaders/kSkyviewLutAnalyticSpv.spv.h"
+#include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
+
+namespace skybake {
+namespace {
+
+// Of the bindings of gpu_shared.h, the atmosphere, AOAS and cloud blocks are uniform.
+bool IsUniformBinding(uint32_t binding) {
+  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS || binding == BINDING_CLOUDS;
+}
+
+// Texels of the cloud tables: the aerial-perspective LUT's in-scattering and
+// transmittance halves, then two per ambient altitude (clouds.glsl).
+size_t CloudLutTexels(const gpu::GpuClouds& c) {
+  return 2 * size_t(c.lut.x) * c.lut.y * c.lut.z + 2 * size_t(c.lut.w);
+}
+
+uint32_t GroupCount(int texels, int local_size) {
+  return uint32_t((texels + local_size - 1) / local_size);
+}
+
+}  // namespace
+
+SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
+                         const QualitySettings& quality, const EffectSettings& effects,
+                         const Rgb& output_scale, bool output_directions,
+                         const AoasInputs& aoas, const CloudInputs& clouds)
+    : context_(context),
+      quality_(quality),
+      effects_(effects),
+      aoas_switches_(aoas.switches),
+      output_directions_(output_directions) {
+  gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
+  disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches);
+  // Clouds (clouds.h): a style without layers gets no cloud pipeline, no
+  // noise and no cloud pass; its buffers are placeholders.
+  cloud_layers_ = output_directions ? 0 : clouds.layers();
+  gpu_clouds_ = clouds.uniform;
+  cloud_weather_images_ = clouds.weather_images;
+  VkDevice device = context_.device();
+
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
+  transmittance_buffer_ = CreateBuffer(
+      VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
+  multiscattering_buffer_ = CreateBuffer(
+      VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
+  output_buffer_ = CreateBuffer(16 * 64, storage);
+  skyview_buffer_ = CreateBuffer(
+      quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 8 : 16, storage);
+  clouds_buffer_ = CreateBuffer(sizeof(gpu::GpuClouds), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
+  cloud_noise_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_)) * 4 : 16, storage);
+  cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
+
+  VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(gpu::SkyPush));
+  set_layout_ = layouts.set;
+  pipeline_layout_ = layouts.pipeline;
+
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 3}};
+  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 2;
+  pool_info.pPoolSizes = pool_sizes;
+  VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &descriptor_pool_));
+  VkDescriptorSetAllocateInfo alloc_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc_info.descriptorPool = descriptor_pool_;
+  alloc_info.descriptorSetCount = 1;
+  alloc_info.pSetLayouts = &set_layout_;
+  VK_CHECK(vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
+  UpdateDescriptors();
+
+  // Pipelines are built once per renderer, never per frame, and only those
+  // the effects need. Compiling is most of a short bake's start-up on
+  // lavapipe (LLVM), and pipeline creation may run on several threads at once
+  // (the device is not externally synchronized for it): one thread each.
+  struct PipelineJob {
+    VkPipeline* pipeline;
+    const uint32_t* code;
+    size_t bytes;
+    bool sun_disc = false;
+    bool sun_disc_pass = false;
+  };
+  // The variants built with the presets' settings fixed (CMakeLists.txt)
+  // compile 10-20 times faster; they compute the same values to float
+  // rounding (tests/sky_renderer_test.cc). SKYBAKE_GENERIC_SHADERS=1 turns
+  // them off, to tell a variant's fault from the shader's.
+  const ShaderSources sources = ChooseShaderSources(quality, aoas.switches.skydome);
+  const bool analytic = sources.analytic_luts;
+  const bool sky_view = quality.sky_view_lut && !aoas.switches.skydome;
+  auto job = [this](VkPipeline* pipeline, bool variant, const auto& variant_code, const auto& generic_code) {
+    if (variant) ++counters_.variant_pipelines;
+    return variant ? PipelineJob{pipeline, variant_code, sizeof(variant_code)}
+                   : PipelineJob{pipeline, generic_code, sizeof(generic_code)};
+  };
+  std::vector<PipelineJob> jobs;
+  if (NeedsTransmittanceLut(quality, effects) || cloud_layers_ > 0)
+    jobs.push_back(job(&transmittance_pipeline_, analytic, kTransmittanceLutAnalyticSpv, kTransmittanceLutSpv));
+  if (effects.multiple_scattering)
+    jobs.push_back(
+        job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
+  if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
+  jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+  for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
+  if (disc_pass_) {
+    // The sky pass without the disc, and the disc pass that adds it.
+    jobs.back().sun_disc = false;
+    jobs.push_back(job(&disc_pipeline_, sources.sky_view_render, kSkyRenderSunDiscPassSpv, kSkyRenderSpv));
+    jobs.back().sun_disc = true;
+    jobs.back().sun_disc_pass = true;
+  }
+  if (cloud_layers_ > 0) {
+    // Built from the analytic variant alone: their own marches of the air
+    // use the analytic step whatever the style's integrator.
+    jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
+    jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
+  }
+  std::vector<std::future<VkPipeline>> compiled;
+  for (const PipelineJob& job : jobs)
+    compiled.push_back(std::async(std::launch::async, [this, job] {
+      return CreatePipeline(job.code, job.bytes, job.sun_disc, job.sun_disc_pass);
+    }));
+  std::exception_ptr failure;
+  for (size_t i = 0; i < jobs.size(); ++i) {
+    try {
+      *jobs[i].pipeline = compiled[i].get();
+      ++counters_.pipelines;
+    } catch (...) {
+      if (!failure) failure = std::current_exception();
+    }
+  }
+  if (failure) {
+    DestroyAll();
+    std::rethrow_exception(failure);
+  }
+
+  VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  command_pool_info.queueFamilyIndex = context_.queue_family();
+  VK_CHECK(vkCreateCommandPool(device, &command_pool_info, nullptr, &command_pool_));
+  VkCommandBufferAllocateInfo cb_info{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cb_info.commandPool = command_pool_;
+  cb_info.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cb_info.commandBufferCount = 1;
+  VK_CHECK(vkAllocateCommandBuffers(device, &cb_info, &command_buffer_));
+  VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_));
+
+  timestamps_supported_ = context_.SupportsTimestamps();
+}
+
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas) {
+  const char* env = std::getenv("SKYBAKE_SUN_DISC_PASS");
+  if (env && std::string(env) == "0") return false;
+  return effects.sun_disc && quality.sky_view_lut && !aoas.skydome && !aoas.ambiguity && !aoas.cloud_noise &&
+         !aoas.cloud_shapes;
+}
+
+std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle) {
+  if (view.mapping == MAPPING_DIRECTIONS) return {{0, 0, view.width, view.height}};
+  constexpr int kTile = 16;
+  auto angle_between = [](const glm::dvec3& a, const glm::dvec3& b) {
+    // atan2 of |a x b| and a . b: accurate at small angles, unlike acos.
+    return std::atan2(glm::length(glm::cross(a, b)), glm::dot(a, b));
+  };
+  std::vector<TexelRect> rects;
+  for (int ty = 0; ty < view.height; ty += kTile) {
+    const int y1 = std::min(ty + kTile, view.height);
+    int first = -1, last = -1;
+    for (int tx = 0; tx < view.width; tx += kTile) {
+      const int x1 = std::min(tx + kTile, view.width);
+      const glm::dvec3 centre = ViewTexelDirection(view, (tx + x1 - 1) / 2, (ty + y1 - 1) / 2);
+      double radius = 0.0;
+      for (int corner = 0; corner < 4; ++corner) {
+        const int x = corner & 1 ? x1 - 1 : tx;
+        const int y = corner & 2 ? y1 - 1 : ty;
+        radius = std::max(radius, angle_between(centre, ViewTexelDirection(view, x, y)));
+      }
+      if (angle_between(centre, direction) <= angle + 1.5 * radius) {
+        if (first < 0) first = tx;
+        last = x1;
+      }
+    }
+    if (first >= 0) {
+      // Joined with the row of tiles above when they span the same columns.
+      if (!rects.empty() && rects.back().y1 == ty && rects.back().x0 == first && rects.back().x1 == last)
+        rects.back().y1 = y1;
+      else
+        rects.push_back({first, ty, last, y1});
+    }
+  }
+  return rects;
+}
+
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome) {
+  const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
+  if (generic && std::string(generic) == "1") return {};
+  ShaderSources sources;
+  sources.analytic_luts = quality.integrator == INTEGRATOR_ANALYTIC;
+  sources.sky_view_render = quality.sky_view_lut && !skydome;
+  return sources;
+}
+
+SkyRenderer::~SkyRenderer() {
+  vkDeviceWaitIdle(context_.device());
+  DestroyAll();
+}
+
+void SkyRenderer::DestroyAll() {
+  VkDevice device = context_.device();
+  if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
+  if (fence_) vkDestroyFence(device, fence_, nullptr);
+  if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
+  for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
+                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_}) {
+    if (*p) vkDestroyPipeline(device, *p, nullptr);
+    *p = VK_NULL_HANDLE;
+  }
+  query_pool_ = VK_NULL_HANDLE;
+  fence_ = VK_NULL_HANDLE;
+  command_pool_ = VK_NULL_HANDLE;
+  vkDestroyDescriptorPool(device, descriptor_pool_, nullptr);
+  vkDestroyPipelineLayout(device, pipeline_layout_, nullptr);
+  vkDestroyDescriptorSetLayout(device, set_layout_, nullptr);
+  descriptor_pool_ = VK_NULL_HANDLE;
+  pipeline_layout_ = VK_NULL_HANDLE;
+  set_layout_ = VK_NULL_HANDLE;
+  DestroyBuffer(skyview_buffer_);
+  DestroyBuffer(cloud_lut_buffer_);
+  DestroyBuffer(cloud_noise_buffer_);
+  DestroyBuffer(clouds_buffer_);
+  DestroyBuffer(output_buffer_);
+  for (std::unique_ptr<FrameSlot>& slot : frame_slots_) DestroyBuffer(slot->buffer);
+  frame_slots_.clear();
+  DestroyBuffer(multiscattering_buffer_);
+  DestroyBuffer(transmittance_buffer_);
+  DestroyBuffer(aoas_buffer_);
+  DestroyBuffer(atmosphere_buffer_);
+}
+
+namespace {
+
+// Where each view's texels start in a buffer holding them all, in texels;
+// `total` gets the texels of all.
+std::vector<size_t> TexelOffsets(const std::vector<ViewRequest>& views, size_t& total) {
+  std::vector<size_t> offsets;
+  total = 0;
+  for (const ViewRequest& v : views) {
+    offsets.push_back(total);
+    total += size_t(v.width) * v.height;
+  }
+  return offsets;
+}
+
+// Asks the kernel for 2 MiB pages behind a large mapping (transparent huge
+// pages, where the system allows them on request). A CPU device's buffers
+// are ordinary memory that the shaders touch first; a 4 KiB page fault cost
+// about 12 us on the development VM (the 84 MB of a W1 frame: 250 ms of
+// faults, 9 ms with huge pages). Advice only: an error (device memory, no
+// huge pages) changes nothing.
+void AdviseHugePages(void* mapped, VkDeviceSize size) {
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  if (!mapped || size < 2 * kHuge) return;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(mapped) + kHuge - 1) & ~(kHuge - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(mapped) + uintptr_t(size)) & ~(kHuge - 1);
+  if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+}
+
+}  // namespace
+
+SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
+  VkDevice device = context_.device();
+  Buffer b;
+  b.size = size;
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VK_CHECK(vkCreateBuffer(device, &info, nullptr, &b.buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, b.buffer, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  // Host-visible so results are read without a staging copy; cached memory
+  // makes the read-back fast where the device offers it.
+  alloc.memoryTypeIndex = context_.FindMemoryType(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+      VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+  VkResult result = vkAllocateMemory(device, &alloc, nullptr, &b.memory);
+  if (result != VK_SUCCESS) {
+    vkDestroyBuffer(device, b.buffer, nullptr);
+    throw VulkanError("cannot allocate " + std::to_string(size >> 20) +
+                          " MiB of Vulkan memory (" + VkResultName(result) +
+                          "): lower render.cube_size or render.latlong_height",
+                      result);
+  }
+  VK_CHECK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
+  VK_CHECK(vkMapMemory(device, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped));
+  AdviseHugePages(b.mapped, size);
+  return b;
+}
+
+void SkyRenderer::DestroyBuffer(Buffer& b) {
+  VkDevice device = context_.device();
+  if (b.mapped) vkUnmapMemory(device, b.memory);
+  if (b.buffer) vkDestroyBuffer(device, b.buffer, nullptr);
+  if (b.memory) vkFreeMemory(device, b.memory, nullptr);
+  // A new buffer may get the same handle: the binding must be written again.
+  if (b.buffer != VK_NULL_HANDLE && b.buffer == bound_output_) bound_output_ = VK_NULL_HANDLE;
+  b = Buffer{};
+}
+
+void SkyRenderer::EnsureOutputCapacity(VkDeviceSize bytes) {
+  if (bytes <= output_buffer_.size) return;
+  DestroyBuffer(output_buffer_);
+  output_buffer_ = CreateBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  UpdateDescriptors();
+}
+
+void SkyRenderer::UpdateDescriptors() {
+  VkDescriptorBufferInfo infos[kBindingCount] = {
+      {atmosphere_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {transmittance_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {multiscattering_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {output_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {skyview_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {aoas_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {clouds_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {cloud_noise_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {cloud_lut_buffer_.buffer, 0, VK_WHOLE_SIZE},
+  };
+  VkWriteDescriptorSet writes[kBindingCount] = {};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
+    writes[i].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+    writes[i].dstSet = descriptor_set_;
+    writes[i].dstBinding = i;
+    writes[i].descriptorCount = 1;
+    writes[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    writes[i].pBufferInfo = &infos[i];
+  }
+  vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
+  bound_output_ = output_buffer_.buffer;
+}
+
+void SkyRenderer::BindOutput(const Buffer& target) {
+  if (target.buffer == bound_output_) return;
+  const VkDescriptorBufferInfo info{target.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  write.dstSet = descriptor_set_;
+  write.dstBinding = BINDING_OUTPUT;
+  write.descriptorCount = 1;
+  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  write.pBufferInfo = &info;
+  vkUpdateDescriptorSets(context_.device(), 1, &write, 0, nullptr);
+  bound_output_ = target.buffer;
+}
+
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass) {
+  VkDevice device = context_.device();
+  VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  module_info.codeSize = bytes;
+  module_info.pCode = code;
+  VkShaderModule module;
+  VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
+
+  // Specialization constants of common.glsl: ids 0..3 the optional effects,
+  // 4..7 the AOAS principles that act per texel, 10..11 the quality
+  // settings, 12..14 the Mie and ozone constituents and night dimming, 15
+  // the sun-disc pass, 20 the cloud layers. Every pipeline gets them all; a
+  // shader that does not use one ignores it.
+  struct {
+    VkBool32 multiple_scattering, sun_disc, ground, output_directions;
+    VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
+    int32_t integrator;
+    VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
+    int32_t cloud_layers;
+  } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
+              output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
+              aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
+              quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
+              effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1)};
+  const VkSpecializationMapEntry entries[15] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
+                                                {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
+                                                {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4},
+                                                {14, 48, 4}, {15, 52, 4}, {20, 56, 4}};
+  VkSpecializationInfo specialization{15, entries, sizeof(values), &values};
+
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = &specialization;
+  info.layout = pipeline_layout_;
+  VkPipeline pipeline;
+  VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(device, module, nullptr);
+  VK_CHECK(result);
+  return pipeline;
+}
+
+void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
+                         const std::vector<bool>& barrier_after) {
+  VkDevice device = context_.device();
+  uint32_t queries = uint32_t(2 * dispatches.size());
+  if (timestamps_supported_ && queries > query_capacity_) {
+    if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
+    VkQueryPoolCreateInfo qinfo{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+    qinfo.queryType = VK_QUERY_TYPE_TIMESTAMP;
+    qinfo.queryCount = std::max<uint32_t>(queries, 16);
+    VK_CHECK(vkCreateQueryPool(device, &qinfo, nullptr, &query_pool_));
+    query_capacity_ = qinfo.queryCount;
+  }
+
+  VK_CHECK(vkResetCommandBuffer(command_buffer_, 0));
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  VK_CHECK(vkBeginCommandBuffer(command_buffer_, &begin));
+  if (timestamps_supported_) vkCmdResetQueryPool(command_buffer_, query_pool_, 0, queries);
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1,
+                          &descriptor_set_, 0, nullptr);
+  for (size_t i = 0; i < dispatches.size(); ++i) {
+    const Dispatch& d = dispatches[i];
+    if (timestamps_supported_)
+      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * i));
+    vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, d.pipeline);
+    vkCmdPushConstants(command_buffer_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                       sizeof(gpu::SkyPush), &d.push);
+    vkCmdDispatch(command_buffer_, d.groups_x, d.groups_y, 1);
+    if (timestamps_supported_)
+      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, query_pool_,
+                          uint32_t(2 * i + 1));
+    if (barrier_after[i]) {
+      // Orders this dispatch's LUT writes before the next dispatch's LUT reads.
+      VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+      barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+      vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+    }
+  }
+  // Makes every shader write of the submission visible to host reads after the fence.
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+  VK_CHECK(vkEndCommandBuffer(command_buffer_));
+
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &command_buffer_;
+  VK_CHECK(vkResetFences(device, 1, &fence_));
+  VK_CHECK(vkQueueSubmit(context_.queue(), 1, &submit, fence_));
+  VK_CHECK(vkWaitForFences(device, 1, &fence_, VK_TRUE, UINT64_MAX));
+
+  timings_.clear();
+  std::vector<uint64_t> stamps(queries, 0);
+  if (timestamps_supported_ && queries > 0)
+    VK_CHECK(vkGetQueryPoolResults(device, query_pool_, 0, queries, stamps.size() * sizeof(uint64_t),
+                                   stamps.data(), sizeof(uint64_t),
+                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  double period_ns = context_.properties().limits.timestampPeriod;
+  for (size_t i = 0; i < dispatches.size(); ++i) {
+    PassTiming t;
+    t.name = dispatches[i].name;
+    if (timestamps_supported_) t.gpu_ms = double(stamps[2 * i + 1] - stamps[2 * i]) * period_ns * 1e-6;
+    timings_.push_back(t);
+  }
+}
+
+void SkyRenderer::PrecomputeLuts() {
+  std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  gpu::SkyPush push{};
+  // A LUT that nothing reads is not computed (pass_plan.h); the clouds read
+  // the transmittance LUT for the sunlight at each sample.
+  const bool transmittance = NeedsTransmittanceLut(quality_, effects_) || cloud_layers_ > 0;
+  if (transmittance) {
+    dispatches.push_back({"transmittance LUT", transmittance_pipeline_, push,
+                          GroupCount(gpu_atmosphere_.lut_sizes.x, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(gpu_atmosphere_.lut_sizes.y, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+  }
+  if (effects_.multiple_scattering) {
+    dispatches.push_back({"multiple-scattering LUT", multiscattering_pipeline_, push,
+                          GroupCount(gpu_atmosphere_.lut_sizes.z, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(gpu_atmosphere_.lut_sizes.w, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+  }
+  if (!dispatches.empty()) Submit(dispatches, barriers);
+  if (transmittance) ++counters_.transmittance_lut_builds;
+  if (effects_.multiple_scattering) ++counters_.multiscattering_lut_builds;
+  luts_ready_ = true;
+  if (cloud_layers_ > 0 && !cloud_noise_ready_) GenerateCloudNoise();
+}
+
+void SkyRenderer::GenerateCloudNoise() {
+  // The weather images first (host writes to the mapped buffer; the
+  // submission below makes them visible to the device), then the volumes
+  // and procedural maps, from the seeds alone.
+  float* noise = static_cast<float*>(cloud_noise_buffer_.mapped);
+  const int n_weather = gpu_clouds_.resolution.z;
+  size_t image = 0;
+  std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  for (int l = 0; l < cloud_layers_; ++l) {
+    const gpu::GpuCloudLayer& layer = gpu_clouds_.layers[l];
+    gpu::SkyPush push{};
+    push.view = {CLOUD_PASS_SHAPE, 0, 0, l};
+    const int ns = gpu_clouds_.resolution.x, nd = gpu_clouds_.resolution.y;
+    dispatches.push_back({"cloud shape noise", cloud_lut_pipeline_, push, GroupCount(ns, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(ns * ns, SKYBAKE_LOCAL_SIZE_Y)});
+    push.view.x = CLOUD_PASS_DETAIL;
+    dispatches.push_back({"cloud detail noise", cloud_lut_pipeline_, push, GroupCount(nd, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(nd * nd, SKYBAKE_LOCAL_SIZE_Y)});
+    if (layer.weather.w > 0.5f) {
+      const size_t count = size_t(n_weather) * n_weather;
+      std::memcpy(noise + layer.noise.z, cloud_weather_images_.data() + image * count, count * sizeof(float));
+      ++image;
+    } else {
+      push.view.x = CLOUD_PASS_WEATHER;
+      dispatches.push_back({"cloud weather map", cloud_lut_pipeline_, push,
+                            GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_X), GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_Y)});
+    }
+  }
+  // Each dispatch writes its own range of the noise buffer: no barriers
+  // between them; the submission's end orders them before later reads.
+  barriers.assign(dispatches.size(), false);
+  Submit(dispatches, barriers);
+  cloud_noise_ready_ = true;
+  ++counters_.cloud_noise_builds;
+}
+
+void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
+                                 std::vector<bool>& barriers) {
+  if (cloud_tables_ready_ && cloud_sun_ == sun) return;
+  cloud_tables_ready_ = true;
+  cloud_sun_ = sun;
+  gpu::SkyPush push{};
+  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+  push.view = {CLOUD_PASS_AERIAL, 0, 0, 0};
+  dispatches.push_back({"cloud aerial perspective", cloud_lut_pipeline_, push,
+                        GroupCount(gpu_clouds_.lut.x, SKYBAKE_LOCAL_SIZE_X),
+                        GroupCount(gpu_clouds_.lut.y, SKYBAKE_LOCAL_SIZE_Y)});
+  barriers.push_back(false);  // the two tables are disjoint ranges of one buffer
+  push.view.x = CLOUD_PASS_AMBIENT;
+  dispatches.push_back({"cloud ambient", cloud_lut_pipeline_, push, GroupCount(gpu_clouds_.lut.w, SKYBAKE_LOCAL_SIZE_X), 1});
+  // The tables' writes before the cloud pass reads them.
+  barriers.push_back(true);
+  ++counters_.cloud_table_builds;
+}
+
+std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
+                                                    const std::vector<ViewRequest>& views, bool sun_disc) {
+  if (!luts_ready_ && !output_directions_) PrecomputeLuts();
+  size_t total = 0;
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
+  // The views share one storage buffer; when they do not fit in the largest
+  // range the device can bind, they are rendered in groups that do.
+  const VkDeviceSize max_range = context_.properties().limits.maxStorageBufferRange;
+  if (VkDeviceSize(total) * 16 > max_range) {
+    if (views.size() == 1)
+      throw VulkanError(fmt::format("a {}x{} view needs {} MiB in one storage buffer; {} allows {} MiB "
+                                    "(maxStorageBufferRange): lower render.cube_size or render.latlong_height",
+                                    views[0].width, views[0].height, (VkDeviceSize(total) * 16) >> 20,
+                                    context_.device_info().name, max_range >> 20),
+                        VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    const size_t half = views.size() / 2;
+    std::vector<std::vector<float>> images =
+        Render(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half), sun_disc);
+    std::vector<PassTiming> timings = last_timings();
+    for (std::vector<float>& image :
+         Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), sun_disc))
+      images.push_back(std::move(image));
+    timings.insert(timings.end(), last_timings().begin(), last_timings().end());
+    timings_ = timings;
+    return images;
+  }
+  EnsureOutputCapacity(std::max<size_t>(total, 1) * 16);
+  SubmitViews(output_buffer_, sun, views, sun_disc, offsets);
+
+  std::vector<std::vector<float>> images;
+  const float* data = static_cast<const float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < views.size(); ++i) {
+    size_t count = size_t(views[i].width) * views[i].height * 4;
+    images.emplace_back(data + offsets[i] * 4, data + offsets[i] * 4 + count);
+  }
+  return images;
+}
+
+RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                         bool sun_disc) {
+  if (!luts_ready_ && !output_directions_) PrecomputeLuts();
+  size_t total = 0;
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
+  const VkDeviceSize bytes = VkDeviceSize(std::max<size_t>(total, 1)) * 16;
+  RenderedViews result;
+  if (bytes > context_.properties().limits.maxStorageBufferRange) {
+    // Rendered in groups (Render) and held in memory of their own.
+    auto images = std::make_shared<std::vector<std::vector<float>>>(Render(sun, views, sun_disc));
+    for (const std::vector<float>& image : *images) result.views.push_back(image.data());
+    result.hold = images;
+    return result;
+  }
+  // A slot whose texels nobody holds any more, large enough; else a new one.
+  FrameSlot* slot = nullptr;
+  for (const std::unique_ptr<FrameSlot>& s : frame_slots_) {
+    if (s->hold.use_count() == 1) {
+      slot = s.get();
+      break;
+    }
+  }
+  if (!slot) {
+    frame_slots_.push_back(std::make_unique<FrameSlot>());
+    slot = frame_slots_.back().get();
+    slot->hold = std::make_shared<int>(0);
+  }
+  // The last holder's reads of the slot before the device writes it again.
+  std::atomic_thread_fence(std::memory_order_acquire);
+  if (slot->buffer.size < bytes) {
+    DestroyBuffer(slot->buffer);
+    slot->buffer = CreateBuffer(bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  }
+  SubmitViews(slot->buffer, sun, views, sun_disc, offsets);
+  const float* data = static_cast<const float*>(slot->buffer.mapped);
+  for (size_t offset : offsets) result.views.push_back(data + offset * 4);
+  result.hold = slot->hold;
+  return result;
+}
+
+bool SkyRenderer::HoldsFrames() const {
+  for (const std::unique_ptr<FrameSlot>& slot : frame_slots_)
+    if (slot->hold.use_count() > 1) return true;
+  return false;
+}
+
+void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                              bool sun_disc, const std::vector<size_t>& offsets) {
+  BindOutput(target);
+  const VkPipeline sky_pipeline = sky_pipeline_;
+
+  static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+  std::vector<Dispatch> dispatches;
+  std::vector<bool> barriers;
+  // The skydome moves the observer, so its texels ray-march: no sky-view LUT.
+  if (quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ &&
+      !(skyview_ready_ && skyview_sun_ == sun)) {
+    // The sky-view LUT depends on the sun only: built once per sun position.
+    skyview_ready_ = true;
+    skyview_sun_ = sun;
+    // The sky-view LUT for this Sun, read by every view below.
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    dispatches.push_back({"sky-view LUT", skyview_pipeline_, push,
+                          GroupCount(quality_.sky_view_width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(quality_.sky_view_height, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(true);
+    ++counters_.skyview_lut_builds;
+  }
+  if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
+  const size_t first_view = dispatches.size();
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewRequest& v = views[i];
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    push.view = {v.mapping, v.width, v.height, v.face};
+    // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
+    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
+    std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
+                       : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
+                                                          : "directions";
+    dispatches.push_back({name, sky_pipeline, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
+    // Views write disjoint ranges of the output buffer: no barriers between them.
+    barriers.push_back(false);
+  }
+  if (disc_pass_ && sun_disc) {
+    // The disc, added to the texels near the Sun once the sky pass has
+    // written them. Its angular radius with the margin NearSunDisc leaves.
+    const double disc_angle = std::min(2.0 * double(gpu_atmosphere_.solar_irradiance.w), 3.14159265358979);
+    const size_t last_view = dispatches.size() - 1;
+    for (size_t i = 0; i < views.size(); ++i) {
+      for (const TexelRect& r : TexelsNearDirection(views[i], sun, disc_angle)) {
+        gpu::SkyPush push = dispatches[first_view + i].push;  // the view's own constants
+        push.rect = {r.x0, r.y0, r.x1, r.y1};
+        dispatches.push_back({"sun disc", disc_pipeline_, push, GroupCount(r.x1 - r.x0, SKYBAKE_LOCAL_SIZE_X),
+                              GroupCount(r.y1 - r.y0, SKYBAKE_LOCAL_SIZE_Y)});
+        // Rectangles are disjoint, within and across views.
+        barriers.push_back(false);
+        ++counters_.sun_disc_dispatches;
+        counters_.sun_disc_texels += (long long)(r.x1 - r.x0) * (r.y1 - r.y0);
+      }
+    }
+    // The sky pass's writes before the disc's reads.
+    if (dispatches.size() > last_view + 1) barriers[last_view] = true;
+  }
+  if (cloud_layers_ > 0) {
+    // The sky and disc passes' writes before the cloud pass reads them.
+    barriers.back() = true;
+    for (size_t i = 0; i < views.size(); ++i) {
+      Dispatch d = dispatches[first_view + i];
+      d.name = "clouds " + d.name;
+      d.pipeline = cloud_pipeline_;
+      dispatches.push_back(d);
+      barriers.push_back(false);  // views are disjoint
+      ++counters_.cloud_dispatches;
+    }
+  }
+  Submit(dispatches, barriers);
+  ++counters_.frames;
+}
+
+std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
+                                                 const std::vector<glm::dvec3>& directions, bool sun_disc) {
+  if (!luts_ready_) PrecomputeLuts();
+  // The directions after the view's texels, where the sun-disc pass still
+  // finds them once the sky pass has written radiance.
+  EnsureOutputCapacity(std::max<size_t>(directions.size(), 1) * 2 * 16);
+  float* data = static_cast<float*>(output_buffer_.mapped) + 4 * directions.size();
+  for (size_t i = 0; i < directions.size(); ++i) {
+    data[4 * i + 0] = float(directions[i].x);
+    data[4 * i + 1] = float(directions[i].y);
+    data[4 * i + 2] = float(directions[i].z);
+    data[4 * i + 3] = 0.0f;
+  }
+  ViewRequest view;
+  view.mapping = MAPPING_DIRECTIONS;
+  view.width = int(directions.size());
+  view.height = 1;
+  return Render(sun, {view}, sun_disc)[0];
+}
+
+bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                                   const EffectSettings& effects, const Rgb& output_scale) {
+  const gpu::GpuAtmosphere g = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
+  // The shader variant (specialization constants) and the buffer sizes must
+  // stay; every other value is uniform data.
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  if (!same(g.lut_sizes, gpu_atmosphere_.lut_sizes) || !same(g.samples, gpu_atmosphere_.samples) ||
+      !same(g.effects, gpu_atmosphere_.effects) || !same(g.render, gpu_atmosphere_.render) ||
+      quality.sky_view_lut != quality_.sky_view_lut || effects.mie != effects_.mie ||
+      effects.ozone != effects_.ozone || effects.night_dimming != effects_.night_dimming)
+    return false;
+  if (same(g, gpu_atmosphere_)) return true;
+  // Every submission waits for its fence, so no dispatch reads the buffer now.
+  gpu_atmosphere_ = g;
+  effects_ = effects;
+  std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
+  luts_ready_ = false;
+  skyview_ready_ = false;
+  cloud_tables_ready_ = false;
+  return true;
+}
+
+bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
+  const gpu::GpuClouds& c = clouds.uniform;
+  auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
+  if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
+      !same(c.lut, gpu_clouds_.lut))
+    return false;
+  // The noise depends on the seeds, the buffer layout and the weather images.
+  bool noise_same = clouds.weather_images == cloud_weather_images_;
+  for (int l = 0; l < cloud_layers_; ++l)
+    noise_same = noise_same && same(c.layers[l].noise, gpu_clouds_.layers[l].noise) &&
+                 (c.layers[l].weather.w > 0.5f) == (gpu_clouds_.layers[l].weather.w > 0.5f);
+  if (same(c, gpu_clouds_) && noise_same) return true;
+  // Every submission waits for its fence, so no dispatch reads the buffers now.
+  if (!noise_same) {
+    cloud_noise_ready_ = false;
+    cloud_weather_images_ = clouds.weather_images;
+  }
+  // The tables depend on the layers' top (the ambient table's range) and distances.
+  if (!same(c.range, gpu_clouds_.range)) cloud_tables_ready_ = false;
+  gpu_clouds_ = c;
+  std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
+  if (!cloud_noise_ready_ && luts_ready_) GenerateCloudNoise();
+  return true;
+}
+
+std::vector<float> SkyRenderer::ReadCloudNoise() const {
+  if (cloud_layers_ == 0) return {};
+  const float* data = static_cast<const float*>(cloud_noise_buffer_.mapped);
+  return std::vector<float>(data, data + CloudNoiseFloats(gpu_clouds_));
+}
+
+bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {
+  const AoasSwitches& s = aoas.switches;
+  if (s.skydome != aoas_switches_.skydome || s.ambiguity != aoas_switches_.ambiguity ||
+      s.cloud_noise != aoas_switches_.cloud_noise || s.cloud_shapes != aoas_switches_.cloud_shapes)
+    return false;
+  // Every submission waits for its fence, so no dispatch reads the buffer now.
+  std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
+  return true;
+}
+
+std::vector<float> SkyRenderer::ReadTransmittanceLut() const {
+  const float* data = static_cast<const float*>(transmittance_buffer_.mapped);
+  return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.x) * gpu_atmosphere_.lut_sizes.y * 4);
+}
+
+std::vector<float> SkyRenderer::ReadMultipleScatteringLut() const {
+  const float* data = static_cast<const float*>(multiscattering_buffer_.mapped);
+  return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.z) * gpu_atmosphere_.lut_sizes.w * 4);
+}
+
+}  // namespace skybake

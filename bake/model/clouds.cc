@@ -1,0 +1,208 @@
+#include "skybake/model/clouds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+
+namespace skybake {
+
+std::array<double, 4> CloudTypeProfile(CloudType type) {
+  // [bottom_in, bottom_full, top_full, top_out], fractions of the layer's
+  // own thickness: the shapes of the Nubis height gradients (a flat base and
+  // a low top for stratus, a fast rise and a rounded top for cumulus, nearly
+  // the whole column for cumulonimbus, a thin sheet for cirrus), each for a
+  // layer that holds one type.
+  switch (type) {
+    case CloudType::kStratus: return {0.0, 0.1, 0.7, 1.0};
+    case CloudType::kStratocumulus: return {0.0, 0.15, 0.55, 1.0};
+    case CloudType::kCumulus: return {0.0, 0.08, 0.45, 1.0};
+    case CloudType::kCumulonimbus: return {0.0, 0.05, 0.8, 1.0};
+    case CloudType::kCirrus: return {0.0, 0.35, 0.65, 1.0};
+    case CloudType::kCustom: break;
+  }
+  return {0.0, 0.1, 0.5, 1.0};
+}
+
+const char* CloudTypeName(CloudType type) {
+  switch (type) {
+    case CloudType::kStratus: return "stratus";
+    case CloudType::kStratocumulus: return "stratocumulus";
+    case CloudType::kCumulus: return "cumulus";
+    case CloudType::kCumulonimbus: return "cumulonimbus";
+    case CloudType::kCirrus: return "cirrus";
+    case CloudType::kCustom: return "custom";
+  }
+  return "custom";
+}
+
+CloudQuality CloudQualityPreset(const std::string& name) {
+  CloudQuality q;  // production
+  if (name == "draft") {
+    q.view_steps = 32;
+    q.light_steps = 6;
+    q.octaves = 4;
+    q.shape_resolution = 48;
+    q.detail_resolution = 24;
+    q.weather_resolution = 128;
+  } else if (name == "reference") {
+    q.view_steps = 192;
+    q.light_steps = 32;
+    q.octaves = 8;
+    q.shape_resolution = 128;
+    q.detail_resolution = 64;
+    q.weather_resolution = 512;
+  }
+  return q;
+}
+
+std::vector<CloudLayer> ActiveCloudLayers(const CloudSettings& clouds) {
+  std::vector<CloudLayer> active;
+  for (const CloudLayer& l : clouds.layers)
+    if (l.coverage > 0.0 && l.density_per_m > 0.0) active.push_back(l);
+  std::stable_sort(active.begin(), active.end(),
+                   [](const CloudLayer& a, const CloudLayer& b) { return a.altitude_m < b.altitude_m; });
+  return active;
+}
+
+namespace {
+
+std::string ResolvePath(const std::string& path, const std::string& style_dir) {
+  std::filesystem::path p(path);
+  if (p.is_relative() && !style_dir.empty()) p = std::filesystem::path(style_dir) / p;
+  return p.string();
+}
+
+}  // namespace
+
+std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const AtmosphereParams& atmosphere,
+                                         const std::string& style_dir) {
+  std::vector<CloudProblem> problems;
+  if (int(clouds.layers.size()) > kMaxCloudLayers)
+    problems.push_back({kMaxCloudLayers, "",
+                        fmt::format("{} cloud layers; at most {} fit: merge or remove [[cloud_layer]] tables",
+                                    clouds.layers.size(), kMaxCloudLayers)});
+  const double loops = CloudLoopIterationsPerTexel(clouds);
+  if (loops > kMaxCloudLoopIterations)
+    problems.push_back({-2, "",
+                        fmt::format("{} cloud layer(s) x {} view steps x {} light steps may run {:.0f} loop "
+                                    "iterations per texel; lavapipe ends a shader's loops after 65535 in all "
+                                    "(LP_MAX_TGSI_LOOP_ITERATIONS): lower quality.cloud_view_steps or "
+                                    "quality.cloud_light_steps (at most {:.0f} iterations)",
+                                    std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers),
+                                    clouds.quality.view_steps, clouds.quality.light_steps, loops,
+                                    kMaxCloudLoopIterations)});
+  const double atmosphere_m = (atmosphere.top_radius_km - atmosphere.bottom_radius_km) * 1000.0;
+  for (size_t i = 0; i < clouds.layers.size(); ++i) {
+    const CloudLayer& l = clouds.layers[i];
+    const int index = int(i);
+    const double top = l.altitude_m + l.thickness_m;
+    if (top > atmosphere_m)
+      problems.push_back({index, "thickness_m",
+                          fmt::format("the layer's top at {} m is above the top of the atmosphere ({} m): lower "
+                                      "altitude_m or thickness_m",
+                                      top, atmosphere_m)});
+    const std::array<double, 4>& p = l.profile;
+    if (!(p[0] <= p[1] && p[1] <= p[2] && p[2] <= p[3]) || p[0] < 0.0 || p[3] > 1.0 || p[3] <= p[0])
+      problems.push_back({index, "profile",
+                          fmt::format("[{}, {}, {}, {}]: expected [bottom_in, bottom_full, top_full, top_out], "
+                                      "non-decreasing fractions in [0, 1] with top_out > bottom_in",
+                                      p[0], p[1], p[2], p[3])});
+    if (!l.weather_image.empty()) {
+      const std::string path = ResolvePath(l.weather_image, style_dir);
+      std::string problem = CheckWeatherImage(path);
+      if (!problem.empty())
+        problems.push_back({index, "weather_image",
+                            fmt::format("{}: {}: give an EXR or PNG whose first channel is the coverage, 0..1",
+                                        path, problem)});
+    }
+  }
+  return problems;
+}
+
+double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
+  const double layers = double(std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers));
+  if (layers == 0.0) return 0.0;
+  const CloudQuality& q = clouds.quality;
+  // Per view sample: the layer loop; per lit sample also the light march
+  // (each step a layer loop), the octaves and the albedo's layer loop.
+  const double per_sample = 1.0 + layers + q.light_steps * (1.0 + layers) + q.octaves + layers;
+  return layers * q.view_steps * per_sample;
+}
+
+size_t CloudNoiseFloats(const gpu::GpuClouds& c) {
+  const size_t per_layer = size_t(c.resolution.x) * c.resolution.x * c.resolution.x +
+                           size_t(c.resolution.y) * c.resolution.y * c.resolution.y +
+                           size_t(c.resolution.z) * c.resolution.z;
+  return std::max<size_t>(per_layer * size_t(std::max(c.counts.x, 0)), 4);
+}
+
+CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
+                          double time_s) {
+  CloudInputs in;
+  gpu::GpuClouds& g = in.uniform;
+  const std::vector<CloudLayer> layers = ActiveCloudLayers(clouds);
+  if (layers.empty()) return in;
+  const CloudQuality& q = clouds.quality;
+  const int count = std::min<int>(int(layers.size()), kMaxCloudLayers);
+  g.counts = {count, q.view_steps, q.light_steps, q.octaves};
+  g.resolution = {q.shape_resolution, q.detail_resolution, q.weather_resolution, 0};
+  // Aerial-perspective LUT 32 azimuths x 64 zenith angles x 32 distances;
+  // ambient table of 16 altitudes.
+  g.lut = {32, 64, 32, 16};
+  // Hillaire 2016 / takram defaults: forward 0.7, backward -0.2, mixed 0.5;
+  // Wrenninge 2013 octaves a = b = c = 0.5.
+  g.phase = {0.7f, -0.2f, 0.5f, 0.0f};
+  g.octave = {0.5f, 0.5f, 0.5f, 0.0f};
+  double top_km = 0.0;
+  const size_t shape = size_t(q.shape_resolution) * q.shape_resolution * q.shape_resolution;
+  const size_t detail = size_t(q.detail_resolution) * q.detail_resolution * q.detail_resolution;
+  const size_t weather = size_t(q.weather_resolution) * q.weather_resolution;
+  for (int i = 0; i < count; ++i) {
+    const CloudLayer& l = layers[i];
+    gpu::GpuCloudLayer& o = g.layers[i];
+    const double bottom_km = l.altitude_m * 1e-3, thickness_km = l.thickness_m * 1e-3;
+    top_km = std::max(top_km, bottom_km + thickness_km);
+    o.shell = {float(bottom_km), float(bottom_km + thickness_km), float(l.density_per_m * 1e3), float(l.albedo)};
+    o.profile = {float(l.profile[0]), float(l.profile[1]), float(l.profile[2]), float(l.profile[3])};
+    o.shape = {float(l.shape_amount), float(1e3 / l.shape_size_m), float(l.detail_amount),
+               float(1e3 / l.detail_size_m)};
+    // World x = east, z = -north.
+    const double seconds = time_s;
+    o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
+                     float(l.shear_m_s_per_km[0] * seconds * 1e-3), float(-l.shear_m_s_per_km[1] * seconds * 1e-3)};
+    if (l.weather_image.empty()) {
+      o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};
+      o.weather_origin = {0.0f, 0.0f, 0.0f, 0.0f};
+    } else {
+      // The image's north-west corner (row 0, column 0) at world x = west
+      // edge, z = -(north edge).
+      o.weather = {float(l.coverage), float(1e3 / l.weather_extent_m[0]), float(1e3 / l.weather_extent_m[1]), 1.0f};
+      o.weather_origin = {float(l.weather_origin_m[0] * 1e-3),
+                          float(-(l.weather_origin_m[1] + l.weather_extent_m[1]) * 1e-3), 0.0f, 0.0f};
+      const std::vector<float> map = ReadWeatherImage(ResolvePath(l.weather_image, style_dir), q.weather_resolution);
+      in.weather_images.insert(in.weather_images.end(), map.begin(), map.end());
+    }
+    const size_t first = size_t(i) * (shape + detail + weather);
+    o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
+               int32_t(l.seed.value_or(aoas_seed))};
+  }
+  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), 0.0f, 0.0f};
+  // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
+  int bands = 0;
+  for (int i = 0; i < count; ++i) {
+    const float lo = g.layers[i].shell.x, hi = g.layers[i].shell.y;
+    if (bands > 0 && lo <= g.bands[bands - 1].y) {
+      g.bands[bands - 1].y = std::max(g.bands[bands - 1].y, hi);
+    } else {
+      g.bands[bands++] = {lo, hi, 0.0f, 0.0f};
+    }
+  }
+  g.resolution.w = bands;
+  return in;
+}
+
+}  // namespace skybake

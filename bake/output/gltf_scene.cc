@@ -1,0 +1,342 @@
+#include "skybake/output/gltf_scene.h"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <fmt/format.h>
+#include <glm/geometric.hpp>
+#include <glm/gtx/quaternion.hpp>
+#include <nlohmann/json.hpp>
+
+#define TINYGLTF_IMPLEMENTATION
+#define TINYGLTF_NO_STB_IMAGE
+#define TINYGLTF_NO_STB_IMAGE_WRITE
+#define TINYGLTF_NO_EXTERNAL_IMAGE
+#define TINYGLTF_NO_INCLUDE_JSON
+#include <tiny_gltf.h>
+
+#include "skybake/output/exr_io.h"
+
+namespace skybake {
+namespace {
+
+using nlohmann::json;
+
+// Appends `bytes` to the buffer, 4-byte aligned, and returns the new bufferView.
+int AddBufferView(tinygltf::Model& model, const void* bytes, size_t size, int target) {
+  std::vector<unsigned char>& data = model.buffers[0].data;
+  while (data.size() % 4) data.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = data.size();
+  view.byteLength = size;
+  view.target = target;
+  const unsigned char* p = static_cast<const unsigned char*>(bytes);
+  data.insert(data.end(), p, p + size);
+  model.bufferViews.push_back(view);
+  return int(model.bufferViews.size() - 1);
+}
+
+int AddAccessor(tinygltf::Model& model, int view, int component, size_t count, int type,
+                std::vector<double> min = {}, std::vector<double> max = {}) {
+  tinygltf::Accessor a;
+  a.bufferView = view;
+  a.componentType = component;
+  a.count = count;
+  a.type = type;
+  a.minValues = std::move(min);
+  a.maxValues = std::move(max);
+  model.accessors.push_back(a);
+  return int(model.accessors.size() - 1);
+}
+
+tinygltf::Value ToValue(const json& j) {
+  if (j.is_object()) {
+    tinygltf::Value::Object o;
+    for (auto it = j.begin(); it != j.end(); ++it) o[it.key()] = ToValue(it.value());
+    return tinygltf::Value(std::move(o));
+  }
+  if (j.is_array()) {
+    tinygltf::Value::Array a;
+    for (const json& item : j) a.push_back(ToValue(item));
+    return tinygltf::Value(std::move(a));
+  }
+  if (j.is_boolean()) return tinygltf::Value(j.get<bool>());
+  if (j.is_number_integer()) return tinygltf::Value(int(j.get<int64_t>()));
+  if (j.is_number()) return tinygltf::Value(j.get<double>());
+  if (j.is_string()) return tinygltf::Value(j.get<std::string>());
+  return tinygltf::Value();
+}
+
+// The texture PNG: a regular file, never read through a link.
+std::string ReadFile(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
+  struct stat st {};
+  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    if (fd >= 0) ::close(fd);
+    throw OutputError(fmt::format("cannot read {} for the glTF scene: not a regular file", path));
+  }
+  std::string bytes;
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      ::close(fd);
+      throw OutputError(fmt::format("cannot read {} for the glTF scene: {}", path, std::strerror(errno)));
+    }
+    if (n == 0) break;
+    bytes.append(buffer, size_t(n));
+  }
+  ::close(fd);
+  return bytes;
+}
+
+}  // namespace
+
+glm::dvec2 LatLongUvFromDirection(const glm::dvec3& d, int w, int h) {
+  // Inverse of Imf::LatLongMap::direction: pixel x = (0.5 - lon / 2pi)(w - 1),
+  // y = (0.5 - lat / pi)(h - 1); texel x's centre is at u = (x + 0.5) / w.
+  glm::dvec3 n = glm::normalize(d);
+  double lat = std::asin(std::clamp(n.y, -1.0, 1.0));
+  double lon = std::atan2(n.x, n.z);
+  double x = (0.5 - lon / (2.0 * M_PI)) * (w - 1);
+  double y = (0.5 - lat / M_PI) * (h - 1);
+  return {(x + 0.5) / w, (y + 0.5) / h};
+}
+
+DomeMesh BuildDome(const GltfSettings& settings, int w, int h) {
+  DomeMesh mesh;
+  const int segments = settings.segments;
+  const int rings_full = segments / 2;  // pole to pole
+  const int rings = settings.dome == DomeShape::kHemisphere ? rings_full / 2 : rings_full;
+  const double vertical = settings.radius_m * (1.0 - settings.flattening);
+  // Vertex (i, j): latitude pi/2 - i pi / rings_full, longitude pi - 2 pi j / segments.
+  // Column j = segments repeats j = 0 at the other edge of the texture.
+  for (int i = 0; i <= rings; ++i) {
+    double lat = M_PI / 2.0 - M_PI * i / rings_full;
+    for (int j = 0; j <= segments; ++j) {
+      double lon = M_PI - 2.0 * M_PI * j / segments;
+      if (i == 0 || i == rings_full) lon = M_PI - 2.0 * M_PI * (j + 0.5) / segments;  // pole: mid-column
+      glm::dvec3 d(std::sin(lon) * std::cos(lat), std::sin(lat), std::cos(lon) * std::cos(lat));
+      if (i == 0) d = {0.0, 1.0, 0.0};
+      if (i == rings_full) d = {0.0, -1.0, 0.0};
+      // Texture coordinates from latitude and longitude directly, so the seam
+      // columns get u at the left (lon +pi) and right (lon -pi) edges.
+      double x = (0.5 - lon / (2.0 * M_PI)) * (w - 1);
+      double y = (0.5 - lat / M_PI) * (h - 1);
+      mesh.uvs.push_back(glm::vec2(float((x + 0.5) / w), float((y + 0.5) / h)));
+      mesh.directions.push_back(d);
+      mesh.positions.push_back(glm::vec3(float(settings.radius_m * d.x), float(vertical * d.y),
+                                         float(settings.radius_m * d.z)));
+    }
+  }
+  const int columns = segments + 1;
+  auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+    // Counter-clockwise seen from the centre: the face normal points inwards.
+    glm::dvec3 pa = mesh.directions[a], pb = mesh.directions[b], pc = mesh.directions[c];
+    glm::dvec3 normal = glm::cross(pb - pa, pc - pa);
+    if (glm::dot(normal, pa + pb + pc) > 0.0) std::swap(b, c);
+    mesh.indices.insert(mesh.indices.end(), {a, b, c});
+  };
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      uint32_t a = uint32_t(i * columns + j), b = a + 1;
+      uint32_t c = uint32_t((i + 1) * columns + j), d = c + 1;
+      if (i != 0) add(a, c, b);                // no degenerate triangle at the top pole
+      if (i + 1 != rings_full) add(b, c, d);   // nor at the bottom pole
+    }
+  }
+  return mesh;
+}
+
+glm::dquat SunNodeRotation(const glm::dvec3& sun_direction) {
+  return glm::rotation(glm::dvec3(0.0, 0.0, 1.0), glm::normalize(sun_direction));
+}
+
+WrittenScene WriteGltfScene(const SceneDescription& scene) {
+  const std::filesystem::path dir(scene.out_dir);
+  WrittenScene written;
+  written.gltf_path = (dir / (scene.name + ".gltf")).string();
+  written.bin_path = (dir / (scene.name + ".bin")).string();
+  written.glb_path = (dir / (scene.name + ".glb")).string();
+
+  DomeMesh dome = BuildDome(scene.dome, scene.texture_width, scene.texture_height);
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "skybake " SKYBAKE_VERSION;
+  model.extensionsUsed = {"KHR_materials_unlit", "KHR_lights_punctual"};
+  model.extensionsRequired = {};
+  model.buffers.resize(1);
+
+  // Geometry.
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : dome.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  int positions = AddAccessor(model,
+                              AddBufferView(model, dome.positions.data(), dome.positions.size() * 12,
+                                            TINYGLTF_TARGET_ARRAY_BUFFER),
+                              TINYGLTF_COMPONENT_TYPE_FLOAT, dome.positions.size(), TINYGLTF_TYPE_VEC3,
+                              {lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z});
+  int uvs = AddAccessor(model,
+                        AddBufferView(model, dome.uvs.data(), dome.uvs.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
+                        TINYGLTF_COMPONENT_TYPE_FLOAT, dome.uvs.size(), TINYGLTF_TYPE_VEC2);
+  int indices = AddAccessor(model,
+                            AddBufferView(model, dome.indices.data(), dome.indices.size() * 4,
+                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, dome.indices.size(), TINYGLTF_TYPE_SCALAR);
+
+  // Sun animation: one rotation key per frame.
+  int animation_input = -1, animation_output = -1;
+  if (scene.suns.size() > 1) {
+    std::vector<float> times;
+    std::vector<float> rotations;
+    for (const SceneSun& s : scene.suns) {
+      times.push_back(float(s.time_s));
+      glm::dquat q = SunNodeRotation(s.direction);
+      rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
+    }
+    // Keep consecutive quaternions in one hemisphere so interpolation takes the short way.
+    for (size_t k = 4; k < rotations.size(); k += 4) {
+      float dot = 0;
+      for (int c = 0; c < 4; ++c) dot += rotations[k + c] * rotations[k - 4 + c];
+      if (dot < 0) for (int c = 0; c < 4; ++c) rotations[k + c] = -rotations[k + c];
+    }
+    animation_input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
+                                  TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR,
+                                  {times.front()}, {times.back()});
+    animation_output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
+                                   TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
+    // Animation data is not vertex data: no target.
+    model.bufferViews[model.accessors[animation_input].bufferView].target = 0;
+    model.bufferViews[model.accessors[animation_output].bufferView].target = 0;
+  }
+
+  // Texture: the tone-mapped sRGB latlong. Clamped, so the seam columns at
+  // u = 0.5 / width and 1 - 0.5 / width never blend with each other.
+  tinygltf::Image image;
+  image.name = "sky";
+  image.uri = scene.texture_file;
+  image.mimeType = "image/png";
+  model.images.push_back(image);
+  tinygltf::Sampler sampler;
+  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  model.samplers.push_back(sampler);
+  tinygltf::Texture texture;
+  texture.source = 0;
+  texture.sampler = 0;
+  model.textures.push_back(texture);
+
+  tinygltf::Material material;
+  material.name = "sky_unlit";
+  material.pbrMetallicRoughness.baseColorTexture.index = 0;
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 1.0;
+  material.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+  model.materials.push_back(material);
+
+  tinygltf::Mesh mesh;
+  mesh.name = "skydome";
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] = positions;
+  primitive.attributes["TEXCOORD_0"] = uvs;
+  primitive.indices = indices;
+  primitive.material = 0;
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  mesh.primitives.push_back(primitive);
+  model.meshes.push_back(mesh);
+
+  // The sun: KHR_lights_punctual directional light, lux.
+  const SceneSun& light_sun = scene.suns.at(size_t(scene.light_frame));
+  tinygltf::Light light;
+  light.name = "sun";
+  light.type = "directional";
+  light.intensity = light_sun.illuminance_lux;
+  light.color = {light_sun.color[0], light_sun.color[1], light_sun.color[2]};
+  model.lights.push_back(light);
+
+  tinygltf::Node dome_node;
+  dome_node.name = "skydome";
+  dome_node.mesh = 0;
+  model.nodes.push_back(dome_node);
+  tinygltf::Node sun_node;
+  sun_node.name = "sun";
+  glm::dquat q = SunNodeRotation(light_sun.direction);
+  sun_node.rotation = {q.x, q.y, q.z, q.w};
+  tinygltf::Value::Object light_ref;
+  light_ref["light"] = tinygltf::Value(0);
+  sun_node.extensions["KHR_lights_punctual"] = tinygltf::Value(light_ref);
+  model.nodes.push_back(sun_node);
+
+  if (animation_input >= 0) {
+    tinygltf::Animation animation;
+    animation.name = "sun_path";
+    tinygltf::AnimationSampler s;
+    s.input = animation_input;
+    s.output = animation_output;
+    s.interpolation = "LINEAR";
+    animation.samplers.push_back(s);
+    tinygltf::AnimationChannel channel;
+    channel.sampler = 0;
+    channel.target_node = 1;
+    channel.target_path = "rotation";
+    animation.channels.push_back(channel);
+    model.animations.push_back(animation);
+  }
+
+  tinygltf::Scene gltf_scene;
+  gltf_scene.name = scene.name;
+  gltf_scene.nodes = {0, 1};
+  json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
+  gltf_scene.extras = ToValue(json{{"skybake", extras}});
+  model.scenes.push_back(gltf_scene);
+  model.defaultScene = 0;
+  json asset_extras = {
+      {"skybake",
+       {{"units", {{"length", "metre"},
+                   {"sun_intensity", "lux (KHR_lights_punctual directional)"},
+                   {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
+        {"frame", "+Y up, right-handed, North -Z, East +X; sun light shines along its node's -Z"},
+        {"texture_layout", "OpenEXR latlong (Imf::LatLongMap): u = 0 at longitude +pi, v = 0 at latitude +pi/2"}}}};
+  model.asset.extras = ToValue(asset_extras);
+
+  tinygltf::TinyGLTF writer;
+  writer.SetImageWriter(nullptr, nullptr);
+
+  // name.gltf + name.bin: the JSON references the .bin and the PNG by name.
+  std::string bin(model.buffers[0].data.begin(), model.buffers[0].data.end());
+  {
+    std::ostringstream out;
+    if (!writer.WriteGltfSceneToStream(&model, out, true, false))
+      throw OutputError(fmt::format("cannot serialise {}", written.gltf_path));
+    json document = json::parse(out.str());
+    document["buffers"][0]["uri"] = scene.name + ".bin";
+    WriteFileAtomically(written.bin_path, bin);
+    WriteFileAtomically(written.gltf_path, document.dump(2) + "\n");
+  }
+  // name.glb: the PNG moves into the binary chunk.
+  {
+    std::string png = ReadFile((dir / scene.texture_file).string());
+    tinygltf::Model glb = model;
+    glb.images[0].uri.clear();
+    glb.images[0].bufferView = AddBufferView(glb, png.data(), png.size(), 0);
+    std::ostringstream out;
+    if (!writer.WriteGltfSceneToStream(&glb, out, false, true))
+      throw OutputError(fmt::format("cannot serialise {}", written.glb_path));
+    WriteFileAtomically(written.glb_path, out.str());
+  }
+  return written;
+}
+
+}  // namespace skybake

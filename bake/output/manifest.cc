@@ -1,0 +1,661 @@
+#include "skybake/output/manifest.h"
+#include "skybake/output/sha256.h"
+
+#include <algorithm>
+#include <cstring>
+#include <limits>
+#include <set>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/output/exr_io.h"
+#include "skybake/output/gltf_scene.h"
+#include "skybake/output/output_lock.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+constexpr const char* kShBasis =
+    "real SH l<=2, order (0,0)(1,-1)(1,0)(1,1)(2,-2)(2,-1)(2,0)(2,1)(2,2), Ramamoorthi-Hanrahan 2001 constants on "
+    "world x,y,z (+Y up); irradiance E(n) = sum E_lm Y_lm(n)";
+constexpr const char* kFrameConvention =
+    "+Y up, right-handed, North -Z, East +X; sun_direction points towards the Sun; azimuth clockwise from North";
+
+// --- JSON form. nlohmann writes doubles in their shortest round-trip form,
+// so a manifest read back holds the very doubles that were written: a merge
+// builds the scene from the same values as the bake that wrote the parts.
+
+json VectorJson(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
+json RgbJson(const Rgb& c) { return {c[0], c[1], c[2]}; }
+json ShJson(const ShRgb& c) {
+  json rows = json::array();
+  for (const Rgb& rgb : c) rows.push_back(RgbJson(rgb));
+  return rows;
+}
+
+json FileJson(const ManifestFile& f) {
+  return {{"file", f.file}, {"kind", f.kind}, {"bytes", f.bytes}, {"sha256", f.sha256}};
+}
+
+json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}}; }
+
+json FrameJson(const ManifestFrame& f) {
+  json files = json::array();
+  for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
+  return {{"frame", f.number},
+          {"style_sha256", f.style_sha256},
+          {"time", f.time ? json(*f.time) : json(nullptr)},
+          {"hours_from_start", f.hours_from_start},
+          {"animation_time_s", f.animation_time_s},
+          {"sun", {{"elevation_deg", f.sun_elevation_deg},
+                   {"azimuth_deg", f.sun_azimuth_deg},
+                   {"direction", VectorJson(f.sun_direction)},
+                   {"illuminance_lux", f.sun_illuminance_lux},
+                   {"irradiance", RgbJson(f.sun_irradiance)}}},
+          {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+          {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
+          {"files", files}};
+}
+
+json ManifestJson(const Manifest& m) {
+  json j = {
+      {"version", m.version},
+      {"style", m.style},
+      {"schedule", m.schedule},
+      {"sequence_sha256", m.sequence_sha256},
+      {"units", m.units},
+      {"exposure_ev100", m.exposure_ev100},
+      {"exposure_source", m.exposure_source},
+      {"texture_frame", m.texture_frame},
+      {"half_scale", m.half_scale},
+      {"sh_basis", kShBasis},
+      {"frame_convention", kFrameConvention},
+      {"gltf", {{"enabled", m.gltf.enabled},
+                {"name", m.gltf.name},
+                {"dome", m.gltf.dome.dome == DomeShape::kHemisphere ? "hemisphere" : "sphere"},
+                {"radius_m", m.gltf.dome.radius_m},
+                {"flattening", m.gltf.dome.flattening},
+                {"segments", m.gltf.dome.segments},
+                {"texture", {{"file", m.gltf.texture_file},
+                             {"width", m.gltf.texture_width},
+                             {"height", m.gltf.texture_height}}}}},
+  };
+  if (m.place) j["place"] = {{"latitude_deg", m.place->latitude_deg}, {"longitude_deg", m.place->longitude_deg}};
+  if (m.sequence) j["sequence"] = RangeJson(*m.sequence);
+  if (m.part) {
+    j["part"] = RangeJson(*m.part);
+    if (m.sequence) j["part"]["of_frames"] = m.sequence->count();
+  }
+  json frames = json::array();
+  for (const ManifestFrame& f : m.frames) frames.push_back(FrameJson(f));
+  j["frames"] = frames;
+  j["complete"] = m.complete;
+  json scene = json::array();
+  for (const ManifestFile& f : m.scene) scene.push_back(FileJson(f));
+  j["scene"] = scene;
+  return j;
+}
+
+// Reading: every access names the file and the entry when it fails.
+class Reader {
+ public:
+  explicit Reader(std::string path) : path_(std::move(path)) {}
+
+  template <typename T>
+  T Get(const json& object, const char* key) const {
+    if (!object.is_object() || !object.contains(key)) Fail(fmt::format("no '{}'", key));
+    try {
+      return object.at(key).get<T>();
+    } catch (const json::exception&) {
+      Fail(fmt::format("'{}' has the wrong type", key));
+    }
+  }
+  // An integer in [lo, hi] (a real, a string or a value out of range fails).
+  int64_t Integer(const json& object, const char* key, int64_t lo, int64_t hi) const {
+    const json& v = Get<json>(object, key);
+    if (v.is_number_unsigned()) {
+      if (v.get<uint64_t>() <= uint64_t(hi) && int64_t(v.get<uint64_t>()) >= lo) return int64_t(v.get<uint64_t>());
+    } else if (v.is_number_integer() && v.get<int64_t>() >= lo && v.get<int64_t>() <= hi) {
+      return v.get<int64_t>();
+    }
+    Fail(fmt::format("'{}' is {}, not an integer in [{}, {}]", key, v.dump(), lo, hi));
+  }
+  int Int(const json& object, const char* key) const {
+    return int(Integer(object, key, std::numeric_limits<int>::min(), std::numeric_limits<int>::max()));
+  }
+  glm::dvec3 Vector(const json& object, const char* key) const {
+    std::vector<double> v = Get<std::vector<double>>(object, key);
+    if (v.size() != 3) Fail(fmt::format("'{}' is not 3 numbers", key));
+    return {v[0], v[1], v[2]};
+  }
+  Rgb RgbOf(const json& object, const char* key) const {
+    glm::dvec3 v = Vector(object, key);
+    return {v.x, v.y, v.z};
+  }
+  ShRgb Sh(const json& object, const char* key) const {
+    std::vector<std::vector<double>> rows = Get<std::vector<std::vector<double>>>(object, key);
+    ShRgb sh{};
+    if (rows.size() != sh.size()) Fail(fmt::format("'{}' is not {} rows", key, sh.size()));
+    for (size_t i = 0; i < sh.size(); ++i) {
+      if (rows[i].size() != 3) Fail(fmt::format("'{}' row {} is not 3 numbers", key, i));
+      sh[i] = {rows[i][0], rows[i][1], rows[i][2]};
+    }
+    return sh;
+  }
+  FrameRange Range(const json& object, const char* key) const {
+    const json& r = Get<json>(object, key);
+    FrameRange range{Int(r, "first_frame"), Int(r, "last_frame")};
+    if (range.last < range.first) Fail(fmt::format("'{}' ends before it starts", key));
+    return range;
+  }
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw ManifestError(fmt::format("{}: {}: not a skybake manifest, or one from another version", path_, what));
+  }
+
+ private:
+  std::string path_;
+};
+
+// The largest file a manifest may list: 2^53 bytes (8 PiB), the integers a
+// JSON number holds exactly in every reader.
+constexpr int64_t kMaxFileBytes = int64_t(1) << 53;
+
+std::vector<ManifestFile> FilesOf(const Reader& r, const json& array) {
+  if (!array.is_array()) r.Fail("a file list is not an array");
+  std::vector<ManifestFile> files;
+  for (const json& f : array)
+    files.push_back({r.Get<std::string>(f, "file"), r.Get<std::string>(f, "kind"),
+                     uint64_t(r.Integer(f, "bytes", 0, kMaxFileBytes)), r.Get<std::string>(f, "sha256")});
+  return files;
+}
+
+std::string FrameRangeText(const FrameRange& r) {
+  return r.first == r.last ? fmt::format("{}", r.first) : fmt::format("{}-{}", r.first, r.last);
+}
+
+// The frames of `numbers` as ranges: "2-3, 7".
+std::string RangesText(const std::vector<int>& numbers) {
+  std::string text;
+  for (size_t i = 0; i < numbers.size();) {
+    size_t j = i;
+    while (j + 1 < numbers.size() && numbers[j + 1] == numbers[j] + 1) ++j;
+    if (!text.empty()) text += ", ";
+    text += FrameRangeText({numbers[i], numbers[j]});
+    i = j + 1;
+  }
+  return text;
+}
+
+// Everything of a manifest that all parts of one bake share.
+json SharedPart(json manifest) {
+  for (const char* key : {"frames", "part", "complete", "scene"}) manifest.erase(key);
+  return manifest;
+}
+
+// A name read from a manifest that is not the one skybake gives: the
+// manifest was edited (or is hostile). Nothing is opened under it.
+[[noreturn]] void FailName(const std::string& path, const std::string& where, const std::string& name,
+                           const std::string& expected) {
+  throw ManifestError(fmt::format("{}: {}: {} is not {}: the manifest was edited or is not skybake's; nothing was "
+                                  "read under that name. Bake the part again (with --force) to rewrite it",
+                                  path, where, EscapedText(name), expected));
+}
+
+bool EndsWith(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+// An image-based-lighting file of a frame (IblFileNames, bake/output/ibl_files.cc), listed
+// after the latlong and before the PNG: BASE_specular_mL.NNNN.exr per level
+// or BASE_specular.NNNN.ktx2, BASE_irradiance.NNNN.exr/.ktx2, and the
+// frame-independent BASE_dfg.exr/.ktx2. `stage` as in CheckNames (3: IBL).
+void CheckIblName(const std::string& path, const std::string& where, int number_in_name, const ManifestFile& file,
+                  std::string& base, int& stage) {
+  const std::string number = file.kind == "ibl_dfg" ? std::string() : FrameNumberSuffix(number_in_name);
+  const char* suffix = file.kind == "ibl_specular" ? "_specular" : file.kind == "ibl_irradiance" ? "_irradiance" : "_dfg";
+  const std::string shape = fmt::format("BASE{}{}.exr or .ktx2{}", suffix, number,
+                                        file.kind == "ibl_specular" ? " (BASE_specular_mLEVEL... for EXR levels)" : "");
+  std::string stem;
+  for (const char* ext : {".exr", ".ktx2"})
+    if (stem.empty() && EndsWith(file.file, number + ext)) stem = file.file.substr(0, file.file.size() - number.size() - std::strlen(ext));
+  if (stage > 3 || !IsPlainFileName(file.file) || stem.empty())
+    FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+  // An EXR specular level: strip its _mLEVEL.
+  if (file.kind == "ibl_specular" && EndsWith(file.file, ".exr")) {
+    const size_t m = stem.rfind("_m");
+    const bool digits = m != std::string::npos && m + 2 < stem.size() &&
+                        stem.find_first_not_of("0123456789", m + 2) == std::string::npos;
+    if (!digits) FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+    stem.resize(m);
+  }
+  if (!EndsWith(stem, suffix) || stem.size() == std::strlen(suffix))
+    FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+  const std::string b = stem.substr(0, stem.size() - std::strlen(suffix));
+  if (!base.empty() && b != base)
+    FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+  base = b;
+  stage = 3;
+}
+
+// Every name of a manifest is a plain file name and the one the bake gives
+// its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
+// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_latlong.NNNN.png, in that order, one BASE per
+// frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
+void CheckNames(const std::string& path, const Manifest& m) {
+  if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
+  if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
+    FailName(path, "gltf.texture.file", m.gltf.texture_file, "a plain file name of a PNG in the folder");
+  for (const ManifestFrame& f : m.frames) {
+    const std::string where = fmt::format("frame {}", f.number);
+    const std::string number = FrameNumberSuffix(f.number);
+    std::string base;
+    std::vector<std::string> faces;
+    int stage = 0;  // 0 faces, 1 cube, 2 latlong, 3 IBL, 4 png, 5 done: the order files are written in
+    auto stem_of = [&](const ManifestFile& file, const char* ext, const char* what) {
+      const std::string tail = number + ext;
+      if (!IsPlainFileName(file.file) || !EndsWith(file.file, tail) || file.file.size() == tail.size())
+        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (...{})", what,
+                                                     f.number, tail));
+      return file.file.substr(0, file.file.size() - tail.size());
+    };
+    auto with_suffix = [&](const ManifestFile& file, const std::string& stem, const char* suffix, const char* what,
+                           int at) {
+      if (stage > at || !EndsWith(stem, suffix) || stem.size() == std::strlen(suffix))
+        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE{}{})", what,
+                                                     f.number, suffix, number));
+      const std::string b = stem.substr(0, stem.size() - std::strlen(suffix));
+      if (!base.empty() && b != base)
+        FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+      base = b;
+      stage = at + 1;
+    };
+    for (const ManifestFile& file : f.files) {
+      if (file.kind == "face") {
+        if (stage > 0 || faces.size() == 6)
+          FailName(path, where, file.file, "one of six face files listed before the frame's other files");
+        faces.push_back(stem_of(file, ".exr", "face"));
+      } else if (file.kind == "cube") {
+        with_suffix(file, stem_of(file, ".exr", "cube strip"), "_cube", "cube strip", 1);
+      } else if (file.kind == "latlong") {
+        with_suffix(file, stem_of(file, ".exr", "latlong"), "_latlong", "latlong", 2);
+      } else if (file.kind == "ibl_specular" || file.kind == "ibl_irradiance" || file.kind == "ibl_dfg") {
+        CheckIblName(path, where, f.number, file, base, stage);
+      } else if (file.kind == "preview" || file.kind == "gltf_texture") {
+        with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
+      } else {
+        FailName(path, where, file.kind,
+                 "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, preview, "
+                 "gltf_texture)");
+      }
+    }
+    if (!faces.empty() && faces.size() != 6)
+      FailName(path, where, faces.back(), "one of six face files (the frame lists " + std::to_string(faces.size()) + ")");
+    // The faces share the frame's basename (the other files', else the
+    // scene's name, else their common prefix) and differ from each other.
+    if (!faces.empty()) {
+      if (base.empty()) {
+        base = m.gltf.name;
+        for (const std::string& face : faces)
+          if (face.compare(0, base.size() + 1, base + "_") != 0) base.clear();
+        if (base.empty()) {
+          for (size_t cut = faces[0].rfind('_'); cut != std::string::npos && cut > 0 && base.empty();
+               cut = faces[0].rfind('_', cut - 1)) {
+            const std::string candidate = faces[0].substr(0, cut);
+            bool all = true;
+            for (const std::string& face : faces) all = all && face.compare(0, cut + 1, candidate + "_") == 0;
+            if (all) base = candidate;
+          }
+        }
+      }
+      std::set<std::string> names;
+      for (size_t i = 0; i < faces.size(); ++i) {
+        const std::string face = faces[i];
+        if (base.empty() || face.compare(0, base.size() + 1, base + "_") != 0 || face.size() == base.size() + 1 ||
+            !names.insert(face).second || face == base + "_cube" || face == base + "_latlong")
+          FailName(path, where, f.files[i].file,
+                   fmt::format("a face file skybake names for frame {} (BASE_FACE{}.exr, six different faces)",
+                               f.number, number));
+      }
+    }
+  }
+  static const std::map<std::string, std::string> kSceneExtension = {
+      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}};
+  for (const ManifestFile& file : m.scene) {
+    auto it = kSceneExtension.find(file.kind);
+    if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
+      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb)", m.gltf.name));
+  }
+}
+
+}  // namespace
+
+std::string FrameNumberSuffix(int number) { return number > 0 ? fmt::format(".{:04d}", number) : ""; }
+
+std::string SequenceIdentityLine(int number, const std::string& time_iso8601, const glm::dvec3& sun,
+                                 const std::string& style_sha256) {
+  return fmt::format("{} {} {:.17g} {:.17g} {:.17g} {}\n", number, time_iso8601, sun.x, sun.y, sun.z, style_sha256);
+}
+
+std::string ManifestFileName(const std::optional<FrameRange>& part) {
+  return part ? fmt::format("manifest.shard-{:04d}-{:04d}.json", part->first, part->last) : "manifest.json";
+}
+
+std::string TimingsFileName(const std::optional<FrameRange>& part) {
+  return part ? fmt::format("timings.shard-{:04d}-{:04d}.json", part->first, part->last) : "timings.json";
+}
+
+ManifestFrame ManifestFrameOf(const FrameResult& frame) {
+  ManifestFrame f;
+  f.number = frame.number;
+  if (frame.time) f.time = frame.time->Iso8601();
+  f.sun_elevation_deg = frame.sun_elevation_deg;
+  f.sun_azimuth_deg = frame.sun_azimuth_deg;
+  f.sun_direction = frame.sun_direction;
+  f.sun_illuminance_lux = frame.sun_illuminance_lux;
+  f.sun_irradiance = frame.sun_irradiance;
+  f.sh_irradiance_with_sun = frame.sh_irradiance_with_sun;
+  f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
+  for (const BakedFile& file : frame.files)
+    f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+  return f;
+}
+
+void WriteManifest(const Manifest& manifest, const std::string& path) {
+  WriteFileAtomically(path, ManifestJson(manifest).dump(2) + "\n");
+}
+
+Manifest ReadManifest(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ManifestError(fmt::format("cannot read {}", path));
+  json j = json::parse(in, nullptr, false);
+  Reader r(path);
+  if (j.is_discarded() || !j.is_object()) r.Fail("invalid JSON");
+  Manifest m;
+  m.version = r.Get<std::string>(j, "version");
+  m.style = r.Get<std::string>(j, "style");
+  m.schedule = r.Get<std::string>(j, "schedule");
+  m.sequence_sha256 = r.Get<std::string>(j, "sequence_sha256");
+  m.units = r.Get<std::string>(j, "units");
+  m.exposure_ev100 = r.Get<double>(j, "exposure_ev100");
+  m.exposure_source = r.Get<std::string>(j, "exposure_source");
+  m.texture_frame = r.Int(j, "texture_frame");
+  m.half_scale = r.Get<double>(j, "half_scale");
+  const json& gltf = r.Get<json>(j, "gltf");
+  m.gltf.enabled = r.Get<bool>(gltf, "enabled");
+  m.gltf.name = r.Get<std::string>(gltf, "name");
+  m.gltf.dome.dome = r.Get<std::string>(gltf, "dome") == "hemisphere" ? DomeShape::kHemisphere : DomeShape::kSphere;
+  m.gltf.dome.radius_m = r.Get<double>(gltf, "radius_m");
+  m.gltf.dome.flattening = r.Get<double>(gltf, "flattening");
+  m.gltf.dome.segments = int(r.Integer(gltf, "segments", 3, 4096));
+  m.gltf.dome.enabled = m.gltf.enabled;
+  const json& texture = r.Get<json>(gltf, "texture");
+  m.gltf.texture_file = r.Get<std::string>(texture, "file");
+  m.gltf.texture_width = int(r.Integer(texture, "width", 1, 16384));
+  m.gltf.texture_height = int(r.Integer(texture, "height", 1, 8192));
+  if (j.contains("place"))
+    m.place = GeoLocation{r.Get<double>(j["place"], "latitude_deg"), r.Get<double>(j["place"], "longitude_deg")};
+  if (j.contains("sequence")) m.sequence = r.Range(j, "sequence");
+  if (j.contains("part")) m.part = r.Range(j, "part");
+  for (const json& f : r.Get<json>(j, "frames")) {
+    ManifestFrame frame;
+    frame.number = r.Int(f, "frame");
+    frame.style_sha256 = r.Get<std::string>(f, "style_sha256");
+    if (f.contains("time") && !f["time"].is_null()) frame.time = r.Get<std::string>(f, "time");
+    frame.hours_from_start = r.Get<double>(f, "hours_from_start");
+    frame.animation_time_s = r.Get<double>(f, "animation_time_s");
+    const json& sun = r.Get<json>(f, "sun");
+    frame.sun_elevation_deg = r.Get<double>(sun, "elevation_deg");
+    frame.sun_azimuth_deg = r.Get<double>(sun, "azimuth_deg");
+    frame.sun_direction = r.Vector(sun, "direction");
+    frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
+    frame.sun_irradiance = r.RgbOf(sun, "irradiance");
+    frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
+    frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
+    frame.files = FilesOf(r, r.Get<json>(f, "files"));
+    m.frames.push_back(std::move(frame));
+  }
+  m.complete = r.Get<bool>(j, "complete");
+  m.scene = FilesOf(r, r.Get<json>(j, "scene"));
+  CheckNames(path, m);
+  return m;
+}
+
+std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir) {
+  // Scene: the dome textured with the reference frame, the sun (animated
+  // for a sequence), all from the manifest's frames.
+  std::vector<BakedFile> scene_files;
+  manifest.scene.clear();
+  if (manifest.gltf.enabled && !manifest.frames.empty()) {
+    json frame_extras = json::array();
+    SceneDescription scene;
+    scene.name = manifest.gltf.name;
+    scene.out_dir = out_dir;
+    scene.texture_file = manifest.gltf.texture_file;
+    scene.texture_width = manifest.gltf.texture_width;
+    scene.texture_height = manifest.gltf.texture_height;
+    scene.dome = manifest.gltf.dome;
+    for (size_t i = 0; i < manifest.frames.size(); ++i) {
+      const ManifestFrame& f = manifest.frames[i];
+      if (f.number == manifest.texture_frame) scene.light_frame = int(i);
+      SceneSun sun;
+      sun.time_s = f.animation_time_s;
+      sun.direction = f.sun_direction;
+      sun.illuminance_lux = f.sun_illuminance_lux;
+      double peak = std::max({f.sun_irradiance[0], f.sun_irradiance[1], f.sun_irradiance[2]});
+      if (peak > 0.0) sun.color = {f.sun_irradiance[0] / peak, f.sun_irradiance[1] / peak, f.sun_irradiance[2] / peak};
+      scene.suns.push_back(sun);
+      frame_extras.push_back({{"frame", f.number},
+                              {"time", f.time.value_or("")},
+                              {"animation_time_s", f.animation_time_s},
+                              {"sun_direction", VectorJson(f.sun_direction)},
+                              {"sun_illuminance_lux", f.sun_illuminance_lux},
+                              {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                              {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}});
+    }
+    json provenance = {{"version", manifest.version},       {"style", manifest.style},
+                       {"schedule", manifest.schedule},     {"units", manifest.units},
+                       {"exposure_ev100", manifest.exposure_ev100}, {"texture_frame", manifest.texture_frame},
+                       {"sh_basis", kShBasis},              {"frames", frame_extras}};
+    scene.extras_json = provenance.dump();
+    WrittenScene written = WriteGltfScene(scene);
+    for (auto [path, kind] : {std::pair{written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"},
+                              {written.glb_path, "glb"}}) {
+      scene_files.push_back({path, kind, fs::file_size(path), Sha256OfFile(path)});
+      manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
+                                scene_files.back().sha256});
+    }
+  }
+  // Manifest: written last, once every file it lists is in place.
+  manifest.complete = true;
+  WriteManifest(manifest, (fs::path(out_dir) / ManifestFileName(std::nullopt)).string());
+  return scene_files;
+}
+
+void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds,
+                  const std::string& path) {
+  json stages = json::array();
+  for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
+  json frames = json::array();
+  for (const FrameResult& f : result.frames) {
+    json passes = json::array();
+    for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
+    frames.push_back({{"frame", f.number}, {"render_s", f.render_seconds}, {"write_s", f.write_seconds},
+                      {"gpu_passes", passes}});
+  }
+  json timings = {{"out_dir", out_dir},
+                  {"renderer_builds", result.renderer_builds},
+                  {"manifest_writes", result.manifest_writes},
+                  {"manifest_bytes_written", result.manifest_bytes_written},
+                  {"total_s", total_seconds},
+                  {"stages", stages},
+                  {"frames", frames}};
+  WriteFileAtomically(path, timings.dump(2) + "\n");
+}
+
+MergeResult MergeShardManifests(const MergeOptions& options) {
+  const fs::path dir(options.dir);
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw ManifestError(fmt::format("{} is not a folder: give the folder the shards baked into", options.dir));
+
+  // The parts: every manifest.shard-FIRST-LAST.json, by first frame.
+  static const std::regex kPartName(R"(manifest\.shard-\d+-\d+\.json)");
+  std::vector<std::string> paths;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file() && std::regex_match(name, kPartName)) paths.push_back(e.path().string());
+  }
+  if (paths.empty())
+    throw ManifestError(fmt::format("no shard manifests (manifest.shard-FIRST-LAST.json) in {}: bake with --shard "
+                                    "I/N or --frames A:B into it first",
+                                    options.dir));
+  std::vector<std::pair<Manifest, json>> parts;
+  for (const std::string& path : paths) {
+    Manifest m = ReadManifest(path);
+    std::ifstream in(path, std::ios::binary);
+    parts.emplace_back(std::move(m), SharedPart(json::parse(in)));
+  }
+  std::vector<size_t> order(parts.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  for (size_t i = 0; i < parts.size(); ++i)
+    if (!parts[i].first.part || !parts[i].first.sequence)
+      throw ManifestError(fmt::format("{} is not the manifest of a part of a sequence", paths[i]));
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return parts[a].first.part->first < parts[b].first.part->first; });
+
+  // One bake: the parts agree on everything but their frames.
+  const size_t first = order.front();
+  for (size_t i : order) {
+    const json& a = parts[first].second;
+    const json& b = parts[i].second;
+    if (a == b) continue;
+    std::string key;
+    for (const json* side : {&a, &b})
+      for (auto it = side->begin(); it != side->end() && key.empty(); ++it)
+        if (!a.contains(it.key()) || !b.contains(it.key()) || a[it.key()] != b[it.key()]) key = it.key();
+    throw ManifestError(fmt::format(
+        "{} and {} come from different bakes: their '{}' differs ({} vs {}): bake every shard with the same "
+        "skybake version, style, schedule, --set and --size into one folder",
+        paths[first], paths[i], key, a.contains(key) ? a[key].dump() : "none", b.contains(key) ? b[key].dump() : "none"));
+  }
+
+  // Every frame once: complete parts, no overlap, no gap.
+  const Manifest& shared = parts[first].first;
+  const FrameRange sequence = *shared.sequence;
+  std::map<int, size_t> owner;  // frame number -> part
+  for (size_t i : order) {
+    const Manifest& m = parts[i].first;
+    if (!m.complete || int(m.frames.size()) != m.part->count())
+      throw ManifestError(fmt::format("{} is incomplete ({} of frames {} baked): finish it by running its bake "
+                                      "again with --resume",
+                                      paths[i], m.frames.size(), FrameRangeText(*m.part)));
+    for (const ManifestFrame& f : m.frames) {
+      if (!m.part->Contains(f.number) || !sequence.Contains(f.number))
+        throw ManifestError(fmt::format("{} lists frame {}, outside its part {}", paths[i], f.number,
+                                        FrameRangeText(*m.part)));
+      auto [it, inserted] = owner.emplace(f.number, i);
+      if (!inserted)
+        throw ManifestError(fmt::format("frame {} is in both {} and {}: the shards overlap; remove one of the two "
+                                        "manifests (with its files if they differ) and merge again",
+                                        f.number, paths[it->second], paths[i]));
+    }
+  }
+  std::vector<int> missing;
+  for (int n = sequence.first; n <= sequence.last; ++n)
+    if (!owner.count(n)) missing.push_back(n);
+  if (!missing.empty()) {
+    const bool one_range = missing.back() - missing.front() + 1 == int(missing.size());
+    throw ManifestError(fmt::format(
+        "frame{} {} of {} {} missing: no shard manifest in {} lists {}: bake {} into {} (the missing --shard, or {}), "
+        "then merge again",
+        missing.size() == 1 ? "" : "s", RangesText(missing), FrameRangeText(sequence),
+        missing.size() == 1 ? "is" : "are", options.dir, missing.size() == 1 ? "it" : "them",
+        missing.size() == 1 ? "it" : "them", options.dir,
+        one_range ? fmt::format("--frames {}:{}", missing.front(), missing.back())
+                  : "--frames FIRST:LAST for each missing range"));
+  }
+
+  // Every listed file in place, as the part recorded it.
+  Manifest merged = shared;
+  merged.part.reset();
+  merged.frames.clear();
+  merged.scene.clear();
+  for (size_t i : order) {
+    for (const ManifestFrame& f : parts[i].first.frames) {
+      for (const ManifestFile& file : f.files) {
+        const fs::path path = dir / file.file;  // a plain name (ReadManifest): inside dir
+        // A link is not followed: only a regular file of the folder is read.
+        const fs::file_status status = fs::symlink_status(path, ec);
+        if (fs::exists(status) && !fs::is_regular_file(status))
+          throw ManifestError(fmt::format("{}, listed in {}, is not a regular file (links are not followed): put the "
+                                          "file itself in the folder",
+                                          path.string(), paths[i]));
+        if (!fs::is_regular_file(status))
+          throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
+                                          "{}, or bake them again with --frames {}:{} --resume",
+                                          path.string(), paths[i], FrameRangeText(*parts[i].first.part),
+                                          parts[i].first.part->first, parts[i].first.part->last));
+        const uint64_t bytes = fs::file_size(path);
+        if (bytes != file.bytes || (options.verify_checksums && Sha256OfFile(path.string()) != file.sha256))
+          throw ManifestError(fmt::format("{} does not match {} ({}): it is truncated, changed or from another bake; "
+                                          "bake frame {} again with --frames {}:{} --resume",
+                                          path.string(), paths[i],
+                                          bytes != file.bytes ? fmt::format("{} bytes, listed with {}", bytes, file.bytes)
+                                                              : "SHA-256 differs",
+                                          f.number, f.number, f.number));
+      }
+      merged.frames.push_back(f);
+    }
+  }
+
+  // The frames are the ones the parts say they baked: their numbers,
+  // times, suns and styles give the parts' sequence_sha256, and the scene's
+  // texture is the texture frame's PNG.
+  std::string identity;
+  std::string texture;
+  for (const ManifestFrame& f : merged.frames) {
+    identity += SequenceIdentityLine(f.number, f.time.value_or(""), f.sun_direction, f.style_sha256);
+    if (f.number == merged.texture_frame)
+      for (const ManifestFile& file : f.files)
+        if (file.kind == "preview" || file.kind == "gltf_texture") texture = file.file;
+  }
+  if (Sha256OfText(identity) != merged.sequence_sha256)
+    throw ManifestError(fmt::format("the frames of the shard manifests in {} (their numbers, times, suns and "
+                                    "style_sha256) do not give their sequence_sha256: a manifest was edited, or "
+                                    "the parts come from different bakes; bake the parts again with --force",
+                                    options.dir));
+  if (merged.gltf.enabled && texture != merged.gltf.texture_file)
+    throw ManifestError(fmt::format("gltf.texture.file {} of the shard manifests in {} is not the PNG of texture "
+                                    "frame {} ({}): a manifest was edited; bake the parts again with --force",
+                                    EscapedText(merged.gltf.texture_file), options.dir, merged.texture_frame,
+                                    texture.empty() ? "none" : EscapedText(texture)));
+
+  // What the merge writes, locked against any other live bake or merge
+  // writing it (OutputLock), then new unless --force.
+  std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
+  if (merged.gltf.enabled)
+    for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
+  const OutputLock lock = OutputLock::Claim(options.dir, outputs);
+  if (!options.force) {
+    for (const std::string& name : outputs)
+      if (fs::exists(dir / name, ec))
+        throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", (dir / name).string()));
+  }
+
+  MergeResult result;
+  for (size_t i : order) result.parts.push_back(paths[i]);
+  result.frames = int(merged.frames.size());
+  result.scene_files = WriteSceneAndManifest(merged, options.dir);
+  result.manifest_path = (dir / ManifestFileName(std::nullopt)).string();
+  return result;
+}
+
+}  // namespace skybake

@@ -1,0 +1,108 @@
+#include "skybake/pipeline/gallery.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "skybake/output/exr_io.h"
+#include "skybake/output/output_lock.h"
+#include "skybake/base/oiio_module.h"
+
+namespace skybake {
+namespace {
+
+constexpr int kLabelHeight = 40;  // pixels above each tile: name, then principles
+constexpr int kMargin = 8;        // pixels between tiles
+constexpr int kNameSize = 17;
+constexpr int kDetailSize = 12;
+constexpr const char* kNameFont = "DejaVuSans-Bold";
+constexpr const char* kDetailFont = "DejaVuSans";
+
+}  // namespace
+
+std::vector<std::string> StyleFilesIn(const std::string& dir) {
+  std::vector<std::string> files;
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    if (entry.is_regular_file() && entry.path().extension() == ".toml")
+      files.push_back(entry.path().string());
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string DescribePrinciples(const SkyStyle& style) {
+  const AoasSettings& a = style.aoas;
+  std::vector<std::string> parts;
+  if (a.skydome.enabled) parts.push_back("skydome");
+  if (a.hue.enabled) parts.push_back(a.hue.color.empty() ? "hue vector" : "hue " + a.hue.color);
+  if (a.ambiguity.enabled) parts.push_back(fmt::format("ambiguity l_pt {:g}", a.ambiguity.l_pt));
+  if (a.clouds.enabled) parts.push_back(fmt::format("clouds s_noise {:g}", a.clouds.s_noise));
+  if (a.shapes.enabled)
+    parts.push_back(fmt::format("{} shape{}", a.shapes.shapes.size(), a.shapes.shapes.size() == 1 ? "" : "s"));
+  for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
+    parts.push_back(fmt::format("{} {:g} km", CloudTypeName(l.type), l.altitude_m * 1e-3));
+  parts.push_back(fmt::format("sun {:g} deg", style.sun.elevation_deg));
+  std::string out;
+  for (size_t i = 0; i < parts.size(); ++i) out += (i ? ", " : "") + parts[i];
+  return out;
+}
+
+GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
+  GalleryResult result;
+  std::filesystem::create_directories(options.out_dir);
+  // The sheet, like every style's files, is new unless --force; a link at
+  // its name counts as a file (it is replaced, never followed). Locked
+  // against another gallery writing it.
+  const std::string sheet_path = (std::filesystem::path(options.out_dir) / "gallery.png").string();
+  const OutputLock lock = OutputLock::Claim(options.out_dir, {"gallery.png"});
+  std::error_code ec;
+  if (!options.bake.force && std::filesystem::exists(std::filesystem::symlink_status(sheet_path, ec)))
+    throw OutputExistsError(fmt::format("{} already exists: pass --force to replace the gallery, or choose another --out",
+                                        sheet_path));
+
+  // Bake each style's latlong preview only.
+  for (const std::string& path : style_paths) {
+    std::vector<std::string> overrides = options.overrides;
+    std::string name = std::filesystem::path(path).stem().string();
+    for (const std::string& o :
+         {std::string("output.faces=false"), std::string("output.cube_strip=false"),
+          std::string("output.latlong=false"), std::string("output.preview=true"),
+          std::string("gltf.enabled=false"),
+          fmt::format("output.basename=\"{}\"", name),
+          fmt::format("render.latlong_height={}", options.latlong_height)})
+      overrides.push_back(o);
+    ConfigResult config = LoadSkyStyle(path, overrides);
+    if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
+    BakeOptions bake = options.bake;
+    bake.out_dir = (std::filesystem::path(options.out_dir) / name).string();  // preview + manifest
+    BakeResult baked = BakeStyle(config.style, bake);
+    result.validation_messages += baked.validation_messages;
+    GalleryEntry entry{name, path, DescribePrinciples(config.style), ""};
+    for (const BakedFile& f : baked.files)
+      if (f.kind == "preview") entry.preview = f.path;
+    result.entries.push_back(entry);
+  }
+
+  // Lay the upper halves out in a grid, each under its label (OpenImageIO module).
+  SheetLayout layout;
+  layout.tile_w = 2 * options.latlong_height;
+  layout.tile_h = options.latlong_height / 2;
+  layout.columns = options.columns;
+  layout.margin = kMargin;
+  layout.label_height = kLabelHeight;
+  layout.name_size = kNameSize;
+  layout.detail_size = kDetailSize;
+  layout.name_font = kNameFont;
+  layout.detail_font = kDetailFont;
+  std::vector<SheetCell> cells;
+  for (const GalleryEntry& e : result.entries) cells.push_back({e.preview, e.name, e.principles});
+  std::vector<uint8_t> rgb;
+  int width = 0, height = 0;
+  std::string error;
+  if (!LoadOiioModule().compose_sheet(cells, layout, rgb, width, height, error)) throw OutputError(error);
+  WritePng(sheet_path, width, height, rgb);
+  result.contact_sheet = sheet_path;
+  return result;
+}
+
+}  // namespace skybake

@@ -1,0 +1,271 @@
+#include "skybake/pipeline/pass_plan.h"
+
+#include "skybake/gpu/ibl.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "skybake/model/aoas.h"
+#include "skybake/gpu/sky_renderer.h"
+
+namespace skybake {
+namespace {
+
+bool AnyPositive(const Rgb& v) { return v[0] > 0.0 || v[1] > 0.0 || v[2] > 0.0; }
+
+// A rough cost per medium sample (3 exponentials, two bilinear LUT reads,
+// phase functions): for the "estimated work" line only.
+constexpr double kFlopPerSample = 60.0;
+
+std::string Size(int w, int h) { return fmt::format("{} x {}", w, h); }
+
+}  // namespace
+
+SkyStyle PrunedStyle(const SkyStyle& style) {
+  SkyStyle s = style;
+  EffectSettings& e = s.effects;
+  const AtmosphereParams& a = style.atmosphere;
+  e.mie = e.mie && (AnyPositive(a.mie_scattering_per_km) || AnyPositive(a.mie_extinction_per_km));
+  e.ozone = e.ozone && AnyPositive(a.ozone_absorption_per_km);
+  e.ground = e.ground && AnyPositive(a.ground_albedo);
+  e.sun_disc = e.sun_disc && e.sun_disc_strength > 0.0 && AnyPositive(a.solar_irradiance);
+  const bool scatters = AnyPositive(style.aoas.hue.enabled ? StyledAtmosphere(a, style.aoas).rayleigh_scattering_per_km
+                                                           : a.rayleigh_scattering_per_km) ||
+                        (e.mie && AnyPositive(a.mie_scattering_per_km));
+  e.multiple_scattering = e.multiple_scattering && e.multiple_scattering_strength > 0.0 && scatters;
+  e.night_dimming = e.night_dimming && e.night_dimming_strength > 0.0;
+  AoasSettings& x = s.aoas;
+  x.hue.enabled = x.hue.enabled && x.hue.strength > 0.0;
+  x.ambiguity.enabled = x.ambiguity.enabled && x.ambiguity.l_pt > 0.0;
+  x.clouds.enabled = x.clouds.enabled && x.clouds.strength > 0.0;
+  x.shapes.enabled = x.shapes.enabled && x.shapes.strength > 0.0 && !x.shapes.shapes.empty();
+  return s;
+}
+
+bool NeedsSkyViewLut(const SkyStyle& style) {
+  return style.quality.sky_view_lut && !style.aoas.skydome.enabled;
+}
+
+bool RendersLatlong(const SkyStyle& style) {
+  return style.output.latlong || WritesLatlongPng(style);
+}
+
+bool WritesLatlongPng(const SkyStyle& style) { return style.output.preview || style.gltf.enabled; }
+
+std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
+  std::vector<ViewRequest> views;
+  const int n = style.render.cube_size;
+  if (style.output.faces)
+    for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+  if (style.output.cube_strip) views.push_back({MAPPING_CUBE_STRIP, n, 6 * n, 0});
+  if (RendersLatlong(style)) {
+    const int h = style.render.latlong_height;
+    views.push_back({MAPPING_LATLONG, 2 * h, h, 0});
+  }
+  return views;
+}
+
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
+  PassPlan plan;
+  plan.frames = int(frames.size());
+  if (frames.empty()) return plan;
+  const SkyStyle& first = frames.front();
+  const SkyStyle pruned = PrunedStyle(first);
+  const EffectSettings& r = first.effects;
+  const EffectSettings& p = pruned.effects;
+  const AtmosphereParams& a = first.atmosphere;
+
+  // Effects, with the keys that decided them.
+  auto decide = [&](const std::string& name, bool requested, bool on, const std::string& why_off,
+                    const std::string& why_on) {
+    plan.effects.push_back({name, requested, on, on ? why_on : (requested ? why_off : "switched off in the style")});
+  };
+  decide("multiple scattering", r.multiple_scattering, p.multiple_scattering,
+         "effects.multiple_scattering_strength = 0 or nothing scatters",
+         fmt::format("effects.multiple_scattering = true, strength {}", r.multiple_scattering_strength));
+  decide("Mie (aerosols)", r.mie, p.mie, "atmosphere.mie coefficients are all 0",
+         "atmosphere.mie.scattering_per_km / extinction_per_km > 0");
+  decide("ozone", r.ozone, p.ozone, "atmosphere.ozone.absorption_per_km is 0",
+         "atmosphere.ozone.absorption_per_km > 0");
+  decide("ground bounce", r.ground, p.ground, "atmosphere.ground_albedo is 0",
+         fmt::format("atmosphere.ground_albedo = [{}, {}, {}]", a.ground_albedo[0], a.ground_albedo[1],
+                     a.ground_albedo[2]));
+  decide("sun disc", r.sun_disc, p.sun_disc, "effects.sun_disc_strength = 0 or no irradiance",
+         fmt::format("effects.sun_disc = true, strength {}", r.sun_disc_strength));
+  const AoasSettings& xr = first.aoas;
+  const AoasSettings& xp = pruned.aoas;
+  decide("skydome (AOAS 3.2)", xr.skydome.enabled, xp.skydome.enabled, "", "[skydome] enabled = true");
+  decide("hue override", xr.hue.enabled, xp.hue.enabled, "hue.strength = 0",
+         fmt::format("[hue] enabled, strength {}", xr.hue.strength));
+  decide("ambiguity (eq. 5-6)", xr.ambiguity.enabled, xp.ambiguity.enabled, "ambiguity.l_pt = 0",
+         fmt::format("[ambiguity] enabled, l_pt {}", xr.ambiguity.l_pt));
+  decide("cloud noise (eq. 7-8)", xr.clouds.enabled, xp.clouds.enabled, "clouds.strength = 0",
+         fmt::format("[clouds] enabled, strength {}", xr.clouds.strength));
+  decide("cloud shapes", xr.shapes.enabled, xp.shapes.enabled, "shapes.strength = 0 or no shape",
+         fmt::format("[shapes] enabled, {} shapes", xr.shapes.shapes.size()));
+  {
+    // Volumetric cloud layers: on when a layer has coverage and density.
+    const std::vector<CloudLayer> active = ActiveCloudLayers(first.clouds);
+    std::string why_on;
+    for (const CloudLayer& l : active)
+      why_on += fmt::format("{}{} at {}-{} m, coverage {}, density {} /m", why_on.empty() ? "" : "; ",
+                            CloudTypeName(l.type), l.altitude_m, l.altitude_m + l.thickness_m, l.coverage,
+                            l.density_per_m);
+    decide("volumetric clouds", !first.clouds.layers.empty(), !active.empty(),
+           "every [[cloud_layer]] has coverage 0 or density_per_m 0 (pruned)",
+           fmt::format("{} [[cloud_layer]]: {}", active.size(), why_on));
+  }
+  decide("twilight and night dimming", r.night_dimming, p.night_dimming, "effects.night_dimming_strength = 0",
+         fmt::format("effects.night_dimming = true, strength {}, night sky {} cd/m^2", r.night_dimming_strength,
+                     r.night_sky_luminance_cd_m2));
+
+  // Distinct atmospheres over the frames: each one rebuilds the LUTs.
+  std::vector<gpu::GpuAtmosphere> keys;
+  for (const SkyStyle& f : frames) {
+    SkyStyle fp = PrunedStyle(f);
+    gpu::GpuAtmosphere key = ToGpuAtmosphere(StyledAtmosphere(fp.atmosphere, fp.aoas), fp.quality, fp.effects,
+                                             OutputScale(fp.output.units));
+    bool seen = std::any_of(keys.begin(), keys.end(), [&](const gpu::GpuAtmosphere& k) {
+      return std::memcmp(&k, &key, sizeof key) == 0;
+    });
+    if (!seen) keys.push_back(key);
+  }
+  plan.atmospheres = int(keys.size());
+
+  const QualitySettings& q = first.quality;
+  const int light = std::max(q.light_steps, 1);
+  if (NeedsTransmittanceLut(q, p) || !ActiveCloudLayers(first.clouds).empty())
+    plan.passes.push_back({"transmittance LUT", Size(q.transmittance_width, q.transmittance_height),
+                           "once per atmosphere", plan.atmospheres,
+                           double(q.transmittance_width) * q.transmittance_height * q.transmittance_steps});
+  if (p.multiple_scattering)
+    plan.passes.push_back({"multiple-scattering LUT", Size(q.multiscattering_size, q.multiscattering_size),
+                           "once per atmosphere", plan.atmospheres,
+                           double(q.multiscattering_size) * q.multiscattering_size * q.multiscattering_sqrt_dirs *
+                               q.multiscattering_sqrt_dirs * q.multiscattering_steps});
+  const bool sky_view = NeedsSkyViewLut(pruned);
+  if (sky_view)
+    plan.passes.push_back({"sky-view LUT", Size(q.sky_view_width, q.sky_view_height), "once per frame",
+                           plan.frames, double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
+  const double per_texel = sky_view ? 1.0 : double(q.view_steps) * light;
+  for (const ViewRequest& v : PlanViews(first)) {
+    std::string name = v.mapping == MAPPING_LATLONG      ? "render latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP ? "render cube strip"
+                                                         : fmt::format("render face {}", v.face);
+    plan.passes.push_back({name, Size(v.width, v.height), sky_view ? "once per frame (LUT reads)" : "once per frame",
+                           plan.frames, double(v.width) * v.height * per_texel});
+  }
+  AoasSwitches switches;
+  switches.skydome = xp.skydome.enabled;
+  switches.ambiguity = xp.ambiguity.enabled;
+  switches.cloud_noise = xp.clouds.enabled;
+  switches.cloud_shapes = xp.shapes.enabled;
+  const bool disc_pass = UsesSunDiscPass(q, p, switches);
+  if (disc_pass)
+    plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
+  const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
+  const CloudQuality& cq = first.clouds.quality;
+  if (!cloud_layers.empty()) {
+    const int layers = int(cloud_layers.size());
+    const double shape = double(cq.shape_resolution) * cq.shape_resolution * cq.shape_resolution;
+    const double detail = double(cq.detail_resolution) * cq.detail_resolution * cq.detail_resolution;
+    plan.passes.push_back({"cloud noise volumes",
+                           fmt::format("{} x ({}^3 + {}^3 + {}^2)", layers, cq.shape_resolution,
+                                       cq.detail_resolution, cq.weather_resolution),
+                           "once per bake (from the seeds)", 1,
+                           layers * (shape + detail + double(cq.weather_resolution) * cq.weather_resolution)});
+    // CloudInputs: aerial perspective 32 x 64 x 32 (4 steps per slice),
+    // ambient 16 altitudes x 64 directions x 16 steps.
+    plan.passes.push_back({"cloud tables", "AP 32 x 64 x 32, ambient 16", "once per frame", plan.frames,
+                           32.0 * 64 * 32 * 4 + 16.0 * 64 * 16});
+    for (const ViewRequest& v : PlanViews(first)) {
+      std::string name = v.mapping == MAPPING_LATLONG      ? "clouds latlong"
+                         : v.mapping == MAPPING_CUBE_STRIP ? "clouds cube strip"
+                                                           : fmt::format("clouds face {}", v.face);
+      // At most view_steps per layer crossing, each lit sample light_steps more.
+      plan.passes.push_back({name, Size(v.width, v.height), "once per frame (at most)", plan.frames,
+                             double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
+    }
+  }
+  for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+  // Image-based lighting (ibl.h): only when an IBL output is asked for.
+  // Its samples are filtered cube reads, not medium samples: not in the total.
+  const IblSettings& ibl = first.ibl;
+  if (ibl.Requested()) {
+    const double source_texels = 6.0 * ibl.size * ibl.size;
+    plan.passes.push_back({"IBL source (no sun disc)", Size(ibl.size, ibl.size) + " x6", "once per frame",
+                           plan.frames, source_texels * per_texel});
+    if (ibl.specular) {
+      double texels = 0.0;
+      for (int level = 1; level < IblLevelCount(ibl); ++level) texels += 6.0 * std::pow(double(ibl.size >> level), 2);
+      plan.passes.push_back({fmt::format("IBL specular {} levels", IblLevelCount(ibl)),
+                             fmt::format("{} samples", ibl.samples), "once per frame (cube reads)", plan.frames,
+                             texels * ibl.samples});
+    }
+    if (ibl.irradiance)
+      plan.passes.push_back({"IBL irradiance", Size(ibl.irradiance_size, ibl.irradiance_size) + " x6",
+                             "once per frame (cube reads)", plan.frames,
+                             6.0 * ibl.irradiance_size * ibl.irradiance_size * ibl.irradiance_samples});
+    if (ibl.dfg)
+      plan.passes.push_back({"IBL DFG table", Size(ibl.dfg_size, ibl.dfg_size), "once per bake", 1,
+                             double(ibl.dfg_size) * ibl.dfg_size * ibl.dfg_samples});
+  }
+
+  static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
+  plan.variant = fmt::format(
+      "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} night={} skydome={} ambiguity={} "
+      "cloud_noise={} cloud_shapes={} integrator={} sky_view={}",
+      p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
+      xp.ambiguity.enabled,
+      xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
+  const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled);
+  plan.variant += fmt::format(
+      "\n  SPIR-V: sky_render {}; LUT shaders {}", sources.sky_view_render
+          ? "from the built-in sky-view variant (ray march compiled out)"
+          : "generic, specialized at pipeline creation",
+      sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
+  if (disc_pass)
+    plan.variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
+  if (!cloud_layers.empty())
+    plan.variant += fmt::format(
+        "\n  clouds: cloud_render with {} layer(s) compiled in (constant 20), after the sky and sun-disc passes; "
+        "per texel at most {} view steps per layer crossing (a third of them for a vertical crossing), {} light "
+        "steps per lit sample, {} scattering octaves, no cloud beyond {} km",
+        cloud_layers.size(), cq.view_steps, cq.light_steps, cq.octaves, cq.max_distance_km);
+  else
+    plan.variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
+  if (plan.frames > 1) {
+    if (plan.atmospheres == 1)
+      plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +
+                            std::to_string(plan.frames) + " frames (the atmosphere does not change)");
+    else
+      plan.reused.push_back(fmt::format("transmittance and multiple-scattering LUTs: built {} times, once per "
+                                        "distinct atmosphere of the schedule",
+                                        plan.atmospheres));
+    plan.reused.push_back("pipelines: compiled once per atmosphere, never per frame");
+  }
+  return plan;
+}
+
+std::string FormatPlan(const PassPlan& plan, const std::string& source) {
+  std::string out = fmt::format("plan for {}: {} frame{}, {} atmosphere{}\n\neffects:\n", source, plan.frames,
+                                plan.frames == 1 ? "" : "s", plan.atmospheres, plan.atmospheres == 1 ? "" : "s");
+  for (const EffectDecision& e : plan.effects)
+    out += fmt::format("  {:<28} {:<4} {}\n", e.name, e.on ? "on" : "off", e.reason);
+  out += "\npasses:\n";
+  for (const PlannedPass& p : plan.passes)
+    out += fmt::format("  {:<26} {:>12}  {:<28} x{:<5} {:>10.3g} samples/run\n", p.name, p.size, p.frequency,
+                       p.runs, p.samples);
+  out += fmt::format("\nshader variant:\n  {}\n", plan.variant);
+  out += fmt::format("\nestimated work: {:.3g} medium samples, about {:.3g} GFLOP at ~{} FLOP per sample\n",
+                     plan.total_samples, plan.total_samples * kFlopPerSample * 1e-9, int(kFlopPerSample));
+  if (!plan.reused.empty()) {
+    out += "\nreused across frames:\n";
+    for (const std::string& r : plan.reused) out += "  " + r + "\n";
+  }
+  return out;
+}
+
+}  // namespace skybake

@@ -1,0 +1,224 @@
+// The GPU sky renderer: builds the transmittance and multiple-scattering LUTs
+// once per atmosphere, then renders any number of output views (latlong,
+// cube strip, Vulkan cube faces, explicit directions) per sun position, all
+// views of a frame in one submission. Each pass is timed with GPU timestamps.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/model/aoas.h"
+#include "skybake/model/atmosphere.h"
+#include "skybake/model/clouds.h"
+#include "skybake/model/view.h"
+#include "skybake/gpu/pass_timing.h"
+#include "skybake/gpu/vulkan_context.h"
+
+namespace skybake {
+
+
+
+// Texels [x0, x1) x [y0, y1) of a view.
+struct TexelRect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+};
+
+// Rectangles, disjoint, that hold every texel of `view` whose direction is
+// within `angle` radians of unit `direction`: tiles of 16 x 16 texels whose
+// centre is within `angle` plus 1.5 times the tile's own angular radius (the
+// largest angle from its centre to a corner), joined along each row of
+// tiles. Every texel of a MAPPING_DIRECTIONS view.
+std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle);
+
+// Whether the sun disc is added by a pass of its own over the texels near
+// the Sun (SkyRenderer::Render) rather than tested by every texel of the sky
+// pass: with the sky-view LUT and none of the AOAS principles that act on
+// the disc after it is added (ambiguity, clouds); SKYBAKE_SUN_DISC_PASS=0
+// turns it off.
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas);
+
+// Where each pipeline's SPIR-V comes from: the variants compiled with the
+// presets' quality fixed and optimized by glslang -Os (CMakeLists.txt), when the
+// settings match them and SKYBAKE_GENERIC_SHADERS is not 1; else the generic
+// shaders, specialized when the pipeline is created.
+struct ShaderSources {
+  bool analytic_luts = false;    // LUT shaders from the analytic-integrator variants
+  bool sky_view_render = false;  // sky_render from the sky-view variant
+};
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome);
+
+// Views rendered in place (SkyRenderer::RenderInPlace): RGBA float texels,
+// rows from the top, in the renderer's host-visible memory. The memory stays
+// unchanged while any copy of `hold` lives, and only that long.
+struct RenderedViews {
+  std::vector<const float*> views;  // one per requested view
+  std::shared_ptr<const void> hold;
+};
+
+class SkyRenderer {
+ public:
+  // With `output_directions`, views contain the unit direction of each texel
+  // (xyz) instead of radiance: the shader-side mapping, for tests. `aoas`
+  // holds the per-texel aesthetic principles (none by default); the hue
+  // principle is already in `atmosphere` (StyledAtmosphere).
+  SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
+              const QualitySettings& quality, const EffectSettings& effects,
+              const Rgb& output_scale, bool output_directions = false,
+              const AoasInputs& aoas = AoasInputs(), const CloudInputs& clouds = CloudInputs());
+  ~SkyRenderer();
+  SkyRenderer(const SkyRenderer&) = delete;
+  SkyRenderer& operator=(const SkyRenderer&) = delete;
+
+  // Builds the transmittance LUT, then the multiple-scattering LUT (only when
+  // multiple scattering is on). Called automatically by the first Render.
+  void PrecomputeLuts();
+
+  // Renders every view for the sun direction (unit, towards the Sun) and
+  // returns one RGBA float image per view, rows from the top.
+  // With `sun_disc` false, the same pipeline renders without the disc (a
+  // push constant), from the same LUTs.
+  std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
+                                         const std::vector<ViewRequest>& views, bool sun_disc = true);
+
+  // Render without the copy: the texels stay where the device wrote them,
+  // for as long as the result's `hold` lives (a bake's writer thread reads
+  // them while the next frame renders into other memory). Must be called on
+  // the renderer's thread; `hold` may be released on any thread. The
+  // renderer must outlive every `hold`.
+  RenderedViews RenderInPlace(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                              bool sun_disc = true);
+
+  // True while the texels of a RenderInPlace are held.
+  bool HoldsFrames() const;
+
+  // Radiance (RGBA) along each unit direction.
+  std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
+                                      const std::vector<glm::dvec3>& directions, bool sun_disc = true);
+
+  // Replaces the atmosphere (a scheduled drift of its constants, say)
+  // without new pipelines: the LUTs are rebuilt by the next Render. False
+  // when the shader variant or a LUT size would change (a new renderer is
+  // needed).
+  bool UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                        const EffectSettings& effects, const Rgb& output_scale);
+
+  // Replaces the per-texel AOAS parameters (drift, strengths, shapes) without
+  // touching the LUTs or pipelines; false when the switches differ (a new
+  // shader variant is needed).
+  bool UpdateAoas(const AoasInputs& aoas);
+
+  // Replaces the cloud layers' parameters (the wind's offsets of a new
+  // frame, say) without new pipelines; the noise volumes are generated again
+  // only when their seeds or weather images change. False when the layer
+  // count or a noise size differs (a new renderer is needed).
+  bool UpdateClouds(const CloudInputs& clouds);
+
+  // The noise buffer of the cloud layers (shape, detail, weather per layer),
+  // for tests; empty without clouds.
+  std::vector<float> ReadCloudNoise() const;
+  // LUT contents (RGBA float per texel, row-major), for tests.
+  std::vector<float> ReadTransmittanceLut() const;
+  std::vector<float> ReadMultipleScatteringLut() const;
+
+  const std::vector<PassTiming>& last_timings() const { return timings_; }
+  const RenderCounters& counters() const { return counters_; }
+
+ private:
+  struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    void* mapped = nullptr;
+    VkDeviceSize size = 0;
+  };
+  // Memory of a frame rendered in place; free when `hold` has no other owner.
+  struct FrameSlot {
+    Buffer buffer;
+    std::shared_ptr<int> hold;
+  };
+  struct Dispatch {
+    std::string name;
+    VkPipeline pipeline;
+    gpu::SkyPush push;
+    uint32_t groups_x, groups_y;
+  };
+
+  Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  void DestroyBuffer(Buffer& buffer);
+  void EnsureOutputCapacity(VkDeviceSize bytes);
+  void UpdateDescriptors();
+  // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
+  void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
+  // Records the dispatches into one command buffer, submits, waits, and
+  // records per-dispatch timings. A barrier follows every dispatch that a
+  // later one reads (`barrier_after`).
+  void Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after);
+  // Points the output binding at `target` (a frame slot, or output_buffer_).
+  void BindOutput(const Buffer& target);
+  // The sky-view LUT when the Sun moved, the views at `offsets` (texels) of
+  // `target`, the sun-disc pass; submitted and waited for.
+  void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                   bool sun_disc, const std::vector<size_t>& offsets);
+
+  // The cloud passes' dispatches of a frame: noise (when not yet built) and
+  // tables (when the sun moved) before the views; the cloud pass after them.
+  void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
+  void GenerateCloudNoise();
+
+  static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
+
+  VulkanContext& context_;
+  gpu::GpuAtmosphere gpu_atmosphere_{};
+  QualitySettings quality_;
+  EffectSettings effects_;
+  AoasSwitches aoas_switches_;
+  bool output_directions_ = false;
+  bool disc_pass_ = false;  // UsesSunDiscPass
+  bool luts_ready_ = false;
+  bool skyview_ready_ = false;
+  glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
+  gpu::GpuClouds gpu_clouds_{};
+  int cloud_layers_ = 0;           // 0: no cloud pass, no cloud pipelines
+  bool cloud_noise_ready_ = false;
+  bool cloud_tables_ready_ = false;
+  glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
+  std::vector<float> cloud_weather_images_;
+
+  Buffer atmosphere_buffer_;
+  Buffer aoas_buffer_;
+  Buffer transmittance_buffer_;
+  Buffer multiscattering_buffer_;
+  Buffer output_buffer_;
+  Buffer skyview_buffer_;
+  Buffer clouds_buffer_;       // GpuClouds
+  Buffer cloud_noise_buffer_;  // noise volumes and weather maps
+  Buffer cloud_lut_buffer_;    // aerial-perspective LUT and ambient table
+  std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
+  VkBuffer bound_output_ = VK_NULL_HANDLE;                // what the output binding points at
+
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  VkDescriptorPool descriptor_pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet descriptor_set_ = VK_NULL_HANDLE;
+  VkPipeline transmittance_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline multiscattering_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline sky_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline skyview_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline disc_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  VkQueryPool query_pool_ = VK_NULL_HANDLE;
+  uint32_t query_capacity_ = 0;
+  bool timestamps_supported_ = false;
+
+  std::vector<PassTiming> timings_;
+  RenderCounters counters_;
+};
+
+}  // namespace skybake

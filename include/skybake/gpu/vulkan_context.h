@@ -1,0 +1,145 @@
+// Headless Vulkan compute context: instance, one physical device, one compute
+// queue. No window, no surface.
+//
+// Device choice: a discrete GPU, else an integrated GPU, else a virtual GPU,
+// else the CPU implementation (Mesa lavapipe). Every rejected device is
+// listed with the reason. With validation on, the Khronos validation layer is
+// loaded and every message it emits is counted and printed.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "skybake/base/errors.h"
+
+namespace skybake {
+
+// A Vulkan call failed (out of memory, device lost, ...).
+class VulkanError : public Error {
+ public:
+  VulkanError(const std::string& what, VkResult result)
+      : Error(what, kExitVulkan), result(result) {}
+  VkResult result;
+};
+
+const char* VkResultName(VkResult result);
+
+#define VK_CHECK(call)                                                                   \
+  do {                                                                                   \
+    VkResult vk_check_result_ = (call);                                                  \
+    if (vk_check_result_ != VK_SUCCESS)                                                  \
+      throw ::skybake::VulkanError(std::string(#call) + " failed with " +                \
+                                       ::skybake::VkResultName(vk_check_result_) + " at " + \
+                                       __FILE__ + ":" + std::to_string(__LINE__),        \
+                                   vk_check_result_);                                    \
+  } while (0)
+
+struct DeviceInfo {
+  int index = 0;
+  std::string name;
+  std::string type;  // "discrete GPU", "integrated GPU", "virtual GPU", "CPU", "other"
+  std::string api_version;
+  std::string driver;
+  bool usable = false;
+  std::string rejected_because;  // empty when usable
+};
+
+// Loading a Vulkan driver costs start-up whether or not it finds a device:
+// the loader opens every installed driver, and Mesa's hardware drivers each
+// link LLVM, whose relocation is most of lavapipe's 0.07-0.09 s device
+// creation on the benchmark machine (docs/performance.md). A hardware driver
+// offers a device only through a GPU's device node, so on a machine with
+// none skybake asks the loader for the software driver alone.
+struct DriverEnvironment {
+  bool drivers_chosen_by_user = false;  // VK_ICD_FILENAMES, VK_DRIVER_FILES, VK_ADD_DRIVER_FILES,
+                                        // VK_LOADER_DRIVERS_SELECT/_DISABLE or SKYBAKE_ALL_VULKAN_DRIVERS=1
+  std::string gpu_device_node;          // the first of /dev/dri/renderD*, /dev/dri/card*, /dev/nvidia*,
+                                        // /dev/dxg, /dev/kgsl*, /dev/mali*; empty when none exists
+  std::vector<std::string> manifests;   // file names of the installed driver manifests (vulkan/icd.d)
+};
+
+// This machine's: environment variables, /dev, the loader's manifest folders.
+DriverEnvironment ProbeDriverEnvironment();
+
+// The loader's VK_LOADER_DRIVERS_SELECT that loads only lavapipe, or "" to
+// load every driver: when the user chose none, no GPU device node exists
+// and lavapipe's manifest is installed.
+std::string SoftwareDriverSelection(const DriverEnvironment& environment);
+
+// Sets VK_LOADER_DRIVERS_SELECT to SoftwareDriverSelection of this machine
+// (call it before any Vulkan call and any thread: it changes the
+// environment); returns the value set, or "". DriverSelection() returns it
+// afterwards.
+std::string SelectSoftwareDriversWithoutGpu();
+const std::string& DriverSelection();
+
+// The layouts of a compute pipeline with one descriptor set of `bindings`
+// and one push-constant block of `push_bytes` bytes; the caller destroys both.
+struct ComputeLayouts {
+  VkDescriptorSetLayout set = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline = VK_NULL_HANDLE;
+};
+ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayoutBinding* bindings,
+                                    uint32_t binding_count, uint32_t push_bytes);
+
+struct VulkanOptions {
+  int device_index = -1;      // -1: choose the best usable device
+  bool validation = false;    // load VK_LAYER_KHRONOS_validation
+  bool print_messages = true; // print validation messages to stderr
+};
+
+class VulkanContext {
+ public:
+  explicit VulkanContext(const VulkanOptions& options);
+  ~VulkanContext();
+  VulkanContext(const VulkanContext&) = delete;
+  VulkanContext& operator=(const VulkanContext&) = delete;
+
+  // Lists every physical device and whether it can run skybake.
+  static std::vector<DeviceInfo> ListDevices();
+
+  VkDevice device() const { return device_; }
+  VkPhysicalDevice physical_device() const { return physical_device_; }
+  VkQueue queue() const { return queue_; }
+  uint32_t queue_family() const { return queue_family_; }
+  const DeviceInfo& device_info() const { return device_info_; }
+  const VkPhysicalDeviceProperties& properties() const { return properties_; }
+
+  // Whether the queue's commands can be timed (timestamp queries with a
+  // known period): GPU pass times are reported only then.
+  bool SupportsTimestamps() const;
+
+  // Number of validation messages (warnings and errors) seen so far.
+  int validation_message_count() const { return validation_messages_; }
+  const std::vector<std::string>& validation_messages() const { return messages_; }
+
+  // Memory type with all `required` flags among `type_bits`; prefers `preferred` too.
+  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
+                          VkMemoryPropertyFlags preferred) const;
+
+ private:
+  static VKAPI_ATTR VkBool32 VKAPI_CALL DebugCallback(
+      VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT types,
+      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkPhysicalDeviceProperties properties_{};
+  VkPhysicalDeviceMemoryProperties memory_properties_{};
+  DeviceInfo device_info_;
+  bool print_messages_ = true;
+  int validation_messages_ = 0;
+  std::vector<std::string> messages_;
+};
+
+}  // namespace skybake

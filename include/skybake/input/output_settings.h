@@ -1,0 +1,77 @@
+// The output part of a sky style ([output], [preview], [gltf], [ibl]): what
+// files a bake writes and how they are encoded. Apart from the rest of the
+// style so that the file writers (output/) read these settings alone.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace skybake {
+
+enum class PixelType { kHalf, kFloat };
+// What a value beyond half-float range does: scale the whole image by a power
+// of two (recorded in the EXR `whiteLuminance`), or refuse to write.
+enum class OverflowPolicy { kScale, kRefuse };
+// kLuminance: linear Rec.709 in cd/m^2 (radiance times Bruneton 2017's
+// SKY_SPECTRAL_RADIANCE_TO_LUMINANCE); kSpectral: W m^-2 sr^-1 nm^-1 at
+// 680/550/440 nm, the unit of the Kider 2014 measurements.
+enum class OutputUnits { kLuminance, kSpectral };
+
+// Deflate level of ZIP-compressed EXRs, chosen from the codec table of
+// docs/performance.md (`build/tests/exr_codec_benchmark`).
+constexpr int kDefaultZipLevel = 2;
+
+struct OutputSettings {
+  std::string basename = "sky";
+  PixelType pixel_type = PixelType::kHalf;
+  std::string compression = "zip";  // none | rle | zips | zip | piz
+  int zip_level = kDefaultZipLevel;  // deflate level of zip and zips, 1..9
+  OverflowPolicy overflow = OverflowPolicy::kScale;
+  OutputUnits units = OutputUnits::kLuminance;
+  bool faces = true;       // six face files
+  bool cube_strip = true;  // one N x 6N cube strip
+  bool latlong = true;     // one 2N x N latlong
+  bool preview = true;     // tone-mapped sRGB PNG of the latlong
+  std::vector<std::string> face_names = {"px", "nx", "py", "ny", "pz", "nz"};
+};
+
+struct PreviewSettings {
+  bool auto_exposure = true;  // key the upper hemisphere's log-average to mid grey
+  double ev100 = 14.0;        // used when auto_exposure is false
+};
+
+// The glTF 2.0 scene written beside the maps (see gltf_scene.h).
+enum class DomeShape { kSphere, kHemisphere };
+struct GltfSettings {
+  bool enabled = true;              // write name.gltf (+ .bin) and name.glb
+  DomeShape dome = DomeShape::kSphere;
+  double radius_m = 1000.0;         // horizontal radius of the dome
+  double flattening = 0.0;          // 0: round; f: vertical radius = (1 - f) * radius_m
+  int segments = 64;                // around the horizon; half as many rings pole to pole
+};
+
+// Image-based lighting outputs from the same bake (include/skybake/ibl.h):
+// split-sum GGX-prefiltered radiance, an irradiance cube, the DFG table. All
+// off by default, and then no pass runs and no key is recorded.
+enum class KtxFormat { kRgba16f, kB10g11r11, kE5b9g9r9 };
+struct IblSettings {
+  bool specular = false;        // GGX-prefiltered radiance, one cube mip level per roughness
+  bool irradiance = false;      // irradiance cube, stored as E / pi (a white Lambertian surface's radiance)
+  bool dfg = false;             // split-sum DFG table (N.V x roughness -> scale, bias of F0)
+  int size = 256;               // face edge of level 0, texels: a power of two in [8, 1024]
+  int levels = 0;               // mip levels; 0: down to 8 x 8 (log2(size) - 2); at most log2(size) + 1
+  int samples = 256;            // GGX samples per texel of a level (filtered importance sampling)
+  int irradiance_size = 32;     // irradiance face edge, texels
+  int irradiance_samples = 512; // cosine samples per irradiance texel
+  int dfg_size = 128;           // DFG table edge, texels
+  int dfg_samples = 1024;       // GGX samples per DFG texel
+  double lod_bias = 0.0;        // mip bias of the filtered lookups, log2 texels (docs/ibl.md: 0 measured best)
+  bool include_sun = false;     // the Sun's energy in the maps (else it is the glTF sun light alone)
+  bool exr = true;              // one EXR per cube level / irradiance / DFG
+  bool ktx2 = false;            // KTX2 cube files with their mips
+  KtxFormat ktx2_format = KtxFormat::kRgba16f;
+  int ktx2_zstd_level = 0;      // 0: no supercompression; 1..19: zstd level
+  bool Requested() const { return specular || irradiance || dfg; }
+};
+
+}  // namespace skybake

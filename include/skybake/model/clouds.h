@@ -1,0 +1,136 @@
+// Volumetric cloud layers of a sky style, and their packing for the cloud
+// passes (shaders/clouds.glsl). Not to be confused with the AOAS `[clouds]`
+// principle (saturation noise, eq. 7-8, aoas.h): these are `[[cloud_layer]]`
+// tables, up to kMaxCloudLayers of them, each a spherical shell of cloud
+// above the planet, ray-marched per output texel and lit by the atmosphere.
+//
+// Model (docs/clouds.md): the density of Schneider 2015 / Nubis (weather
+// coverage x height profile x Perlin-Worley shape noise, eroded by Worley
+// detail noise), Beer-Lambert extinction with the energy-conserving step
+// integral (Hillaire 2016, section 5.6.3), the sun through the atmosphere's
+// transmittance LUT and through the cloud (marched light steps), a dual-lobe
+// Henyey-Greenstein phase with Wrenninge 2013's multiple-scattering octaves,
+// ambient light of the sky above and the ground below at the sample's
+// altitude, and the atmosphere between the viewer and every cloud sample
+// (aerial-perspective LUT).
+//
+// Frame and units: the world frame of the sky (+Y up, North = -Z, East = +X);
+// altitudes, thicknesses and sizes in metres, extinction in 1/m, wind in m/s
+// ([east, north]), shear in m/s per km of height above the layer's bottom.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "skybake/model/atmosphere.h"
+#include "skybake/gpu_shared.h"
+
+namespace skybake {
+
+constexpr int kMaxCloudLayers = CLOUD_MAX_LAYERS;
+
+// Height profiles: where in the layer (0 = bottom, 1 = top) the cloud grows
+// from nothing to full density and fades out again.
+enum class CloudType { kStratus, kStratocumulus, kCumulus, kCumulonimbus, kCirrus, kCustom };
+
+// The profile of a type as [bottom_in, bottom_full, top_full, top_out]
+// fractions of the layer's thickness (the remap stops of the Nubis height
+// gradient, chosen for a layer of its own).
+std::array<double, 4> CloudTypeProfile(CloudType type);
+const char* CloudTypeName(CloudType type);
+
+struct CloudLayer {
+  double altitude_m = 1500.0;   // bottom of the layer above the ground
+  double thickness_m = 1500.0;  // top = altitude_m + thickness_m
+  CloudType type = CloudType::kCumulus;
+  std::array<double, 4> profile = CloudTypeProfile(CloudType::kCumulus);  // type = "custom" sets it
+  double coverage = 0.5;        // 0: no cloud, 0.5: the weather map as is, 1: overcast
+  double density_per_m = 0.05;  // extinction at full density, 1/m
+  double albedo = 0.99;         // single-scattering albedo
+  double shape_amount = 1.0;    // 0: a flat slab, 1: the full Perlin-Worley shape
+  double shape_size_m = 4000.0; // edge of one tile of the shape noise
+  double detail_amount = 0.35;  // erosion by the detail noise, 0..1
+  double detail_size_m = 400.0; // edge of one tile of the detail noise
+  std::array<double, 2> wind_m_s = {0.0, 0.0};           // [east, north] at the bottom
+  std::array<double, 2> shear_m_s_per_km = {0.0, 0.0};   // extra wind per km above the bottom
+  std::optional<uint32_t> seed;  // aoas.seed when unset
+  // Weather map: procedural tiling noise of this extent, or an image.
+  double weather_size_m = 30000.0;  // edge of one tile of the procedural weather map
+  std::string weather_image;        // EXR or PNG; R = coverage (0..1); "" = procedural
+  std::array<double, 2> weather_extent_m = {30000.0, 30000.0};  // [east, north] size of the image
+  std::array<double, 2> weather_origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner
+};
+
+// Cloud sampling settings; quality.preset sets them, [quality] cloud_* keys
+// refine them.
+struct CloudQuality {
+  int view_steps = 48;          // view samples per layer crossing of a texel
+  int light_steps = 6;          // samples toward the Sun per lit view sample
+  int octaves = 8;              // Wrenninge multiple-scattering octaves
+  int shape_resolution = 64;    // shape noise volume edge, voxels
+  int detail_resolution = 32;   // detail noise volume edge, voxels
+  int weather_resolution = 256; // procedural weather map edge, texels
+  double max_distance_km = 300.0;  // no cloud beyond this distance from the viewer
+};
+CloudQuality CloudQualityPreset(const std::string& name);
+
+struct CloudSettings {
+  std::vector<CloudLayer> layers;
+  CloudQuality quality;
+};
+
+// The layers a bake renders: those with coverage and density above 0 (the
+// others are pruned and change nothing), sorted by altitude.
+std::vector<CloudLayer> ActiveCloudLayers(const CloudSettings& clouds);
+
+// A problem with one layer found before any GPU work: `layer` indexes the
+// style's [[cloud_layer]] tables (-1: the whole list), `key` the layer's key.
+struct CloudProblem {
+  int layer = -1;
+  std::string key;
+  std::string message;
+};
+// Cross-field checks: top above the atmosphere, >4 layers, a weather image
+// that cannot be read (relative paths from `style_dir`). Ranges of single
+// keys are checked while reading.
+std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const AtmosphereParams& atmosphere,
+                                         const std::string& style_dir);
+
+// Loop iterations one texel of the cloud pass may run, at most: every band
+// crossed with view_steps samples, each lit sample marching light_steps
+// samples over every layer and summing the octaves. Lavapipe ends all the
+// loops of an invocation after 65535 iterations in all (Mesa's
+// LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of a shader), which
+// would cut the march short silently; the style check refuses settings
+// above kMaxCloudLoopIterations.
+double CloudLoopIterationsPerTexel(const CloudSettings& clouds);
+constexpr double kMaxCloudLoopIterations = 60000.0;
+
+// What the renderer needs: the uniform block, the weather images (R channel,
+// resampled to the procedural map's resolution), and the sizes of the noise
+// volumes. Empty `uniform.counts.x` (0 layers) means no cloud pass at all.
+struct CloudInputs {
+  gpu::GpuClouds uniform{};
+  std::vector<float> weather_images;  // per layer with an image: resolution^2 floats, in layer order
+  int layers() const { return uniform.counts.x; }
+};
+// `time_s`: clock time since the sequence's first frame; the wind moves the
+// clouds by wind x time_s (no re-randomising per frame).
+CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
+                          double time_s);
+
+// Floats of the noise buffer (shape, detail and weather of every active
+// layer), and where each part of layer i starts.
+size_t CloudNoiseFloats(const gpu::GpuClouds& clouds);
+
+// Reads a weather image's first channel (coverage) resampled to
+// `resolution` x `resolution` (rows from the north edge); throws
+// std::runtime_error naming the path when it cannot.
+std::vector<float> ReadWeatherImage(const std::string& path, int resolution);
+// Checks a weather image without keeping its pixels: "" or what is wrong.
+std::string CheckWeatherImage(const std::string& path);
+
+}  // namespace skybake

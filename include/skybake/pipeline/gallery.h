@@ -1,0 +1,58 @@
+// The style gallery: bakes a set of styles at preview size and lays their
+// tone-mapped skies out on one labelled contact sheet (PNG).
+//
+// Each tile is the upper half of the style's latlong preview (the sky above
+// the ground plane, all 360 degrees of azimuth; South in the middle, North at
+// both ends), under a label with the style's name and the AOAS principles it
+// uses. Labels are drawn with OpenImageIO's text renderer (FreeType and the
+// DejaVu fonts, Debian package fonts-dejavu-core).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "skybake/pipeline/pipeline.h"
+
+namespace skybake {
+
+struct GalleryOptions {
+  std::string out_dir = "out/gallery";
+  int latlong_height = 192;             // each style's latlong is 2H x H
+  int columns = 2;
+  std::vector<std::string> overrides;   // --set, applied to every style
+  BakeOptions bake;                     // device, validation, progress; bake.force replaces a previous gallery
+};
+
+struct GalleryEntry {
+  std::string name;        // the style file's stem
+  std::string path;        // the style file
+  std::string principles;  // e.g. "hue, clouds, shapes"
+  std::string preview;     // its latlong preview PNG
+};
+
+struct GalleryResult {
+  std::vector<GalleryEntry> entries;
+  std::string contact_sheet;  // the labelled PNG
+  int validation_messages = 0;
+};
+
+// The .toml files of `dir`, sorted by name.
+std::vector<std::string> StyleFilesIn(const std::string& dir);
+
+// The AOAS principles a style turns on, as a short list ("physical" if none).
+std::string DescribePrinciples(const SkyStyle& style);
+
+// Bakes every style into out_dir/<style>/ (its latlong preview and its
+// manifest) and writes out_dir/gallery.png. Throws ConfigFailure for an invalid style, and
+// what BakeStyle throws.
+GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options);
+
+// A style of the gallery did not load.
+struct ConfigFailure : std::runtime_error {
+  ConfigFailure(const std::string& what, std::vector<ConfigError> e)
+      : std::runtime_error(what), errors(std::move(e)) {}
+  std::vector<ConfigError> errors;
+};
+
+}  // namespace skybake
