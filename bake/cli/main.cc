@@ -439,30 +439,11 @@ int main(int argc, char** argv) {
       return RunMergeManifest(merge_options);
     }
     return RunBake(args, Mode::kBake);
-  } catch (const UsageError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitUsage;
-  } catch (const ManifestError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitMerge;
-  } catch (const ConfigFailure& e) {
-    PrintErrors(e.errors);
-    return kExitConfig;
-  } catch (const VulkanUnavailable& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitVulkan;
-  } catch (const VulkanError& e) {
-    std::fprintf(stderr, "skybake: error: Vulkan: %s\n", Printable(e.what()).c_str());
-    return kExitVulkan;
-  } catch (const BudgetError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitBudget;
-  } catch (const OutputExistsError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitExists;
-  } catch (const OutputError& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
-    return kExitOutput;
+  } catch (const Error& e) {
+    // Every user error of every layer (base/errors.h): its message, its exit code.
+    if (const auto* config = dynamic_cast<const ConfigFailure*>(&e)) PrintErrors(config->errors);
+    else std::fprintf(stderr, "skybake: error: %s\n", Printable(e.message()).c_str());
+    return e.exit_code();
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
                          "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");

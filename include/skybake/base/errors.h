@@ -1,8 +1,10 @@
 // The errors skybake reports to its user: one class per failure kind, each
 // carrying the process exit code of that kind (README "Exit codes"). Every
-// layer throws these (or VulkanError, gpu/vulkan_context.h, which adds the
-// VkResult); the CLI maps any Error to its message and exit code in one place.
-// A bug is any other exception (exit code 1).
+// layer throws these, or one derived from them beside its concept
+// (VulkanError in gpu/vulkan_context.h adds the VkResult, ConfigFailure in
+// input/config.h the located errors, OutputLockedError in output/output_lock.h);
+// the CLI maps any Error to its message and exit code in one place. A bug is
+// any other exception (exit code 1).
 #pragma once
 
 #include <stdexcept>
@@ -28,6 +30,8 @@ class Error : public std::runtime_error {
  public:
   Error(const std::string& what, ExitCode code) : std::runtime_error(what), code_(code) {}
   ExitCode exit_code() const { return code_; }
+  // The line the CLI prints after "skybake: error: ".
+  virtual std::string message() const { return what(); }
 
  private:
   ExitCode code_;

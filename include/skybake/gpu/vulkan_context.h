@@ -25,6 +25,7 @@ class VulkanError : public Error {
  public:
   VulkanError(const std::string& what, VkResult result)
       : Error(what, kExitVulkan), result(result) {}
+  std::string message() const override { return std::string("Vulkan: ") + what(); }
   VkResult result;
 };
 

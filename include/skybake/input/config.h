@@ -12,6 +12,7 @@
 #include <string_view>
 #include <vector>
 
+#include "skybake/base/errors.h"
 #include "skybake/input/style.h"
 
 namespace skybake {
@@ -24,6 +25,15 @@ struct ConfigError {
   std::string key; // dotted key path, e.g. "atmosphere.mie.g"
   std::string message;
   std::string Format() const;  // "file:line:col: key: message"
+};
+
+// A style or schedule that did not load, thrown where a caller cannot return
+// its errors (the gallery's styles): the CLI prints every located error.
+class ConfigFailure : public Error {
+ public:
+  ConfigFailure(const std::string& what, std::vector<ConfigError> e)
+      : Error(what, kExitConfig), errors(std::move(e)) {}
+  std::vector<ConfigError> errors;
 };
 
 struct ConfigResult {

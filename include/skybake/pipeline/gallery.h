@@ -48,11 +48,4 @@ std::string DescribePrinciples(const SkyStyle& style);
 // what BakeStyle throws.
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options);
 
-// A style of the gallery did not load.
-struct ConfigFailure : std::runtime_error {
-  ConfigFailure(const std::string& what, std::vector<ConfigError> e)
-      : std::runtime_error(what), errors(std::move(e)) {}
-  std::vector<ConfigError> errors;
-};
-
 }  // namespace skybake
