@@ -116,6 +116,36 @@ colour = "red"
   EXPECT_NE(steps.errors[0].Format().find("s.toml:2:25"), std::string::npos) << steps.errors[0].Format();
 }
 
+// A schedule typo gets the same answer as a style typo: located, with the
+// nearest known key (the shared TOML reader, bake/input/toml_reader.h), in
+// [schedule], its sun table and its ramps; no suggestion for a key near none.
+TEST(Schedule, UnknownKeysSuggestTheNearestKnownOne) {
+  ScheduleResult r = ParseSchedule(R"([schedule]
+date = "2013-05-27"
+latitude_deg = 42.4
+longitude_deg = -76.5
+utc_offset_hours = -4
+tiems = [09:30:00]
+frist_frame = 3
+sun_colour = "red"
+)",
+                                   "typo.toml");
+  ASSERT_FALSE(r.ok());
+  std::string all;
+  for (const ConfigError& e : r.errors) all += e.Format() + "\n";
+  EXPECT_NE(all.find("typo.toml:6:9: schedule.tiems: unknown key 'tiems' (did you mean 'times'?) (expected "),
+            std::string::npos) << all;
+  EXPECT_NE(all.find("typo.toml:7:15: schedule.frist_frame: unknown key 'frist_frame' (did you mean 'first_frame'?)"),
+            std::string::npos) << all;
+  EXPECT_NE(all.find("schedule.sun_colour: unknown key 'sun_colour' (expected "), std::string::npos) << all;
+
+  ScheduleResult sun = ParseSchedule("[schedule]\nsun = { elevation_deg = 10, azimuht_deg = 135 }\n", "sun.toml");
+  ASSERT_FALSE(sun.ok());
+  std::string sun_all;
+  for (const ConfigError& e : sun.errors) sun_all += e.Format() + "\n";
+  EXPECT_NE(sun_all.find("unknown key 'azimuht_deg' (did you mean 'azimuth_deg'?)"), std::string::npos) << sun_all;
+}
+
 TEST(Schedule, PerFrameStyleChanges) {
   std::string style = WriteTemp("style.toml", "[atmosphere.mie]\ng = 0.8\n[render]\ncube_size = 8\n");
   std::string text = std::string(kDay24) + R"(

@@ -313,7 +313,7 @@ sun = { elevation_deg = { start = 0, end = 10, step = 0 }, azimuth_deg = 135 }
 tiems = [09:30:00]
 sun = { elevation_deg = 10, azimuth_deg = 135 }
 )toml", "", 3,
-         "skybake: error: schedule.toml:2:9: schedule.tiems: unknown key 'tiems' (expected 'first_frame', 'date', 'latitude_deg', 'longitude_deg', 'utc_offset_hours', 'times', 'sun', 'frames', 'ramp', 'per_hour')\n"
+         "skybake: error: schedule.toml:2:9: schedule.tiems: unknown key 'tiems' (did you mean 'times'?) (expected 'first_frame', 'date', 'latitude_deg', 'longitude_deg', 'utc_offset_hours', 'times', 'sun', 'frames', 'ramp', 'per_hour')\n"
          "skybake: 1 error; nothing was baked\n"},
     {"ScheduleLatitudeOutOfRange", R"toml()toml",
      R"toml([schedule]

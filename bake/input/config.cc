@@ -25,6 +25,8 @@
 #include <glm/glm.hpp>
 #include <toml++/toml.h>
 
+#include "toml_reader.h"
+
 namespace skybake {
 namespace {
 
@@ -78,21 +80,6 @@ std::string JoinNames(const std::vector<std::string>& names) {
     out += "'" + names[i] + "'";
   }
   return out;
-}
-
-int EditDistance(std::string_view a, std::string_view b) {
-  std::vector<int> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = int(j);
-  for (size_t i = 1; i <= a.size(); ++i) {
-    int diagonal = row[0];
-    row[0] = int(i);
-    for (size_t j = 1; j <= b.size(); ++j) {
-      int up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-      diagonal = up;
-    }
-  }
-  return row[b.size()];
 }
 
 // A name is safe as an output file name component: no separators, no "..",
@@ -686,20 +673,7 @@ class StyleReader {
     }
   }
 
-  std::string Suggest(const std::string& path) const {
-    std::string best;
-    int best_distance = 1 << 30;
-    for (const std::string& candidate : known_) {
-      int d = EditDistance(path, candidate);
-      if (d < best_distance) {
-        best_distance = d;
-        best = candidate;
-      }
-    }
-    // Suggest only near misses: at most a third of the key's length.
-    if (best.empty() || best_distance > std::max<int>(2, int(path.size()) / 3)) return "";
-    return fmt::format(" (did you mean '{}'?)", best);
-  }
+  std::string Suggest(const std::string& path) const { return DidYouMean(path, known_); }
 
   static std::string TypeName(const toml::node& node) {
     switch (node.type()) {
@@ -720,16 +694,7 @@ class StyleReader {
   }
 
   void ErrorAt(const toml::source_region& where, const std::string& path, const std::string& message) {
-    ConfigError e;
-    e.file = file_;
-    if (where.begin) {
-      e.line = int(where.begin.line);
-      e.column = int(where.begin.column);
-      if (where.path) e.file = *where.path;
-    }
-    e.key = path.empty() ? "\"\"" : path;  // a TOML key may be the empty string
-    e.message = message;
-    errors_.push_back(std::move(e));
+    errors_.push_back(LocatedError(file_, where, path, message));
   }
 
   const toml::table& root_;

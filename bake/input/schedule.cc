@@ -10,6 +10,8 @@
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "toml_reader.h"
+
 #include "skybake/model/atmosphere.h"
 
 namespace skybake {
@@ -23,14 +25,7 @@ class ScheduleReader {
       : file_(std::move(file)), errors_(errors) {}
 
   ConfigError Origin(const toml::node* node, const std::string& key) const {
-    ConfigError e;
-    e.file = file_;
-    e.key = key;
-    if (node && node->source().begin) {
-      e.line = int(node->source().begin.line);
-      e.column = int(node->source().begin.column);
-    }
-    return e;
+    return LocatedError(file_, node ? node->source() : toml::source_region{}, key, "");
   }
 
   void Error(const toml::node* node, const std::string& key, const std::string& message) {
@@ -105,7 +100,7 @@ class ScheduleReader {
     return values;
   }
 
-  // Reports keys of `table` outside `known`.
+  // Reports keys of `table` outside `known`, with the nearest known one.
   void CheckKeys(const toml::table& table, const std::string& prefix, std::initializer_list<const char*> known) {
     for (const auto& [k, node] : table) {
       bool ok = false;
@@ -114,7 +109,7 @@ class ScheduleReader {
         std::string names;
         for (const char* name : known) names += (names.empty() ? "'" : ", '") + std::string(name) + "'";
         Error(&node, prefix + "." + std::string(k.str()),
-              fmt::format("unknown key '{}' (expected {})", k.str(), names));
+              fmt::format("unknown key '{}'{} (expected {})", k.str(), DidYouMean(k.str(), known), names));
       }
     }
   }

@@ -1,0 +1,36 @@
+#include "toml_reader.h"
+
+#include <algorithm>
+
+namespace skybake {
+
+ConfigError LocatedError(const std::string& file, const toml::source_region& where, const std::string& key,
+                         const std::string& message) {
+  ConfigError e;
+  e.file = file;
+  if (where.begin) {
+    e.line = int(where.begin.line);
+    e.column = int(where.begin.column);
+    if (where.path) e.file = *where.path;
+  }
+  e.key = key.empty() ? "\"\"" : key;  // a TOML key may be the empty string
+  e.message = message;
+  return e;
+}
+
+int EditDistance(std::string_view a, std::string_view b) {
+  std::vector<int> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = int(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    int diagonal = row[0];
+    row[0] = int(i);
+    for (size_t j = 1; j <= b.size(); ++j) {
+      int up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace skybake
