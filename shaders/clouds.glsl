@@ -21,7 +21,7 @@ layout(std430, set = 0, binding = BINDING_CLOUD_LUT) buffer CloudLutBuffer {
 };
 // Active layers: the loops over layers have this bound, so a style's layer
 // count is compiled in (the cloud pipelines exist only when it is > 0).
-layout(constant_id = 20) const int kCloudLayers = 1;
+layout(constant_id = SPEC_CLOUD_LAYERS) const int kCloudLayers = 1;
 
 // ---------------------------------------------------------------- hashing and tiling noise
 

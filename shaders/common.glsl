@@ -37,14 +37,14 @@ layout(push_constant) uniform PushBlock {
 };
 
 // Optional effects (EffectSettings); off effects are compiled out.
-layout(constant_id = 0) const bool kMultipleScattering = true;
-layout(constant_id = 1) const bool kSunDisc = true;
-layout(constant_id = 2) const bool kGround = true;
-layout(constant_id = 12) const bool kMie = true;
-layout(constant_id = 13) const bool kOzone = true;
-layout(constant_id = 14) const bool kNight = false;
+layout(constant_id = SPEC_MULTIPLE_SCATTERING) const bool kMultipleScattering = true;
+layout(constant_id = SPEC_SUN_DISC) const bool kSunDisc = true;
+layout(constant_id = SPEC_GROUND) const bool kGround = true;
+layout(constant_id = SPEC_MIE) const bool kMie = true;
+layout(constant_id = SPEC_OZONE) const bool kOzone = true;
+layout(constant_id = SPEC_NIGHT) const bool kNight = false;
 // Writes the texel direction instead of radiance (mapping tests).
-layout(constant_id = 3) const bool kOutputDirection = false;
+layout(constant_id = SPEC_OUTPUT_DIRECTION) const bool kOutputDirection = false;
 // sky_render as the sun-disc pass (SkyRenderer::Render): adds the disc to the
 // texels of push.rect that the sky pass wrote without it. Its variant
 // (CMakeLists.txt) has the pass fixed, so that glslang drops the sky pass's
@@ -52,7 +52,7 @@ layout(constant_id = 3) const bool kOutputDirection = false;
 #ifdef SKYBAKE_VARIANT_SUN_DISC_PASS
 const bool kSunDiscPass = true;
 #else
-layout(constant_id = 15) const bool kSunDiscPass = false;
+layout(constant_id = SPEC_SUN_DISC_PASS) const bool kSunDiscPass = false;
 #endif
 // The AOAS principles (AoasSwitches); a style that does not use one compiles
 // it out. The sky hue needs no switch: it is the Rayleigh vector itself.
@@ -62,11 +62,11 @@ layout(constant_id = 15) const bool kSunDiscPass = false;
 // per-texel ray march is not in the SPIR-V at all.
 const bool kSkydome = false;
 #else
-layout(constant_id = 4) const bool kSkydome = false;
+layout(constant_id = SPEC_SKYDOME) const bool kSkydome = false;
 #endif
-layout(constant_id = 5) const bool kAmbiguity = false;
-layout(constant_id = 6) const bool kCloudNoise = false;
-layout(constant_id = 7) const bool kCloudShapes = false;
+layout(constant_id = SPEC_AMBIGUITY) const bool kAmbiguity = false;
+layout(constant_id = SPEC_CLOUD_NOISE) const bool kCloudNoise = false;
+layout(constant_id = SPEC_CLOUD_SHAPES) const bool kCloudShapes = false;
 // Quadrature rule (INTEGRATOR_*) and whether output texels read the sky-view
 // LUT instead of ray-marching; ids from 10 on are the quality settings.
 #ifdef SKYBAKE_VARIANT_ANALYTIC
@@ -74,12 +74,12 @@ layout(constant_id = 7) const bool kCloudShapes = false;
 // compiled out.
 const int kIntegrator = INTEGRATOR_ANALYTIC;
 #else
-layout(constant_id = 10) const int kIntegrator = INTEGRATOR_ANALYTIC;
+layout(constant_id = SPEC_INTEGRATOR) const int kIntegrator = INTEGRATOR_ANALYTIC;
 #endif
 #ifdef SKYBAKE_VARIANT_SKY_VIEW
 const bool kUseSkyView = true;
 #else
-layout(constant_id = 11) const bool kUseSkyView = false;
+layout(constant_id = SPEC_USE_SKY_VIEW) const bool kUseSkyView = false;
 #endif
 
 vec3 TransmittanceLutTexel(int x, int y) {

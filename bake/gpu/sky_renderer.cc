@@ -400,11 +400,8 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
   VkShaderModule module;
   VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
 
-  // Specialization constants of common.glsl: ids 0..3 the optional effects,
-  // 4..7 the AOAS principles that act per texel, 10..11 the quality
-  // settings, 12..14 the Mie and ozone constituents and night dimming, 15
-  // the sun-disc pass, 20 the cloud layers. Every pipeline gets them all; a
-  // shader that does not use one ignores it.
+  // Specialization constants (SPEC_* of gpu_shared.h). Every pipeline gets
+  // them all; a shader that does not use one ignores it.
   struct {
     VkBool32 multiple_scattering, sun_disc, ground, output_directions;
     VkBool32 skydome, ambiguity, cloud_noise, cloud_shapes;
@@ -416,10 +413,12 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1)};
-  const VkSpecializationMapEntry entries[15] = {{0, 0, 4},   {1, 4, 4},   {2, 8, 4},   {3, 12, 4},
-                                                {4, 16, 4},  {5, 20, 4},  {6, 24, 4},  {7, 28, 4},
-                                                {10, 32, 4}, {11, 36, 4}, {12, 40, 4}, {13, 44, 4},
-                                                {14, 48, 4}, {15, 52, 4}, {20, 56, 4}};
+  const VkSpecializationMapEntry entries[15] = {
+      {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
+      {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
+      {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
+      {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
+      {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4}};
   VkSpecializationInfo specialization{15, entries, sizeof(values), &values};
 
   VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};

@@ -2,6 +2,8 @@
 
 #include "skybake/pipeline/pass_plan.h"
 
+#include "renderer_cache.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -94,85 +96,6 @@ struct FramePlan {
 // without clock times).
 double CloudTimeOf(const FramePlan& plan) { return plan.hours_from_start * 3600.0; }
 
-// What the shaders of one style see: the atmosphere with the hue principle
-// applied (its Rayleigh constants), and the per-texel AOAS principles, whose
-// saturation is judged in Rec.709 luminance RGB.
-struct StyledInputs {
-  AtmosphereParams atmosphere;
-  AoasInputs aoas;
-};
-StyledInputs StyledInputsOf(const SkyStyle& style) {
-  return {StyledAtmosphere(style.atmosphere, style.aoas),
-          ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance))};
-}
-
-// The renderer for one styled atmosphere (it also renders without the disc,
-// for the sky-only SH, from the same LUTs). Rebuilt only when a frame changes
-// what the shaders see.
-class RendererCache {
- public:
-  RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
-
-  // `cloud_time_s`: the frame's clock time since the sequence's first frame,
-  // which the wind moves the clouds by.
-  SkyRenderer& Main(const SkyStyle& style, double cloud_time_s = 0.0) {
-    Update(style, cloud_time_s);
-    return *main_;
-  }
-  // The renderer of the last frame.
-  SkyRenderer& Current() { return *main_; }
- private:
-  void Update(const SkyStyle& unpruned, double cloud_time_s) {
-    // The pass plan's pruning: zero-strength and unused effects compiled out.
-    const SkyStyle style = PrunedStyle(unpruned);
-    StyledInputs in = StyledInputsOf(style);
-    const CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
-                                             std::filesystem::path(style.source_path).parent_path().string(),
-                                             cloud_time_s);
-    // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
-    const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
-    gpu::GpuAtmosphere key =
-        ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
-    // A new atmosphere with the same shader variant (a scheduled drift of
-    // its constants): new uniforms and LUTs, the same pipelines.
-    if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) != 0 &&
-        main_->UpdateAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units))) {
-      key_ = key;
-      ++result_.atmosphere_updates;
-    }
-    if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
-      // Same atmosphere: the LUTs stay; per-texel AOAS parameters (a cloud
-      // drift, say) change in place when the shader variant is the same.
-      if (std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0 &&
-          in.aoas.switches.skydome == aoas_key_.switches.skydome &&
-          in.aoas.switches.ambiguity == aoas_key_.switches.ambiguity &&
-          in.aoas.switches.cloud_noise == aoas_key_.switches.cloud_noise &&
-          in.aoas.switches.cloud_shapes == aoas_key_.switches.cloud_shapes)
-        return;
-      if (main_->UpdateAoas(in.aoas)) {
-        aoas_key_ = in.aoas;
-        return;
-      }
-    }
-    // A renderer whose frame the writer thread still reads lives on until
-    // that frame is written.
-    std::erase_if(retired_, [](const std::unique_ptr<SkyRenderer>& r) { return !r->HoldsFrames(); });
-    if (main_ && main_->HoldsFrames()) retired_.push_back(std::move(main_));
-    main_.reset();
-    main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
-                                          OutputScale(style.output.units), false, in.aoas, clouds);
-    ++result_.renderer_builds;
-    key_ = key;
-    aoas_key_ = in.aoas;
-  }
-
-  VulkanContext& context_;
-  BakeResult& result_;
-  std::unique_ptr<SkyRenderer> main_;
-  std::vector<std::unique_ptr<SkyRenderer>> retired_;
-  gpu::GpuAtmosphere key_{};
-  AoasInputs aoas_key_;
-};
 
 // Converts spectral output to luminance for exposure; a copy.
 std::vector<float> DisplayLuminance(const float* rgba, size_t texels, OutputUnits units) {
@@ -932,62 +855,6 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 void KeepFrameMemoryInHeap() {
   mallopt(M_MMAP_THRESHOLD, 1 << 30);
   mallopt(M_TRIM_THRESHOLD, 1 << 30);
-}
-
-// Ray-march samples per second of lavapipe on the 2-core CI machine, measured
-// on the default style's production bake (3.67 Mtexels x 48 steps in 14.5 s;
-// README "Limits"). A slower or faster machine scales every estimate alike.
-constexpr double kLavapipeSamplesPerSecond = 1.2e7;
-
-ResourceEstimate EstimateResources(const SkyStyle& style) {
-  const std::vector<ViewRequest> views = PlanViews(style);
-  const double latlong = 2.0 * style.render.latlong_height * double(style.render.latlong_height);
-  double texels = 0.0, largest = 0.0;
-  for (const ViewRequest& v : views) {
-    texels += double(v.width) * v.height;
-    largest = std::max(largest, double(v.width) * v.height);
-  }
-  const QualitySettings& q = style.quality;
-  const double luts = 16.0 * (double(q.transmittance_width) * q.transmittance_height +
-                              double(q.multiscattering_size) * q.multiscattering_size +
-                              (q.sky_view_lut ? double(q.sky_view_width) * q.sky_view_height : 0.0));
-  const double channel = style.output.pixel_type == PixelType::kHalf ? 2.0 : 4.0;
-  ResourceEstimate e;
-  // Device output buffer and its host copy (RGBA float each), the largest
-  // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG.
-  const bool preview = WritesLatlongPng(style);
-  const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
-  e.memory_mib = bytes / (1024.0 * 1024.0);
-  // Samples: the pass plan's count for one frame (each ray-marched texel
-  // marches view_steps, times light_steps when the Sun's transmittance is
-  // marched too; a sky-view texel is one LUT read; plus the LUTs).
-  e.samples = PlanPasses({style}).total_samples;
-  e.seconds = e.samples / kLavapipeSamplesPerSecond;
-  return e;
-}
-
-void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
-  const ResourceEstimate e = EstimateResources(style);
-  // Whole MiB, unless the two would then read the same ("1 MiB above 1 MiB").
-  auto pair = [](double need, double budget) {
-    const bool close = fmt::format("{:.0f}", need) == fmt::format("{:.0f}", budget);
-    return close ? std::pair{fmt::format("{:.3f}", need), fmt::format("{:.3f}", budget)}
-                 : std::pair{fmt::format("{:.0f}", need), fmt::format("{:.0f}", budget)};
-  };
-  if (e.memory_mib > options.max_memory_mib) {
-    const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
-    throw BudgetError(fmt::format(
-        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
-        "of {} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
-        "--max-memory-mib (README \"Limits\")",
-        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, budget));
-  }
-  if (e.seconds > options.max_frame_seconds)
-    throw BudgetError(fmt::format(
-        "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "
-        "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
-        "--max-frame-seconds (README \"Limits\")",
-        e.samples, e.seconds, options.max_frame_seconds));
 }
 
 BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options) {

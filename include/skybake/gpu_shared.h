@@ -18,6 +18,25 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SKYBAKE_GPU_STRUCT(name) struct name
 #endif
 
+// Specialization constants (constant_id) of the sky and cloud shaders
+// (shaders/common.glsl, clouds.glsl). SkyRenderer::CreatePipeline gives every
+// pipeline all of them; a shader that does not use one ignores it.
+#define SPEC_MULTIPLE_SCATTERING 0  // bool, EffectSettings
+#define SPEC_SUN_DISC 1             // bool
+#define SPEC_GROUND 2               // bool
+#define SPEC_OUTPUT_DIRECTION 3     // bool: write texel directions (mapping tests)
+#define SPEC_SKYDOME 4              // bool, the AOAS principles that act per texel
+#define SPEC_AMBIGUITY 5            // bool
+#define SPEC_CLOUD_NOISE 6          // bool
+#define SPEC_CLOUD_SHAPES 7         // bool
+#define SPEC_INTEGRATOR 10          // int INTEGRATOR_*, the quality settings
+#define SPEC_USE_SKY_VIEW 11        // bool
+#define SPEC_MIE 12                 // bool, the constituents and night dimming
+#define SPEC_OZONE 13               // bool
+#define SPEC_NIGHT 14               // bool
+#define SPEC_SUN_DISC_PASS 15       // bool: sky_render as the sun-disc pass
+#define SPEC_CLOUD_LAYERS 20        // int: the active volumetric cloud layers
+
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere
 #define BINDING_TRANSMITTANCE 1    // storage vec4[], transmittance LUT

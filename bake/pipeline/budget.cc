@@ -1,0 +1,69 @@
+// The resource estimate of one frame and the budget check (pipeline.h).
+#include <algorithm>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+
+namespace skybake {
+
+// Ray-march samples per second of lavapipe on the 2-core CI machine, measured
+// on the default style's production bake (3.67 Mtexels x 48 steps in 14.5 s;
+// README "Limits"). A slower or faster machine scales every estimate alike.
+constexpr double kLavapipeSamplesPerSecond = 1.2e7;
+
+ResourceEstimate EstimateResources(const SkyStyle& style) {
+  const std::vector<ViewRequest> views = PlanViews(style);
+  const double latlong = 2.0 * style.render.latlong_height * double(style.render.latlong_height);
+  double texels = 0.0, largest = 0.0;
+  for (const ViewRequest& v : views) {
+    texels += double(v.width) * v.height;
+    largest = std::max(largest, double(v.width) * v.height);
+  }
+  const QualitySettings& q = style.quality;
+  const double luts = 16.0 * (double(q.transmittance_width) * q.transmittance_height +
+                              double(q.multiscattering_size) * q.multiscattering_size +
+                              (q.sky_view_lut ? double(q.sky_view_width) * q.sky_view_height : 0.0));
+  const double channel = style.output.pixel_type == PixelType::kHalf ? 2.0 : 4.0;
+  ResourceEstimate e;
+  // Device output buffer and its host copy (RGBA float each), the largest
+  // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG.
+  const bool preview = WritesLatlongPng(style);
+  const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
+  e.memory_mib = bytes / (1024.0 * 1024.0);
+  // Samples: the pass plan's count for one frame (each ray-marched texel
+  // marches view_steps, times light_steps when the Sun's transmittance is
+  // marched too; a sky-view texel is one LUT read; plus the LUTs).
+  e.samples = PlanPasses({style}).total_samples;
+  e.seconds = e.samples / kLavapipeSamplesPerSecond;
+  return e;
+}
+
+void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
+  const ResourceEstimate e = EstimateResources(style);
+  // Whole MiB, unless the two would then read the same ("1 MiB above 1 MiB").
+  auto pair = [](double need, double budget) {
+    const bool close = fmt::format("{:.0f}", need) == fmt::format("{:.0f}", budget);
+    return close ? std::pair{fmt::format("{:.3f}", need), fmt::format("{:.3f}", budget)}
+                 : std::pair{fmt::format("{:.0f}", need), fmt::format("{:.0f}", budget)};
+  };
+  if (e.memory_mib > options.max_memory_mib) {
+    const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
+    throw BudgetError(fmt::format(
+        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
+        "of {} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
+        "--max-memory-mib (README \"Limits\")",
+        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, budget));
+  }
+  if (e.seconds > options.max_frame_seconds)
+    throw BudgetError(fmt::format(
+        "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "
+        "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
+        "--max-frame-seconds (README \"Limits\")",
+        e.samples, e.seconds, options.max_frame_seconds));
+}
+
+}  // namespace skybake

@@ -1,0 +1,60 @@
+#include "renderer_cache.h"
+
+#include <cstring>
+#include <filesystem>
+
+#include "skybake/input/config.h"
+#include "skybake/pipeline/pass_plan.h"
+
+namespace skybake {
+
+StyledInputs StyledInputsOf(const SkyStyle& style) {
+  return {StyledAtmosphere(style.atmosphere, style.aoas),
+          ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance))};
+}
+
+void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
+  // The pass plan's pruning: zero-strength and unused effects compiled out.
+  const SkyStyle style = PrunedStyle(unpruned);
+  StyledInputs in = StyledInputsOf(style);
+  const CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
+                                           std::filesystem::path(style.source_path).parent_path().string(),
+                                           cloud_time_s);
+  // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
+  const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
+  gpu::GpuAtmosphere key =
+      ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+  // A new atmosphere with the same shader variant (a scheduled drift of
+  // its constants): new uniforms and LUTs, the same pipelines.
+  if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) != 0 &&
+      main_->UpdateAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units))) {
+    key_ = key;
+    ++result_.atmosphere_updates;
+  }
+  if (clouds_kept && main_ && std::memcmp(&key, &key_, sizeof key) == 0) {
+    // Same atmosphere: the LUTs stay; per-texel AOAS parameters (a cloud
+    // drift, say) change in place when the shader variant is the same.
+    if (std::memcmp(&in.aoas.uniform, &aoas_key_.uniform, sizeof(gpu::GpuAoas)) == 0 &&
+        in.aoas.switches.skydome == aoas_key_.switches.skydome &&
+        in.aoas.switches.ambiguity == aoas_key_.switches.ambiguity &&
+        in.aoas.switches.cloud_noise == aoas_key_.switches.cloud_noise &&
+        in.aoas.switches.cloud_shapes == aoas_key_.switches.cloud_shapes)
+      return;
+    if (main_->UpdateAoas(in.aoas)) {
+      aoas_key_ = in.aoas;
+      return;
+    }
+  }
+  // A renderer whose frame the writer thread still reads lives on until
+  // that frame is written.
+  std::erase_if(retired_, [](const std::unique_ptr<SkyRenderer>& r) { return !r->HoldsFrames(); });
+  if (main_ && main_->HoldsFrames()) retired_.push_back(std::move(main_));
+  main_.reset();
+  main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
+                                        OutputScale(style.output.units), false, in.aoas, clouds);
+  ++result_.renderer_builds;
+  key_ = key;
+  aoas_key_ = in.aoas;
+}
+
+}  // namespace skybake

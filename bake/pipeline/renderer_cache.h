@@ -1,0 +1,52 @@
+// The bake's renderers (private to the pipeline layer): one SkyRenderer per
+// styled atmosphere and shader variant, kept across the frames of a
+// sequence and rebuilt only when a frame changes what the shaders see.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "skybake/gpu/sky_renderer.h"
+#include "skybake/gpu/vulkan_context.h"
+#include "skybake/input/style.h"
+#include "skybake/model/aoas.h"
+#include "skybake/output/bake_record.h"
+
+namespace skybake {
+
+// What the shaders of one style see: the atmosphere with the hue principle
+// applied (its Rayleigh constants), and the per-texel AOAS principles, whose
+// saturation is judged in Rec.709 luminance RGB.
+struct StyledInputs {
+  AtmosphereParams atmosphere;
+  AoasInputs aoas;
+};
+StyledInputs StyledInputsOf(const SkyStyle& style);
+
+// The renderer for one styled atmosphere (it also renders without the disc,
+// for the sky-only SH, from the same LUTs). Rebuilt only when a frame changes
+// what the shaders see.
+class RendererCache {
+ public:
+  RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
+
+  // `cloud_time_s`: the frame's clock time since the sequence's first frame,
+  // which the wind moves the clouds by.
+  SkyRenderer& Main(const SkyStyle& style, double cloud_time_s = 0.0) {
+    Update(style, cloud_time_s);
+    return *main_;
+  }
+  // The renderer of the last frame.
+  SkyRenderer& Current() { return *main_; }
+ private:
+  void Update(const SkyStyle& unpruned, double cloud_time_s);
+
+  VulkanContext& context_;
+  BakeResult& result_;
+  std::unique_ptr<SkyRenderer> main_;
+  std::vector<std::unique_ptr<SkyRenderer>> retired_;
+  gpu::GpuAtmosphere key_{};
+  AoasInputs aoas_key_;
+};
+
+}  // namespace skybake
