@@ -98,6 +98,31 @@ TEST(PassPlanTest, GltfOnlyBakePlansTheLatlongItsTextureNeeds) {
   EXPECT_NE(run.output.find("render latlong"), std::string::npos) << run.output;
 }
 
+// The environment's shader switches are read once, by the CLI, and reach the
+// planner as they reach the renderer: the plan of the default style names the
+// generic shaders with SKYBAKE_GENERIC_SHADERS=1 and has no sun-disc pass with
+// SKYBAKE_SUN_DISC_PASS=0; the library itself reads no environment.
+TEST(PassPlanTest, EnvironmentSwitchesReachThePlanThroughTheCli) {
+  const std::string style = testing::SourceDir() + "/configs/default.toml";
+  const testing::CommandRun plain = testing::RunSkybake("plan " + style);
+  ASSERT_EQ(plain.exit_code, 0) << plain.output;
+  EXPECT_NE(plain.output.find("sky_render from the built-in sky-view variant"), std::string::npos) << plain.output;
+  EXPECT_NE(plain.output.find("near the Sun"), std::string::npos) << plain.output;
+  const testing::CommandRun generic = testing::RunSkybake("plan " + style, "SKYBAKE_GENERIC_SHADERS=1");
+  ASSERT_EQ(generic.exit_code, 0) << generic.output;
+  EXPECT_NE(generic.output.find("sky_render generic, specialized at pipeline creation"), std::string::npos)
+      << generic.output;
+  const testing::CommandRun no_pass = testing::RunSkybake("plan " + style, "SKYBAKE_SUN_DISC_PASS=0");
+  ASSERT_EQ(no_pass.exit_code, 0) << no_pass.output;
+  EXPECT_EQ(no_pass.output.find("near the Sun"), std::string::npos) << no_pass.output;
+
+  ShaderSwitches generic_switches;
+  generic_switches.generic = true;
+  const SkyStyle s = Style("");
+  EXPECT_NE(PlanPasses({s}, generic_switches).variant.find("sky_render generic"), std::string::npos);
+  EXPECT_NE(PlanPasses({s}).variant.find("sky_render from the built-in sky-view variant"), std::string::npos);
+}
+
 // The disc has a pass of its own only where nothing acts on it after it is
 // added: clouds scale the saturation of the sky with the disc in it, and the
 // ambiguity moves the direction it is seen along.

@@ -303,9 +303,10 @@ TEST(SkyRendererTest, ShaderVariantsMatchGenericShaders) {
     atmosphere.observer_altitude_m = altitude_m;
     std::vector<std::vector<float>> images[2];
     for (int generic = 0; generic < 2; ++generic) {
-      if (generic) ::setenv("SKYBAKE_GENERIC_SHADERS", "1", 1);
-      SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
-      ::unsetenv("SKYBAKE_GENERIC_SHADERS");
+      ShaderSwitches shaders;
+      shaders.generic = generic;
+      SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1}, false, AoasInputs(),
+                           CloudInputs(), shaders);
       EXPECT_EQ(renderer.counters().variant_pipelines, generic ? 0 : renderer.counters().pipelines);
       for (double elevation : {45.0, 0.3, -3.0, -12.0})
         for (std::vector<float>& image :
@@ -395,9 +396,10 @@ TEST(SkyRendererTest, SunDiscPassMatchesDiscInTheSkyPass) {
   for (double altitude_m : {0.0, 150000.0}) {
     AtmosphereParams atmosphere;
     atmosphere.observer_altitude_m = altitude_m;
-    ::setenv("SKYBAKE_SUN_DISC_PASS", "0", 1);
-    SkyRenderer inline_disc(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
-    ::unsetenv("SKYBAKE_SUN_DISC_PASS");
+    ShaderSwitches no_disc_pass;
+    no_disc_pass.sun_disc_pass = false;
+    SkyRenderer inline_disc(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1}, false, AoasInputs(),
+                            CloudInputs(), no_disc_pass);
     SkyRenderer disc_pass(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
     EXPECT_EQ(disc_pass.counters().pipelines, inline_disc.counters().pipelines + 1);
     for (const glm::dvec3& sun : suns) {

@@ -61,6 +61,11 @@ bool EnvFlag(const char* name) {
   return v && *v && std::string(v) != "0";
 }
 
+bool EnvIs(const char* name, const char* value) {
+  const char* v = std::getenv(name);
+  return v && std::string(v) == value;
+}
+
 int RunDevices() {
   std::vector<DeviceInfo> devices = VulkanContext::ListDevices();
   if (devices.empty()) {
@@ -95,6 +100,7 @@ struct BakeArgs {
   bool dry_run = false;  // print the plan instead of baking
   std::string frames;    // --frames FIRST:LAST, empty: every frame
   std::string shard;     // --shard I/N, empty: no split
+  ShaderSwitches shaders;  // from the environment (main)
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -173,7 +179,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
     } else {
       planned.push_back(config.style);
     }
-    PassPlan plan = PlanPasses(planned);
+    PassPlan plan = PlanPasses(planned, args.shaders);
     std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
     if (part)
       what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
@@ -198,7 +204,8 @@ int RunBake(const BakeArgs& args, Mode mode) {
   options.resume = args.resume;
   options.frames = part;
   options.vulkan.device_index = args.device;
-  options.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  options.vulkan.validation = args.validation;
+  options.shaders = args.shaders;
   if (!args.quiet) {
     options.progress = [](const StageReport& s) {
       std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
@@ -264,7 +271,8 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.columns = gallery.columns;
   options.overrides = args.overrides;
   options.bake.vulkan.device_index = args.device;
-  options.bake.vulkan.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  options.bake.vulkan.validation = args.validation;
+  options.bake.shaders = args.shaders;
   options.bake.force = args.force;
   size_t done = 0;
   if (!args.quiet) {
@@ -423,6 +431,10 @@ int main(int argc, char** argv) {
 
   // Single-threaded still: the only point where the environment may change.
   SelectSoftwareDriversWithoutGpu();
+  // The environment's switches, read once here and passed in (README).
+  args.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
+  args.shaders.generic = EnvIs("SKYBAKE_GENERIC_SHADERS", "1");
+  args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");
   try {
     if (devices->parsed()) return RunDevices();
     if (accuracy->parsed()) {

@@ -48,14 +48,14 @@ uint32_t GroupCount(int texels, int local_size) {
 SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
                          const QualitySettings& quality, const EffectSettings& effects,
                          const Rgb& output_scale, bool output_directions,
-                         const AoasInputs& aoas, const CloudInputs& clouds)
+                         const AoasInputs& aoas, const CloudInputs& clouds, const ShaderSwitches& shaders)
     : context_(context),
       quality_(quality),
       effects_(effects),
       aoas_switches_(aoas.switches),
       output_directions_(output_directions) {
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
-  disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches);
+  disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches, shaders);
   // Clouds (clouds.h): a style without layers gets no cloud pipeline, no
   // noise and no cloud pass; its buffers are placeholders.
   cloud_layers_ = output_directions ? 0 : clouds.layers();
@@ -119,9 +119,9 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   };
   // The variants built with the presets' settings fixed (CMakeLists.txt)
   // compile 10-20 times faster; they compute the same values to float
-  // rounding (tests/sky_renderer_test.cc). SKYBAKE_GENERIC_SHADERS=1 turns
-  // them off, to tell a variant's fault from the shader's.
-  const ShaderSources sources = ChooseShaderSources(quality, aoas.switches.skydome);
+  // rounding (tests/sky_renderer_test.cc). shaders.generic turns them off,
+  // to tell a variant's fault from the shader's.
+  const ShaderSources sources = ChooseShaderSources(quality, aoas.switches.skydome, shaders);
   const bool analytic = sources.analytic_luts;
   const bool sky_view = quality.sky_view_lut && !aoas.switches.skydome;
   auto job = [this](VkPipeline* pipeline, bool variant, const auto& variant_code, const auto& generic_code) {
@@ -185,11 +185,10 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   timestamps_supported_ = context_.SupportsTimestamps();
 }
 
-bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas) {
-  const char* env = std::getenv("SKYBAKE_SUN_DISC_PASS");
-  if (env && std::string(env) == "0") return false;
-  return effects.sun_disc && quality.sky_view_lut && !aoas.skydome && !aoas.ambiguity && !aoas.cloud_noise &&
-         !aoas.cloud_shapes;
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas,
+                     const ShaderSwitches& shaders) {
+  return shaders.sun_disc_pass && effects.sun_disc && quality.sky_view_lut && !aoas.skydome && !aoas.ambiguity &&
+         !aoas.cloud_noise && !aoas.cloud_shapes;
 }
 
 std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle) {
@@ -228,9 +227,8 @@ std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::d
   return rects;
 }
 
-ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome) {
-  const char* generic = std::getenv("SKYBAKE_GENERIC_SHADERS");
-  if (generic && std::string(generic) == "1") return {};
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome, const ShaderSwitches& shaders) {
+  if (shaders.generic) return {};
   ShaderSources sources;
   sources.analytic_luts = quality.integrator == INTEGRATOR_ANALYTIC;
   sources.sky_view_render = quality.sky_view_lut && !skydome;

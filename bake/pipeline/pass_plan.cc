@@ -67,7 +67,7 @@ std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
   return views;
 }
 
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders) {
   PassPlan plan;
   plan.frames = int(frames.size());
   if (frames.empty()) return plan;
@@ -162,7 +162,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
   switches.ambiguity = xp.ambiguity.enabled;
   switches.cloud_noise = xp.clouds.enabled;
   switches.cloud_shapes = xp.shapes.enabled;
-  const bool disc_pass = UsesSunDiscPass(q, p, switches);
+  const bool disc_pass = UsesSunDiscPass(q, p, switches, shaders);
   if (disc_pass)
     plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
   const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
@@ -220,7 +220,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
       p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
       xp.ambiguity.enabled,
       xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
-  const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled);
+  const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled, shaders);
   plan.variant += fmt::format(
       "\n  SPIR-V: sky_render {}; LUT shaders {}", sources.sky_view_render
           ? "from the built-in sky-view variant (ray march compiled out)"

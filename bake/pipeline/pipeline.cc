@@ -387,7 +387,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
   }
 
   // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
-  RendererCache renderers(context, result);
+  RendererCache renderers(context, result, options.shaders);
   std::unique_ptr<IblBaker> ibl_baker;  // created by the first frame that asks for IBL maps
   {
     const RenderCounters& c = renderers.Main(first).counters();

@@ -51,7 +51,7 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   if (main_ && main_->HoldsFrames()) retired_.push_back(std::move(main_));
   main_.reset();
   main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
-                                        OutputScale(style.output.units), false, in.aoas, clouds);
+                                        OutputScale(style.output.units), false, in.aoas, clouds, shaders_);
   ++result_.renderer_builds;
   key_ = key;
   aoas_key_ = in.aoas;

@@ -28,7 +28,8 @@ StyledInputs StyledInputsOf(const SkyStyle& style);
 // what the shaders see.
 class RendererCache {
  public:
-  RendererCache(VulkanContext& context, BakeResult& result) : context_(context), result_(result) {}
+  RendererCache(VulkanContext& context, BakeResult& result, const ShaderSwitches& shaders)
+      : context_(context), result_(result), shaders_(shaders) {}
 
   // `cloud_time_s`: the frame's clock time since the sequence's first frame,
   // which the wind moves the clouds by.
@@ -43,6 +44,7 @@ class RendererCache {
 
   VulkanContext& context_;
   BakeResult& result_;
+  ShaderSwitches shaders_;
   std::unique_ptr<SkyRenderer> main_;
   std::vector<std::unique_ptr<SkyRenderer>> retired_;
   gpu::GpuAtmosphere key_{};

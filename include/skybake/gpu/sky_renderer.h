@@ -33,22 +33,31 @@ struct TexelRect {
 // tiles. Every texel of a MAPPING_DIRECTIONS view.
 std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::dvec3& direction, double angle);
 
+// Diagnostic switches of the shaders. The CLI sets them from the environment
+// (README "Shaders"), read once in main; the library never reads it.
+struct ShaderSwitches {
+  bool generic = false;       // SKYBAKE_GENERIC_SHADERS=1: every pipeline from the generic shaders, no variant
+  bool sun_disc_pass = true;  // SKYBAKE_SUN_DISC_PASS=0: the disc tested by every texel, no pass of its own
+};
+
 // Whether the sun disc is added by a pass of its own over the texels near
 // the Sun (SkyRenderer::Render) rather than tested by every texel of the sky
 // pass: with the sky-view LUT and none of the AOAS principles that act on
-// the disc after it is added (ambiguity, clouds); SKYBAKE_SUN_DISC_PASS=0
-// turns it off.
-bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas);
+// the disc after it is added (ambiguity, clouds), unless shaders.sun_disc_pass
+// is off.
+bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas,
+                     const ShaderSwitches& shaders = ShaderSwitches());
 
 // Where each pipeline's SPIR-V comes from: the variants compiled with the
 // presets' quality fixed and optimized by glslang -Os (CMakeLists.txt), when the
-// settings match them and SKYBAKE_GENERIC_SHADERS is not 1; else the generic
-// shaders, specialized when the pipeline is created.
+// settings match them and shaders.generic is off; else the generic shaders,
+// specialized when the pipeline is created.
 struct ShaderSources {
   bool analytic_luts = false;    // LUT shaders from the analytic-integrator variants
   bool sky_view_render = false;  // sky_render from the sky-view variant
 };
-ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome);
+ShaderSources ChooseShaderSources(const QualitySettings& quality, bool skydome,
+                                  const ShaderSwitches& shaders = ShaderSwitches());
 
 // Views rendered in place (SkyRenderer::RenderInPlace): RGBA float texels,
 // rows from the top, in the renderer's host-visible memory. The memory stays
@@ -67,7 +76,8 @@ class SkyRenderer {
   SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
               const QualitySettings& quality, const EffectSettings& effects,
               const Rgb& output_scale, bool output_directions = false,
-              const AoasInputs& aoas = AoasInputs(), const CloudInputs& clouds = CloudInputs());
+              const AoasInputs& aoas = AoasInputs(), const CloudInputs& clouds = CloudInputs(),
+              const ShaderSwitches& shaders = ShaderSwitches());
   ~SkyRenderer();
   SkyRenderer(const SkyRenderer&) = delete;
   SkyRenderer& operator=(const SkyRenderer&) = delete;

@@ -63,7 +63,8 @@ bool WritesLatlongPng(const SkyStyle& style);
 // device-limit check and the renderer all read this list.
 std::vector<ViewRequest> PlanViews(const SkyStyle& style);
 
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames);
+// `shaders`: the CLI's diagnostic switches, as the bake would get them.
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders = ShaderSwitches());
 
 // The plan as `skybake plan` prints it.
 std::string FormatPlan(const PassPlan& plan, const std::string& source);

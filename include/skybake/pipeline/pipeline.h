@@ -29,6 +29,7 @@ using ProgressCallback = std::function<void(const StageReport&)>;
 struct BakeOptions {
   std::string out_dir = "out";
   VulkanOptions vulkan;
+  ShaderSwitches shaders;     // the CLI's diagnostic switches (from the environment, read in main)
   ProgressCallback progress;  // may be empty
   bool force = false;   // overwrite files of a previous bake in out_dir
   bool resume = false;  // sequence: keep frames verified against its manifest in out_dir, bake the rest
