@@ -25,6 +25,7 @@
 
 #include "skybake/accuracy.h"
 #include "skybake/config.h"
+#include "skybake/engine_preset.h"
 #include "skybake/exr_io.h"
 #include "skybake/gallery.h"
 #include "skybake/manifest.h"
@@ -95,6 +96,7 @@ struct BakeArgs {
   bool dry_run = false;  // print the plan instead of baking
   std::string frames;    // --frames FIRST:LAST, empty: every frame
   std::string shard;     // --shard I/N, empty: no split
+  std::string engine;    // --engine NAME: output.engine
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -111,6 +113,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
     overrides.push_back(fmt::format("render.cube_size={}", args.size));
     overrides.push_back(fmt::format("render.latlong_height={}", args.size));
   }
+  if (!args.engine.empty()) overrides.push_back("output.engine=" + args.engine);
   ConfigResult config = LoadSkyStyle(args.style_path, overrides);
   if (!config.ok()) {
     PrintErrors(config.errors);
@@ -353,6 +356,14 @@ int main(int argc, char** argv) {
                    "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
                    "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
       ->type_name("I/N");
+  {
+    std::string engines;
+    for (const std::string& name : EngineNames()) engines += (engines.empty() ? "" : "|") + name;
+    bake->add_option("--engine", args.engine,
+                     "Also write the files one engine loads the right way up (output.engine; docs/engines.md)")
+        ->type_name(engines)
+        ->check(CLI::IsMember(EngineNames()));
+  }
   bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
   bake->add_flag("--vulkan-validation", args.validation,

@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/engine_preset.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/output_lock.h"
@@ -287,12 +288,22 @@ void CheckNames(const std::string& path, const Manifest& m) {
         with_suffix(file, stem_of(file, ".exr", "latlong"), "_latlong", "latlong", 2);
       } else if (file.kind == "ibl_specular" || file.kind == "ibl_irradiance" || file.kind == "ibl_dfg") {
         CheckIblName(path, where, f.number, file, base, stage);
+      } else if (file.kind == "engine") {
+        // BASE_ENGINE_SUFFIX.NNNN.exr (engine_preset.h), after the IBL files.
+        const std::optional<std::string> b = EngineFileBase(file.file, f.number);
+        if (stage > 4 || !IsPlainFileName(file.file) || !b || b->empty())
+          FailName(path, where, file.file, fmt::format("an engine preset's file skybake names for frame {} "
+                                                       "(BASE_ENGINE_SUFFIX{}.exr)", f.number, number));
+        if (!base.empty() && *b != base)
+          FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+        base = *b;
+        stage = 4;
       } else if (file.kind == "preview" || file.kind == "gltf_texture") {
         with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
       } else {
         FailName(path, where, file.kind,
-                 "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, preview, "
-                 "gltf_texture)");
+                 "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, engine, "
+                 "preview, gltf_texture)");
       }
     }
     if (!faces.empty() && faces.size() != 6)

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <openssl/evp.h>
 
+#include "skybake/engine_preset.h"
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
@@ -196,12 +197,14 @@ struct FrameNames {
   std::vector<std::string> faces;  // six, when output.faces
   std::string cube, latlong, png;  // empty when not written
   std::vector<IblFileName> ibl;    // the IBL maps' files (ibl.h), when asked for
+  std::vector<std::string> engine;  // the engine preset's files (engine_preset.h), when one is set
   bool with_dfg = false;           // the bake's first frame carries the DFG table
   std::vector<std::string> All() const {
     std::vector<std::string> all = faces;
     for (const std::string* n : {&cube, &latlong})
       if (!n->empty()) all.push_back(*n);
     for (const IblFileName& n : ibl) all.push_back(n.name);
+    for (const std::string& n : engine) all.push_back(n);
     if (!png.empty()) all.push_back(png);
     return all;
   }
@@ -218,6 +221,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
   if (o.preview || style.gltf.enabled) names.png = o.basename + "_latlong" + number + ".png";
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
+  names.engine = EngineFileNames(style, number_in_name);
   return names;
 }
 
@@ -307,6 +311,7 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   if (!names.cube.empty()) kinds.push_back("cube");
   if (!names.latlong.empty()) kinds.push_back("latlong");
   for (const IblFileName& n : names.ibl) kinds.push_back(n.kind);
+  kinds.insert(kinds.end(), names.engine.size(), "engine");
   if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
   size_t index = 0;
   for (const json& entry : f["files"]) {
@@ -346,6 +351,7 @@ struct FrameJob {
   double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
   std::optional<IblMaps> ibl;     // the frame's IBL maps, when asked for
+  std::vector<RgbaImage> engine;  // the engine preset's images (engine_preset.h)
 };
 
 // What it gives back.
@@ -636,6 +642,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     for (const RgbaImage& image : images) all.push_back(&image);
     const std::vector<RgbaImage> ibl_images = job.ibl ? IblImagesForRangeCheck(*job.ibl) : std::vector<RgbaImage>();
     for (const RgbaImage& image : ibl_images) all.push_back(&image);
+    for (const RgbaImage& image : job.engine) all.push_back(&image);
     const double max_value = CheckedMaxValue(all);
     w.half_scale = job.half_scale;
     if (style.output.pixel_type == PixelType::kHalf) {
@@ -723,6 +730,10 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
         WriteFileAtomically(path, ibl_files[i]);
         w.files.push_back({path, names.ibl[i].kind, ibl_files[i].size(), Sha256OfText(ibl_files[i])});
       }
+    }
+    if (!job.engine.empty()) {
+      const std::vector<BakedFile> engine = WriteEngineFiles(style, job.engine, exr, options.out_dir, names.engine);
+      w.files.insert(w.files.end(), engine.begin(), engine.end());
     }
     w.exr_seconds = SecondsSince(write_start);
     w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
@@ -879,6 +890,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                       style.ibl.irradiance_samples, request.dfg ? ", DFG table" : "",
                                       style.ibl.include_sun ? ", sun included" : ""));
     }
+    std::vector<RgbaImage> engine_images;
+    if (!names.engine.empty() && !verified) {
+      engine_images = RenderEngineImages(renderer, plan.sun, style);
+      timer.Finish("engine", fmt::format("{}: {} images for {}", label, engine_images.size(), style.output.engine));
+    }
     if (verified) {
       collect_pending();
       frame.files = *verified;
@@ -895,7 +911,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     collect_pending();
-    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps)};
+    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps),
+                 std::move(engine_images)};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

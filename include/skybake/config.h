@@ -54,6 +54,7 @@ struct OutputSettings {
   bool latlong = true;     // one 2N x N latlong
   bool preview = true;     // tone-mapped sRGB PNG of the latlong
   std::vector<std::string> face_names = {"px", "nx", "py", "ny", "pz", "nz"};
+  std::string engine = "none";  // an engine preset (engine_preset.h) writes its files too
 };
 
 struct PreviewSettings {
