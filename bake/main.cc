@@ -33,6 +33,7 @@
 #include "skybake/pass_plan.h"
 #include "skybake/schedule.h"
 #include "skybake/shard.h"
+#include "skybake/test_pattern.h"
 #include "skybake/vulkan_context.h"
 
 namespace {
@@ -396,6 +397,18 @@ int main(int argc, char** argv) {
   gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
   gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
 
+  TestPatternOptions pattern;
+  CLI::App* testpattern = app.add_subcommand(
+      "testpattern", "Write an orientation test pattern (faces named, axes, horizon, N E S W) as a bake's files, "
+                     "through an engine preset: check the preset in your engine (docs/engines.md)");
+  testpattern->add_option("--out", pattern.out_dir, "Output folder")->capture_default_str();
+  testpattern->add_option("--engine", pattern.engine, "Engine preset whose files to write too")
+      ->check(CLI::IsMember(EngineNames()));
+  testpattern->add_option("--size", pattern.size, "Cube face size N; the latlong is 2N x N")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  testpattern->add_flag("--force", pattern.force, "Overwrite the pattern's files in --out");
+
   MergeOptions merge_options;
   bool sizes_only = false;
   CLI::App* merge = app.add_subcommand(
@@ -445,6 +458,10 @@ int main(int argc, char** argv) {
     if (check->parsed()) return RunBake(args, Mode::kCheck);
     if (plan->parsed()) return RunBake(args, Mode::kPlan);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
+    if (testpattern->parsed()) {
+      for (const std::string& path : WriteTestPattern(pattern)) std::printf("%s\n", path.c_str());
+      return kExitOk;
+    }
     if (merge->parsed()) {
       merge_options.verify_checksums = !sizes_only;
       return RunMergeManifest(merge_options);

@@ -17,6 +17,7 @@
 
 #include "skybake/config.h"
 #include "skybake/engine_preset.h"
+#include "skybake/test_pattern.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -311,6 +312,46 @@ TEST(EnginePresetCliTest, ResumeVerifiesTheEngineFiles) {
   EXPECT_NE(again.output.find("files verified by checksum"), std::string::npos) << again.output;
   EXPECT_NE(first.output.find("skybake: engine "), std::string::npos) << first.output;
   EXPECT_EQ(again.output.find("skybake: engine "), std::string::npos) << "nothing rendered again: " << again.output;
+}
+
+// The test pattern: each face's tint below the horizon, the horizon white,
+// each face's name in black above its centre, reading the right way round
+// from inside (its first glyph, the sign, on the left as seen from the
+// centre: towards the face's right = cross(axis, +Y) is the axis letter).
+TEST(TestPatternTest, FacesHorizonAndLabels) {
+  const glm::dvec3 axes[6] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (int f = 0; f < 6; ++f) {
+    const glm::dvec3 d = f == 2 || f == 3 ? axes[f] : axes[f] + glm::dvec3(0, -0.18, 0);
+    EXPECT_EQ(TestPatternColor(d), TestPatternFaceColor(f)) << f;
+  }
+  EXPECT_EQ(TestPatternColor({0.3, 0.0, -1.0}), glm::dvec3(1.0));
+  // "+X" on the +X face, seen from inside: right is +Z. The '+' (left
+  // glyph) has its bar across the full glyph width, the 'X' not on its middle row.
+  auto black_on_row = [](double b, double a0, double a1) {
+    int black = 0;
+    for (double a = a0; a <= a1; a += 0.002)
+      if (TestPatternColor({1.0, b, a}) == glm::dvec3(0.0)) ++black;
+    return black;
+  };
+  const double cell = 0.3 / 7.0, middle = 0.35;  // the centre of glyph row 3 of 7: the text is centred at b = 0.35
+  // Left glyph spans a in [-5.5, -0.5] cells, right glyph [0.5, 5.5]: '+' fills its middle row, 'X' one cell.
+  EXPECT_GT(black_on_row(middle, -5.4 * cell, -0.6 * cell), 2 * black_on_row(middle, 0.6 * cell, 5.4 * cell));
+  EXPECT_GT(black_on_row(middle, 0.6 * cell, 5.4 * cell), 0);
+}
+
+TEST(TestPatternTest, CommandWritesEveryPresetsFilesAndKeepsExistingOnes) {
+  const std::string dir = testing::FreshTempDir("pattern");
+  testing::CommandRun r = testing::RunSkybake("testpattern --engine unity --size 16 --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* f : {"sky_px.exr", "sky_cube.exr", "sky_latlong.exr", "sky_unity_Front.exr", "sky_unity_Down.exr"})
+    EXPECT_TRUE(testing::FileNames(dir).count(f)) << f;
+  const std::string before = testing::ReadFileBytes(dir + "/sky_unity_Left.exr");
+  testing::CommandRun again = testing::RunSkybake("testpattern --engine unity --size 32 --out " + dir);
+  EXPECT_EQ(again.exit_code, 6) << again.output;
+  EXPECT_NE(again.output.find("--force"), std::string::npos) << again.output;
+  EXPECT_EQ(testing::ReadFileBytes(dir + "/sky_unity_Left.exr"), before);
+  testing::CommandRun bad = testing::RunSkybake("testpattern --engine unity3d --out " + dir);
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
 }
 
 }  // namespace
