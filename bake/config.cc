@@ -229,6 +229,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("gltf.radius_m", g.radius_m, kPositive);
   v.Real("gltf.flattening", g.flattening, kFlattening);
   v.Int("gltf.segments", g.segments, 8, 1024);
+  v.Bool("gltf.image_based_light", g.image_based_light);
 
   IblSettings& i = s.ibl;
   v.Bool("ibl.specular", i.specular);
@@ -1179,6 +1180,12 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       break;
     }
   }
+  if (result.style.gltf.image_based_light && (!result.style.ibl.specular || !result.style.gltf.enabled)) {
+    ConfigError e = locate("gltf.image_based_light");
+    e.message = "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
+                "(and gltf.enabled = true), or gltf.image_based_light = false";
+    result.errors.push_back(e);
+  }
   if (std::optional<std::string> engine = EngineStyleError(result.style)) {
     ConfigError e = locate("output.engine");
     e.message = *engine;
@@ -1242,6 +1249,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   toml::table recorded = writer.table();
   if (!result.style.ibl.Requested()) recorded.erase("ibl");
   if (result.style.output.engine == "none") recorded["output"].as_table()->erase("engine");
+  if (!result.style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
   std::ostringstream resolved;
   resolved << recorded;
   result.style.resolved_toml = resolved.str();

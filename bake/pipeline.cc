@@ -22,6 +22,7 @@
 #include "skybake/engine_preset.h"
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
+#include "skybake/gltf_ibl.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/ibl.h"
 #include "skybake/sh.h"
@@ -882,6 +883,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       for (int face = 0; face < 6; ++face) source.faces[face] = std::move(source_faces[face]);
       IblRequest request{style.ibl, plan.sun, frame.sun_irradiance, style.ibl.dfg && names.with_dfg};
       ibl_maps = ibl_baker->Bake(request, source);
+      ibl_maps->gltf_scale = GltfIblScale(frame.sh_irradiance_without_sun);
       for (const PassTiming& t : ibl_baker->last_timings()) frame.gpu_passes.push_back(t);
       timer.Finish("IBL", fmt::format("{}: {} x {} source without the sun disc, {} specular levels x {} samples, "
                                       "irradiance {} x {} samples{}{}",

@@ -70,6 +70,7 @@ struct GltfSettings {
   double radius_m = 1000.0;         // horizontal radius of the dome
   double flattening = 0.0;          // 0: round; f: vertical radius = (1 - f) * radius_m
   int segments = 64;                // around the horizon; half as many rings pole to pole
+  bool image_based_light = false;   // EXT_lights_image_based from ibl.specular (gltf_ibl.h)
 };
 
 // Image-based lighting outputs from the same bake (include/skybake/ibl.h):
