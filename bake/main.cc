@@ -34,6 +34,7 @@
 #include "skybake/schedule.h"
 #include "skybake/shard.h"
 #include "skybake/test_pattern.h"
+#include "skybake/viewer_page.h"
 #include "skybake/vulkan_context.h"
 
 namespace {
@@ -409,6 +410,13 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(8, 4096));
   testpattern->add_flag("--force", pattern.force, "Overwrite the pattern's files in --out");
 
+  ViewPageOptions view_options;
+  CLI::App* view = app.add_subcommand(
+      "view", "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
+              "to look around, exposure, frames");
+  view->add_option("dir", view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
+  view->add_flag("--force", view_options.force, "Replace an existing view.html");
+
   MergeOptions merge_options;
   bool sizes_only = false;
   CLI::App* merge = app.add_subcommand(
@@ -458,6 +466,10 @@ int main(int argc, char** argv) {
     if (check->parsed()) return RunBake(args, Mode::kCheck);
     if (plan->parsed()) return RunBake(args, Mode::kPlan);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
+    if (view->parsed()) {
+      std::printf("%s\n", WriteViewPage(view_options).c_str());
+      return kExitOk;
+    }
     if (testpattern->parsed()) {
       for (const std::string& path : WriteTestPattern(pattern)) std::printf("%s\n", path.c_str());
       return kExitOk;

@@ -22,9 +22,11 @@ const screenshot = path.resolve(screenshotArg ?? path.join(os.tmpdir(), `skybake
 const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
                 '.gltf': 'model/gltf+json', '.glb': 'model/gltf-binary', '.png': 'image/png' };
 let pageReport = null;
+const requests = [];  // every path the page asked for, in order
 
 const server = http.createServer((req, res) => {
   const url = new URL(req.url, 'http://127.0.0.1');
+  requests.push(url.pathname);
   if (url.pathname === '/report' && req.method === 'POST') {
     let body = '';
     req.on('data', (d) => { body += d; });
@@ -62,7 +64,7 @@ const code = await new Promise((resolve) => chromium.on('close', resolve));
 clearTimeout(timer);
 server.close();
 fs.rmSync(profile, { recursive: true, force: true });
-console.log(JSON.stringify({ chromium_exit: code, report: pageReport, screenshot }));
+console.log(JSON.stringify({ chromium_exit: code, report: pageReport, screenshot, requests }));
 if (!pageReport || pageReport.ok !== true) {
   console.error(stderr.split('\n').slice(-20).join('\n'));
   process.exit(1);
