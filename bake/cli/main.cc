@@ -33,6 +33,9 @@
 #include "skybake/input/schedule.h"
 #include "skybake/input/shard.h"
 #include "skybake/gpu/vulkan_context.h"
+#include "skybake/input/engine_preset.h"
+#include "skybake/pipeline/test_pattern.h"
+#include "skybake/pipeline/viewer_page.h"
 
 namespace {
 
@@ -101,6 +104,7 @@ struct BakeArgs {
   std::string frames;    // --frames FIRST:LAST, empty: every frame
   std::string shard;     // --shard I/N, empty: no split
   ShaderSwitches shaders;  // from the environment (main)
+  std::string engine;    // --engine NAME: output.engine
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -117,6 +121,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
     overrides.push_back(fmt::format("render.cube_size={}", args.size));
     overrides.push_back(fmt::format("render.latlong_height={}", args.size));
   }
+  if (!args.engine.empty()) overrides.push_back("output.engine=" + args.engine);
   ConfigResult config = LoadSkyStyle(args.style_path, overrides);
   if (!config.ok()) {
     PrintErrors(config.errors);
@@ -361,6 +366,14 @@ int main(int argc, char** argv) {
                    "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
                    "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
       ->type_name("I/N");
+  {
+    std::string engines;
+    for (const std::string& name : EngineNames()) engines += (engines.empty() ? "" : "|") + name;
+    bake->add_option("--engine", args.engine,
+                     "Also write the files one engine loads the right way up (output.engine; docs/engines.md)")
+        ->type_name(engines)
+        ->check(CLI::IsMember(EngineNames()));
+  }
   bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
   bake->add_flag("--vulkan-validation", args.validation,
@@ -392,6 +405,25 @@ int main(int argc, char** argv) {
   gallery->add_flag("--force", args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
   gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
   gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
+
+  TestPatternOptions pattern;
+  CLI::App* testpattern = app.add_subcommand(
+      "testpattern", "Write an orientation test pattern (faces named, axes, horizon, N E S W) as a bake's files, "
+                     "through an engine preset: check the preset in your engine (docs/engines.md)");
+  testpattern->add_option("--out", pattern.out_dir, "Output folder")->capture_default_str();
+  testpattern->add_option("--engine", pattern.engine, "Engine preset whose files to write too")
+      ->check(CLI::IsMember(EngineNames()));
+  testpattern->add_option("--size", pattern.size, "Cube face size N; the latlong is 2N x N")
+      ->capture_default_str()
+      ->check(CLI::Range(8, 4096));
+  testpattern->add_flag("--force", pattern.force, "Overwrite the pattern's files in --out");
+
+  ViewPageOptions view_options;
+  CLI::App* view = app.add_subcommand(
+      "view", "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
+              "to look around, exposure, frames");
+  view->add_option("dir", view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
+  view->add_flag("--force", view_options.force, "Replace an existing view.html");
 
   MergeOptions merge_options;
   bool sizes_only = false;
@@ -446,6 +478,14 @@ int main(int argc, char** argv) {
     if (check->parsed()) return RunBake(args, Mode::kCheck);
     if (plan->parsed()) return RunBake(args, Mode::kPlan);
     if (gallery->parsed()) return RunGallery(gallery_args, args);
+    if (view->parsed()) {
+      std::printf("%s\n", WriteViewPage(view_options).c_str());
+      return kExitOk;
+    }
+    if (testpattern->parsed()) {
+      for (const std::string& path : WriteTestPattern(pattern)) std::printf("%s\n", path.c_str());
+      return kExitOk;
+    }
     if (merge->parsed()) {
       merge_options.verify_checksums = !sizes_only;
       return RunMergeManifest(merge_options);

@@ -4,6 +4,7 @@
 // valid range. The same declaration drives reading (StyleReader), writing the
 // resolved TOML for provenance (StyleWriter), and the unknown-key check.
 #include "skybake/input/config.h"
+#include "skybake/input/engine_preset.h"
 
 #include <algorithm>
 #include <cmath>
@@ -174,6 +175,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("output.latlong", o.latlong);
   v.Bool("output.preview", o.preview);
   v.FileNames("output.face_names", o.face_names, 6);
+  v.Choice("output.engine", o.engine,
+           {{"none", std::string("none")}, {"unity", std::string("unity")}, {"unreal", std::string("unreal")},
+            {"godot", std::string("godot")}, {"blender", std::string("blender")},
+            {"threejs", std::string("threejs")}, {"babylon", std::string("babylon")},
+            {"filament", std::string("filament")}, {"exrenvmap", std::string("exrenvmap")}});
 
   v.Bool("preview.auto_exposure", s.preview.auto_exposure);
   v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
@@ -210,6 +216,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("gltf.radius_m", g.radius_m, kPositive);
   v.Real("gltf.flattening", g.flattening, kFlattening);
   v.Int("gltf.segments", g.segments, 8, 1024);
+  v.Bool("gltf.image_based_light", g.image_based_light);
 
   IblSettings& i = s.ibl;
   v.Bool("ibl.specular", i.specular);
@@ -1138,6 +1145,17 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       break;
     }
   }
+  if (result.style.gltf.image_based_light && (!result.style.ibl.specular || !result.style.gltf.enabled)) {
+    ConfigError e = locate("gltf.image_based_light");
+    e.message = "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
+                "(and gltf.enabled = true), or gltf.image_based_light = false";
+    result.errors.push_back(e);
+  }
+  if (std::optional<std::string> engine = EngineStyleError(result.style)) {
+    ConfigError e = locate("output.engine");
+    e.message = *engine;
+    result.errors.push_back(e);
+  }
   // IBL: a cube mip chain needs a power-of-two level 0 and at most one
   // level per halving; some file format must be asked for.
   const IblSettings& ibl = result.style.ibl;
@@ -1195,6 +1213,8 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   // bake's files are the same bytes as before the keys existed.
   toml::table recorded = writer.table();
   if (!result.style.ibl.Requested()) recorded.erase("ibl");
+  if (result.style.output.engine == "none") recorded["output"].as_table()->erase("engine");
+  if (!result.style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
   std::ostringstream resolved;
   resolved << recorded;
   result.style.resolved_toml = resolved.str();

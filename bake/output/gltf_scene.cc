@@ -1,4 +1,5 @@
 #include "skybake/output/gltf_scene.h"
+#include "skybake/output/gltf_ibl.h"
 
 #include <cerrno>
 #include <cmath>
@@ -99,6 +100,40 @@ std::string ReadFile(const std::string& path) {
   }
   ::close(fd);
   return bytes;
+}
+
+
+// EXT_lights_image_based: the RGBD faces as images (by file name; the .glb
+// embeds them), the SH times the PNGs' scale k, intensity 1 / k, and the
+// scene's reference to the light (gltf_ibl.h).
+void AddImageBasedLight(const SceneDescription& scene, tinygltf::Model& model, tinygltf::Scene& gltf_scene) {
+  const double k = GltfIblScale(scene.ibl_sh);
+  const int size = PngWidth(ReadFile((std::filesystem::path(scene.out_dir) / scene.ibl_images[0]).string()));
+  if (size <= 0) throw OutputError(fmt::format("{} is not a PNG", scene.ibl_images[0]));
+  json levels = json::array();
+  for (size_t level = 0; level * 6 < scene.ibl_images.size(); ++level) {
+    json faces = json::array();
+    for (size_t face = 0; face < 6; ++face) {
+      tinygltf::Image image;
+      image.name = scene.ibl_images[level * 6 + face];
+      image.uri = scene.ibl_images[level * 6 + face];
+      image.mimeType = "image/png";
+      faces.push_back(int(model.images.size()));
+      model.images.push_back(image);
+    }
+    levels.push_back(faces);
+  }
+  json coefficients = json::array();
+  for (const Rgb& c : scene.ibl_sh) coefficients.push_back({c[0] * k, c[1] * k, c[2] * k});
+  json light = {{"name", scene.name + " sky"},
+                {"intensity", 1.0 / k},
+                {"rotation", {0.0, 0.0, 0.0, 1.0}},
+                {"irradianceCoefficients", coefficients},
+                {"specularImageSize", size},
+                {"specularImages", levels}};
+  model.extensions["EXT_lights_image_based"] = ToValue(json{{"lights", json::array({light})}});
+  model.extensionsUsed.push_back("EXT_lights_image_based");
+  gltf_scene.extensions["EXT_lights_image_based"] = ToValue(json{{"light", 0}});
 }
 
 }  // namespace
@@ -298,6 +333,7 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
   tinygltf::Scene gltf_scene;
   gltf_scene.name = scene.name;
   gltf_scene.nodes = {0, 1};
+  if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
   json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
   gltf_scene.extras = ToValue(json{{"skybake", extras}});
   model.scenes.push_back(gltf_scene);
@@ -331,6 +367,11 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
     tinygltf::Model glb = model;
     glb.images[0].uri.clear();
     glb.images[0].bufferView = AddBufferView(glb, png.data(), png.size(), 0);
+    for (size_t i = 1; i < glb.images.size(); ++i) {
+      const std::string face = ReadFile((dir / glb.images[i].uri).string());
+      glb.images[i].uri.clear();
+      glb.images[i].bufferView = AddBufferView(glb, face.data(), face.size(), 0);
+    }
     std::ostringstream out;
     if (!writer.WriteGltfSceneToStream(&glb, out, false, true))
       throw OutputError(fmt::format("cannot serialise {}", written.glb_path));

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "skybake/output/gltf_ibl.h"
 #include "skybake/output/ktx2.h"
 #include "skybake/output/manifest.h"
 
@@ -28,6 +29,10 @@ std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name,
     if (s.irradiance) names.push_back({base + "_irradiance" + number + ".ktx2", "ibl_irradiance"});
     if (s.dfg && with_dfg) names.push_back({base + "_dfg.ktx2", "ibl_dfg"});
   }
+  if (s.specular && style.gltf.enabled && style.gltf.image_based_light)
+    for (int level = 0; level < IblLevelCount(s); ++level)
+      for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"})
+        names.push_back({fmt::format("{}_specular_m{}_{}{}.png", base, level, face, number), "ibl_gltf"});
   return names;
 }
 
@@ -130,6 +135,11 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& maps, const SkyStyle& sty
       encoded.push_back(EncodeKtx2Image(maps.dfg_size, maps.dfg_size, maps.dfg, o));
     }
   }
+  if (s.specular && style.gltf.enabled && style.gltf.image_based_light)
+    for (int level = 0; level < levels; ++level)
+      for (int face = 0; face < 6; ++face)
+        encoded.push_back(EncodeRgbdFacePng(maps.specular[level].faces[face].data(), maps.specular[level].size,
+                                            maps.gltf_scale));
   return encoded;
 }
 

@@ -16,6 +16,7 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/output_lock.h"
+#include "skybake/input/engine_preset.h"
 
 namespace skybake {
 namespace {
@@ -219,6 +220,28 @@ bool EndsWith(const std::string& s, const std::string& tail) {
 // frame-independent BASE_dfg.exr/.ktx2. `stage` as in CheckNames (3: IBL).
 void CheckIblName(const std::string& path, const std::string& where, int number_in_name, const ManifestFile& file,
                   std::string& base, int& stage) {
+  if (file.kind == "ibl_gltf") {
+    // BASE_specular_mLEVEL_FACE.NNNN.png: the scene's EXT_lights_image_based faces (gltf_ibl.h).
+    const std::string tail = FrameNumberSuffix(number_in_name) + ".png";
+    std::string stem = EndsWith(file.file, tail) ? file.file.substr(0, file.file.size() - tail.size()) : "";
+    const size_t face = stem.size() > 3 ? stem.size() - 3 : std::string::npos;
+    const std::string face_name = face == std::string::npos ? "" : stem.substr(face);
+    const bool face_ok = face_name == "_px" || face_name == "_nx" || face_name == "_py" || face_name == "_ny" ||
+                         face_name == "_pz" || face_name == "_nz";
+    if (face_ok) stem.resize(face);
+    const size_t m = stem.rfind("_specular_m");
+    const bool level_ok = m != std::string::npos && m > 0 && m + 11 < stem.size() &&
+                          stem.find_first_not_of("0123456789", m + 11) == std::string::npos;
+    if (stage > 3 || !IsPlainFileName(file.file) || !face_ok || !level_ok)
+      FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE_specular_mLEVEL_FACE{})",
+                                                   file.kind, number_in_name, tail));
+    const std::string b = stem.substr(0, m);
+    if (!base.empty() && b != base)
+      FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+    base = b;
+    stage = 3;
+    return;
+  }
   const std::string number = file.kind == "ibl_dfg" ? std::string() : FrameNumberSuffix(number_in_name);
   const char* suffix = file.kind == "ibl_specular" ? "_specular" : file.kind == "ibl_irradiance" ? "_irradiance" : "_dfg";
   const std::string shape = fmt::format("BASE{}{}.exr or .ktx2{}", suffix, number,
@@ -286,14 +309,25 @@ void CheckNames(const std::string& path, const Manifest& m) {
         with_suffix(file, stem_of(file, ".exr", "cube strip"), "_cube", "cube strip", 1);
       } else if (file.kind == "latlong") {
         with_suffix(file, stem_of(file, ".exr", "latlong"), "_latlong", "latlong", 2);
-      } else if (file.kind == "ibl_specular" || file.kind == "ibl_irradiance" || file.kind == "ibl_dfg") {
+      } else if (file.kind == "ibl_specular" || file.kind == "ibl_irradiance" || file.kind == "ibl_dfg" ||
+                 file.kind == "ibl_gltf") {
         CheckIblName(path, where, f.number, file, base, stage);
+      } else if (file.kind == "engine") {
+        // BASE_ENGINE_SUFFIX.NNNN.exr (engine_preset.h), after the IBL files.
+        const std::optional<std::string> b = EngineFileBase(file.file, f.number);
+        if (stage > 4 || !IsPlainFileName(file.file) || !b || b->empty())
+          FailName(path, where, file.file, fmt::format("an engine preset's file skybake names for frame {} "
+                                                       "(BASE_ENGINE_SUFFIX{}.exr)", f.number, number));
+        if (!base.empty() && *b != base)
+          FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
+        base = *b;
+        stage = 4;
       } else if (file.kind == "preview" || file.kind == "gltf_texture") {
         with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
       } else {
         FailName(path, where, file.kind,
-                 "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, preview, "
-                 "gltf_texture)");
+                 "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, ibl_gltf, "
+                 "engine, preview, gltf_texture)");
       }
     }
     if (!faces.empty() && faces.size() != 6)
@@ -336,8 +370,6 @@ void CheckNames(const std::string& path, const Manifest& m) {
 }
 
 }  // namespace
-
-std::string FrameNumberSuffix(int number) { return number > 0 ? fmt::format(".{:04d}", number) : ""; }
 
 std::string SequenceIdentityLine(int number, const std::string& time_iso8601, const glm::dvec3& sun,
                                  const std::string& style_sha256) {
@@ -444,7 +476,13 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
     scene.dome = manifest.gltf.dome;
     for (size_t i = 0; i < manifest.frames.size(); ++i) {
       const ManifestFrame& f = manifest.frames[i];
-      if (f.number == manifest.texture_frame) scene.light_frame = int(i);
+      if (f.number == manifest.texture_frame) {
+        scene.light_frame = int(i);
+        // EXT_lights_image_based: the texture frame's RGBD faces (gltf_ibl.h).
+        for (const ManifestFile& file : f.files)
+          if (file.kind == "ibl_gltf") scene.ibl_images.push_back(file.file);
+        scene.ibl_sh = f.sh_irradiance_without_sun;
+      }
       SceneSun sun;
       sun.time_s = f.animation_time_s;
       sun.direction = f.sun_direction;

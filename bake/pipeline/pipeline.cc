@@ -30,6 +30,9 @@
 #include "skybake/output/manifest.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/model/tonemap.h"
+#include "skybake/input/engine_preset.h"
+#include "skybake/pipeline/engine_files.h"
+#include "skybake/output/gltf_ibl.h"
 
 namespace skybake {
 namespace {
@@ -120,12 +123,14 @@ struct FrameNames {
   std::vector<std::string> faces;  // six, when output.faces
   std::string cube, latlong, png;  // empty when not written
   std::vector<IblFileName> ibl;    // the IBL maps' files (ibl.h), when asked for
+  std::vector<std::string> engine;  // the engine preset's files (engine_preset.h), when one is set
   bool with_dfg = false;           // the bake's first frame carries the DFG table
   std::vector<std::string> All() const {
     std::vector<std::string> all = faces;
     for (const std::string* n : {&cube, &latlong})
       if (!n->empty()) all.push_back(*n);
     for (const IblFileName& n : ibl) all.push_back(n.name);
+    for (const std::string& n : engine) all.push_back(n);
     if (!png.empty()) all.push_back(png);
     return all;
   }
@@ -142,6 +147,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
   if (WritesLatlongPng(style)) names.png = o.basename + "_latlong" + number + ".png";
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
+  names.engine = EngineFileNames(style, number_in_name);
   return names;
 }
 
@@ -231,6 +237,7 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   if (!names.cube.empty()) kinds.push_back("cube");
   if (!names.latlong.empty()) kinds.push_back("latlong");
   for (const IblFileName& n : names.ibl) kinds.push_back(n.kind);
+  kinds.insert(kinds.end(), names.engine.size(), "engine");
   if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
   size_t index = 0;
   for (const json& entry : f["files"]) {
@@ -270,6 +277,7 @@ struct FrameJob {
   double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
   std::optional<IblMaps> ibl;     // the frame's IBL maps, when asked for
+  std::vector<RgbaImage> engine;  // the engine preset's images (engine_preset.h)
 };
 
 // What it gives back.
@@ -560,6 +568,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     for (const RgbaImage& image : images) all.push_back(&image);
     const std::vector<RgbaImage> ibl_images = job.ibl ? IblImagesForRangeCheck(*job.ibl) : std::vector<RgbaImage>();
     for (const RgbaImage& image : ibl_images) all.push_back(&image);
+    for (const RgbaImage& image : job.engine) all.push_back(&image);
     const double max_value = CheckedMaxValue(all);
     w.half_scale = job.half_scale;
     if (style.output.pixel_type == PixelType::kHalf) {
@@ -647,6 +656,10 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
         WriteFileAtomically(path, ibl_files[i]);
         w.files.push_back({path, names.ibl[i].kind, ibl_files[i].size(), Sha256OfText(ibl_files[i])});
       }
+    }
+    if (!job.engine.empty()) {
+      const std::vector<BakedFile> engine = WriteEngineFiles(style, job.engine, exr, options.out_dir, names.engine);
+      w.files.insert(w.files.end(), engine.begin(), engine.end());
     }
     w.exr_seconds = SecondsSince(write_start);
     w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
@@ -791,6 +804,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       for (int face = 0; face < 6; ++face) source.faces[face] = std::move(source_faces[face]);
       IblRequest request{style.ibl, plan.sun, frame.sun_irradiance, style.ibl.dfg && names.with_dfg};
       ibl_maps = ibl_baker->Bake(request, source);
+      ibl_maps->gltf_scale = GltfIblScale(frame.sh_irradiance_without_sun);
       for (const PassTiming& t : ibl_baker->last_timings()) frame.gpu_passes.push_back(t);
       timer.Finish("IBL", fmt::format("{}: {} x {} source without the sun disc, {} specular levels x {} samples, "
                                       "irradiance {} x {} samples{}{}",
@@ -798,6 +812,11 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                       style.ibl.samples, style.ibl.irradiance ? style.ibl.irradiance_size : 0,
                                       style.ibl.irradiance_samples, request.dfg ? ", DFG table" : "",
                                       style.ibl.include_sun ? ", sun included" : ""));
+    }
+    std::vector<RgbaImage> engine_images;
+    if (!names.engine.empty() && !verified) {
+      engine_images = RenderEngineImages(renderer, plan.sun, style);
+      timer.Finish("engine", fmt::format("{}: {} images for {}", label, engine_images.size(), style.output.engine));
     }
     if (verified) {
       collect_pending();
@@ -815,7 +834,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     collect_pending();
-    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps)};
+    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps),
+                 std::move(engine_images)};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

@@ -90,6 +90,7 @@ struct IblMaps {
   CubeLevel irradiance;             // size 0 unless settings.irradiance
   int dfg_size = 0;                 // 0 unless request.dfg
   std::vector<float> dfg;           // dfg_size^2 RGBA texels, rows by roughness from 0 at the top
+  double gltf_scale = 1.0;          // gltf.image_based_light: the PNGs' scale k (gltf_ibl.h)
 };
 
 // The filtering pipeline, created once per bake on the bake's device.

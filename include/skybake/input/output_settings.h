@@ -33,6 +33,7 @@ struct OutputSettings {
   bool latlong = true;     // one 2N x N latlong
   bool preview = true;     // tone-mapped sRGB PNG of the latlong
   std::vector<std::string> face_names = {"px", "nx", "py", "ny", "pz", "nz"};
+  std::string engine = "none";  // an engine preset (engine_preset.h) writes its files too
 };
 
 struct PreviewSettings {
@@ -48,6 +49,7 @@ struct GltfSettings {
   double radius_m = 1000.0;         // horizontal radius of the dome
   double flattening = 0.0;          // 0: round; f: vertical radius = (1 - f) * radius_m
   int segments = 64;                // around the horizon; half as many rings pole to pole
+  bool image_based_light = false;   // EXT_lights_image_based from ibl.specular (gltf_ibl.h)
 };
 
 // Image-based lighting outputs from the same bake (include/skybake/ibl.h):

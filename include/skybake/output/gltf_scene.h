@@ -67,6 +67,10 @@ struct SceneDescription {
   std::vector<SceneSun> suns;      // 1 for a bake, one per frame for a sequence
   int light_frame = 0;             // which sun sets the light's colour and intensity
   std::string extras_json;         // JSON object merged into the scene's extras (skybake provenance)
+  // EXT_lights_image_based (gltf_ibl.h): levels x 6 RGBD PNGs in out_dir, level-major,
+  // +X -X +Y -Y +Z -Z; none: no image-based light.
+  std::vector<std::string> ibl_images;
+  ShRgb ibl_sh{};                  // E_lm of the sky without the Sun, the bake's units
 };
 
 struct WrittenScene {

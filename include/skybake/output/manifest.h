@@ -22,6 +22,7 @@
 
 #include "skybake/model/atmosphere.h"
 #include "skybake/input/config.h"
+#include "skybake/input/frame_numbering.h"
 #include "skybake/base/errors.h"
 #include "skybake/output/bake_record.h"
 #include "skybake/model/sh.h"
@@ -87,9 +88,6 @@ struct Manifest {
 std::string ManifestFileName(const std::optional<FrameRange>& part);
 std::string TimingsFileName(const std::optional<FrameRange>& part);
 
-// ".0012" for frame 12 in file names (at least four digits), "" for 0 (a
-// single bake).
-std::string FrameNumberSuffix(int number);
 
 // One frame's line of the text whose SHA-256 is a manifest's
 // sequence_sha256: number, ISO 8601 time ("" without), sun direction,

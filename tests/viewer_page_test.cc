@@ -1,0 +1,133 @@
+// `skybake view DIR` (viewer_page.h): the page opens in headless Chromium
+// with nothing but itself (every request the page makes is listed: only the
+// page, the test's report and Chromium's own favicon), the view moves with
+// a drag through the page's own pointer handlers, and the screenshot's
+// pixels show what lies there: on a `skybake testpattern` folder, the +X
+// face's red 10 degrees below the horizon after turning to East, the white
+// horizon facing North; the exposure slider darkens; on a two-frame
+// sequence the frame slider shows the other frame (the night one, darker).
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <glm/glm.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/pipeline/test_pattern.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+struct Shot {
+  nlohmann::json report, requests;
+  int width = 0, height = 0;
+  std::vector<uint8_t> rgb;
+  glm::dvec3 At(int x, int y) const {
+    const size_t i = 3 * (size_t(y) * width + x);
+    return {double(rgb[i]), double(rgb[i + 1]), double(rgb[i + 2])};
+  }
+  // Mean over the upper half (the panel sits at the bottom left).
+  double UpperMean() const {
+    double sum = 0.0;
+    for (int y = 0; y < height / 2; ++y)
+      for (int x = 0; x < width; ++x) sum += At(x, y).x + At(x, y).y + At(x, y).z;
+    return sum / (3.0 * width * (height / 2));
+  }
+};
+
+Shot Open(const std::string& dir, const std::string& test) {
+  Shot shot;
+  const std::string png = dir + "/shot.png";
+  std::remove(png.c_str());
+  const std::string command = "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs bake/view.html '" +
+                              dir + "' '" + png + "' 'test=" + test + "'";
+  auto [code, output] = testing::RunCommand(command);
+  EXPECT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("{\"chromium_exit\"");
+  if (at == std::string::npos) {
+    ADD_FAILURE() << output;
+    return shot;
+  }
+  nlohmann::json line = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at));
+  shot.report = line["report"];
+  shot.requests = line["requests"];
+  auto in = OIIO::ImageInput::open(png);
+  EXPECT_TRUE(in) << png;
+  if (!in) return shot;
+  shot.width = in->spec().width;
+  shot.height = in->spec().height;
+  shot.rgb.resize(size_t(shot.width) * shot.height * 3);
+  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, shot.rgb.data());
+  return shot;
+}
+
+double Srgb8(double linear) {
+  const double v = linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+  return 255.0 * v;
+}
+
+TEST(ViewerPageTest, LooksAroundTheTestPattern) {
+  const std::string dir = testing::FreshTempDir("view_pattern");
+  ASSERT_EQ(testing::RunSkybake("testpattern --size 256 --out " + dir).exit_code, 0);
+  testing::CommandRun view = testing::RunSkybake("view " + dir);
+  ASSERT_EQ(view.exit_code, 0) << view.output;
+  EXPECT_EQ(testing::RunSkybake("view " + dir).exit_code, 6) << "an existing page is kept without --force";
+  EXPECT_EQ(testing::RunSkybake("view --force " + dir).exit_code, 0);
+
+  // Drag 360 px left: a quarter turn to the East; 40 px up: 10 degrees down.
+  Shot east = Open(dir, "drag:-360,-40;tonemap:linear");
+  ASSERT_EQ(east.report.value("ok", false), true) << east.report.dump();
+  EXPECT_EQ(east.report["yaw"], 90);
+  EXPECT_EQ(east.report["pitch"], -10);
+  EXPECT_EQ(east.requests, nlohmann::json({"/bake/view.html", "/report", "/favicon.ico"}))
+      << "the page asks for nothing but itself";
+  ASSERT_EQ(east.width, 320);
+  const glm::dvec3 red = TestPatternFaceColor(0);
+  const glm::dvec3 centre = east.At(160, 120);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(centre[c], Srgb8(red[c]), 4.0) << "the +X face's red at the centre";
+
+  // No drag: facing North on the horizon, white; 10 degrees below, -Z's yellow.
+  Shot north = Open(dir, "tonemap:linear");
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(north.At(160, 120)[c], 255.0, 4.0) << "the horizon ahead";
+  Shot below = Open(dir, "drag:0,-40;tonemap:linear");
+  const glm::dvec3 yellow = TestPatternFaceColor(5);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(below.At(160, 120)[c], Srgb8(yellow[c]), 4.0) << "North's -Z face";
+
+  // Four stops down: a sixteenth of the linear value.
+  Shot darker = Open(dir, "drag:-360,-40;tonemap:linear;ev:-4");
+  EXPECT_NEAR(darker.At(160, 120).x, Srgb8(red.x / 16.0), 4.0);
+}
+
+TEST(ViewerPageTest, ScrubsTheFramesOfASequence) {
+  const std::string dir = testing::FreshTempDir("view_sequence");
+  const std::string schedule = dir + "/schedule.toml";
+  FILE* f = std::fopen(schedule.c_str(), "w");
+  ASSERT_TRUE(f);
+  std::fputs("[schedule]\nsun = { elevation_deg = { start = 30, end = -10, step = -40 }, azimuth_deg = 135 }\n", f);
+  std::fclose(f);
+  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --schedule " +
+                                                 schedule + " --size 32 -q --out " + dir + "/out");
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  ASSERT_EQ(testing::RunSkybake("view " + dir + "/out").exit_code, 0);
+  Shot day = Open(dir + "/out", "drag:0,40");
+  Shot night = Open(dir + "/out", "drag:0,40;frame:1");
+  ASSERT_EQ(day.report["frames"], 2);
+  EXPECT_EQ(day.report["label"], "frame 1");
+  EXPECT_EQ(night.report["label"], "frame 2");
+  std::printf("upper-half mean sRGB: frame 1 %.1f, frame 2 %.1f\n", day.UpperMean(), night.UpperMean());
+  EXPECT_GT(day.UpperMean(), 40.0) << "the day sky at the bake's exposure";
+  EXPECT_LT(night.UpperMean(), 0.5 * day.UpperMean()) << "sun 10 degrees below the horizon, same exposure";
+}
+
+TEST(ViewerPageTest, NothingToShowIsRefused) {
+  const std::string dir = testing::FreshTempDir("view_empty");
+  testing::CommandRun r = testing::RunSkybake("view " + dir);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("holds no latlong to show"), std::string::npos) << r.output;
+}
+
+}  // namespace
+}  // namespace skybake
