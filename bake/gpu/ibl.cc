@@ -37,6 +37,12 @@ int IblLevelCount(const IblSettings& settings) {
   return std::max(1, Log2(settings.size) - 2);  // down to 8 x 8
 }
 
+int IblLevelSamples(const IblSettings& s, double roughness) {
+  if (s.full_samples_roughness <= 0.0) return s.samples;
+  const double wanted = std::ceil(s.samples * roughness / s.full_samples_roughness);
+  return int(std::clamp(wanted, double(std::min(16, s.samples)), double(s.samples)));
+}
+
 double IblRoughness(int level, int levels) { return levels > 1 ? double(level) / double(levels - 1) : 0.0; }
 
 // W = integral over n.l > 0 of (n.l) D(h) / 4 dl with v = n. With l the
@@ -425,8 +431,9 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
     gpu::IblPush push{};
     const double roughness = roughness_of(p.level);
     const double alpha = roughness * roughness;
-    const int samples = p.mode == IBL_MODE_SPECULAR ? s.samples : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
-                                                                                               : s.dfg_samples;
+    const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
+                        : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
+                                                        : s.dfg_samples;
     push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
     push.source = {source.size, int32_t(source_levels), 0, 0};
     push.lobe = {float(alpha), float(s.lod_bias),

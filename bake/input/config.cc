@@ -66,6 +66,7 @@ constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
 constexpr Range kCloudDistance{1.0, 2000.0, false, false};
 constexpr Range kIblLodBias{-4.0, 4.0, false, false};
+constexpr Range kIblFullSamplesRoughness{0.0, 1.0, false, false};
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -230,6 +231,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Int("ibl.dfg_size", i.dfg_size, 2, 1024);
   v.Int("ibl.dfg_samples", i.dfg_samples, 1, 65536);
   v.Real("ibl.lod_bias", i.lod_bias, kIblLodBias);
+  v.Real("ibl.full_samples_roughness", i.full_samples_roughness, kIblFullSamplesRoughness);
   v.Bool("ibl.include_sun", i.include_sun);
   v.Bool("ibl.exr", i.exr);
   v.Bool("ibl.ktx2", i.ktx2);
@@ -1213,6 +1215,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   // bake's files are the same bytes as before the keys existed.
   toml::table recorded = writer.table();
   if (!result.style.ibl.Requested()) recorded.erase("ibl");
+  else if (result.style.ibl.full_samples_roughness == 0.0) recorded["ibl"].as_table()->erase("full_samples_roughness");
   if (result.style.output.engine == "none") recorded["output"].as_table()->erase("engine");
   if (!result.style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
   std::ostringstream resolved;

@@ -67,7 +67,8 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& maps, const SkyStyle& sty
             "GGX-prefiltered radiance (split sum, Karis 2013), N = V = R; level {} of {}; perceptual roughness {:.9g} "
             "= level / (levels - 1), alpha = roughness^2 = {:.9g}; {} samples, filtered importance sampling, mip bias "
             "{:.9g}",
-            level, levels, roughness, roughness * roughness, s.samples, s.lod_bias);
+            level, levels, roughness, roughness * roughness,
+            level == 0 ? s.samples : IblLevelSamples(s, roughness), s.lod_bias);
         o.attributes["skybake:ibl_sun"] = sun;
         o.attributes["skybake:layout"] = layout;
         exrs.push_back({fmt::format("specular level {}", level), nullptr, o});

@@ -198,11 +198,20 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
     plan.passes.push_back({"IBL source (no sun disc)", Size(ibl.size, ibl.size) + " x6", "once per frame",
                            plan.frames, source_texels * per_texel});
     if (ibl.specular) {
-      double texels = 0.0;
-      for (int level = 1; level < IblLevelCount(ibl); ++level) texels += 6.0 * std::pow(double(ibl.size >> level), 2);
+      double texels = 0.0, reads = 0.0;
+      std::string counts;  // per level, with ibl.lobe_samples
+      for (int level = 1; level < IblLevelCount(ibl); ++level) {
+        const double t = 6.0 * std::pow(double(ibl.size >> level), 2);
+        const double r = IblRoughness(level, IblLevelCount(ibl));
+        const int n = IblLevelSamples(ibl, r);
+        texels += t;
+        reads += t * n;
+        counts += (counts.empty() ? "" : " ") + std::to_string(n);
+      }
       plan.passes.push_back({fmt::format("IBL specular {} levels", IblLevelCount(ibl)),
-                             fmt::format("{} samples", ibl.samples), "once per frame (cube reads)", plan.frames,
-                             texels * ibl.samples});
+                             ibl.full_samples_roughness > 0.0 ? fmt::format("{} samples (levels 1..)", counts)
+                                                    : fmt::format("{} samples", ibl.samples),
+                             "once per frame (cube reads)", plan.frames, reads});
     }
     if (ibl.irradiance)
       plan.passes.push_back({"IBL irradiance", Size(ibl.irradiance_size, ibl.irradiance_size) + " x6",

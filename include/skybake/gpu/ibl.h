@@ -121,4 +121,13 @@ class IblBaker {
   std::vector<PassTiming> timings_;
 };
 
+// GGX samples of a specular level of perceptual roughness `roughness`:
+// ibl.samples, or with ibl.full_samples_roughness = r0 > 0,
+// clamp(ceil(ibl.samples x roughness / r0), 16, ibl.samples). With a fixed
+// count the error against a converged reference grows with roughness (the
+// lobe spans more of the sky's structure: docs/performance.md, 0.24% at
+// roughness 1/6 to 1.1% at 1 for 256 samples), so the narrow lobes need
+// fewer samples to stay within the roughest level's error.
+int IblLevelSamples(const IblSettings& settings, double roughness);
+
 }  // namespace skybake

@@ -67,6 +67,7 @@ struct IblSettings {
   int irradiance_samples = 512; // cosine samples per irradiance texel
   int dfg_size = 128;           // DFG table edge, texels
   int dfg_samples = 1024;       // GGX samples per DFG texel
+  double full_samples_roughness = 0.0;  // 0: ibl.samples at every level; r > 0: fewer below roughness r (IblLevelSamples)
   double lod_bias = 0.0;        // mip bias of the filtered lookups, log2 texels (docs/ibl.md: 0 measured best)
   bool include_sun = false;     // the Sun's energy in the maps (else it is the glTF sun light alone)
   bool exr = true;              // one EXR per cube level / irradiance / DFG
