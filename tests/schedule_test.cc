@@ -8,6 +8,7 @@
 
 #include "skybake/input/schedule.h"
 #include "skybake/model/solar_position.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -21,14 +22,7 @@ std::string WriteTemp(const std::string& name, const std::string& text) {
   return path;
 }
 
-const char* kDay24 = R"(
-[schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 06:00:00, end = 11:45:00, step_minutes = 15 }
-)";
+using testing::kDay24;
 
 TEST(Schedule, ClockTimeRange) {
   ScheduleResult r = ParseSchedule(kDay24, "day24.toml");

@@ -20,6 +20,7 @@
 
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/input/schedule.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -30,14 +31,7 @@ using testing::RunCommand;
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-const char* kDay24 = R"(
-[schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 06:00:00, end = 11:45:00, step_minutes = 15 }
-)";
+using testing::kDay24;
 
 // Small and quick: 16^3 cube faces, a 32 x 16 latlong.
 const std::vector<std::string> kSmall = {"render.cube_size=16", "render.latlong_height=16", "gltf.segments=32"};

@@ -1014,23 +1014,9 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
                            const std::vector<std::string>& overrides) {
   ConfigResult result;
   result.style.source_path = name;
-  toml::table root;
-  if (std::optional<ConfigError> deep = DeepKeyError(toml_text, name)) {
-    result.errors.push_back(*deep);
-    return result;
-  }
-  try {
-    root = toml::parse(toml_text, name);
-  } catch (const toml::parse_error& e) {
-    ConfigError error;
-    error.file = name;
-    error.line = int(e.source().begin.line);
-    error.column = int(e.source().begin.column);
-    error.key = "(syntax)";
-    error.message = std::string(e.description());
-    result.errors.push_back(error);
-    return result;
-  }
+  std::optional<toml::table> parsed = ParseTomlText(toml_text, name, result.errors);
+  if (!parsed) return result;
+  toml::table& root = *parsed;
   for (const std::string& o : overrides) ApplyOverride(root, o, result.errors);
 
   StyleReader reader(root, name, result.errors);

@@ -225,23 +225,9 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
   ScheduleResult result;
   Schedule& schedule = result.schedule;
   schedule.source_path = name;
-  toml::table root;
-  if (std::optional<ConfigError> deep = DeepKeyError(toml_text, name)) {
-    result.errors.push_back(*deep);
-    return result;
-  }
-  try {
-    root = toml::parse(toml_text, name);
-  } catch (const toml::parse_error& e) {
-    ConfigError error;
-    error.file = name;
-    error.line = int(e.source().begin.line);
-    error.column = int(e.source().begin.column);
-    error.key = "(syntax)";
-    error.message = std::string(e.description());
-    result.errors.push_back(error);
-    return result;
-  }
+  std::optional<toml::table> parsed = ParseTomlText(toml_text, name, result.errors);
+  if (!parsed) return result;
+  toml::table& root = *parsed;
   ScheduleReader r(name, result.errors);
   const toml::table* s = root["schedule"].as_table();
   if (!s) {

@@ -18,6 +18,26 @@ ConfigError LocatedError(const std::string& file, const toml::source_region& whe
   return e;
 }
 
+std::optional<toml::table> ParseTomlText(std::string_view text, const std::string& name,
+                                         std::vector<ConfigError>& errors) {
+  if (std::optional<ConfigError> deep = DeepKeyError(text, name)) {
+    errors.push_back(*deep);
+    return std::nullopt;
+  }
+  try {
+    return toml::parse(text, name);
+  } catch (const toml::parse_error& e) {
+    ConfigError error;
+    error.file = name;
+    error.line = int(e.source().begin.line);
+    error.column = int(e.source().begin.column);
+    error.key = "(syntax)";
+    error.message = std::string(e.description());
+    errors.push_back(error);
+    return std::nullopt;
+  }
+}
+
 int EditDistance(std::string_view a, std::string_view b) {
   std::vector<int> row(b.size() + 1);
   for (size_t j = 0; j <= b.size(); ++j) row[j] = int(j);

@@ -4,6 +4,7 @@
 // nearest known one ("did you mean"). Private to the input layer.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +20,12 @@ namespace skybake {
 // shown as "").
 ConfigError LocatedError(const std::string& file, const toml::source_region& where, const std::string& key,
                          const std::string& message);
+
+// `text` (read from `name`) parsed, or nothing with the error appended to
+// `errors`: a key of too many parts (DeepKeyError), or a TOML syntax error at
+// its line and column (key "(syntax)").
+std::optional<toml::table> ParseTomlText(std::string_view text, const std::string& name,
+                                         std::vector<ConfigError>& errors);
 
 // Levenshtein distance: insertions, deletions and substitutions.
 int EditDistance(std::string_view a, std::string_view b);
