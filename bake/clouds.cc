@@ -190,7 +190,7 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
   }
-  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), 0.0f, 0.0f};
+  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 0.0f};
   // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
   int bands = 0;
   for (int i = 0; i < count; ++i) {
