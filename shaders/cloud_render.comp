@@ -2,7 +2,9 @@
 #extension GL_GOOGLE_include_directive : require
 // The cloud pass: for every texel of one output view, after the sky and
 // sun-disc passes wrote the clear sky there, the clouds in front of it and
-// the sky behind them attenuated by the clouds' transmittance.
+// the sky behind them attenuated by the clouds' transmittance; or, with a
+// panorama (cloud_panorama.glsl), the panorama's texels, which
+// cloud_resample.comp then reads into every view.
 #include "common.glsl"
 #include "clouds.glsl"
 
@@ -19,11 +21,14 @@ vec3 ViewDirection(ivec2 texel) {
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
-  vec3 view = ViewDirection(texel);
-  uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
   AtmosphereParameters atm = AtmosphereFromUniform();
-  CloudMarch m = MarchClouds(atm, view, push.sun_direction.xyz);
+  CloudMarch m = MarchClouds(atm, ViewDirection(texel), push.sun_direction.xyz);
+  if (push.rect.w == CLOUD_MODE_PANORAMA) {
+    cloud_lut[push.rect.x + texel.y * push.view.y + texel.x] = vec4(m.radiance, m.transmittance);
+    return;
+  }
   if (m.transmittance == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
+  uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
   vec4 sky = output_texels[index];
   output_texels[index] = vec4(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
                                   m.transmittance * sky.xyz, sky.w);

@@ -425,6 +425,32 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
   return -r0 * mu + branch * sqrt(max(disc, 0.0));
 }
 
+// Optical depth (dimensionless) toward the Sun through the bands above the
+// one whose top is `band_top` (Layers shadow each other: a deck above darkens
+// the sunlight of the clouds below it): each band the Sun's ray crosses on
+// its way up, marched with min(light_steps, 4) uniform samples (a band above
+// is crossed whole; its shape without detail, as in the light march).
+float CloudOpticalDepthOfBandsAbove(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun,
+                                    float band_top) {
+  float r = atm.bottom_radius + h;
+  int n = min(gpu_clouds.counts.z, 4);
+  int bands = gpu_clouds.resolution.w;
+  float depth = 0.0;
+  for (int b = 0; b < CLOUD_MAX_LAYERS; ++b) {
+    if (b >= bands) continue;
+    float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
+    if (lo < band_top) continue;
+    float s0 = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
+    float s1 = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
+    float ds = (s1 - s0) / float(n);
+    for (int i = 0; i < n; ++i) {
+      float s = s0 + (float(i) + 0.5) * ds;
+      depth += CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * ds;
+    }
+  }
+  return depth;
+}
+
 // Marches the view ray through the part [t0, t1] of a band of thickness
 // `band_thickness`: steps of a third of view_steps per thickness crossed,
 // at most view_steps (a vertical crossing takes a third of them, a
@@ -453,6 +479,7 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     vec3 scattered = vec3(0.0);
     if (max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
       float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
+      if (gpu_clouds.resolution.w > 1) tau += CloudOpticalDepthOfBandsAbove(atm, xz, h, mu_s, sun, band_top);
       // Wrenninge 2013: octave o scatters a^o of the light, sees b^o of the
       // optical depth and a phase of eccentricity c^o.
       float a = 1.0, b = 1.0, c = 1.0, sum = 0.0;

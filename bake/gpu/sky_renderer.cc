@@ -15,6 +15,7 @@
 
 #include "shaders/kCloudLutSpv.spv.h"
 #include "shaders/kCloudRenderSpv.spv.h"
+#include "shaders/kCloudResampleSpv.spv.h"
 #include "shaders/kMultiscatteringLutSpv.spv.h"
 #include "shaders/kSkyRenderSpv.spv.h"
 #include "shaders/kSkyviewLutSpv.spv.h"
@@ -24,6 +25,7 @@
 #include "shaders/kSkyRenderSunDiscPassSpv.spv.h"
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
+#include "skybake/gpu/cloud_panorama.h"
 
 namespace skybake {
 namespace {
@@ -150,6 +152,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     // use the analytic step whatever the style's integrator.
     jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
     jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
+    jobs.push_back(job(&cloud_resample_pipeline_, true, kCloudResampleSpv, kCloudResampleSpv));
   }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
@@ -246,7 +249,8 @@ void SkyRenderer::DestroyAll() {
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
-                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_}) {
+                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
+                        &cloud_resample_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -342,6 +346,14 @@ void SkyRenderer::DestroyBuffer(Buffer& b) {
   // A new buffer may get the same handle: the binding must be written again.
   if (b.buffer != VK_NULL_HANDLE && b.buffer == bound_output_) bound_output_ = VK_NULL_HANDLE;
   b = Buffer{};
+}
+
+void SkyRenderer::EnsureCloudLutCapacity(size_t texels) {
+  if (VkDeviceSize(texels) * 16 <= cloud_lut_buffer_.size) return;
+  DestroyBuffer(cloud_lut_buffer_);
+  cloud_lut_buffer_ = CreateBuffer(VkDeviceSize(texels) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  UpdateDescriptors();
+  cloud_tables_ready_ = false;  // the new buffer holds no tables yet
 }
 
 void SkyRenderer::EnsureOutputCapacity(VkDeviceSize bytes) {
@@ -671,6 +683,10 @@ bool SkyRenderer::HoldsFrames() const {
 
 void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                               bool sun_disc, const std::vector<size_t>& offsets) {
+  // The cloud panorama (cloud_panorama.h), after the cloud tables in their
+  // buffer; growing it rewrites the descriptors, so before the output's.
+  const CloudPanorama panorama = cloud_layers_ > 0 ? ChooseCloudPanorama(views, gpu_clouds_.range.z) : CloudPanorama{};
+  if (panorama.width > 0) EnsureCloudLutCapacity(CloudLutTexels(gpu_clouds_) + panorama.texels());
   BindOutput(target);
   const VkPipeline sky_pipeline = sky_pipeline_;
 
@@ -693,6 +709,17 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     ++counters_.skyview_lut_builds;
   }
   if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
+  if (panorama.width > 0) {
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    push.view = {MAPPING_LATLONG, panorama.width, panorama.height, 0};
+    push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
+    // Read by the cloud passes after the views' barrier below.
+    dispatches.push_back({"clouds panorama", cloud_pipeline_, push, GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(panorama.height, SKYBAKE_LOCAL_SIZE_Y)});
+    barriers.push_back(false);
+    ++counters_.cloud_dispatches;
+  }
   const size_t first_view = dispatches.size();
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
@@ -737,6 +764,10 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       Dispatch d = dispatches[first_view + i];
       d.name = "clouds " + d.name;
       d.pipeline = cloud_pipeline_;
+      if (panorama.width > 0) {
+        d.pipeline = cloud_resample_pipeline_;
+        d.push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_RESAMPLE};
+      }
       dispatches.push_back(d);
       barriers.push_back(false);  // views are disjoint
       ++counters_.cloud_dispatches;

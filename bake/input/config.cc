@@ -65,6 +65,7 @@ constexpr Range kNoiseOffset{-1e4, 1e4, false, false};
 constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
 constexpr Range kCloudDistance{1.0, 2000.0, false, false};
+constexpr Range kCloudPanoramaScale{0.0, 4.0, false, false};
 constexpr Range kIblLodBias{-4.0, 4.0, false, false};
 constexpr Range kIblFullSamplesRoughness{0.0, 1.0, false, false};
 
@@ -155,6 +156,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
     v.Int("quality.cloud_detail_resolution", cq.detail_resolution, 8, 256);
     v.Int("quality.cloud_weather_resolution", cq.weather_resolution, 8, 2048);
     v.Real("quality.cloud_max_distance_km", cq.max_distance_km, kCloudDistance);
+    v.Real("quality.cloud_panorama_scale", cq.panorama_scale, kCloudPanoramaScale);
   }
 
   v.Int("render.cube_size", s.render.cube_size, 1, kMaxCubeSize);

@@ -44,7 +44,9 @@ CloudQuality CloudQualityPreset(const std::string& name) {
   if (name == "draft") {
     q.view_steps = 32;
     q.light_steps = 6;
-    q.octaves = 4;
+    // 8 octaves as production: 4 cost no measurable time and add 3e-2 to the
+    // error (tests/benchmark/cloud_study.py, docs/effects.md).
+    q.octaves = 8;
     q.shape_resolution = 48;
     q.detail_resolution = 24;
     q.weather_resolution = 128;
@@ -128,8 +130,11 @@ double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
   if (layers == 0.0) return 0.0;
   const CloudQuality& q = clouds.quality;
   // Per view sample: the layer loop; per lit sample also the light march
-  // (each step a layer loop), the octaves and the albedo's layer loop.
-  const double per_sample = 1.0 + layers + q.light_steps * (1.0 + layers) + q.octaves + layers;
+  // (each step a layer loop), the octaves and the albedo's layer loop, and
+  // with more than one layer the march through the bands above (a band per
+  // layer at most, min(light_steps, 4) steps each, each a layer loop).
+  const double above = layers > 1.0 ? layers * (1.0 + std::min(q.light_steps, 4) * (1.0 + layers)) : 0.0;
+  const double per_sample = 1.0 + layers + q.light_steps * (1.0 + layers) + q.octaves + layers + above;
   return layers * q.view_steps * per_sample;
 }
 
@@ -190,7 +195,7 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
   }
-  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), 0.0f, 0.0f};
+  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 0.0f};
   // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
   int bands = 0;
   for (int i = 0; i < count; ++i) {

@@ -149,6 +149,10 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 #define CLOUD_PASS_SHAPE 2    // shape noise volume of layer SkyPush.view.w, once per renderer
 #define CLOUD_PASS_DETAIL 3   // detail noise volume of layer SkyPush.view.w
 #define CLOUD_PASS_WEATHER 4  // procedural weather map of layer SkyPush.view.w
+// Modes of the cloud pass (SkyPush.rect.w; cloud_panorama.glsl, cloud_panorama.h).
+#define CLOUD_MODE_MARCH 0     // march the view's own texels (no panorama)
+#define CLOUD_MODE_PANORAMA 1  // march the panorama's texels into the cloud table buffer
+#define CLOUD_MODE_RESAMPLE 2  // composite the view from the panorama
 
 SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo
@@ -166,7 +170,7 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   ivec4 lut;         // aerial perspective LUT x: azimuth texels; y: zenith texels; z: distance slices; w: ambient altitudes
   vec4 phase;        // x: forward g; y: backward g; z: forward weight; w: unused
   vec4 octave;       // Wrenninge 2013 x: contribution a; y: attenuation b; z: eccentricity c; w: unused
-  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; zw: unused
+  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; z: panorama scale; w: unused
   // The union of the layers' shells, overlapping layers merged: x, y: bottom
   // and top altitude km, by altitude; resolution.w of them. The view ray is
   // marched through each band it crosses, in order along the ray.

@@ -122,11 +122,18 @@ def main():
     results["w3_half"] = median_run(
         "W3 half (W1 + cumulus layer)", bake(w3, "w3"), args.reps_w3,
         after=lambda: w3_stage_runs.append(json.load(open(os.path.join(work, "w3", "timings.json")))))
+    # W3 with every view marching its own texels (no cloud panorama): the
+    # speed of the panorama, and the reference its images are compared with.
+    w3m_stage_runs = []
+    results["w3_marched"] = median_run(
+        "W3 half, every view marched (cloud_panorama_scale = 0)",
+        bake(w3 + ["--set", "quality.cloud_panorama_scale=0"], "w3m"), args.reps_w3,
+        after=lambda: w3m_stage_runs.append(json.load(open(os.path.join(work, "w3m", "timings.json")))))
     if args.w3_sequence:
         results["w3_sequence"] = median_run("W3 96 frames", bake(w3 + ["--schedule", "configs/benchmark/w2.toml"],
                                                                  "w3s"), 1)
     if args.only_clouds:
-        print_clouds(results, w1_stage_runs, w3_stage_runs)
+        print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs)
         return
     results["w1_cold"] = median_run("W1 half, Mesa shader cache off", bake(w1, "w1c"), args.reps_w1,
                                     env={"MESA_SHADER_CACHE_DISABLE": "true"})
@@ -219,15 +226,17 @@ def main():
     print(f"| render incl. SH (wall) | {render_s * 1e3:.0f} ms | | |")
     print(f"| encode + write + checksum 8 EXRs | {write_s * 1e3:.0f} ms | {raw_mb:.1f} MB of half RGB in, "
           f"{frame_mb:.2f} MB written | {raw_mb / write_s:.0f} MB/s in, {frame_mb / write_s:.1f} MB/s out |")
-    print_clouds(results, w1_stage_runs, w3_stage_runs)
+    print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs)
 
 
-def print_clouds(results, w1_stage_runs, w3_stage_runs):
+def print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs):
     """W3 beside W1: the render stage, and the cloud passes of W3's first frame."""
     def median_stage(runs, name):
         return statistics.median([r[name] for r in runs])
+    def render(runs):
+        return statistics.median([{s["stage"]: s["seconds"] for s in t["stages"]}["render"] for t in runs])
     w1_render = median_stage(w1_stage_runs, "render")
-    w3_render = statistics.median([{s["stage"]: s["seconds"] for s in t["stages"]}["render"] for t in w3_stage_runs])
+    w3_render = render(w3_stage_runs)
     passes = w3_stage_runs[-1]["frames"][0]["gpu_passes"]
     cloud_ms = sum(p["gpu_ms"] for p in passes if p["name"].startswith("cloud"))
     print("\n## Clouds (W3)\n")
@@ -235,7 +244,9 @@ def print_clouds(results, w1_stage_runs, w3_stage_runs):
     print("| --- | ---: | ---: |")
     print(f"| W1 | {w1_render:.3f} s | {len(w1_stage_runs)} |")
     print(f"| W3 | {w3_render:.3f} s ({w3_render / w1_render:.1f}x W1; target 8x) | {len(w3_stage_runs)} |")
-    for key in ("w3_half", "w3_sequence"):
+    w3m_render = render(w3m_stage_runs)
+    print(f"| W3, every view marched | {w3m_render:.3f} s ({w3m_render / w1_render:.1f}x W1) | {len(w3m_stage_runs)} |")
+    for key in ("w3_half", "w3_marched", "w3_sequence"):
         if key in results:
             r = results[key]
             print(f"| {r['label']}, whole process | {r['wall']:.2f} s, {r['peak_max']:.0f} MiB peak | {len(r['walls'])} |")

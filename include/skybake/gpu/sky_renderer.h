@@ -158,6 +158,7 @@ class SkyRenderer {
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
+  void EnsureCloudLutCapacity(size_t texels);  // the cloud tables and the panorama after them
   void UpdateDescriptors();
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
@@ -220,6 +221,7 @@ class SkyRenderer {
   VkPipeline disc_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -74,6 +74,9 @@ struct CloudQuality {
   int detail_resolution = 32;   // detail noise volume edge, voxels
   int weather_resolution = 256; // procedural weather map edge, texels
   double max_distance_km = 300.0;  // no cloud beyond this distance from the viewer
+  // Cloud panorama height over the finest view's (cloud_panorama.h); 0: every
+  // view marches its own texels.
+  double panorama_scale = 1.0;
 };
 CloudQuality CloudQualityPreset(const std::string& name);
 

@@ -1,0 +1,43 @@
+// The cloud panorama: the clouds of a frame marched once, into one latlong
+// of cloud radiance and transmittance, and resampled into every view of the
+// frame (docs/clouds.md, "Speed"). The views of a bake look along the same
+// directions from the same observer (six faces, the cube strip and the
+// latlong: 5.24 Mtexels for W3), so marching each of them repeats the same
+// work; the panorama marches the directions of the finest view once.
+//
+// The panorama's texel grid is the OpenEXR latlong's (Imf::LatLongMap: row 0
+// the zenith, column 0 and column width - 1 the same meridian), so a latlong
+// view of the panorama's size reads its own texels, bit for bit what marching
+// that view gives; the other views read it bilinearly.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "skybake/gpu/sky_renderer.h"
+
+namespace skybake {
+
+struct CloudPanorama {
+  int width = 0;   // 0: no panorama, every view marches its own texels
+  int height = 0;
+  size_t texels() const { return size_t(width) * size_t(height); }
+};
+
+// The latlong height whose angular texel spacing matches the finest of `view`:
+// its own height for a latlong, ceil(pi / 2 x face size) for a cube view (a
+// face's texels are 2 / N rad apart at its centre, a latlong's pi / H); 0 for
+// a view of explicit directions (never resampled).
+int CloudPanoramaHeightFor(const ViewRequest& view);
+
+// The panorama of a frame's views: height = ceil(scale x the finest view's
+// height above), width = 2 x height. None (width 0) when scale is 0, when
+// a view of explicit directions is among them, when it would not be cheaper
+// than marching the views (its texels more than 2/3 of theirs: a bake of one
+// latlong view marches it), or when it would exceed kMaxCloudPanoramaHeight.
+CloudPanorama ChooseCloudPanorama(const std::vector<ViewRequest>& views, double scale);
+
+// 4096 x 2048 texels of RGBA float: 128 MiB.
+constexpr int kMaxCloudPanoramaHeight = 2048;
+
+}  // namespace skybake
