@@ -103,6 +103,13 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
          fmt::format("effects.night_dimming = true, strength {}, night sky {} cd/m^2", r.night_dimming_strength,
                      r.night_sky_luminance_cd_m2));
 
+  // The night sky (night_sky.h): stars and the Moon's disc splatted on the
+  // host, moonlight a second render with the Moon as the light.
+  const NightSettings& night = first.night;
+  decide("night sky (stars, Moon, moonlight)", night.Any(), night.Any(), "",
+         fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}", night.stars,
+                     night.star_magnitude_limit, night.moon, night.moonlight));
+
   // Distinct atmospheres over the frames: each one rebuilds the LUTs.
   std::vector<gpu::GpuAtmosphere> keys;
   for (const SkyStyle& f : frames) {
@@ -171,6 +178,13 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
                              double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
     }
   }
+  if (night.moonlight)
+    for (const ViewRequest& v : PlanViews(first))
+      plan.passes.push_back({"moonlit sky " + (v.mapping == MAPPING_LATLONG      ? std::string("latlong")
+                                               : v.mapping == MAPPING_CUBE_STRIP ? std::string("cube strip")
+                                                                                 : fmt::format("face {}", v.face)),
+                             Size(v.width, v.height), "per frame with the Sun down and the Moon above -10 deg",
+                             plan.frames, double(v.width) * v.height * per_texel});
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
   // Image-based lighting (ibl.h): only when an IBL output is asked for.
   // Its samples are filtered cube reads, not medium samples: not in the total.

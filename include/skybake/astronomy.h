@@ -135,6 +135,21 @@ struct MoonState {
   double ecliptic_elongation_deg = 0.0;   // Moon minus Sun ecliptic longitude, [0, 360)
 };
 
+// The Moon of one baked frame, as FrameResult and the manifest record it.
+struct MoonRecord {
+  glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, towards the Moon (topocentric)
+  double elevation_deg = 0.0;
+  double azimuth_deg = 0.0;             // clockwise from North
+  double phase_angle_deg = 0.0;         // 0 = full, 180 = new
+  double illuminated_fraction = 0.0;
+  double bright_limb_deg = 0.0;
+  double angular_radius_rad = 0.0;
+  double top_illuminance_lux = 0.0;     // outside the atmosphere (Krisciunas & Schaefer 1991)
+  double illuminance_lux = 0.0;         // at the observer, after the atmosphere (0 below the horizon)
+  Rgb irradiance{0.0, 0.0, 0.0};        // the same in output units x sr
+  bool light = false;                   // night.moonlight: a light of the scene (glTF, SH)
+};
+
 MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double observer_altitude_m);
 
 // Krisciunas & Schaefer 1991 eq. 8 in lux, at `distance_km`.

@@ -15,6 +15,7 @@
 #include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
 #include "skybake/clouds.h"
+#include "skybake/night_settings.h"
 
 namespace skybake {
 
@@ -108,6 +109,7 @@ struct SkyStyle {
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   GltfSettings gltf;
   IblSettings ibl;
+  NightSettings night;        // stars, the Moon, moonlight (night_sky.h)
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance
 };

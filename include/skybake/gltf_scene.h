@@ -14,6 +14,8 @@
 //             node's -Z: the node is rotated so that +Z points at the Sun
 //   sequence  a core node-rotation animation of the sun node, one key per
 //             frame (1 s of animation per hour of clock time, else per frame)
+//   moon      with the night sky's moonlight: a second directional light and
+//             node "moon", animated the same way
 //
 // Files: name.gltf + name.bin beside the PNG, and name.glb with everything
 // embedded. Provenance and units go in asset.extras and scene extras.
@@ -27,6 +29,7 @@
 #include <glm/vec2.hpp>
 #include <glm/vec3.hpp>
 
+#include "skybake/astronomy.h"
 #include "skybake/config.h"
 #include "skybake/sh.h"
 
@@ -66,8 +69,16 @@ struct SceneDescription {
   GltfSettings dome;
   std::vector<SceneSun> suns;      // 1 for a bake, one per frame for a sequence
   int light_frame = 0;             // which sun sets the light's colour and intensity
+  // The Moon as a second directional light (night.moonlight), one key per
+  // frame that has it; its intensity and colour are the brightest key's
+  // (a light's intensity is not animated in core glTF). Empty: no Moon.
+  std::vector<SceneSun> moons;
   std::string extras_json;         // JSON object merged into the scene's extras (skybake provenance)
 };
+
+// A frame's Moon as a light key: its direction, illuminance at the observer
+// and colour (irradiance with the largest channel 1).
+SceneSun SceneMoonOf(const MoonRecord& moon, double time_s);
 
 struct WrittenScene {
   std::string gltf_path, bin_path, glb_path;

@@ -11,6 +11,7 @@
 #include <string_view>
 #include <vector>
 
+#include "skybake/astronomy.h"
 #include "skybake/config.h"
 #include "skybake/exr_io.h"
 #include "skybake/schedule.h"
@@ -101,6 +102,7 @@ struct FrameResult {
   ShRgb sh_irradiance_without_sun{};  // E_lm of the sky alone
   Rgb sun_irradiance{0, 0, 0};        // transmitted sun at the observer, output units x sr
   double sun_illuminance_lux = 0.0;
+  std::optional<MoonRecord> moon;     // with night.moon or night.moonlight (night_sky.h)
   double render_seconds = 0.0;
   double write_seconds = 0.0;
   std::vector<PassTiming> gpu_passes;
