@@ -154,14 +154,31 @@ Rgb StarColorFromBMinusV(double bv) {
   return rgb;
 }
 
+namespace {
+glm::dvec3 UnitFromEquatorial(double ra_deg, double dec_deg) {
+  const double ra = ra_deg * kDeg, dec = dec_deg * kDeg;
+  return {std::cos(dec) * std::cos(ra), std::cos(dec) * std::sin(ra), std::sin(dec)};
+}
+}  // namespace
+
 std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,
                                    const GeoLocation& place, double min_elevation_deg) {
+  // Precession and the horizontal transform are rotations: libnova turns
+  // the three J2000 axes (RA 0 and 90 deg on the equator, the pole) into
+  // world directions once per frame, and each star's J2000 unit vector is
+  // rotated by the matrix they make (the same place as HorizontalFromJ2000
+  // per star, to 1e-9; tests/astronomy_test.cc).
+  const glm::dvec3 x = HorizontalFromJ2000(0.0, 0.0, julian_day_ut, place).direction;
+  const glm::dvec3 y = HorizontalFromJ2000(90.0, 0.0, julian_day_ut, place).direction;
+  const glm::dvec3 z = HorizontalFromJ2000(0.0, 90.0, julian_day_ut, place).direction;
+  const double min_y = std::sin(min_elevation_deg * kDeg);
   std::vector<PlacedStar> placed;
   for (const CatalogueStar& s : catalogue.stars) {
     if (s.v_magnitude > magnitude_limit) continue;
-    const SkyDirection d = HorizontalFromJ2000(s.ra_j2000_deg, s.dec_j2000_deg, julian_day_ut, place);
-    if (d.elevation_deg <= min_elevation_deg) continue;
-    placed.push_back({d.direction, StarIlluminanceLux(s.v_magnitude), StarColorFromBMinusV(s.b_minus_v)});
+    const glm::dvec3 v = UnitFromEquatorial(s.ra_j2000_deg, s.dec_j2000_deg);
+    const glm::dvec3 d = v.x * x + v.y * y + v.z * z;
+    if (d.y <= min_y) continue;
+    placed.push_back({d, StarIlluminanceLux(s.v_magnitude), StarColorFromBMinusV(s.b_minus_v)});
   }
   return placed;
 }

@@ -254,6 +254,8 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
            Range{kMinStarMagnitudeLimit, kMaxStarMagnitudeLimit, false, false});
     v.Bool("night.moon", n.moon);
     v.Bool("night.moonlight", n.moonlight);
+    v.Bool("night.airglow", n.airglow);
+    v.Real("night.airglow_height_km", n.airglow_height_km, Range{0.0, 500.0, true, false});
   }
 }
 

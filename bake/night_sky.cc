@@ -301,6 +301,36 @@ Rgb TransmittanceTable::At(double mu) const {
   return out;
 }
 
+std::vector<Rgb> AirglowTable(const AtmosphereParams& atmosphere, const TransmittanceTable& t, double height_km,
+                              double zenith_cd_m2, OutputUnits units) {
+  const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
+  const Rgb output = OutputScale(units);
+  const double r = atmosphere.bottom_radius_km + atmosphere.observer_altitude_m * 1e-3;
+  const double ratio = std::min(r / (atmosphere.bottom_radius_km + height_km), 1.0 - 1e-9);
+  const Rgb zenith_t = t.At(1.0);
+  std::vector<Rgb> table(kAirglowEntries);
+  for (int i = 0; i < kAirglowEntries; ++i) {
+    const double mu = -1.0 + 2.0 * i / (kAirglowEntries - 1);
+    const double van_rhijn = 1.0 / std::sqrt(1.0 - ratio * ratio * (1.0 - mu * mu));
+    const Rgb tr = t.At(mu);
+    // Neutral in Rec.709 luminance, then the output units (as NightSkyRadiance).
+    for (int c = 0; c < 3; ++c)
+      table[i][c] = zenith_t[c] > 0.0 ? zenith_cd_m2 / to_luminance[c] * output[c] * van_rhijn * tr[c] / zenith_t[c] : 0.0;
+  }
+  return table;
+}
+
+Rgb AirglowAt(const std::vector<Rgb>& table, double mu) {
+  const double f = (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * (table.size() - 1);
+  const size_t i = std::min(size_t(f), table.size() - 2);
+  const double a = f - double(i);
+  // Behind the ground the table is zero: no blend across the horizon.
+  if (table[i][1] == 0.0 || table[i + 1][1] == 0.0) return a < 0.5 ? table[i] : table[i + 1];
+  Rgb out;
+  for (int c = 0; c < 3; ++c) out[c] = table[i][c] * (1.0 - a) + table[i + 1][c] * a;
+  return out;
+}
+
 std::vector<PointSource> MoonDiscSources(const glm::dvec3& moon_direction, double rho, const glm::dvec3& sun_direction,
                                          const Rgb& disc_irradiance, int samples_across) {
   const glm::dvec3 m = glm::normalize(moon_direction);
@@ -409,6 +439,37 @@ std::vector<std::vector<float>> NightSkyRenderer::MoonlitSky(const SkyStyle& sty
   return sky;
 }
 
+const std::vector<float>& NightSkyRenderer::TexelMu(const ViewRequest& view) {
+  const std::array<int, 4> key = {view.mapping, view.width, view.height, view.face};
+  auto it = texel_mu_.find(key);
+  if (it != texel_mu_.end()) return it->second;
+  std::vector<float> mu(size_t(view.width) * view.height);
+  for (int y = 0; y < view.height; ++y)
+    for (int x = 0; x < view.width; ++x) mu[size_t(y) * view.width + x] = float(ViewTexelDirection(view, x, y).y);
+  return texel_mu_.emplace(key, std::move(mu)).first->second;
+}
+
+namespace {
+
+// Adds the airglow where it is at least kNightSplatMinRelative of the
+// texel; returns whether any was (with `rgba_out` null: only tells).
+bool AddAirglow(const std::vector<Rgb>& table, const std::vector<float>& mu, const float* rgba_in, float* rgba_out) {
+  bool any = false;
+  for (size_t i = 0; i < mu.size(); ++i) {
+    const Rgb a = AirglowAt(table, mu[i]);
+    const float* t = rgba_in + 4 * i;
+    const double current = std::max({double(t[0]), double(t[1]), double(t[2])});
+    const double add = std::max({a[0], a[1], a[2]});
+    if (add <= 0.0 || add < kNightSplatMinRelative * current) continue;
+    any = true;
+    if (!rgba_out) return true;
+    for (int c = 0; c < 3; ++c) rgba_out[4 * i + c] += float(a[c]);
+  }
+  return any;
+}
+
+}  // namespace
+
 void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night, const std::vector<ViewRequest>& views,
                                   std::vector<RgbaImage>& images) {
   std::vector<std::vector<float>> moonlit;
@@ -424,6 +485,13 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
       own();
       for (size_t k = 0; k < image.rgba.size(); ++k)
         if (k % 4 != 3) image.rgba[k] += moonlit[i][k];
+    }
+    if (!night.airglow.empty()) {
+      const std::vector<float>& mu = TexelMu(views[i]);
+      if (AddAirglow(night.airglow, mu, image.data(), nullptr)) {
+        own();
+        AddAirglow(night.airglow, mu, image.rgba.data(), image.rgba.data());
+      }
     }
     const std::vector<TexelAdd> adds = SplatPointSources(views[i], night.sources);
     if (ApplyTexelAdds(adds, image.data(), nullptr, kNightSplatMinRelative) == 0) continue;
@@ -442,6 +510,7 @@ void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night
     if (!moonlit.empty())
       for (size_t k = 0; k < faces[i].size(); ++k)
         if (k % 4 != 3) faces[i][k] += moonlit[i][k];
+    if (!night.airglow.empty()) AddAirglow(night.airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
     ApplyTexelAdds(SplatPointSources(views[i], stars), faces[i].data(), faces[i].data(), kNightSplatMinRelative);
   }
 }
@@ -475,6 +544,7 @@ std::unique_ptr<NightSkyBake> NightSkyBake::For(const std::vector<const SkyStyle
 std::optional<NightFrame> NightSkyBake::Frame(const SkyStyle& unpruned, const std::optional<CivilTime>& time,
                                               const glm::dvec3& sun) {
   if (!unpruned.night.Any() || !time) return std::nullopt;
+  const auto start = std::chrono::steady_clock::now();
   const SkyStyle style = PrunedStyle(unpruned);
   // The transmittance table of the frame's atmosphere (a schedule's drift
   // makes a new one).
@@ -490,7 +560,14 @@ std::optional<NightFrame> NightSkyBake::Frame(const SkyStyle& unpruned, const st
     table = tables_.back().second.get();
   }
   const StarCatalogue* catalogue = style.night.stars ? &catalogues_.Get(StarCataloguePathOf(style)) : nullptr;
-  return ComputeNightFrame(style, catalogue, *table, JulianDayUt(*time), place_, sun);
+  NightFrame frame = ComputeNightFrame(style, catalogue, *table, JulianDayUt(*time), place_, sun);
+  // The glow's zenith luminance is the floor's, which the pruned style has
+  // taken out of the shaders (PrunedStyle).
+  if (style.night.airglow)
+    frame.airglow = AirglowTable(atmosphere, *table, style.night.airglow_height_km,
+                                 unpruned.effects.night_sky_luminance_cd_m2, style.output.units);
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return frame;
 }
 
 void NightSkyBake::RecordMoon(const SkyStyle& style, const NightFrame& night, ShRgb& sh_radiance_with_lights,
@@ -513,14 +590,40 @@ void NightSkyBake::RecordMoon(const SkyStyle& style, const NightFrame& night, Sh
   record = r;
 }
 
+namespace {
+double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+}  // namespace
+
 void NightSkyBake::AddToViews(NightSkyRenderer& renderer, const SkyStyle& style, const NightFrame& night,
-                              const std::vector<ViewRequest>& views, std::vector<RgbaImage>& images) const {
+                              const std::vector<ViewRequest>& views, std::vector<RgbaImage>& images) {
+  const auto start = std::chrono::steady_clock::now();
   renderer.AddToViews(PrunedStyle(style), night, views, images);
+  seconds_ += SecondsSince(start);
 }
 
 void NightSkyBake::AddToFaces(NightSkyRenderer& renderer, const SkyStyle& style, const NightFrame& night,
-                              const std::vector<ViewRequest>& views, std::vector<std::vector<float>>& faces) const {
+                              const std::vector<ViewRequest>& views, std::vector<std::vector<float>>& faces) {
+  const auto start = std::chrono::steady_clock::now();
   renderer.AddToFaces(PrunedStyle(style), night, views, faces);
+  seconds_ += SecondsSince(start);
+}
+
+double NightSkyBake::TakeSeconds() {
+  const double s = seconds_;
+  seconds_ = 0.0;
+  return s;
+}
+
+std::string NightSkyBake::Describe(const NightFrame& night) {
+  std::string d = fmt::format("{} stars", night.stars);
+  if (night.moon)
+    d += fmt::format(", Moon at {:.1f} deg, phase angle {:.1f} deg, {:.3g} lux{}", night.moon->sky.elevation_deg,
+                     night.moon->phase_angle_deg, night.moon_illuminance_lux,
+                     night.moonlight_scale > 0.0 ? ", moonlit sky rendered" : "");
+  if (!night.airglow.empty()) d += ", airglow";
+  return d;
 }
 
 }  // namespace skybake

@@ -37,6 +37,9 @@ SkyStyle PrunedStyle(const SkyStyle& style) {
                         (e.mie && AnyPositive(a.mie_scattering_per_km));
   e.multiple_scattering = e.multiple_scattering && e.multiple_scattering_strength > 0.0 && scatters;
   e.night_dimming = e.night_dimming && e.night_dimming_strength > 0.0;
+  // night.airglow replaces the flat night floor (night_sky.h): the dimming
+  // then blends the Sun's sky to black and the glow is added on the host.
+  if (s.night.airglow) e.night_sky_luminance_cd_m2 = 0.0;
   AoasSettings& x = s.aoas;
   x.hue.enabled = x.hue.enabled && x.hue.strength > 0.0;
   x.ambiguity.enabled = x.ambiguity.enabled && x.ambiguity.l_pt > 0.0;
@@ -106,9 +109,9 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
   // The night sky (night_sky.h): stars and the Moon's disc splatted on the
   // host, moonlight a second render with the Moon as the light.
   const NightSettings& night = first.night;
-  decide("night sky (stars, Moon, moonlight)", night.Any(), night.Any(), "",
-         fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}", night.stars,
-                     night.star_magnitude_limit, night.moon, night.moonlight));
+  decide("night sky (stars, Moon, moonlight, airglow)", night.Any(), night.Any(), "",
+         fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}, night.airglow = {}",
+                     night.stars, night.star_magnitude_limit, night.moon, night.moonlight, night.airglow));
 
   // Distinct atmospheres over the frames: each one rebuilds the LUTs.
   std::vector<gpu::GpuAtmosphere> keys;

@@ -907,6 +907,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     if (night_frame) night->AddToViews(*night_renderer, style, *night_frame, views, images);
+    if (night_frame) timer.Report("night sky", night->TakeSeconds(), label + ": " + NightSkyBake::Describe(*night_frame));
     collect_pending();
     FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps)};
     pending.emplace(std::move(frame),

@@ -265,6 +265,22 @@ TEST(Astronomy, StarColourFromBMinusV) {
   EXPECT_NEAR(sun[0] / sun[2], 1.1, 0.2);  // a 5800 K black body is nearly white in Rec.709 (D65)
 }
 
+// PlaceStars' per-frame rotation matrix gives every star the place
+// HorizontalFromJ2000 gives it one by one.
+TEST(Astronomy, PlaceStarsMatchesThePerStarTransform) {
+  StarCatalogue c;
+  for (double ra = 3.0; ra < 360.0; ra += 37.0)
+    for (double dec = -85.0; dec <= 85.0; dec += 17.0) c.stars.push_back({ra, dec, 1.0, 0.5});
+  const double jd = JulianDay(2031, 7, 2, 3, 30);
+  const GeoLocation place{-33.9, 18.4};
+  const std::vector<PlacedStar> placed = PlaceStars(c, 6.0, jd, place, -90.0);
+  ASSERT_EQ(placed.size(), c.stars.size());
+  for (size_t i = 0; i < placed.size(); ++i) {
+    const SkyDirection d = HorizontalFromJ2000(c.stars[i].ra_j2000_deg, c.stars[i].dec_j2000_deg, jd, place);
+    EXPECT_LT(glm::length(placed[i].direction - d.direction), 1e-9) << i;
+  }
+}
+
 TEST(Astronomy, LoadsTheInstalledCatalogue) {
   std::string error;
   const std::optional<StarCatalogue> c = LoadStarCatalogue(DefaultStarCataloguePath(), error);

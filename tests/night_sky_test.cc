@@ -165,6 +165,29 @@ TEST(NightSky, MoonDiscIsLitOnTheSunsSide) {
   EXPECT_TRUE(MoonDiscSources(moon, rho, moon, total, 64).empty());
 }
 
+// van Rhijn: the glow's zenith value is the given luminance, it brightens
+// towards the horizon until the extinction wins, and is zero behind the ground.
+TEST(NightSky, AirglowBrightensTowardsTheHorizon) {
+  AtmosphereParams atmosphere;
+  const TransmittanceTable t(atmosphere, QualitySettings(), EffectSettings());
+  const std::vector<Rgb> table = AirglowTable(atmosphere, t, 90.0, 1.7e-4, OutputUnits::kLuminance);
+  auto luminance = [&](double mu) {
+    const Rgb a = AirglowAt(table, mu);
+    return 0.2126 * a[0] + 0.7152 * a[1] + 0.0722 * a[2];
+  };
+  EXPECT_NEAR(luminance(1.0) / 1.7e-4, 1.0, 1e-9);
+  // At 60 deg from the zenith: van Rhijn 1 / sqrt(1 - (6360/6450)^2 0.75) = 1.88, less extinction.
+  const double r = 6360.0 / 6450.0;
+  const double v60 = 1.0 / std::sqrt(1.0 - r * r * 0.75);
+  const Rgb t60 = t.At(0.5), t0 = t.At(1.0);
+  const double expected = 1.7e-4 * v60 * (0.2126 * t60[0] / t0[0] * 1 + 0.7152 * t60[1] / t0[1] + 0.0722 * t60[2] / t0[2]);
+  EXPECT_NEAR(luminance(0.5) / expected, 1.0, 2e-3);
+  EXPECT_GT(luminance(std::sin(15.0 * M_PI / 180.0)), 1.5 * luminance(1.0));
+  EXPECT_EQ(luminance(-0.01), 0.0);
+  for (int i = 0; i < kAirglowEntries; ++i)
+    for (double c : table[i]) EXPECT_GE(c, 0.0);
+}
+
 TEST(NightSky, OffKeysResolveAsBefore) {
   const ConfigResult plain = ParseSkyStyle("", "plain.toml");
   const ConfigResult off = ParseSkyStyle("[night]\nstars = false\nmoon = false\nmoonlight = false\n", "plain.toml");
@@ -409,6 +432,38 @@ TEST_F(NightBake, OffIsByteIdenticalAndPrunedInThePlan) {
   EXPECT_NE(plan_off.output.find("night sky"), std::string::npos) << plan_off.output;
   EXPECT_EQ(plan_off.output.find("moonlit sky"), std::string::npos) << plan_off.output;
   EXPECT_NE(plan_on.output.find("moonlit sky"), std::string::npos) << plan_on.output;
+}
+
+// night.airglow replaces the flat floor: the same zenith luminance, brighter
+// towards the horizon.
+TEST_F(NightBake, AirglowReplacesTheFlatFloor) {
+  const std::string style = dir_ + "/style.toml";
+  const std::string base = "--set night.stars=false --set night.moon=false --set night.moonlight=false --set output.faces=false";
+  testing::CommandRun flat = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/flat' --quiet {} "
+      "--set night.airglow=false", style, SourceDir(), dir_, base));
+  testing::CommandRun glow = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/glow' --quiet {} "
+      "--set night.airglow=true", style, SourceDir(), dir_, base), "SKYBAKE_VULKAN_VALIDATION=1");
+  ASSERT_EQ(flat.exit_code, 0) << flat.output;
+  ASSERT_EQ(glow.exit_code, 0) << glow.output;
+  int w = 0, h = 0;
+  const std::vector<float> f = ReadExr(dir_ + "/flat/sky_latlong.0002.exr", w, h);
+  const std::vector<float> g = ReadExr(dir_ + "/glow/sky_latlong.0002.exr", w, h);
+  auto lum = [&](const std::vector<float>& v, int row) {
+    const float* t = &v[(size_t(row) * w + w / 3) * 4];
+    return 0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2];
+  };
+  // The flat floor: 1.7e-4 cd/m^2 everywhere above the horizon.
+  EXPECT_NEAR(lum(f, 1) / 1.7e-4, 1.0, 0.02);
+  EXPECT_NEAR(lum(f, h / 2 - 3) / 1.7e-4, 1.0, 0.02);
+  // The glow: the same at the zenith, brighter 10-15 deg up, black below the horizon.
+  EXPECT_NEAR(lum(g, 0) / 1.7e-4, 1.0, 0.02);
+  EXPECT_GT(lum(g, h / 2 - 5), 1.5 * lum(g, 0));
+  EXPECT_EQ(lum(g, h - 1), 0.0);
+  size_t bad = 0;
+  for (float v : g) bad += !std::isfinite(v) || v < 0.0f;
+  EXPECT_EQ(bad, 0u);
 }
 
 // Above the horizon the Sun's sky outshines the moonlit sky of a full moon

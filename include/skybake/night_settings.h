@@ -15,7 +15,12 @@ struct NightSettings {
   double star_magnitude_limit = 6.5;   // V; stars fainter are left out; [-1.5, 14]
   bool moon = false;                   // the Moon's disc
   bool moonlight = false;              // the Moon as a second light (sky, SH, IBL, glTF)
-  bool Any() const { return stars || moon || moonlight; }
+  // The natural night-sky glow with the van Rhijn brightening towards the
+  // horizon, replacing the flat floor of effects.night_dimming; its zenith
+  // luminance is effects.night_sky_luminance_cd_m2.
+  bool airglow = false;
+  double airglow_height_km = 90.0;     // the emitting layer (Leinert et al. 1998: 90 km); (0, 500]
+  bool Any() const { return stars || moon || moonlight || airglow; }
 };
 
 inline constexpr double kMinStarMagnitudeLimit = -1.5;  // brighter than Sirius (-1.44): no stars

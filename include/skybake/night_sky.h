@@ -42,6 +42,7 @@
 // output units times sr (as FrameResult::sun_irradiance).
 #pragma once
 
+#include <array>
 #include <map>
 #include <memory>
 #include <optional>
@@ -129,7 +130,23 @@ struct NightFrame {
   Rgb moon_irradiance{0.0, 0.0, 0.0}; // the Moon at the observer, output units x sr (after the atmosphere)
   double moon_illuminance_lux = 0.0;  // the same as illuminance
   double moonlight_scale = 0.0;       // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
+  // With night.airglow: the glow's radiance by mu = cos(zenith angle) of
+  // the view (output units), AirglowTable.
+  std::vector<Rgb> airglow;
 };
+
+// The night-sky glow of a thin layer at `height_km` above the ground of
+// `atmosphere` with zenith luminance `zenith_cd_m2` (neutral), seen through
+// the atmosphere, at kAirglowEntries values of mu from -1 to 1: the van
+// Rhijn 1921 brightening V(z) = 1 / sqrt(1 - (r / (R + h))^2 sin^2 z)
+// (r: the observer's radius, R: the ground's) times the transmittance
+// relative to the zenith's (Leinert et al. 1998, A&AS 127, 1, sec. 9); zero
+// behind the ground. In `output` units.
+inline constexpr int kAirglowEntries = 2048;
+std::vector<Rgb> AirglowTable(const AtmosphereParams& atmosphere, const TransmittanceTable& t, double height_km,
+                              double zenith_cd_m2, OutputUnits output);
+// The table read at `mu` (nearest entry below, linear).
+Rgb AirglowAt(const std::vector<Rgb>& table, double mu);
 
 // The night of one frame at `julian_day_ut` and `place`, with the Sun along
 // `sun` (unit). `catalogue` is needed with night.stars. `style`: pruned.
@@ -165,7 +182,10 @@ class NightSkyRenderer {
  private:
   std::vector<std::vector<float>> MoonlitSky(const SkyStyle& style, const NightFrame& night,
                                              const std::vector<ViewRequest>& views);
+  // mu = cos(zenith angle) of every texel of a view, computed once.
+  const std::vector<float>& TexelMu(const ViewRequest& view);
   VulkanContext& context_;
+  std::map<std::array<int, 4>, std::vector<float>> texel_mu_;
   std::unique_ptr<SkyRenderer> moonlight_;
   gpu::GpuAtmosphere moonlight_key_{};
   int moonlight_renders_ = 0;
@@ -197,13 +217,19 @@ class NightSkyBake {
   // Sun's) when night.moonlight.
   void RecordMoon(const SkyStyle& style, const NightFrame& night, ShRgb& sh_radiance_with_lights,
                   std::optional<MoonRecord>& record) const;
+  // Host time spent in Frame, AddToViews and AddToFaces (the moonlit
+  // renders included) since the last call, s; and what a frame adds, for
+  // the progress line.
+  double TakeSeconds();
+  static std::string Describe(const NightFrame& night);
   // `renderer`: the bake's, made after (and so destroyed before) its Vulkan context.
   void AddToViews(NightSkyRenderer& renderer, const SkyStyle& style, const NightFrame& night,
-                  const std::vector<ViewRequest>& views, std::vector<RgbaImage>& images) const;
+                  const std::vector<ViewRequest>& views, std::vector<RgbaImage>& images);
   void AddToFaces(NightSkyRenderer& renderer, const SkyStyle& style, const NightFrame& night,
-                  const std::vector<ViewRequest>& views, std::vector<std::vector<float>>& faces) const;
+                  const std::vector<ViewRequest>& views, std::vector<std::vector<float>>& faces);
 
  private:
+  double seconds_ = 0.0;
   GeoLocation place_;
   StarCatalogues catalogues_;
   std::vector<std::pair<std::vector<unsigned char>, std::unique_ptr<TransmittanceTable>>> tables_;
