@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 #include <libnova/lunar.h>
+#include <libnova/nutation.h>
 #include <libnova/parallax.h>
 #include <libnova/precession.h>
 #include <libnova/julian_day.h>
@@ -31,6 +32,24 @@ double Wrap360(double deg) {
 double CompassAzimuthFromLibnova(double libnova_azimuth_deg) { return Wrap360(libnova_azimuth_deg + 180.0); }
 
 namespace {
+
+// libnova caches its nutation (and lunar and solar series) by Julian day
+// and reuses a value for a nearby day, so a result depends on the calls
+// before it at the 1e-10 level. Computing each at a day far away first
+// makes the next call at `julian_day_ut` compute afresh: a frame's stars
+// and Moon are then the same whichever frames were computed before it (a
+// shard of a sequence gives the unsharded bake's bytes).
+void ResetLibnovaCaches(double julian_day_ut) {
+  const double far = julian_day_ut + 400.0;
+  ln_nutation nutation{};
+  ln_get_nutation(far, &nutation);
+  ln_equ_posn equatorial{};
+  ln_get_lunar_equ_coords(far, &equatorial);
+  ln_get_solar_equ_coords(far, &equatorial);
+  ln_lnlat_posn ecliptic{};
+  ln_get_lunar_ecl_coords(far, &ecliptic, 0.0);
+  ln_get_solar_ecl_coords(far, &ecliptic);
+}
 
 SkyDirection FromLibnovaHorizontal(const ln_hrz_posn& h) {
   SkyDirection s;
@@ -168,6 +187,7 @@ std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnit
   // world directions once per frame, and each star's J2000 unit vector is
   // rotated by the matrix they make (the same place as HorizontalFromJ2000
   // per star, to 1e-9; tests/astronomy_test.cc).
+  ResetLibnovaCaches(julian_day_ut);
   const glm::dvec3 x = HorizontalFromJ2000(0.0, 0.0, julian_day_ut, place).direction;
   const glm::dvec3 y = HorizontalFromJ2000(90.0, 0.0, julian_day_ut, place).direction;
   const glm::dvec3 z = HorizontalFromJ2000(0.0, 90.0, julian_day_ut, place).direction;
@@ -192,6 +212,7 @@ double MoonIlluminanceLux(double phase_angle_deg, double distance_km) {
 
 MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double observer_altitude_m) {
   MoonState m;
+  ResetLibnovaCaches(julian_day_ut);
   // Geocentric apparent place (ELP 2000-82B). libnova 0.16 refers it to the
   // J2000 equinox, as its solar coordinates (tests/astronomy_test.cc checks
   // this against Meeus example 47.a), so it is precessed to the date.

@@ -373,6 +373,23 @@ TEST_F(NightBake, GltfHasTheMoonAsASecondLightAndValidates) {
   EXPECT_EQ(count, 2u) << output;
 }
 
+// Shards of a night sequence merge into the unsharded bake's manifest and
+// scene, the Moon's records and light included, byte for byte.
+TEST_F(NightBake, ShardsMergeWithTheMoon) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  const std::string shards = dir_ + "/shards";
+  for (const char* part : {"1/2", "2/2"}) {
+    testing::CommandRun r = RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 "
+                                                   "--out '{1}' --quiet --shard {2}",
+                                                   dir_, shards, part));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  testing::CommandRun merge = RunSkybake(fmt::format("merge-manifest '{}'", shards));
+  ASSERT_EQ(merge.exit_code, 0) << merge.output;
+  for (const char* name : {"manifest.json", "sky.gltf", "sky.bin"})
+    EXPECT_EQ(testing::ReadFileBytes(shards + "/" + name), testing::ReadFileBytes(dir_ + "/out/" + name)) << name;
+}
+
 // Bad input is refused before any GPU work, with exit code 3 and the fix.
 TEST_F(NightBake, RefusesBadInputWithTheFix) {
   const std::string style = dir_ + "/style.toml";
