@@ -181,6 +181,10 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames) {
                              double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
     }
   }
+  if (night.moonlight && sky_view)
+    plan.passes.push_back({"moonlit sky-view LUT", Size(q.sky_view_width, q.sky_view_height),
+                           "per frame with the Sun down and the Moon above -10 deg", plan.frames,
+                           double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
   if (night.moonlight)
     for (const ViewRequest& v : PlanViews(first))
       plan.passes.push_back({"moonlit sky " + (v.mapping == MAPPING_LATLONG      ? std::string("latlong")
