@@ -16,6 +16,7 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "skybake/pipeline/night_sky.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -277,6 +278,51 @@ TEST(HardCaseExtraTest, SunDiscSurvivesHalfFloatOutput) {
   std::filesystem::remove(path);
   EXPECT_THROW(HalfRangeScale(CheckedMaxValue({&image}), OverflowPolicy::kRefuse), OutputError);
   testing::ExpectNoValidationMessages();
+}
+
+// The night sky's host-side parts (night_sky.h) at midnight, at dusk with
+// the Sun and the Moon both up, and with the Moon on the horizon: every
+// star, disc sample, airglow value and the Moon's irradiance finite and
+// non-negative, in both output units. (tests/night_sky_test.cc bakes the
+// same cases on lavapipe and checks every texel of the maps.)
+TEST(HardCaseNightTest, NightSkyFiniteAndNonNegative) {
+  std::string error;
+  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
+  ASSERT_TRUE(catalogue) << error << " (bash .ci/setup installs it)";
+  const GeoLocation paranal{-24.6272, -70.4042};
+  struct Case {
+    const char* name;
+    CivilTime time;
+  };
+  const std::vector<Case> cases = {{"midnight", {2024, 4, 24, 0, 0, 0.0, -4.0}},
+                                   {"dusk, Sun and Moon up", {2024, 4, 15, 18, 20, 0.0, -4.0}},
+                                   {"Moon on the horizon", {2024, 4, 24, 7, 22, 0.0, -4.0}}};
+  for (OutputUnits units : {OutputUnits::kLuminance, OutputUnits::kSpectral}) {
+    SkyStyle style;
+    style.night.stars = style.night.moon = style.night.moonlight = style.night.airglow = true;
+    style.night.star_magnitude_limit = 8.0;
+    style.output.units = units;
+    const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
+    for (const Case& c : cases) {
+      const double jd = JulianDayUt(c.time);
+      const SolarPosition sun = ComputeSolarPosition(c.time, paranal);
+      const NightFrame night = ComputeNightFrame(style, &*catalogue, table, jd, paranal, sun.direction);
+      ASSERT_TRUE(night.moon) << c.name;
+      EXPECT_GT(night.stars, 1000u) << c.name;
+      size_t bad = 0;
+      for (const PointSource& p : night.sources)
+        for (double v : p.irradiance) bad += !std::isfinite(v) || v < 0.0;
+      for (double v : night.moon_irradiance) bad += !std::isfinite(v) || v < 0.0;
+      for (const Rgb& a : AirglowTable(style.atmosphere, table, 90.0, 1.7e-4, units))
+        for (double v : a) bad += !std::isfinite(v) || v < 0.0;
+      EXPECT_EQ(bad, 0u) << c.name;
+      EXPECT_TRUE(std::isfinite(night.moon_illuminance_lux) && night.moon_illuminance_lux >= 0.0) << c.name;
+      // Splatted into a latlong and a cube strip: finite, non-negative texels.
+      for (const ViewRequest& v : {ViewRequest{MAPPING_LATLONG, 128, 64, 0}, ViewRequest{MAPPING_CUBE_STRIP, 32, 192, 0}})
+        for (const TexelAdd& a : SplatPointSources(v, night.sources))
+          for (float x : a.rgb) EXPECT_TRUE(std::isfinite(x) && x >= 0.0f) << c.name;
+    }
+  }
 }
 
 }  // namespace

@@ -36,6 +36,7 @@
 #include "skybake/input/engine_preset.h"
 #include "skybake/pipeline/test_pattern.h"
 #include "skybake/pipeline/viewer_page.h"
+#include "skybake/pipeline/night_sky.h"
 
 namespace {
 
@@ -149,6 +150,19 @@ int RunBake(const BakeArgs& args, Mode mode) {
     }
     schedule = std::move(loaded.schedule);
     frame_styles = std::move(styles.styles);
+  }
+  // The night sky: its catalogue readable, its frames clock times at a place (night_sky.h).
+  {
+    std::vector<const SkyStyle*> styles;
+    if (schedule)
+      for (const SkyStyle& style : frame_styles) styles.push_back(&style);
+    else
+      styles.push_back(&config.style);
+    const std::vector<ConfigError> night_errors = CheckNightSky(styles, schedule ? &*schedule : nullptr);
+    if (!night_errors.empty()) {
+      PrintErrors(night_errors);
+      return kExitConfig;
+    }
   }
   // Budget: every frame's memory and time estimate, before any GPU work.
   BakeOptions options;

@@ -240,6 +240,21 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Choice("ibl.ktx2_format", i.ktx2_format,
            {{"rgba16f", KtxFormat::kRgba16f}, {"b10g11r11", KtxFormat::kB10g11r11}, {"e5b9g9r9", KtxFormat::kE5b9g9r9}});
   v.Int("ibl.ktx2_zstd_level", i.ktx2_zstd_level, 0, 19);
+
+  // The night sky (night_sky.h): read always; written into the resolved
+  // style only when a part of it is on, so a style without it resolves
+  // (and its EXR headers record it) as before the night sky existed.
+  NightSettings& n = s.night;
+  if (v.kReads || n.Any()) {
+    v.Bool("night.stars", n.stars);
+    v.Text("night.star_catalogue", n.star_catalogue);
+    v.Real("night.star_magnitude_limit", n.star_magnitude_limit,
+           Range{kMinStarMagnitudeLimit, kMaxStarMagnitudeLimit, false, false});
+    v.Bool("night.moon", n.moon);
+    v.Bool("night.moonlight", n.moonlight);
+    v.Bool("night.airglow", n.airglow);
+    v.Real("night.airglow_height_km", n.airglow_height_km, Range{0.0, 500.0, true, false});
+  }
 }
 
 // --------------------------------------------------------------- reading
@@ -390,6 +405,17 @@ class StyleReader {
       return;
     }
     out = text;
+  }
+
+  // Any string (a path).
+  void Text(const char* path, std::string& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      return;
+    }
+    out = node->as_string()->get();
   }
 
   void FileNames(const char* path, std::vector<std::string>& out, size_t count) {
@@ -732,6 +758,7 @@ class StyleWriter {
       if (c.second == v) Put(path, std::string(c.first));
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
+  void Text(const char* path, std::string& v) { Put(path, v); }
   void Preset(const char* path, std::string& name, QualitySettings&, CloudQuality&) { Put(path, name); }
   void Uint(const char* path, uint32_t& v) { Put(path, int64_t(v)); }
   void Vector(const char* path, glm::dvec3& v, const Range&) { Put(path, toml::array{v.x, v.y, v.z}); }

@@ -198,6 +198,81 @@ glm::dquat SunNodeRotation(const glm::dvec3& sun_direction) {
   return glm::rotation(glm::dvec3(0.0, 0.0, 1.0), glm::normalize(sun_direction));
 }
 
+namespace {
+
+// The Moon: light 1, node 2, its rotation keys in the animation (a second
+// one when the Sun has none).
+void AddMoonLight(tinygltf::Model& model, const std::vector<SceneSun>& moons, tinygltf::Scene& gltf_scene) {
+  size_t brightest = 0;
+  for (size_t i = 1; i < moons.size(); ++i)
+    if (moons[i].illuminance_lux > moons[brightest].illuminance_lux) brightest = i;
+  const SceneSun& key = moons[brightest];
+  tinygltf::Light light;
+  light.name = "moon";
+  light.type = "directional";
+  light.intensity = key.illuminance_lux;
+  light.color = {key.color[0], key.color[1], key.color[2]};
+  model.lights.push_back(light);
+  tinygltf::Node node;
+  node.name = "moon";
+  const glm::dquat q = SunNodeRotation(key.direction);
+  node.rotation = {q.x, q.y, q.z, q.w};
+  tinygltf::Value::Object light_ref;
+  light_ref["light"] = tinygltf::Value(int(model.lights.size()) - 1);
+  node.extensions["KHR_lights_punctual"] = tinygltf::Value(light_ref);
+  model.nodes.push_back(node);
+  const int node_index = int(model.nodes.size()) - 1;
+  gltf_scene.nodes.push_back(node_index);
+  if (moons.size() < 2) return;
+  std::vector<float> times, rotations;
+  for (const SceneSun& m : moons) {
+    times.push_back(float(m.time_s));
+    const glm::dquat r = SunNodeRotation(m.direction);
+    rotations.insert(rotations.end(), {float(r.x), float(r.y), float(r.z), float(r.w)});
+  }
+  for (size_t k = 4; k < rotations.size(); k += 4) {
+    float dot = 0;
+    for (int c = 0; c < 4; ++c) dot += rotations[k + c] * rotations[k - 4 + c];
+    if (dot < 0)
+      for (int c = 0; c < 4; ++c) rotations[k + c] = -rotations[k + c];
+  }
+  const int input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
+                                TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR, {times.front()},
+                                {times.back()});
+  const int output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
+                                 TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
+  model.bufferViews[model.accessors[input].bufferView].target = 0;
+  model.bufferViews[model.accessors[output].bufferView].target = 0;
+  if (model.animations.empty()) {
+    tinygltf::Animation animation;
+    animation.name = "moon_path";
+    model.animations.push_back(animation);
+  }
+  tinygltf::Animation& animation = model.animations.front();
+  tinygltf::AnimationSampler sampler;
+  sampler.input = input;
+  sampler.output = output;
+  sampler.interpolation = "LINEAR";
+  animation.samplers.push_back(sampler);
+  tinygltf::AnimationChannel channel;
+  channel.sampler = int(animation.samplers.size()) - 1;
+  channel.target_node = node_index;
+  channel.target_path = "rotation";
+  animation.channels.push_back(channel);
+}
+
+}  // namespace
+
+SceneSun SceneMoonOf(const MoonRecord& moon, double time_s) {
+  SceneSun s;
+  s.time_s = time_s;
+  s.direction = moon.direction;
+  s.illuminance_lux = moon.illuminance_lux;
+  const double peak = std::max({moon.irradiance[0], moon.irradiance[1], moon.irradiance[2]});
+  if (peak > 0.0) s.color = {moon.irradiance[0] / peak, moon.irradiance[1] / peak, moon.irradiance[2] / peak};
+  return s;
+}
+
 WrittenScene WriteGltfScene(const SceneDescription& scene) {
   const std::filesystem::path dir(scene.out_dir);
   WrittenScene written;
@@ -334,6 +409,7 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
   gltf_scene.name = scene.name;
   gltf_scene.nodes = {0, 1};
   if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
+  if (!scene.moons.empty()) AddMoonLight(model, scene.moons, gltf_scene);
   json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
   gltf_scene.extras = ToValue(json{{"skybake", extras}});
   model.scenes.push_back(gltf_scene);

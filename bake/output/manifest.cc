@@ -48,7 +48,23 @@ json FileJson(const ManifestFile& f) {
 
 json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}}; }
 
+json MoonJson(const MoonRecord& m) {
+  return {{"direction", VectorJson(m.direction)},   {"elevation_deg", m.elevation_deg},
+          {"azimuth_deg", m.azimuth_deg},           {"phase_angle_deg", m.phase_angle_deg},
+          {"illuminated_fraction", m.illuminated_fraction}, {"bright_limb_deg", m.bright_limb_deg},
+          {"angular_radius_rad", m.angular_radius_rad},     {"top_illuminance_lux", m.top_illuminance_lux},
+          {"illuminance_lux", m.illuminance_lux},   {"irradiance", RgbJson(m.irradiance)},
+          {"light", m.light}};
+}
+
+json FrameJsonWithoutMoon(const ManifestFrame& f);
 json FrameJson(const ManifestFrame& f) {
+  json frame = FrameJsonWithoutMoon(f);
+  if (f.moon) frame["moon"] = MoonJson(*f.moon);
+  return frame;
+}
+
+json FrameJsonWithoutMoon(const ManifestFrame& f) {
   json files = json::array();
   for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
   return {{"frame", f.number},
@@ -394,6 +410,7 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sun_illuminance_lux = frame.sun_illuminance_lux;
   f.sun_irradiance = frame.sun_irradiance;
   f.sh_irradiance_with_sun = frame.sh_irradiance_with_sun;
+  f.moon = frame.moon;
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
   for (const BakedFile& file : frame.files)
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
@@ -451,6 +468,22 @@ Manifest ReadManifest(const std::string& path) {
     frame.sun_irradiance = r.RgbOf(sun, "irradiance");
     frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
     frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
+    if (f.contains("moon")) {
+      const json& moon = r.Get<json>(f, "moon");
+      MoonRecord mr;
+      mr.direction = r.Vector(moon, "direction");
+      mr.elevation_deg = r.Get<double>(moon, "elevation_deg");
+      mr.azimuth_deg = r.Get<double>(moon, "azimuth_deg");
+      mr.phase_angle_deg = r.Get<double>(moon, "phase_angle_deg");
+      mr.illuminated_fraction = r.Get<double>(moon, "illuminated_fraction");
+      mr.bright_limb_deg = r.Get<double>(moon, "bright_limb_deg");
+      mr.angular_radius_rad = r.Get<double>(moon, "angular_radius_rad");
+      mr.top_illuminance_lux = r.Get<double>(moon, "top_illuminance_lux");
+      mr.illuminance_lux = r.Get<double>(moon, "illuminance_lux");
+      mr.irradiance = r.RgbOf(moon, "irradiance");
+      mr.light = r.Get<bool>(moon, "light");
+      frame.moon = mr;
+    }
     frame.files = FilesOf(r, r.Get<json>(f, "files"));
     m.frames.push_back(std::move(frame));
   }
@@ -490,6 +523,7 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
       double peak = std::max({f.sun_irradiance[0], f.sun_irradiance[1], f.sun_irradiance[2]});
       if (peak > 0.0) sun.color = {f.sun_irradiance[0] / peak, f.sun_irradiance[1] / peak, f.sun_irradiance[2] / peak};
       scene.suns.push_back(sun);
+      if (f.moon && f.moon->light) scene.moons.push_back(SceneMoonOf(*f.moon, f.animation_time_s));
       frame_extras.push_back({{"frame", f.number},
                               {"time", f.time.value_or("")},
                               {"animation_time_s", f.animation_time_s},
@@ -498,6 +532,9 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
                               {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
                               {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}});
     }
+    for (size_t i = 0; i < manifest.frames.size(); ++i)
+      if (manifest.frames[i].moon && manifest.frames[i].moon->light)
+        frame_extras[i]["moon"] = MoonJson(*manifest.frames[i].moon);
     json provenance = {{"version", manifest.version},       {"style", manifest.style},
                        {"schedule", manifest.schedule},     {"units", manifest.units},
                        {"exposure_ev100", manifest.exposure_ev100}, {"texture_frame", manifest.texture_frame},

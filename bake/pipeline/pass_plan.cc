@@ -36,6 +36,9 @@ SkyStyle PrunedStyle(const SkyStyle& style) {
                         (e.mie && AnyPositive(a.mie_scattering_per_km));
   e.multiple_scattering = e.multiple_scattering && e.multiple_scattering_strength > 0.0 && scatters;
   e.night_dimming = e.night_dimming && e.night_dimming_strength > 0.0;
+  // night.airglow replaces the flat night floor (night_sky.h): the dimming
+  // then blends the Sun's sky to black and the glow is added on the host.
+  if (s.night.airglow) e.night_sky_luminance_cd_m2 = 0.0;
   AoasSettings& x = s.aoas;
   x.hue.enabled = x.hue.enabled && x.hue.strength > 0.0;
   x.ambiguity.enabled = x.ambiguity.enabled && x.ambiguity.l_pt > 0.0;
@@ -121,6 +124,13 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
          fmt::format("effects.night_dimming = true, strength {}, night sky {} cd/m^2", r.night_dimming_strength,
                      r.night_sky_luminance_cd_m2));
 
+  // The night sky (night_sky.h): stars and the Moon's disc splatted on the
+  // host, moonlight a second render with the Moon as the light.
+  const NightSettings& night = first.night;
+  decide("night sky (stars, Moon, moonlight, airglow)", night.Any(), night.Any(), "",
+         fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}, night.airglow = {}",
+                     night.stars, night.star_magnitude_limit, night.moon, night.moonlight, night.airglow));
+
   // Distinct atmospheres over the frames: each one rebuilds the LUTs.
   std::vector<gpu::GpuAtmosphere> keys;
   for (const SkyStyle& f : frames) {
@@ -189,6 +199,17 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                              double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
     }
   }
+  if (night.moonlight && sky_view)
+    plan.passes.push_back({"moonlit sky-view LUT", Size(q.sky_view_width, q.sky_view_height),
+                           "per frame with the Sun down and the Moon above -10 deg", plan.frames,
+                           double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
+  if (night.moonlight)
+    for (const ViewRequest& v : PlanViews(first))
+      plan.passes.push_back({"moonlit sky " + (v.mapping == MAPPING_LATLONG      ? std::string("latlong")
+                                               : v.mapping == MAPPING_CUBE_STRIP ? std::string("cube strip")
+                                                                                 : fmt::format("face {}", v.face)),
+                             Size(v.width, v.height), "per frame with the Sun down and the Moon above -10 deg",
+                             plan.frames, double(v.width) * v.height * per_texel});
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
   // Image-based lighting (ibl.h): only when an IBL output is asked for.
   // Its samples are filtered cube reads, not medium samples: not in the total.

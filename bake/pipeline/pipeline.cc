@@ -33,6 +33,7 @@
 #include "skybake/input/engine_preset.h"
 #include "skybake/pipeline/engine_files.h"
 #include "skybake/output/gltf_ibl.h"
+#include "skybake/pipeline/night_sky.h"
 
 namespace skybake {
 namespace {
@@ -345,6 +346,10 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                     options.out_dir, ec.message()));
   }
   const OutputLock lock = OutputLock::Claim(options.out_dir, planned);
+  // The night sky (night_sky.h): its catalogues read, its input checked, before any GPU work.
+  std::vector<const SkyStyle*> plan_styles;
+  for (const FramePlan& plan : plans) plan_styles.push_back(plan.style);
+  std::unique_ptr<NightSkyBake> night = NightSkyBake::For(plan_styles, schedule);
   // What the renames at the end could not replace is found now, before any
   // GPU work: a directory (or a pipe, a socket) under an output's name.
   for (const std::string& name : planned) {
@@ -379,6 +384,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
 
   // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
   VulkanContext context(options.vulkan);
+  std::optional<NightSkyRenderer> night_renderer;  // the moonlit sky's renderer, destroyed before the device
+  if (night) night_renderer.emplace(context);
   timer.Finish("device", fmt::format("{} ({}){}", context.device_info().name, context.device_info().type,
                                      DriverSelection().empty() ? "" : ", software driver only (no GPU device node)"));
   // Each render's output is one storage buffer: refuse views the device cannot bind.
@@ -759,11 +766,14 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     // SH: the sky without the disc from small faces; the disc added as the
     // irradiance it delivers (centre radiance times its limb-darkened solid
     // angle), which point-sampled texels would alias.
+    std::optional<NightFrame> night_frame;
+    if (night) night_frame = night->Frame(style, plan.time, plan.sun);
     const std::vector<float> with_disc = renderer.RenderDirections(plan.sun, {plan.sun});
     const std::vector<float> without_disc = renderer.RenderDirections(plan.sun, {plan.sun}, false);
     std::vector<ViewRequest> sh_views = ShViews(style);
     std::vector<std::vector<float>> sh_faces = renderer.Render(plan.sun, sh_views, false);
     for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+    if (night_frame) night->AddToFaces(*night_renderer, style, *night_frame, sh_views, sh_faces);
     const double alpha = style.atmosphere.sun_angular_radius_rad;
     const double disc_solid_angle = M_PI * alpha * alpha * (1.0 - style.atmosphere.limb_darkening_u / 3.0);
     for (int c = 0; c < 3; ++c)
@@ -780,6 +790,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                  sh_views[0].width);
     frame.sh_irradiance_without_sun = RadianceToIrradiance(sky);
     AddDirectionalSource(sky, plan.sun, frame.sun_irradiance);
+    if (night_frame) night->RecordMoon(style, *night_frame, sky, frame.moon);
     frame.sh_irradiance_with_sun = RadianceToIrradiance(sky);
     frame.render_seconds = SecondsSince(render_start);
     size_t texels = 0;
@@ -798,6 +809,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       std::vector<ViewRequest> source_views;
       for (int face = 0; face < 6; ++face) source_views.push_back({MAPPING_VULKAN_FACE, n, n, face});
       std::vector<std::vector<float>> source_faces = renderer.Render(plan.sun, source_views, false);
+      if (night_frame) night->AddToFaces(*night_renderer, style, *night_frame, source_views, source_faces);
       for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back({"IBL source " + t.name, t.gpu_ms});
       CubeLevel source;
       source.size = n;
@@ -833,6 +845,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     // bake's, are waited for at once).
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
+    if (night_frame) night->AddToViews(*night_renderer, style, *night_frame, views, images);
+    if (night_frame) timer.Report("night sky", night->TakeSeconds(), label + ": " + NightSkyBake::Describe(*night_frame));
     collect_pending();
     FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps),
                  std::move(engine_images)};

@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "skybake/input/night_settings.h"
 #include "skybake/input/output_settings.h"
 #include "skybake/model/aoas.h"
 #include "skybake/model/atmosphere.h"
@@ -36,6 +37,7 @@ struct SkyStyle {
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   GltfSettings gltf;
   IblSettings ibl;
+  NightSettings night;        // stars, the Moon, moonlight (pipeline/night_sky.h)
   std::string source_path;    // where it was read from
   std::string resolved_toml;  // every key with its final value, for provenance
 };

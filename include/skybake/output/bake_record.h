@@ -10,6 +10,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/input/astronomy.h"
 #include "skybake/gpu/pass_timing.h"
 #include "skybake/model/atmosphere.h"
 #include "skybake/model/sh.h"
@@ -42,6 +43,7 @@ struct FrameResult {
   ShRgb sh_irradiance_without_sun{};  // E_lm of the sky alone
   Rgb sun_irradiance{0, 0, 0};        // transmitted sun at the observer, output units x sr
   double sun_illuminance_lux = 0.0;
+  std::optional<MoonRecord> moon;     // with night.moon or night.moonlight (pipeline/night_sky.h)
   double render_seconds = 0.0;
   double write_seconds = 0.0;
   std::vector<PassTiming> gpu_passes;

@@ -14,6 +14,8 @@
 //             node's -Z: the node is rotated so that +Z points at the Sun
 //   sequence  a core node-rotation animation of the sun node, one key per
 //             frame (1 s of animation per hour of clock time, else per frame)
+//   moon      with the night sky's moonlight: a second directional light and
+//             node "moon", animated the same way
 //
 // Files: name.gltf + name.bin beside the PNG, and name.glb with everything
 // embedded. Provenance and units go in asset.extras and scene extras.
@@ -29,6 +31,8 @@
 
 #include "skybake/input/output_settings.h"
 #include "skybake/model/sh.h"
+#include "skybake/model/astronomy.h"
+#include "skybake/input/config.h"
 
 namespace skybake {
 
@@ -66,12 +70,20 @@ struct SceneDescription {
   GltfSettings dome;
   std::vector<SceneSun> suns;      // 1 for a bake, one per frame for a sequence
   int light_frame = 0;             // which sun sets the light's colour and intensity
+  // The Moon as a second directional light (night.moonlight), one key per
+  // frame that has it; its intensity and colour are the brightest key's
+  // (a light's intensity is not animated in core glTF). Empty: no Moon.
+  std::vector<SceneSun> moons;
   std::string extras_json;         // JSON object merged into the scene's extras (skybake provenance)
   // EXT_lights_image_based (gltf_ibl.h): levels x 6 RGBD PNGs in out_dir, level-major,
   // +X -X +Y -Y +Z -Z; none: no image-based light.
   std::vector<std::string> ibl_images;
   ShRgb ibl_sh{};                  // E_lm of the sky without the Sun, the bake's units
 };
+
+// A frame's Moon as a light key: its direction, illuminance at the observer
+// and colour (irradiance with the largest channel 1).
+SceneSun SceneMoonOf(const MoonRecord& moon, double time_s);
 
 struct WrittenScene {
   std::string gltf_path, bin_path, glb_path;

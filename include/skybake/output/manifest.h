@@ -51,6 +51,7 @@ struct ManifestFrame {
   Rgb sun_irradiance{0, 0, 0};  // transmitted sun at the observer, output units x sr
   ShRgb sh_irradiance_with_sun{};
   ShRgb sh_irradiance_without_sun{};
+  std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
   std::vector<ManifestFile> files;  // in the order they are written
 };
 

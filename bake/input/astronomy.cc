@@ -1,0 +1,257 @@
+#include "skybake/input/astronomy.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <libnova/lunar.h>
+#include <libnova/nutation.h>
+#include <libnova/parallax.h>
+#include <libnova/precession.h>
+#include <libnova/julian_day.h>
+#include <libnova/solar.h>
+#include <libnova/transform.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/input/config.h"
+
+namespace skybake {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double Wrap360(double deg) {
+  double d = std::fmod(deg, 360.0);
+  return d < 0.0 ? d + 360.0 : d;
+}
+
+}  // namespace
+
+double CompassAzimuthFromLibnova(double libnova_azimuth_deg) { return Wrap360(libnova_azimuth_deg + 180.0); }
+
+namespace {
+
+// libnova caches its nutation (and lunar and solar series) by Julian day
+// and reuses a value for a nearby day, so a result depends on the calls
+// before it at the 1e-10 level. Computing each at a day far away first
+// makes the next call at `julian_day_ut` compute afresh: a frame's stars
+// and Moon are then the same whichever frames were computed before it (a
+// shard of a sequence gives the unsharded bake's bytes).
+void ResetLibnovaCaches(double julian_day_ut) {
+  const double far = julian_day_ut + 400.0;
+  ln_nutation nutation{};
+  ln_get_nutation(far, &nutation);
+  ln_equ_posn equatorial{};
+  ln_get_lunar_equ_coords(far, &equatorial);
+  ln_get_solar_equ_coords(far, &equatorial);
+  ln_lnlat_posn ecliptic{};
+  ln_get_lunar_ecl_coords(far, &ecliptic, 0.0);
+  ln_get_solar_ecl_coords(far, &ecliptic);
+}
+
+SkyDirection FromLibnovaHorizontal(const ln_hrz_posn& h) {
+  SkyDirection s;
+  s.azimuth_deg = CompassAzimuthFromLibnova(h.az);
+  s.elevation_deg = h.alt;
+  s.direction = SunDirectionFromElevationAzimuth(s.elevation_deg, s.azimuth_deg);
+  return s;
+}
+
+}  // namespace
+
+std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = fmt::format("cannot read the star catalogue {}: give night.star_catalogue the path of a d3-celestial "
+                        "stars.*.json (bash .ci/setup installs configs/stars/node_modules/d3-celestial/data/stars.8.json)",
+                        EscapedText(path));
+    return std::nullopt;
+  }
+  nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
+  if (doc.is_discarded() || !doc.is_object() || !doc.contains("features") || !doc["features"].is_array()) {
+    error = fmt::format("{} is not a d3-celestial star file (a GeoJSON FeatureCollection with \"features\"): give "
+                        "night.star_catalogue a stars.6.json, stars.8.json or stars.14.json of d3-celestial",
+                        EscapedText(path));
+    return std::nullopt;
+  }
+  StarCatalogue catalogue;
+  catalogue.path = path;
+  catalogue.faintest_magnitude = -HUGE_VAL;
+  size_t index = 0;
+  for (const nlohmann::json& f : doc["features"]) {
+    ++index;
+    const nlohmann::json* coords = nullptr;
+    const nlohmann::json* props = nullptr;
+    if (f.is_object() && f.contains("geometry") && f["geometry"].is_object() &&
+        f["geometry"].contains("coordinates"))
+      coords = &f["geometry"]["coordinates"];
+    if (f.is_object() && f.contains("properties") && f["properties"].is_object()) props = &f["properties"];
+    if (!coords || !props || !coords->is_array() || coords->size() < 2 || !(*coords)[0].is_number() ||
+        !(*coords)[1].is_number() || !props->contains("mag") || !(*props)["mag"].is_number()) {
+      error = fmt::format("{}: star {} has no [lon, lat] coordinates or no numeric \"mag\": give "
+                          "night.star_catalogue an unmodified d3-celestial stars.*.json",
+                          EscapedText(path), index);
+      return std::nullopt;
+    }
+    CatalogueStar s;
+    const double lon = (*coords)[0].get<double>(), lat = (*coords)[1].get<double>();
+    s.ra_j2000_deg = Wrap360(lon);
+    s.dec_j2000_deg = lat;
+    s.v_magnitude = (*props)["mag"].get<double>();
+    if (!std::isfinite(lon) || !std::isfinite(lat) || std::abs(lat) > 90.0 || !std::isfinite(s.v_magnitude)) {
+      error = fmt::format("{}: star {} has coordinates or a magnitude out of range: give night.star_catalogue an "
+                          "unmodified d3-celestial stars.*.json", EscapedText(path), index);
+      return std::nullopt;
+    }
+    if (props->contains("bv")) {
+      const nlohmann::json& bv = (*props)["bv"];
+      if (bv.is_number()) s.b_minus_v = bv.get<double>();
+      if (bv.is_string() && !bv.get<std::string>().empty()) {
+        char* end = nullptr;
+        const std::string text = bv.get<std::string>();
+        const double v = std::strtod(text.c_str(), &end);
+        if (end && *end == '\0' && std::isfinite(v)) s.b_minus_v = v;
+      }
+    }
+    catalogue.faintest_magnitude = std::max(catalogue.faintest_magnitude, s.v_magnitude);
+    catalogue.stars.push_back(s);
+  }
+  if (catalogue.stars.empty()) {
+    error = fmt::format("{} holds no stars: give night.star_catalogue a d3-celestial stars.*.json", EscapedText(path));
+    return std::nullopt;
+  }
+  return catalogue;
+}
+
+std::string DefaultStarCataloguePath() {
+  if (const char* env = std::getenv("SKYBAKE_STAR_CATALOGUE"); env && *env) return env;
+#ifdef SKYBAKE_SOURCE_DIR
+  return std::string(SKYBAKE_SOURCE_DIR) + "/configs/stars/node_modules/d3-celestial/data/stars.8.json";
+#else
+  return "configs/stars/node_modules/d3-celestial/data/stars.8.json";
+#endif
+}
+
+SkyDirection HorizontalFromJ2000(double ra_j2000_deg, double dec_j2000_deg, double julian_day_ut,
+                                 const GeoLocation& place) {
+  ln_equ_posn j2000{ra_j2000_deg, dec_j2000_deg};
+  ln_equ_posn of_date{};
+  ln_get_equ_prec2(&j2000, JD2000, julian_day_ut, &of_date);
+  ln_lnlat_posn observer{place.longitude_deg, place.latitude_deg};
+  ln_hrz_posn h{};
+  ln_get_hrz_from_equ(&of_date, &observer, julian_day_ut, &h);
+  return FromLibnovaHorizontal(h);
+}
+
+double StarIlluminanceLux(double v_magnitude) {
+  return kZeroMagnitudeIlluminanceLux * std::pow(10.0, -0.4 * v_magnitude);
+}
+
+double TemperatureFromBMinusV(double bv) {
+  bv = std::clamp(bv, -0.4, 2.0);
+  return 4600.0 * (1.0 / (0.92 * bv + 1.7) + 1.0 / (0.92 * bv + 0.62));
+}
+
+Rgb StarColorFromBMinusV(double bv) {
+  const double t = std::clamp(TemperatureFromBMinusV(bv), 1667.0, 25000.0);
+  const double t2 = t * t, t3 = t2 * t;
+  // Kim et al. 2002: the Planckian locus in CIE 1931 xy.
+  const double x = t <= 4000.0 ? -0.2661239e9 / t3 - 0.2343589e6 / t2 + 0.8776956e3 / t + 0.179910
+                               : -3.0258469e9 / t3 + 2.1070379e6 / t2 + 0.2226347e3 / t + 0.240390;
+  const double x2 = x * x, x3 = x2 * x;
+  const double y = t <= 2222.0   ? -1.1063814 * x3 - 1.34811020 * x2 + 2.18555832 * x - 0.20219683
+                   : t <= 4000.0 ? -0.9549476 * x3 - 1.37418593 * x2 + 2.09137015 * x - 0.16748867
+                                 : 3.0817580 * x3 - 5.87338670 * x2 + 3.75112997 * x - 0.37001483;
+  const double X = x / y, Y = 1.0, Z = (1.0 - x - y) / y;
+  Rgb rgb = {3.2404542 * X - 1.5371385 * Y - 0.4985314 * Z, -0.9692660 * X + 1.8760108 * Y + 0.0415560 * Z,
+             0.0556434 * X - 0.2040259 * Y + 1.0572252 * Z};
+  for (double& c : rgb) c = std::max(c, 0.0);
+  const double luminance = 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+  for (double& c : rgb) c /= luminance;
+  return rgb;
+}
+
+namespace {
+glm::dvec3 UnitFromEquatorial(double ra_deg, double dec_deg) {
+  const double ra = ra_deg * kDeg, dec = dec_deg * kDeg;
+  return {std::cos(dec) * std::cos(ra), std::cos(dec) * std::sin(ra), std::sin(dec)};
+}
+}  // namespace
+
+std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,
+                                   const GeoLocation& place, double min_elevation_deg) {
+  // Precession and the horizontal transform are rotations: libnova turns
+  // the three J2000 axes (RA 0 and 90 deg on the equator, the pole) into
+  // world directions once per frame, and each star's J2000 unit vector is
+  // rotated by the matrix they make (the same place as HorizontalFromJ2000
+  // per star, to 1e-9; tests/astronomy_test.cc).
+  ResetLibnovaCaches(julian_day_ut);
+  const glm::dvec3 x = HorizontalFromJ2000(0.0, 0.0, julian_day_ut, place).direction;
+  const glm::dvec3 y = HorizontalFromJ2000(90.0, 0.0, julian_day_ut, place).direction;
+  const glm::dvec3 z = HorizontalFromJ2000(0.0, 90.0, julian_day_ut, place).direction;
+  const double min_y = std::sin(min_elevation_deg * kDeg);
+  std::vector<PlacedStar> placed;
+  for (const CatalogueStar& s : catalogue.stars) {
+    if (s.v_magnitude > magnitude_limit) continue;
+    const glm::dvec3 v = UnitFromEquatorial(s.ra_j2000_deg, s.dec_j2000_deg);
+    const glm::dvec3 d = v.x * x + v.y * y + v.z * z;
+    if (d.y <= min_y) continue;
+    placed.push_back({d, StarIlluminanceLux(s.v_magnitude), StarColorFromBMinusV(s.b_minus_v)});
+  }
+  return placed;
+}
+
+double MoonIlluminanceLux(double phase_angle_deg, double distance_km) {
+  const double a = std::abs(phase_angle_deg);
+  const double foot_candles = std::pow(10.0, -0.4 * (3.84 + 0.026 * a + 4e-9 * a * a * a * a));
+  const double r = kMoonMeanDistanceKm / distance_km;
+  return foot_candles * kLuxPerFootCandle * r * r;
+}
+
+MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double observer_altitude_m) {
+  MoonState m;
+  ResetLibnovaCaches(julian_day_ut);
+  // Geocentric apparent place (ELP 2000-82B). libnova 0.16 refers it to the
+  // J2000 equinox, as its solar coordinates (tests/astronomy_test.cc checks
+  // this against Meeus example 47.a), so it is precessed to the date.
+  ln_equ_posn j2000{};
+  ln_get_lunar_equ_coords(julian_day_ut, &j2000);
+  ln_equ_posn geocentric{};
+  ln_get_equ_prec2(&j2000, JD2000, julian_day_ut, &geocentric);
+  const double distance_geocentric_km = ln_get_lunar_earth_dist(julian_day_ut);
+  ln_lnlat_posn observer{place.longitude_deg, place.latitude_deg};
+  ln_hrz_posn h{};
+  ln_get_hrz_from_equ(&geocentric, &observer, julian_day_ut, &h);
+  m.geocentric_elevation_deg = h.alt;
+  m.geocentric_ra_deg = geocentric.ra;
+  m.geocentric_dec_deg = geocentric.dec;
+  m.geocentric_distance_km = distance_geocentric_km;
+  // Topocentric: libnova's ln_get_parallax gives the shifts in RA and Dec
+  // (degrees) for the observer's place on the geoid.
+  ln_equ_posn shift{};
+  ln_get_parallax(&geocentric, distance_geocentric_km / kKmPerAu, &observer, observer_altitude_m, julian_day_ut,
+                  &shift);
+  ln_equ_posn topocentric{geocentric.ra + shift.ra, geocentric.dec + shift.dec};
+  ln_get_hrz_from_equ(&topocentric, &observer, julian_day_ut, &h);
+  m.sky = FromLibnovaHorizontal(h);
+  // Topocentric distance: the triangle Earth's centre, observer, Moon, with
+  // the observer 6378.14 km from the centre (libnova's equatorial radius)
+  // and the geocentric zenith angle between the two sides.
+  const double r_km = 6378.14 + observer_altitude_m * 1e-3;
+  m.distance_km = std::sqrt(distance_geocentric_km * distance_geocentric_km + r_km * r_km -
+                            2.0 * distance_geocentric_km * r_km * std::sin(m.geocentric_elevation_deg * kDeg));
+  m.angular_radius_rad = std::asin(kMoonRadiusKm / m.distance_km);
+  m.phase_angle_deg = ln_get_lunar_phase(julian_day_ut);
+  m.illuminated_fraction = ln_get_lunar_disk(julian_day_ut);
+  m.bright_limb_deg = ln_get_lunar_bright_limb(julian_day_ut);
+  m.illuminance_lux = MoonIlluminanceLux(m.phase_angle_deg, m.distance_km);
+  ln_lnlat_posn moon_ecl{}, sun_ecl{};
+  ln_get_lunar_ecl_coords(julian_day_ut, &moon_ecl, 0.0);
+  ln_get_solar_ecl_coords(julian_day_ut, &sun_ecl);
+  m.ecliptic_elongation_deg = Wrap360(moon_ecl.lng - sun_ecl.lng);
+  return m;
+}
+
+}  // namespace skybake

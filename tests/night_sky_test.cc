@@ -1,0 +1,515 @@
+// The night sky in the maps (night_sky.h): the energy-conserving splat, the
+// texel solid angles, the transmittance table, the Moon's disc, and bakes of
+// a night schedule on lavapipe under the validation layer (moonlit sky,
+// manifest, glTF, SH, bad input, byte identity when off).
+#include "skybake/pipeline/night_sky.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+#include <OpenImageIO/imageio.h>
+
+#include "skybake/input/config.h"
+#include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/tools/reference_model.h"
+#include "skybake/input/schedule.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using testing::RunCommand;
+using testing::RunSkybake;
+using testing::SourceDir;
+
+std::vector<ViewRequest> ViewsOfSize(int n) {
+  std::vector<ViewRequest> views;
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});
+  views.push_back({MAPPING_CUBE_STRIP, n, 6 * n, 0});
+  views.push_back({MAPPING_LATLONG, 2 * n, n, 0});
+  return views;
+}
+
+// Energy (sum of radiance x solid angle) per channel of the additions.
+glm::dvec3 Energy(const ViewRequest& view, const std::vector<TexelAdd>& adds) {
+  glm::dvec3 e(0.0);
+  for (const TexelAdd& a : adds) {
+    const int x = int(a.texel % view.width), y = int(a.texel / view.width);
+    const double omega = ViewTexelSolidAngle(view, x, y);
+    for (int c = 0; c < 3; ++c) e[c] += double(a.rgb[c]) * omega;
+  }
+  return e;
+}
+
+TEST(NightSky, TexelSolidAnglesCoverTheSphere) {
+  for (int n : {4, 64, 257}) {
+    for (const ViewRequest& v : {ViewRequest{MAPPING_CUBE_STRIP, n, 6 * n, 0}, ViewRequest{MAPPING_LATLONG, 2 * n, n, 0}}) {
+      double sum = 0.0;
+      for (int y = 0; y < v.height; ++y)
+        for (int x = 0; x < v.width; ++x) sum += ViewTexelSolidAngle(v, x, y);
+      EXPECT_NEAR(sum, 4.0 * M_PI, 1e-9) << v.mapping << " " << n;
+    }
+    double faces = 0.0;
+    for (int face = 0; face < 6; ++face)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) faces += ViewTexelSolidAngle({MAPPING_VULKAN_FACE, n, n, face}, x, y);
+    EXPECT_NEAR(faces, 4.0 * M_PI, 1e-9) << n;
+  }
+}
+
+// Each star's energy is its irradiance at cube sizes 64, 256 and 1024, in
+// every layout; its splat's centroid is its direction.
+TEST(NightSky, StarEnergyIsTheSameAtEveryResolution) {
+  const std::vector<glm::dvec3> directions = {
+      glm::normalize(glm::dvec3(0.3, 0.8, -0.2)), glm::normalize(glm::dvec3(1.0, 0.999, 0.2)),  // near a cube edge
+      glm::normalize(glm::dvec3(-0.5, 0.05, 0.9)), glm::normalize(glm::dvec3(0.001, 1.0, -0.002)),  // near the pole
+      glm::normalize(glm::dvec3(-1e-4, 0.3, -1.0))};  // at the latlong's seam
+  for (const glm::dvec3& d : directions) {
+    const PointSource star{d, {2.0e-6, 3.0e-6, 5.0e-6}};
+    for (int n : {64, 256, 1024}) {
+      glm::dvec3 cube_total(0.0);
+      for (const ViewRequest& v : ViewsOfSize(n)) {
+        const std::vector<TexelAdd> adds = SplatPointSources(v, {star});
+        const glm::dvec3 e = Energy(v, adds);
+        if (v.mapping == MAPPING_VULKAN_FACE) {
+          cube_total += e;
+          continue;
+        }
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(e[c] / star.irradiance[c], 1.0, 1e-6) << v.mapping << " " << n;
+        // Centroid of the splat: within a texel of the star.
+        glm::dvec3 centroid(0.0);
+        for (const TexelAdd& a : adds) {
+          const int x = int(a.texel % v.width), y = int(a.texel / v.width);
+          if (v.mapping == MAPPING_LATLONG && x == v.width - 1) continue;  // the repeated meridian
+          centroid += double(a.rgb[1]) * ViewTexelSolidAngle(v, x, y) * ViewTexelDirection(v, x, y);
+        }
+        const double angle = std::acos(std::min(1.0, glm::dot(glm::normalize(centroid), d)));
+        EXPECT_LT(angle, 2.0 * M_PI / n) << v.mapping << " " << n;
+      }
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(cube_total[c] / star.irradiance[c], 1.0, 1e-6) << "faces " << n;
+    }
+  }
+}
+
+// A star moving by a tenth of a texel per frame: its energy stays put and its
+// brightest texel's value changes smoothly (no popping between frames).
+TEST(NightSky, MovingStarDoesNotAlias) {
+  const ViewRequest v{MAPPING_LATLONG, 256, 128, 0};
+  double previous_peak = -1.0;
+  double largest_jump = 0.0;
+  for (int step = 0; step < 40; ++step) {
+    const double azimuth = 30.0 + step * (360.0 / 255.0) * 0.1;
+    const PointSource star{SunDirectionFromElevationAzimuth(40.0, azimuth), {1.0, 1.0, 1.0}};
+    const std::vector<TexelAdd> adds = SplatPointSources(v, {star});
+    EXPECT_NEAR(Energy(v, adds).y, 1.0, 1e-6);
+    double peak = 0.0;
+    for (const TexelAdd& a : adds) peak = std::max(peak, double(a.rgb[1]) * ViewTexelSolidAngle(v, int(a.texel % v.width), int(a.texel / v.width)));
+    if (previous_peak >= 0.0) largest_jump = std::max(largest_jump, std::abs(peak - previous_peak));
+    previous_peak = peak;
+  }
+  // Bilinear weights move by at most 0.1 x 2 (both axes) per step.
+  EXPECT_LT(largest_jump, 0.25);
+}
+
+TEST(NightSky, TransmittanceTableMatchesTheSharedIntegral) {
+  AtmosphereParams atmosphere;
+  const TransmittanceTable table(atmosphere, QualitySettings(), EffectSettings());
+  const ReferenceModel model(atmosphere, QualitySettings(), EffectSettings(), {1.0, 1.0, 1.0});
+  for (double mu : {1.0, 0.7, 0.2, 0.05, 0.01}) {
+    const Rgb t = table.At(mu);
+    const glm::dvec3 direct = model.TransmittanceDirect(0.0, mu, 256);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(t[c] / direct[c], 1.0, 2e-3) << mu;
+  }
+  for (double c : table.At(-0.01)) EXPECT_EQ(c, 0.0);  // behind the ground
+  // Blue is attenuated more than red (Rayleigh).
+  EXPECT_LT(table.At(0.2)[2], table.At(0.2)[0]);
+}
+
+TEST(NightSky, MoonDiscIsLitOnTheSunsSide) {
+  const glm::dvec3 moon = glm::normalize(glm::dvec3(0.0, 0.6, -0.8));
+  const Rgb total = {1.0, 2.0, 3.0};
+  const double rho = 0.0045;
+  // Full: the Sun behind the observer; Lommel-Seeliger makes the disc uniform.
+  const std::vector<PointSource> full = MoonDiscSources(moon, rho, -moon, total, 64);
+  glm::dvec3 sum(0.0);
+  double lo = 1e30, hi = 0.0;
+  for (const PointSource& p : full) {
+    for (int c = 0; c < 3; ++c) sum[c] += p.irradiance[c];
+    lo = std::min(lo, p.irradiance[0]);
+    hi = std::max(hi, p.irradiance[0]);
+    EXPECT_LT(std::acos(std::min(1.0, glm::dot(p.direction, moon))), rho * 1.0001);
+  }
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], total[c], 1e-9);
+  EXPECT_NEAR(lo / hi, 1.0, 1e-9);
+  EXPECT_GT(full.size(), 3000u);
+  // Quarter: the Sun 90 deg away, towards +X: the lit half is on the +X side.
+  const std::vector<PointSource> quarter = MoonDiscSources(moon, rho, {1.0, 0.0, 0.0}, total, 64);
+  glm::dvec3 centroid(0.0);
+  double energy = 0.0;
+  for (const PointSource& p : quarter) {
+    centroid += p.irradiance[0] * p.direction;
+    energy += p.irradiance[0];
+    EXPECT_GT(glm::dot(p.direction - moon, glm::dvec3(1, 0, 0)), -1e-12);
+  }
+  EXPECT_NEAR(energy, total[0], 1e-9);
+  EXPECT_GT(glm::dot(centroid / energy - moon, glm::dvec3(1, 0, 0)), 0.3 * rho);
+  // New: the Sun behind the Moon, nothing lit (no earthshine).
+  EXPECT_TRUE(MoonDiscSources(moon, rho, moon, total, 64).empty());
+}
+
+// van Rhijn: the glow's zenith value is the given luminance, it brightens
+// towards the horizon until the extinction wins, and is zero behind the ground.
+TEST(NightSky, AirglowBrightensTowardsTheHorizon) {
+  AtmosphereParams atmosphere;
+  const TransmittanceTable t(atmosphere, QualitySettings(), EffectSettings());
+  const std::vector<Rgb> table = AirglowTable(atmosphere, t, 90.0, 1.7e-4, OutputUnits::kLuminance);
+  auto luminance = [&](double mu) {
+    const Rgb a = AirglowAt(table, mu);
+    return 0.2126 * a[0] + 0.7152 * a[1] + 0.0722 * a[2];
+  };
+  EXPECT_NEAR(luminance(1.0) / 1.7e-4, 1.0, 1e-9);
+  // At 60 deg from the zenith: van Rhijn 1 / sqrt(1 - (6360/6450)^2 0.75) = 1.88, less extinction.
+  const double r = 6360.0 / 6450.0;
+  const double v60 = 1.0 / std::sqrt(1.0 - r * r * 0.75);
+  const Rgb t60 = t.At(0.5), t0 = t.At(1.0);
+  const double expected = 1.7e-4 * v60 * (0.2126 * t60[0] / t0[0] * 1 + 0.7152 * t60[1] / t0[1] + 0.0722 * t60[2] / t0[2]);
+  EXPECT_NEAR(luminance(0.5) / expected, 1.0, 2e-3);
+  EXPECT_GT(luminance(std::sin(15.0 * M_PI / 180.0)), 1.5 * luminance(1.0));
+  EXPECT_EQ(luminance(-0.01), 0.0);
+  for (int i = 0; i < kAirglowEntries; ++i)
+    for (double c : table[i]) EXPECT_GE(c, 0.0);
+}
+
+TEST(NightSky, OffKeysResolveAsBefore) {
+  const ConfigResult plain = ParseSkyStyle("", "plain.toml");
+  const ConfigResult off = ParseSkyStyle("[night]\nstars = false\nmoon = false\nmoonlight = false\n", "plain.toml");
+  ASSERT_TRUE(plain.ok() && off.ok());
+  EXPECT_EQ(plain.style.resolved_toml, off.style.resolved_toml);
+  EXPECT_EQ(plain.style.resolved_toml.find("[night]"), std::string::npos);
+  const ConfigResult on = ParseSkyStyle("[night]\nstars = true\n", "on.toml");
+  ASSERT_TRUE(on.ok());
+  EXPECT_NE(on.style.resolved_toml.find("star_magnitude_limit"), std::string::npos);
+  const ConfigResult bad = ParseSkyStyle("[night]\nstar_magnitude_limit = 15.0\n", "bad.toml");
+  ASSERT_EQ(bad.errors.size(), 1u);
+  EXPECT_EQ(bad.errors[0].Format(), "bad.toml:2:24: night.star_magnitude_limit: 15 is out of range [-1.5, 14]");
+}
+
+// --- Bakes on lavapipe
+
+// A night at Cerro Paranal under the full moon (configs/schedules/night.toml):
+// 21:00 (Moon 37 deg up, the Sun -37), and frames made for the hard cases.
+// Nights at Cerro Paranal (configs/schedules/night.toml): dusk at first
+// quarter with the Sun just up and then just down and the Moon high (frames 1,
+// 2), the full moon 37 deg up (3), after midnight (4), the full moon setting
+// through the horizon at dawn (5).
+constexpr const char* kNightSchedule = R"([schedule]
+date = 2024-04-23
+latitude_deg = -24.6272
+longitude_deg = -70.4042
+utc_offset_hours = -4.0
+[[schedule.frames]]
+date = 2024-04-15
+time = 18:20:00
+[[schedule.frames]]
+date = 2024-04-15
+time = 18:50:00
+[[schedule.frames]]
+time = 21:00:00
+[[schedule.frames]]
+date = 2024-04-24
+time = 01:00:00
+[[schedule.frames]]
+date = 2024-04-24
+time = 07:22:00
+)";
+
+class NightBake : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = testing::FreshTempDir("night_bake");
+    std::ofstream(dir_ + "/night.toml") << kNightSchedule;
+    std::ofstream(dir_ + "/style.toml") << "[effects]\nnight_dimming = true\n[night]\nstars = true\nmoon = true\n"
+                                           "moonlight = true\n[output]\npixel_type = \"float\"\n";
+    run_ = RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 --out '{0}/out' "
+                                  "--quiet",
+                                  dir_),
+                      "SKYBAKE_VULKAN_VALIDATION=1");
+    moonless_ = RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 --out '{0}/plain' "
+                                       "--quiet --frames 3:3 --set night.moonlight=false "
+                                       "--set night.moon=false --set night.stars=false",
+                                       dir_),
+                           "SKYBAKE_VULKAN_VALIDATION=1");
+  }
+  static void TearDownTestSuite() { fs::remove_all(dir_); }
+
+  static std::vector<float> ReadExr(const std::string& path, int& w, int& h) {
+    auto in = OIIO::ImageInput::open(path);
+    EXPECT_TRUE(in) << path;
+    if (!in) return {};
+    const OIIO::ImageSpec& spec = in->spec();
+    w = spec.width;
+    h = spec.height;
+    std::vector<float> pixels(size_t(w) * h * spec.nchannels);
+    in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, pixels.data());
+    // As RGBA, whatever the file's channels.
+    std::vector<float> rgba(size_t(w) * h * 4, 1.0f);
+    for (size_t i = 0; i < size_t(w) * h; ++i)
+      for (int c = 0; c < std::min(spec.nchannels, 4); ++c) rgba[4 * i + c] = pixels[i * spec.nchannels + c];
+    return rgba;
+  }
+
+  static std::string dir_;
+  static testing::CommandRun run_, moonless_;
+};
+std::string NightBake::dir_;
+testing::CommandRun NightBake::run_, NightBake::moonless_;
+
+TEST_F(NightBake, BakesWithoutValidationMessages) {
+  EXPECT_EQ(run_.exit_code, 0) << run_.output;
+  EXPECT_EQ(moonless_.exit_code, 0) << moonless_.output;
+}
+
+// Midnight, dusk with the Sun and the Moon both up, the Moon on the horizon:
+// every texel of every map finite and non-negative (the hard cases).
+TEST_F(NightBake, NoNanInfOrNegativeAtMidnightDuskAndMoonOnTheHorizon) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  const json manifest = json::parse(std::ifstream(dir_ + "/out/manifest.json"));
+  ASSERT_EQ(manifest["frames"].size(), 5u);
+  auto elevation = [&](int i, const char* body) { return manifest["frames"][i][body]["elevation_deg"].get<double>(); };
+  EXPECT_GT(elevation(0, "sun"), 0.0);  // dusk, the Sun up
+  EXPECT_GT(elevation(0, "moon"), 30.0);
+  EXPECT_LT(elevation(1, "sun"), 0.0);  // the Sun just down, the Moon up: both lights
+  EXPECT_GT(elevation(1, "sun"), -10.0);
+  EXPECT_GT(elevation(1, "moon"), 30.0);
+  EXPECT_LT(elevation(3, "sun"), -60.0);  // after midnight
+  EXPECT_LT(std::abs(elevation(4, "moon")), 1.0);  // the Moon on the horizon
+  for (int frame = 1; frame <= 5; ++frame)
+    for (const char* name : {"sky_latlong", "sky_cube", "sky_px", "sky_nz", "sky_py"}) {
+      int w = 0, h = 0;
+      const std::vector<float> px = ReadExr(fmt::format("{}/out/{}.{:04d}.exr", dir_, name, frame), w, h);
+      ASSERT_FALSE(px.empty());
+      size_t bad = 0;
+      for (float v : px) bad += !std::isfinite(v) || v < 0.0f;
+      EXPECT_EQ(bad, 0u) << name << " frame " << frame;
+    }
+}
+
+TEST_F(NightBake, ManifestRecordsTheMoonPerFrame) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  const json manifest = json::parse(std::ifstream(dir_ + "/out/manifest.json"));
+  const json& moon = manifest["frames"][2]["moon"];
+  EXPECT_NEAR(moon["elevation_deg"].get<double>(), 37.0, 1.5);
+  EXPECT_LT(moon["phase_angle_deg"].get<double>(), 3.0);
+  EXPECT_GT(moon["illuminated_fraction"].get<double>(), 0.99);
+  // Krisciunas & Schaefer: 0.1..0.3 lux on the ground from a high full moon.
+  EXPECT_GT(moon["illuminance_lux"].get<double>(), 0.1);
+  EXPECT_LT(moon["illuminance_lux"].get<double>(), 0.3);
+  EXPECT_TRUE(moon["light"].get<bool>());
+  glm::dvec3 d(moon["direction"][0].get<double>(), moon["direction"][1].get<double>(), moon["direction"][2].get<double>());
+  EXPECT_NEAR(glm::length(d), 1.0, 1e-9);
+  // The SH with the lights has the Moon in it: brighter towards the Moon than without.
+  const json& f = manifest["frames"][2];
+  EXPECT_GT(f["sh_irradiance_with_sun"][0][1].get<double>(), f["sh_irradiance_without_sun"][0][1].get<double>());
+  // The moonless style's manifest has no moon entry.
+  const json plain = json::parse(std::ifstream(dir_ + "/plain/manifest.shard-0003-0003.json"));
+  EXPECT_FALSE(plain["frames"][0].contains("moon"));
+}
+
+// Moonlight: a dim blue sky, far brighter than the same night without the
+// Moon; the Moon's disc and the stars in the map.
+TEST_F(NightBake, MoonlitSkyIsADimBlueSky) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  ASSERT_EQ(moonless_.exit_code, 0) << moonless_.output;
+  int w = 0, h = 0;
+  const std::vector<float> lit = ReadExr(dir_ + "/out/sky_latlong.0003.exr", w, h);
+  const std::vector<float> dark = ReadExr(dir_ + "/plain/sky_latlong.0003.exr", w, h);
+  ASSERT_EQ(lit.size(), dark.size());
+  // The zenith (row 0): blue over red, 1e-3..1e-1 cd/m^2 (a moonlit sky is
+  // about 1e-6 of a daylit one), over ten times the night floor alone.
+  const int x = w / 4, y = h / 6;  // 60 deg up
+  const float* l = &lit[(size_t(y) * w + x) * 4];
+  const float* d = &dark[(size_t(y) * w + x) * 4];
+  EXPECT_GT(l[2], l[0]);
+  const double lum = 0.2126 * l[0] + 0.7152 * l[1] + 0.0722 * l[2];
+  EXPECT_GT(lum, 1e-3);
+  EXPECT_LT(lum, 1e-1);
+  EXPECT_GT(lum, 10.0 * (0.2126 * d[0] + 0.7152 * d[1] + 0.0722 * d[2]));
+  // The Moon's disc: the brightest texel is near the Moon's direction.
+  size_t brightest = 0;
+  for (size_t i = 0; i < lit.size() / 4; ++i)
+    if (lit[4 * i + 1] > lit[4 * brightest + 1]) brightest = i;
+  const json manifest = json::parse(std::ifstream(dir_ + "/out/manifest.json"));
+  const json& md = manifest["frames"][2]["moon"]["direction"];
+  const glm::dvec3 moon(md[0].get<double>(), md[1].get<double>(), md[2].get<double>());
+  const glm::dvec3 at = ViewTexelDirection({MAPPING_LATLONG, w, h, 0}, int(brightest % w), int(brightest / w));
+  EXPECT_LT(std::acos(std::min(1.0, glm::dot(at, moon))), 3.0 * M_PI / h)
+      << "brightest " << brightest % w << "," << brightest / w << " " << at.x << " " << at.y << " " << at.z << " moon "
+      << moon.x << " " << moon.y << " " << moon.z << " value " << lit[4 * brightest + 1];
+}
+
+TEST_F(NightBake, GltfHasTheMoonAsASecondLightAndValidates) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  const json gltf = json::parse(std::ifstream(dir_ + "/out/sky.gltf"));
+  const json& lights = gltf["extensions"]["KHR_lights_punctual"]["lights"];
+  ASSERT_EQ(lights.size(), 2u);
+  EXPECT_EQ(lights[1]["name"].get<std::string>(), "moon");
+  EXPECT_GT(lights[1]["intensity"].get<double>(), 0.1);  // lux, the brightest frame's
+  EXPECT_LT(lights[1]["intensity"].get<double>(), 0.3);
+  EXPECT_EQ(gltf["animations"][0]["channels"].size(), 2u);
+  auto [status, output] = RunCommand("cd '" + SourceDir() + "/tests/viewer' && node validate.mjs '" + dir_ +
+                                     "/out/sky.gltf' '" + dir_ + "/out/sky.glb'");
+  EXPECT_EQ(status, 0) << output << "\n(install with: bash .ci/setup)";
+  size_t count = 0;
+  for (size_t p = output.find("0 errors, 0 warnings"); p != std::string::npos; p = output.find("0 errors, 0 warnings", p + 1))
+    ++count;
+  EXPECT_EQ(count, 2u) << output;
+}
+
+// Shards of a night sequence merge into the unsharded bake's manifest and
+// scene, the Moon's records and light included, byte for byte.
+TEST_F(NightBake, ShardsMergeWithTheMoon) {
+  ASSERT_EQ(run_.exit_code, 0) << run_.output;
+  const std::string shards = dir_ + "/shards";
+  for (const char* part : {"1/2", "2/2"}) {
+    testing::CommandRun r = RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 "
+                                                   "--out '{1}' --quiet --shard {2}",
+                                                   dir_, shards, part));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  testing::CommandRun merge = RunSkybake(fmt::format("merge-manifest '{}'", shards));
+  ASSERT_EQ(merge.exit_code, 0) << merge.output;
+  for (const char* name : {"manifest.json", "sky.gltf", "sky.bin"})
+    EXPECT_EQ(testing::ReadFileBytes(shards + "/" + name), testing::ReadFileBytes(dir_ + "/out/" + name)) << name;
+}
+
+// Bad input is refused before any GPU work, with exit code 3 and the fix.
+TEST_F(NightBake, RefusesBadInputWithTheFix) {
+  const std::string style = dir_ + "/style.toml";
+  const std::string schedule = dir_ + "/night.toml";
+  testing::CommandRun single = RunSkybake(fmt::format("bake '{}' --out '{}/x'", style, dir_));
+  EXPECT_EQ(single.exit_code, 3) << single.output;
+  EXPECT_NE(single.output.find("style.toml:4:9: night.stars: the night sky needs each frame's date, time and place"),
+            std::string::npos) << single.output;
+  EXPECT_NE(single.output.find("--schedule"), std::string::npos);
+  // A schedule of sun positions has no clock time either.
+  std::ofstream(dir_ + "/suns.toml") << "[schedule]\nsun = { elevation_deg = [-20.0, -30.0], azimuth_deg = 90.0 }\n";
+  testing::CommandRun suns = RunSkybake(fmt::format("check '{}' --schedule '{}/suns.toml'", style, dir_));
+  EXPECT_EQ(suns.exit_code, 3) << suns.output;
+  EXPECT_NE(suns.output.find("suns.toml gives sun positions only"), std::string::npos) << suns.output;
+  testing::CommandRun missing = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}' --out '{}/y' --set night.star_catalogue='\"/no/such/stars.json\"'", style, schedule, dir_));
+  EXPECT_EQ(missing.exit_code, 3) << missing.output;
+  EXPECT_NE(missing.output.find("cannot read the star catalogue '/no/such/stars.json'"), std::string::npos)
+      << missing.output;
+  EXPECT_NE(missing.output.find("bash .ci/setup"), std::string::npos);
+  testing::CommandRun limit =
+      RunSkybake(fmt::format("check '{}' --schedule '{}' --set night.star_magnitude_limit=20", style, schedule));
+  EXPECT_EQ(limit.exit_code, 3) << limit.output;
+  EXPECT_NE(limit.output.find("night.star_magnitude_limit: 20 is out of range [-1.5, 14]"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir_ + "/x"));
+  EXPECT_FALSE(fs::exists(dir_ + "/y/manifest.json"));
+}
+
+// With every night key off the bake is the one without the table, byte
+// for byte (the golden outputs test covers the default styles); the pass
+// plan names the night sky and why it is off.
+TEST_F(NightBake, OffIsByteIdenticalAndPrunedInThePlan) {
+  const std::string style = dir_ + "/style.toml";
+  const std::string schedule = dir_ + "/night.toml";
+  const std::string off = "--set night.stars=false --set night.moon=false --set night.moonlight=false";
+  testing::CommandRun a = RunSkybake(fmt::format("bake '{}' --schedule '{}' --size 16 --frames 2:2 --out '{}/off' --quiet {}",
+                                                 style, schedule, dir_, off));
+  std::ofstream(dir_ + "/bare.toml") << "[effects]\nnight_dimming = true\n[output]\npixel_type = \"float\"\n";
+  testing::CommandRun b = RunSkybake(fmt::format("bake '{}/bare.toml' --schedule '{}' --size 16 --frames 2:2 --out '{}/bare' --quiet",
+                                                 dir_, schedule, dir_));
+  ASSERT_EQ(a.exit_code, 0) << a.output;
+  ASSERT_EQ(b.exit_code, 0) << b.output;
+  for (const char* name : {"sky_latlong.0002.exr", "sky_cube.0002.exr", "sky_px.0002.exr", "sky_latlong.0002.png"}) {
+    const std::string x = testing::ReadFileBytes(dir_ + "/off/" + name), y = testing::ReadFileBytes(dir_ + "/bare/" + name);
+    ASSERT_FALSE(x.empty()) << name;
+    // The EXR headers record the style's path, which differs: compare the
+    // pixels by decoding (EXR) and the PNG bytes.
+    if (std::string(name).find(".png") != std::string::npos) {
+      EXPECT_EQ(x, y) << name;
+    } else {
+      int w = 0, h = 0;
+      EXPECT_EQ(ReadExr(dir_ + "/off/" + name, w, h), ReadExr(dir_ + "/bare/" + name, w, h)) << name;
+    }
+  }
+  testing::CommandRun plan_off = RunSkybake(fmt::format("plan '{}' --schedule '{}' {}", style, schedule, off));
+  testing::CommandRun plan_on = RunSkybake(fmt::format("plan '{}' --schedule '{}'", style, schedule));
+  EXPECT_NE(plan_off.output.find("night sky"), std::string::npos) << plan_off.output;
+  EXPECT_EQ(plan_off.output.find("moonlit sky"), std::string::npos) << plan_off.output;
+  EXPECT_NE(plan_on.output.find("moonlit sky"), std::string::npos) << plan_on.output;
+}
+
+// night.airglow replaces the flat floor: the same zenith luminance, brighter
+// towards the horizon.
+TEST_F(NightBake, AirglowReplacesTheFlatFloor) {
+  const std::string style = dir_ + "/style.toml";
+  const std::string base = "--set night.stars=false --set night.moon=false --set night.moonlight=false --set output.faces=false";
+  testing::CommandRun flat = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/flat' --quiet {} "
+      "--set night.airglow=false", style, SourceDir(), dir_, base));
+  testing::CommandRun glow = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/glow' --quiet {} "
+      "--set night.airglow=true", style, SourceDir(), dir_, base), "SKYBAKE_VULKAN_VALIDATION=1");
+  ASSERT_EQ(flat.exit_code, 0) << flat.output;
+  ASSERT_EQ(glow.exit_code, 0) << glow.output;
+  int w = 0, h = 0;
+  const std::vector<float> f = ReadExr(dir_ + "/flat/sky_latlong.0002.exr", w, h);
+  const std::vector<float> g = ReadExr(dir_ + "/glow/sky_latlong.0002.exr", w, h);
+  auto lum = [&](const std::vector<float>& v, int row) {
+    const float* t = &v[(size_t(row) * w + w / 3) * 4];
+    return 0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2];
+  };
+  // The flat floor: 1.7e-4 cd/m^2 everywhere above the horizon.
+  EXPECT_NEAR(lum(f, 1) / 1.7e-4, 1.0, 0.02);
+  EXPECT_NEAR(lum(f, h / 2 - 3) / 1.7e-4, 1.0, 0.02);
+  // The glow: the same at the zenith, brighter 10-15 deg up, black below the horizon.
+  EXPECT_NEAR(lum(g, 0) / 1.7e-4, 1.0, 0.02);
+  EXPECT_GT(lum(g, h / 2 - 5), 1.5 * lum(g, 0));
+  EXPECT_EQ(lum(g, h - 1), 0.0);
+  size_t bad = 0;
+  for (float v : g) bad += !std::isfinite(v) || v < 0.0f;
+  EXPECT_EQ(bad, 0u);
+}
+
+// Above the horizon the Sun's sky outshines the moonlit sky of a full moon
+// by more than half float's resolution everywhere in the upper hemisphere,
+// so moonlight is rendered only while the Sun is down.
+TEST(NightSkyGpu, MoonlightIsBelowHalfFloatResolutionWhileTheSunIsUp) {
+  AtmosphereParams atmosphere;
+  EffectSettings effects;
+  effects.sun_disc = false;
+  SkyRenderer renderer(testing::Vulkan(), atmosphere, QualitySettings(), effects, OutputScale(OutputUnits::kLuminance));
+  std::vector<glm::dvec3> directions;
+  for (double el = 1.0; el <= 89.0; el += 8.0)
+    for (double az = 0.0; az < 360.0; az += 30.0) directions.push_back(SunDirectionFromElevationAzimuth(el, az));
+  const Rgb k_lum = OutputScale(OutputUnits::kLuminance);
+  const double sun_lux = 0.2126 * atmosphere.solar_irradiance[0] * k_lum[0] +
+                         0.7152 * atmosphere.solar_irradiance[1] * k_lum[1] +
+                         0.0722 * atmosphere.solar_irradiance[2] * k_lum[2];
+  const double k = MoonIlluminanceLux(0.0, 356500.0) / sun_lux;  // a full moon at perigee
+  const std::vector<float> sunlit = renderer.RenderDirections(SunDirectionFromElevationAzimuth(0.0, 270.0), directions, false);
+  for (double moon_elevation : {10.0, 45.0, 85.0}) {
+    const std::vector<float> moonlit =
+        renderer.RenderDirections(SunDirectionFromElevationAzimuth(moon_elevation, 90.0), directions, false);
+    double worst = 0.0;
+    for (size_t i = 0; i < directions.size(); ++i)
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, k * moonlit[4 * i + c] / sunlit[4 * i + c]);
+    EXPECT_LT(worst, 1.0 / 2048.0) << moon_elevation;
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+}  // namespace
+}  // namespace skybake
