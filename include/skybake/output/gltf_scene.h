@@ -31,7 +31,7 @@
 
 #include "skybake/input/output_settings.h"
 #include "skybake/model/sh.h"
-#include "skybake/model/astronomy.h"
+#include "skybake/input/astronomy.h"
 #include "skybake/input/config.h"
 
 namespace skybake {
