@@ -11,6 +11,8 @@ import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 
+import { serveFile } from './static_files.mjs';
+
 const here = path.dirname(fileURLToPath(import.meta.url));
 const [pageArg, bakeArg, screenshotArg, query] = process.argv.slice(2);
 if (!pageArg || !bakeArg) {
@@ -19,8 +21,6 @@ if (!pageArg || !bakeArg) {
 }
 const bakeDir = path.resolve(bakeArg);
 const screenshot = path.resolve(screenshotArg ?? path.join(os.tmpdir(), `skybake-page-${process.pid}.png`));
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
-                '.gltf': 'model/gltf+json', '.glb': 'model/gltf-binary', '.png': 'image/png' };
 let pageReport = null;
 const requests = [];  // every path the page asked for, in order
 
@@ -36,16 +36,7 @@ const server = http.createServer((req, res) => {
     });
     return;
   }
-  const root = url.pathname.startsWith('/bake/') ? bakeDir : here;
-  const rel = decodeURIComponent(url.pathname.replace(/^\/bake\//, '/'));
-  const file = path.join(root, path.normalize(rel));
-  if (!file.startsWith(root) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) {
-    res.statusCode = 404;
-    res.end();
-    return;
-  }
-  res.setHeader('Content-Type', types[path.extname(file)] ?? 'application/octet-stream');
-  fs.createReadStream(file).pipe(res);
+  serveFile(res, url.pathname, 'bake', bakeDir, here);
 });
 await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
 const port = server.address().port;

@@ -10,6 +10,8 @@ import path from 'node:path';
 import { spawn } from 'node:child_process';
 import { fileURLToPath } from 'node:url';
 
+import { serveFile } from './static_files.mjs';
+
 const here = path.dirname(fileURLToPath(import.meta.url));
 const [sceneArg, screenshotArg] = process.argv.slice(2);
 if (!sceneArg || !screenshotArg) {
@@ -18,9 +20,6 @@ if (!sceneArg || !screenshotArg) {
 }
 const sceneFile = path.resolve(sceneArg);
 const screenshot = path.resolve(screenshotArg);
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
-                '.gltf': 'model/gltf+json', '.glb': 'model/gltf-binary', '.bin': 'application/octet-stream',
-                '.png': 'image/png' };
 let pageReport = null;
 
 const server = http.createServer((req, res) => {
@@ -31,16 +30,7 @@ const server = http.createServer((req, res) => {
     return;
   }
   // /scene/<file> comes from the scene's folder, anything else from here.
-  const root = url.pathname.startsWith('/scene/') ? path.dirname(sceneFile) : here;
-  const rel = decodeURIComponent(url.pathname.replace(/^\/scene\//, '/'));
-  const file = path.join(root, path.normalize(rel));
-  if (!file.startsWith(root) || !fs.existsSync(file) || fs.statSync(file).isDirectory()) {
-    res.statusCode = 404;
-    res.end();
-    return;
-  }
-  res.setHeader('Content-Type', types[path.extname(file)] ?? 'application/octet-stream');
-  fs.createReadStream(file).pipe(res);
+  serveFile(res, url.pathname, 'scene', path.dirname(sceneFile), here);
 });
 await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
 const port = server.address().port;
