@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "cloud_shadow_json.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
 #include "skybake/output_lock.h"
@@ -49,7 +50,7 @@ json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_f
 json FrameJson(const ManifestFrame& f) {
   json files = json::array();
   for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
-  return {{"frame", f.number},
+  json frame = {{"frame", f.number},
           {"style_sha256", f.style_sha256},
           {"time", f.time ? json(*f.time) : json(nullptr)},
           {"hours_from_start", f.hours_from_start},
@@ -62,6 +63,8 @@ json FrameJson(const ManifestFrame& f) {
           {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
           {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
           {"files", files}};
+  if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
+  return frame;
 }
 
 json ManifestJson(const Manifest& m) {
@@ -246,7 +249,8 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 
 // Every name of a manifest is a plain file name and the one the bake gives
 // its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
-// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_latlong.NNNN.png, in that order, one BASE per
+// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png, in
+// that order, one BASE per
 // frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
@@ -289,10 +293,12 @@ void CheckNames(const std::string& path, const Manifest& m) {
         CheckIblName(path, where, f.number, file, base, stage);
       } else if (file.kind == "preview" || file.kind == "gltf_texture") {
         with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
+      } else if (file.kind == "cloud_shadow") {
+        with_suffix(file, stem_of(file, ".exr", "cloud shadow"), "_cloudshadow", "cloud shadow", 3);
       } else {
         FailName(path, where, file.kind,
                  "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, preview, "
-                 "gltf_texture)");
+                 "gltf_texture, cloud_shadow)");
       }
     }
     if (!faces.empty() && faces.size() != 6)
@@ -364,6 +370,7 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
   for (const BakedFile& file : frame.files)
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+  f.cloud_shadow = frame.cloud_shadow;
   return f;
 }
 
@@ -419,6 +426,7 @@ Manifest ReadManifest(const std::string& path) {
     frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
     frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
     frame.files = FilesOf(r, r.Get<json>(f, "files"));
+    if (f.contains("cloud_shadow")) frame.cloud_shadow = CloudShadowFromJson(f["cloud_shadow"]);
     m.frames.push_back(std::move(frame));
   }
   m.complete = r.Get<bool>(j, "complete");

@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 #include <openssl/evp.h>
 
+#include "cloud_shadow_file.h"
 #include "skybake/envmap.h"
 #include "skybake/exr_io.h"
 #include "skybake/gltf_scene.h"
@@ -125,9 +126,9 @@ class RendererCache {
     // The pass plan's pruning: zero-strength and unused effects compiled out.
     const SkyStyle style = PrunedStyle(unpruned);
     StyledInputs in = StyledInputsOf(style);
-    const CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
-                                             std::filesystem::path(style.source_path).parent_path().string(),
-                                             cloud_time_s);
+    CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
+                                       std::filesystem::path(style.source_path).parent_path().string(), cloud_time_s);
+    ApplyGroundCloudShadow(style.cloud_shadow, clouds);  // the ground below the horizon in the clouds' shadow
     // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
     const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
     gpu::GpuAtmosphere key =
@@ -197,11 +198,13 @@ struct FrameNames {
   std::string cube, latlong, png;  // empty when not written
   std::vector<IblFileName> ibl;    // the IBL maps' files (ibl.h), when asked for
   bool with_dfg = false;           // the bake's first frame carries the DFG table
+  std::string cloud_shadow;        // the cloud shadow map (cloud_shadow.h), when asked for
   std::vector<std::string> All() const {
     std::vector<std::string> all = faces;
     for (const std::string* n : {&cube, &latlong})
       if (!n->empty()) all.push_back(*n);
     for (const IblFileName& n : ibl) all.push_back(n.name);
+    if (!cloud_shadow.empty()) all.push_back(cloud_shadow);
     if (!png.empty()) all.push_back(png);
     return all;
   }
@@ -218,6 +221,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
   if (o.preview || style.gltf.enabled) names.png = o.basename + "_latlong" + number + ".png";
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
+  if (style.cloud_shadow.enabled) names.cloud_shadow = CloudShadowFileName(o.basename, number_in_name);
   return names;
 }
 
@@ -307,6 +311,7 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   if (!names.cube.empty()) kinds.push_back("cube");
   if (!names.latlong.empty()) kinds.push_back("latlong");
   for (const IblFileName& n : names.ibl) kinds.push_back(n.kind);
+  if (!names.cloud_shadow.empty()) kinds.push_back("cloud_shadow");
   if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
   size_t index = 0;
   for (const json& entry : f["files"]) {
@@ -346,6 +351,8 @@ struct FrameJob {
   double half_scale = 1.0;        // a sequence's; a single bake's is found from the images
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
   std::optional<IblMaps> ibl;     // the frame's IBL maps, when asked for
+  std::vector<float> cloud_shadow;  // the frame's cloud shadow map (cloud_shadow.h), when asked for
+  std::optional<CloudShadowInfo> cloud_shadow_info;
 };
 
 // What it gives back.
@@ -724,6 +731,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
         w.files.push_back({path, names.ibl[i].kind, ibl_files[i].size(), Sha256OfText(ibl_files[i])});
       }
     }
+    if (job.cloud_shadow_info) w.files.push_back(WriteCloudShadowFile(path_of(names.cloud_shadow), job.cloud_shadow,
+                                                                      *job.cloud_shadow_info, exr.attributes));
     w.exr_seconds = SecondsSince(write_start);
     w.exr_detail = fmt::format("{} files, {} compression{}, {}", w.files.size(), style.output.compression,
                                style.output.compression == "zip" || style.output.compression == "zips"
@@ -879,6 +888,16 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
                                       style.ibl.irradiance_samples, request.dfg ? ", DFG table" : "",
                                       style.ibl.include_sun ? ", sun included" : ""));
     }
+    // The cloud shadow map (cloud_shadow.h): its placement follows from the
+    // style, the sun and the time alone (recorded for verified frames too).
+    std::vector<float> cloud_shadow;
+    if (style.cloud_shadow.enabled) {
+      frame.cloud_shadow = CloudShadowInfoOf(PrunedStyle(style).clouds, style.cloud_shadow, plan.sun, CloudTimeOf(plan));
+      if (!verified) {
+        cloud_shadow = renderer.RenderCloudShadow(plan.sun, style.cloud_shadow);
+        for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+      }
+    }
     if (verified) {
       collect_pending();
       frame.files = *verified;
@@ -895,7 +914,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     std::vector<RgbaImage> images;
     for (size_t i = 0; i < views.size(); ++i) images.push_back({views[i].width, views[i].height, {}, rendered.views[i]});
     collect_pending();
-    FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps)};
+    FrameJob job{plan,  names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps),
+                 std::move(cloud_shadow), frame.cloud_shadow};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

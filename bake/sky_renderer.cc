@@ -249,7 +249,8 @@ void SkyRenderer::DestroyAll() {
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
-                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_}) {
+                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
+                        &cloud_shadow_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }

@@ -5,6 +5,7 @@
 // the sky behind them attenuated by the clouds' transmittance.
 #include "common.glsl"
 #include "clouds.glsl"
+#include "cloud_shadow.glsl"
 
 vec3 ViewDirection(ivec2 texel) {
   int mapping = push.view.x;
@@ -23,8 +24,12 @@ void main() {
   uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
   AtmosphereParameters atm = AtmosphereFromUniform();
   CloudMarch m = MarchClouds(atm, view, push.sun_direction.xyz);
-  if (m.transmittance == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
+  // The clouds' shadow on the ground below the horizon (cloud_shadow.glsl; off: 0).
+  vec3 ground_loss = GroundCloudShadowLoss(atm, view, push.sun_direction.xyz);
+  if (m.transmittance == 1.0 && ground_loss == vec3(0.0)) return;  // the sky as the sky pass wrote it
   vec4 sky = output_texels[index];
+  if (ground_loss != vec3(0.0))
+    sky.xyz = max(sky.xyz - ground_loss * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz, vec3(0.0));
   output_texels[index] = vec4(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
                                   m.transmittance * sky.xyz, sky.w);
 }

@@ -14,6 +14,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
+#include "skybake/cloud_shadow.h"
 #include "skybake/clouds.h"
 
 namespace skybake {
@@ -106,6 +107,7 @@ struct SkyStyle {
   PreviewSettings preview;
   AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
+  CloudShadowSettings cloud_shadow;  // [cloud_shadow]: the frame's cloud shadow map (cloud_shadow.h)
   GltfSettings gltf;
   IblSettings ibl;
   std::string source_path;    // where it was read from

@@ -147,7 +147,8 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   ivec4 lut;         // aerial perspective LUT x: azimuth texels; y: zenith texels; z: distance slices; w: ambient altitudes
   vec4 phase;        // x: forward g; y: backward g; z: forward weight; w: unused
   vec4 octave;       // Wrenninge 2013 x: contribution a; y: attenuation b; z: eccentricity c; w: unused
-  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; zw: unused
+  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km;
+                     // z: ground cloud-shadow strength (0: off; cloud_shadow.h); w: its samples per band
   // The union of the layers' shells, overlapping layers merged: x, y: bottom
   // and top altitude km, by altitude; resolution.w of them. The view ray is
   // marched through each band it crosses, in order along the ray.

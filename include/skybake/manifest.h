@@ -20,6 +20,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/cloud_shadow.h"
 #include "skybake/atmosphere.h"
 #include "skybake/config.h"
 #include "skybake/pipeline.h"
@@ -58,6 +59,7 @@ struct ManifestFrame {
   ShRgb sh_irradiance_with_sun{};
   ShRgb sh_irradiance_without_sun{};
   std::vector<ManifestFile> files;  // in the order they are written
+  std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
 };
 
 // What the glTF scene takes from the style, decided from the whole sequence

@@ -104,6 +104,7 @@ struct FrameResult {
   double render_seconds = 0.0;
   double write_seconds = 0.0;
   std::vector<PassTiming> gpu_passes;
+  std::optional<CloudShadowInfo> cloud_shadow;  // placement of the frame's cloud shadow map, when written
 };
 
 struct BakeResult {

@@ -12,6 +12,7 @@
 
 #include "skybake/aoas.h"
 #include "skybake/atmosphere.h"
+#include "skybake/cloud_shadow.h"
 #include "skybake/clouds.h"
 #include "skybake/vulkan_context.h"
 
@@ -140,6 +141,11 @@ class SkyRenderer {
   // count or a noise size differs (a new renderer is needed).
   bool UpdateClouds(const CloudInputs& clouds);
 
+  // The cloud shadow map (cloud_shadow.h): resolution^2 transmittances,
+  // row 0 north; zeros when the Sun's centre is at or below the horizon,
+  // ones without cloud layers. Defined in bake/cloud_shadow_render.cc.
+  std::vector<float> RenderCloudShadow(const glm::dvec3& sun_direction, const CloudShadowSettings& shadow);
+
   // The noise buffer of the cloud layers (shape, detail, weather per layer),
   // for tests; empty without clouds.
   std::vector<float> ReadCloudNoise() const;
@@ -234,6 +240,7 @@ class SkyRenderer {
   VkPipeline disc_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
+  VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
