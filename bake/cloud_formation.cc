@@ -85,19 +85,33 @@ uint32_t FormationRandom(uint32_t seed, uint64_t step, uint64_t cell, uint32_t c
 
 void ApplyFormationRules(CloudLattice& l) {
   const std::vector<uint8_t> act = l.act;  // the rules read step t, write step t + 1
-  auto at = [&](int x, int y, int z) -> uint8_t {
-    if (z < 0 || z >= l.nz) return 0;
-    x = ((x % l.nx) + l.nx) % l.nx;
-    y = ((y % l.ny) + l.ny) % l.ny;
-    return act[l.Index(x, y, z)];
+  // Wrapped neighbour columns and rows, once (no modulo per cell).
+  auto wrapped = [](int n, int d) {
+    std::vector<int> w(static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) w[size_t(i)] = ((i + d) % n + n) % n;
+    return w;
   };
+  const std::vector<int> xm1 = wrapped(l.nx, -1), xp1 = wrapped(l.nx, 1), xm2 = wrapped(l.nx, -2), xp2 = wrapped(l.nx, 2);
+  const std::vector<int> ym1 = wrapped(l.ny, -1), yp1 = wrapped(l.ny, 1), ym2 = wrapped(l.ny, -2), yp2 = wrapped(l.ny, 2);
+  const size_t layer = size_t(l.nx) * l.ny;
   for (int z = 0; z < l.nz; ++z) {
+    const uint8_t* here = act.data() + z * layer;
+    const uint8_t* below1 = z >= 1 ? here - layer : nullptr;
+    const uint8_t* below2 = z >= 2 ? here - 2 * layer : nullptr;
+    const uint8_t* above1 = z + 1 < l.nz ? here + layer : nullptr;
     for (int y = 0; y < l.ny; ++y) {
+      const uint8_t* row = here + size_t(y) * l.nx;
+      const uint8_t* r_m1 = here + size_t(ym1[y]) * l.nx;
+      const uint8_t* r_p1 = here + size_t(yp1[y]) * l.nx;
+      const uint8_t* r_m2 = here + size_t(ym2[y]) * l.nx;
+      const uint8_t* r_p2 = here + size_t(yp2[y]) * l.nx;
       for (int x = 0; x < l.nx; ++x) {
         const size_t i = l.Index(x, y, z);
-        const uint8_t f_act = at(x + 1, y, z) | at(x - 1, y, z) | at(x, y + 1, z) | at(x, y - 1, z) |
-                              at(x, y, z + 1) | at(x, y, z - 1) | at(x + 2, y, z) | at(x - 2, y, z) |
-                              at(x, y + 2, z) | at(x, y - 2, z) | at(x, y, z - 2);
+        const size_t c = size_t(y) * l.nx + x;
+        uint8_t f_act = row[xp1[x]] | row[xm1[x]] | row[xp2[x]] | row[xm2[x]] | r_m1[x] | r_p1[x] | r_m2[x] | r_p2[x];
+        if (below1) f_act |= below1[c];
+        if (below2) f_act |= below2[c];
+        if (above1) f_act |= above1[c];
         const uint8_t a = act[i], h = l.hum[i];
         l.hum[i] = h & uint8_t(!a);
         l.cld[i] = l.cld[i] | a;
@@ -110,8 +124,7 @@ void ApplyFormationRules(CloudLattice& l) {
 void StepFormation(CloudLattice& l, const FormationThresholds& t, uint32_t seed, uint64_t step) {
   ApplyFormationRules(l);
   const size_t columns = size_t(l.nx) * l.ny;
-  for (size_t i = 0; i < l.Cells(); ++i) {
-    const size_t c = i % columns;
+  for (size_t i = 0, c = 0; i < l.Cells(); ++i, c = c + 1 == columns ? 0 : c + 1) {
     if (l.cld[i] && FormationRandom(seed, step, i, 0) < t.ext[c]) l.cld[i] = 0;
     if (!l.hum[i] && FormationRandom(seed, step, i, 1) < t.hum[c]) l.hum[i] = 1;
     if (!l.act[i] && l.hum[i] && FormationRandom(seed, step, i, 2) < t.act[c]) l.act[i] = 1;
