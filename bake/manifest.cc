@@ -249,9 +249,8 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 
 // Every name of a manifest is a plain file name and the one the bake gives
 // its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
-// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png, in
-// that order, one BASE per
-// frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
+// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png,
+// in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
   if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))

@@ -233,6 +233,8 @@ velocity_cells_per_hour = [1.0, 0.0, 0.0]
   const SkyStyle pruned = PrunedStyle(style);
   ASSERT_TRUE(r->UpdateClouds(ToCloudInputs(pruned.clouds, pruned.aoas.seed, "", 3600.0)));
   const std::vector<float> t1 = r->RenderCloudShadow(sun, s);
+  // The new coverage map was copied in; the noise volumes were built once.
+  EXPECT_EQ(r->counters().cloud_noise_builds, 1);
   double moved = 0.0, unmoved = 0.0;
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 32; ++x) {

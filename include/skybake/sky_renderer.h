@@ -197,6 +197,7 @@ class SkyRenderer {
   // tables (when the sun moved) before the views; the cloud pass after them.
   void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   void GenerateCloudNoise();
+  void CopyCloudWeatherImages();  // the weather images into the noise buffer, the volumes kept
 
   static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
 
