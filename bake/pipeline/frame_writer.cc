@@ -7,6 +7,7 @@
 #include "bake_outputs.h"
 #include "skybake/model/envmap.h"
 #include "skybake/model/tonemap.h"
+#include "skybake/output/cloud_shadow_file.h"
 #include "skybake/output/ibl_files.h"
 #include "skybake/output/sha256.h"
 #include "skybake/pipeline/engine_files.h"
@@ -161,6 +162,9 @@ WrittenFrame WriteFrameFiles(FrameJob& job, const RenderPlan& plan, const BakeOp
   const ExrWriteOptions exr = FrameExrOptions(*job.plan, w.half_scale);
   w.files = WriteViewExrs(job, exr, options);
   if (job.ibl) WriteIblFiles(job, exr, options, w.files);
+  if (job.cloud_shadow_info)
+    w.files.push_back(WriteCloudShadowFile(OutputPath(options, job.plan->names.cloud_shadow), job.cloud_shadow,
+                                           *job.cloud_shadow_info, exr.attributes));
   if (!job.engine.empty()) {
     const std::vector<BakedFile> engine =
         WriteEngineFiles(style, job.engine, exr, options.out_dir, job.plan->names.engine);

@@ -29,6 +29,8 @@ struct FrameJob {
   std::shared_ptr<const void> hold;  // the renderer's memory the images view (RenderInPlace)
   std::optional<IblMaps> ibl;        // the frame's IBL maps, when asked for
   std::vector<RgbaImage> engine;     // the engine preset's images (engine_preset.h)
+  std::vector<float> cloud_shadow;   // the frame's cloud shadow map (cloud_shadow.h), when asked for
+  std::optional<CloudShadowInfo> cloud_shadow_info;
   // Filled in by FrameWriter::Write: a sequence's exposure and half scale
   // (a single bake's frame finds its own from its images and latlong).
   double half_scale = 1.0;

@@ -135,11 +135,23 @@ void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
     engine = RenderEngineImages(renderer, plan.sun, style);
     s.timer.Finish("engine", fmt::format("{}: {} images for {}", plan.Label(), engine.size(), style.output.engine));
   }
+  // The cloud shadow map (cloud_shadow.h): its placement follows from the
+  // style, the sun and the time alone (recorded for verified frames too).
+  std::vector<float> cloud_shadow;
+  if (style.cloud_shadow.enabled) {
+    frame.cloud_shadow =
+        CloudShadowInfoOf(PrunedStyle(style).clouds, style.cloud_shadow, plan.sun, plan.CloudTimeSeconds());
+    if (!verified) {
+      cloud_shadow = renderer.RenderCloudShadow(plan.sun, style.cloud_shadow);
+      for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+    }
+  }
   if (verified) return writer.RecordVerified(std::move(frame), std::move(*verified));
 
   // Files: encoded, written and checksummed on the writer thread while the
   // device renders the next frame.
-  FrameJob job{&plan, {}, std::move(rendered.hold), std::move(ibl), std::move(engine)};
+  FrameJob job{&plan, {}, std::move(rendered.hold), std::move(ibl), std::move(engine), std::move(cloud_shadow),
+               frame.cloud_shadow};
   for (size_t i = 0; i < plan.views.size(); ++i)
     job.images.push_back({plan.views[i].width, plan.views[i].height, {}, rendered.views[i]});
   if (night) {

@@ -7,6 +7,7 @@
 #include "skybake/input/engine_preset.h"
 #include "skybake/input/frame_numbering.h"
 #include "skybake/model/atmosphere.h"
+#include "skybake/output/cloud_shadow_file.h"
 #include "skybake/output/manifest.h"
 #include "skybake/pipeline/pass_plan.h"
 
@@ -17,6 +18,7 @@ std::vector<std::string> FrameNames::All() const {
   for (const std::string* n : {&cube, &latlong})
     if (!n->empty()) all.push_back(*n);
   for (const IblFileName& n : ibl) all.push_back(n.name);
+  if (!cloud_shadow.empty()) all.push_back(cloud_shadow);
   for (const std::string& n : engine) all.push_back(n);
   if (!png.empty()) all.push_back(png);
   return all;
@@ -27,6 +29,7 @@ std::vector<std::string> FrameNames::Kinds(const SkyStyle& style) const {
   if (!cube.empty()) kinds.push_back("cube");
   if (!latlong.empty()) kinds.push_back("latlong");
   for (const IblFileName& n : ibl) kinds.push_back(n.kind);
+  if (!cloud_shadow.empty()) kinds.push_back("cloud_shadow");
   kinds.insert(kinds.end(), engine.size(), "engine");
   if (!png.empty()) kinds.push_back(style.output.preview ? "preview" : "gltf_texture");
   return kinds;
@@ -44,6 +47,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
   names.engine = EngineFileNames(style, number_in_name);
+  if (style.cloud_shadow.enabled) names.cloud_shadow = CloudShadowFileName(o.basename, number_in_name);
   return names;
 }
 

@@ -26,6 +26,7 @@ struct FrameNames {
   std::vector<IblFileName> ibl;     // the IBL maps' files (ibl_files.h), when asked for
   std::vector<std::string> engine;  // the engine preset's files (engine_preset.h), when one is set
   bool with_dfg = false;            // the bake's first frame carries the DFG table
+  std::string cloud_shadow;         // the cloud shadow map (cloud_shadow.h), when asked for
   std::vector<std::string> All() const;
   // The manifest's kind of each file, in the order of All().
   std::vector<std::string> Kinds(const SkyStyle& style) const;
