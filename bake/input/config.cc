@@ -33,25 +33,9 @@ namespace {
 
 // --------------------------------------------------------------- ranges
 
-struct Range {
-  double min;
-  double max;
-  bool min_open;
-  bool max_open;
-  bool Contains(double v) const {
-    if (min_open ? !(v > min) : !(v >= min)) return false;
-    if (max_open ? !(v < max) : !(v <= max)) return false;
-    return true;
-  }
-  std::string Describe() const {
-    return fmt::format("{}{}, {}{}", min_open ? '(' : '[', min, max, max_open ? ')' : ']');
-  }
-};
-
 constexpr double kInf = HUGE_VAL;
 constexpr Range kPositive{0.0, kInf, true, true};
 constexpr Range kNonNegative{0.0, kInf, false, true};
-constexpr Range kAnyFinite{-kInf, kInf, true, true};
 constexpr Range kUnit{0.0, 1.0, false, false};
 constexpr Range kOpenUnitSymmetric{-1.0, 1.0, true, true};
 constexpr Range kElevation{-90.0, 90.0, false, false};
@@ -259,76 +243,31 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
 // --------------------------------------------------------------- reading
 
-class StyleReader {
+class StyleReader : public TomlReader {
  public:
   static constexpr bool kReads = true;
   StyleReader(const toml::table& root, std::string file, std::vector<ConfigError>& errors)
-      : root_(root), file_(std::move(file)), errors_(errors) {}
+      : TomlReader(std::move(file), errors), root_(root) {}
 
   void Real(const char* path, double& out, const Range& range) {
     const toml::node* node = Find(path);
     if (!node) return;
-    std::optional<double> value = node->value<double>();  // accepts integers too
-    // An integer beyond 2^53 is still a number (toml++ refuses the inexact
-    // conversion): the nearest double.
-    if (!value && node->is_integer()) value = double(node->as_integer()->get());
-    if (!value || node->is_boolean()) {
-      Error(node, path, fmt::format("expected a number, got {}", TypeName(*node)));
-      return;
-    }
-    if (!std::isfinite(*value)) {
-      Error(node, path, "must be a finite number (got " + FormatNumber(*value) + ")");
-      return;
-    }
-    if (!range.Contains(*value)) {
-      Error(node, path, fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
-      return;
-    }
-    out = *value;
+    if (std::optional<double> value = Number(*node, path, range)) out = *value;
   }
 
+  // A scalar sets all three channels.
   void Triple(const char* path, Rgb& out, const Range& range) {
     const toml::node* node = Find(path);
     if (!node) return;
-    if (node->is_number()) {  // a scalar sets all three channels
-      double value = 0.0;
-      Real(path, value, range);
-      out = {value, value, value};
-      return;
-    }
-    const toml::array* array = node->as_array();
-    if (!array || array->size() != 3) {
-      Error(node, path, "expected a number or an array of 3 numbers [680 nm, 550 nm, 440 nm]");
-      return;
-    }
-    Rgb result = out;
-    for (size_t i = 0; i < 3; ++i) {
-      const toml::node& item = *array->get(i);
-      std::optional<double> value = item.value<double>();
-      std::string item_path = fmt::format("{}[{}]", path, i);
-      if (!value || item.is_boolean()) {
-        Error(&item, item_path, fmt::format("expected a number, got {}", TypeName(item)));
-        return;
-      }
-      if (!std::isfinite(*value)) {
-        Error(&item, item_path, "must be a finite number (got " + FormatNumber(*value) + ")");
-        return;
-      }
-      if (!range.Contains(*value)) {
-        Error(&item, item_path,
-              fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
-        return;
-      }
-      result[i] = *value;
-    }
-    out = result;
+    if (std::optional<std::vector<double>> v = NumberOrTriple(*node, path, range))
+      out = v->size() == 1 ? Rgb{(*v)[0], (*v)[0], (*v)[0]} : Rgb{(*v)[0], (*v)[1], (*v)[2]};
   }
 
   void Int(const char* path, int& out, int min, int max) {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_integer()) {
-      Error(node, path, fmt::format("expected an integer, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected an integer, got {}", TomlTypeName(*node)));
       return;
     }
     int64_t value = node->as_integer()->get();
@@ -343,7 +282,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_boolean()) {
-      Error(node, path, fmt::format("expected true or false, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected true or false, got {}", TomlTypeName(*node)));
       return;
     }
     out = node->as_boolean()->get();
@@ -356,7 +295,7 @@ class StyleReader {
     std::vector<std::string> names;
     for (const auto& c : choices) names.push_back(c.first);
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(names), TypeName(*node)));
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(names), TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -374,7 +313,7 @@ class StyleReader {
     if (!node) return;
     std::vector<std::string> list = QualityPresetNames();
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TypeName(*node)));
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -391,7 +330,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected a string, got {}", TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -412,7 +351,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected a string, got {}", TomlTypeName(*node)));
       return;
     }
     out = node->as_string()->get();
@@ -703,7 +642,7 @@ class StyleReader {
       // A table replaced by a value (`--set sun=1`) would drop every key of
       // it silently: refused.
       if (tables_.count(path) && !node.is_table()) {
-        Error(&node, path, fmt::format("expected a table ([{}] with its keys), got {}", path, TypeName(node)));
+        Error(&node, path, fmt::format("expected a table ([{}] with its keys), got {}", path, TomlTypeName(node)));
         continue;
       }
       if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
@@ -712,31 +651,7 @@ class StyleReader {
 
   std::string Suggest(const std::string& path) const { return DidYouMean(path, known_); }
 
-  static std::string TypeName(const toml::node& node) {
-    switch (node.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a number";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date or time";
-    }
-  }
-
-  static std::string FormatNumber(double v) { return fmt::format("{}", v); }
-
-  void Error(const toml::node* node, const std::string& path, const std::string& message) {
-    ErrorAt(node ? node->source() : toml::source_region{}, path, message);
-  }
-
-  void ErrorAt(const toml::source_region& where, const std::string& path, const std::string& message) {
-    errors_.push_back(LocatedError(file_, where, path, message));
-  }
-
   const toml::table& root_;
-  std::string file_;
-  std::vector<ConfigError>& errors_;
   std::set<std::string> known_;
   std::set<std::string> tables_;  // prefixes of known keys: tables
   std::set<std::string> given_;

@@ -19,29 +19,19 @@ namespace {
 
 constexpr int kMaxFrames = 100000;
 
-class ScheduleReader {
+class ScheduleReader : public TomlReader {
  public:
-  ScheduleReader(std::string file, std::vector<ConfigError>& errors)
-      : file_(std::move(file)), errors_(errors) {}
+  using TomlReader::Number;
+  ScheduleReader(std::string file, std::vector<ConfigError>& errors) : TomlReader(std::move(file), errors) {}
 
   ConfigError Origin(const toml::node* node, const std::string& key) const {
-    return LocatedError(file_, node ? node->source() : toml::source_region{}, key, "");
+    return LocatedError(file(), node ? node->source() : toml::source_region{}, key, "");
   }
 
-  void Error(const toml::node* node, const std::string& key, const std::string& message) {
-    ConfigError e = Origin(node, key);
-    e.message = message;
-    errors_.push_back(std::move(e));
-  }
-
+  // A finite number (TomlReader::Number), when the key is given.
   std::optional<double> Number(const toml::node* node, const std::string& key) {
     if (!node) return std::nullopt;
-    std::optional<double> v = node->value<double>();
-    if (!v || node->is_boolean() || !std::isfinite(*v)) {
-      Error(node, key, "expected a finite number");
-      return std::nullopt;
-    }
-    return v;
+    return Number(*node, key);
   }
 
   // A number, a list of numbers, or a {start, end, step} range.
@@ -173,27 +163,6 @@ class ScheduleReader {
     }
   }
 
-  // A number or an array of 3 numbers.
-  std::optional<std::vector<double>> Values(const toml::node& node, const std::string& key) {
-    if (node.is_number()) {
-      std::optional<double> v = Number(&node, key);
-      if (!v) return std::nullopt;
-      return std::vector<double>{*v};
-    }
-    const toml::array* array = node.as_array();
-    if (!array || array->size() != 3) {
-      Error(&node, key, "expected a number or an RGB triple [680 nm, 550 nm, 440 nm]");
-      return std::nullopt;
-    }
-    std::vector<double> values;
-    for (size_t i = 0; i < 3; ++i) {
-      std::optional<double> v = Number(array->get(i), fmt::format("{}[{}]", key, i));
-      if (!v) return std::nullopt;
-      values.push_back(*v);
-    }
-    return values;
-  }
-
   static std::string ValueText(const toml::node& node) {
     if (node.is_floating_point()) return fmt::format("{:.17g}", node.as_floating_point()->get());
     std::ostringstream out;
@@ -201,11 +170,6 @@ class ScheduleReader {
     return out.str();
   }
 
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  std::vector<ConfigError>& errors_;
 };
 
 CivilTime MakeCivilTime(const toml::date& date, const toml::time& time, double offset) {
@@ -482,8 +446,8 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
           r.Error(&node, where, "expected [from, to]: two numbers, or two RGB triples");
           return;
         }
-        std::optional<std::vector<double>> from = r.Values(*pair->get(0), where + "[0]");
-        std::optional<std::vector<double>> to = r.Values(*pair->get(1), where + "[1]");
+        std::optional<std::vector<double>> from = r.NumberOrTriple(*pair->get(0), where + "[0]");
+        std::optional<std::vector<double>> to = r.NumberOrTriple(*pair->get(1), where + "[1]");
         if (!from || !to) return;
         if (from->size() != to->size()) {
           r.Error(&node, where, "from and to must both be numbers or both RGB triples");
@@ -500,7 +464,7 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
       if (!schedule.clock_times && !t->empty())
         r.Error(per_hour, "schedule.per_hour", "rates per hour need clock-time frames (`times`)");
       r.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
-        std::optional<std::vector<double>> rate = r.Values(node, "schedule.per_hour." + key);
+        std::optional<std::vector<double>> rate = r.NumberOrTriple(node, "schedule.per_hour." + key);
         if (rate) schedule.rates.push_back({key, *rate, r.Origin(&node, key)});
       }, "schedule.per_hour");
     } else {
