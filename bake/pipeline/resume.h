@@ -7,9 +7,8 @@
 #include <string>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "skybake/output/bake_record.h"
+#include "skybake/output/manifest.h"
 #include "skybake/pipeline/render_plan.h"
 
 namespace skybake {
@@ -19,12 +18,15 @@ struct PreviousBake {
   bool loaded = false;
   double half_scale = 0.0;
   double exposure_ev100 = 0.0;
-  std::map<int, nlohmann::json> frames;  // by frame number
+  std::map<int, ManifestFrame> frames;  // by frame number
 };
 
-// The manifest at `path`, when there is one (nothing loaded otherwise);
-// OutputExistsError (exit 6) when it is a directory, not a regular file, or
-// not JSON.
+// The manifest at `path` read by ReadManifest (manifest.h), when there is
+// one (nothing loaded otherwise). OutputExistsError (exit 6) when it is a
+// directory, not a regular file, or not JSON. A manifest ReadManifest finds
+// malformed (a value of the wrong type, an entry missing) proves no frame:
+// loaded, with no frames, every frame is baked again. Its names are checked
+// by VerifiedFrame, against this bake's.
 PreviousBake ReadPreviousManifest(const std::string& path);
 
 // The files of `frame` from the previous manifest when every one of them is
