@@ -575,7 +575,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     for (const RgbaImage& image : images) all.push_back(&image);
     const std::vector<RgbaImage> ibl_images = job.ibl ? IblImagesForRangeCheck(*job.ibl) : std::vector<RgbaImage>();
     for (const RgbaImage& image : ibl_images) all.push_back(&image);
-    for (const RgbaImage& image : job.engine) all.push_back(&image);
+    // Not the engine images: a preset never changes the scale of the bake's
+    // own files (WriteEngineFiles gives them a smaller one when they need it).
     const double max_value = CheckedMaxValue(all);
     w.half_scale = job.half_scale;
     if (style.output.pixel_type == PixelType::kHalf) {
