@@ -59,30 +59,26 @@ float FilteredLod(float sample_solid_angle, int face_size, int levels, float bia
   return clamp(lod, 0.0, float(levels - 1));
 }
 
-// Karis 2013's PrefilterEnvMap with N = V = R: the sum of L(l) (n.l) over
-// GGX-distributed samples, divided by the sum of (n.l).
-vec3 PrefilterGgx(samplerCube source, vec3 n, float alpha, uint samples, int face_size, int levels, float bias) {
-  if (alpha <= 0.0) return textureLod(source, n, 0.0).rgb;
-  mat3 frame = FrameAround(n);
-  vec3 sum = vec3(0.0);
-  float weight = 0.0;
-  for (uint i = 0u; i < samples; ++i) {
-    vec3 h = ImportanceSampleGgx(Hammersley(i, samples), alpha, frame);
-    float n_dot_h = dot(n, h);
-    vec3 l = 2.0 * n_dot_h * h - n;
-    float n_dot_l = dot(n, l);
-    if (n_dot_l <= 0.0) continue;
-    // pdf(l) = D(h) (n.h) / (4 (v.h)), and v.h = n.h when v = n.
-    float pdf = DGgx(n_dot_h, alpha) * 0.25;
-    float lod = FilteredLod(1.0 / (float(samples) * pdf), face_size, levels, bias);
-    sum += textureLod(source, l, lod).rgb * n_dot_l;
-    weight += n_dot_l;
-  }
-  return weight > 0.0 ? sum / weight : vec3(0.0);
+// One entry of a level's GGX sample table (Karis 2013's PrefilterEnvMap with
+// N = V = R, in the frame of n: z = n): xyz the direction l of sample i of n,
+// w the source mip its filtered lookup reads; w < 0 marks a sample below the
+// horizon of n (n.l <= 0), which the filter skips. Every texel of a level
+// shares the table: with N = V the pdf and the mip depend on the sample
+// alone, so they are computed once per level, not once per texel and sample.
+// The estimate is the sum of L(frame(n) l) (n.l) over the table divided by
+// the sum of (n.l) (PrefilterWithTable in ibl_prefilter.comp).
+vec4 GgxSampleEntry(uint i, uint samples, float alpha, int face_size, int levels, float bias) {
+  vec3 h = ImportanceSampleGgx(Hammersley(i, samples), alpha, mat3(1.0));
+  float n_dot_h = h.z;
+  vec3 l = 2.0 * n_dot_h * h - vec3(0.0, 0.0, 1.0);
+  if (l.z <= 0.0) return vec4(0.0, 0.0, 1.0, -1.0);
+  // pdf(l) = D(h) (n.h) / (4 (v.h)), and v.h = n.h when v = n.
+  float pdf = DGgx(n_dot_h, alpha) * 0.25;
+  return vec4(l, FilteredLod(1.0 / (float(samples) * pdf), face_size, levels, bias));
 }
 
 // The Sun as a point source of irradiance E (at normal incidence) in
-// direction s, through the same kernel as PrefilterGgx: E (n.s) D(h) / 4 / W,
+// direction s, through the same kernel as the GGX sample table: E (n.s) D(h) / 4 / W,
 // W the kernel's normalization (the integral of (n.l) D(h) / 4 over n.l > 0,
 // IblSunKernelNormalization in bake/gpu/ibl.cc). The kernel depends on n.s only
 // and integrates to 1 over l, so it also integrates to 1 over n: the Sun's

@@ -13,9 +13,32 @@ layout(set = 0, binding = IBL_BINDING_SOURCE) uniform samplerCube source_cube;
 layout(std430, set = 0, binding = IBL_BINDING_OUTPUT) buffer OutputTexels { vec4 output_texels[]; };
 layout(push_constant) uniform Push { IblPush push; };
 
+// The GGX prefilter of direction n from the level's sample table
+// (GgxSampleEntry), `samples` entries from output_texels[first].
+vec3 PrefilterWithTable(vec3 n, uint first, uint samples) {
+  mat3 frame = FrameAround(n);
+  vec3 sum = vec3(0.0);
+  float weight = 0.0;
+  for (uint i = 0u; i < samples; ++i) {
+    vec4 entry = output_texels[first + i];
+    if (entry.w < 0.0) continue;
+    sum += textureLod(source_cube, frame * entry.xyz, entry.w).rgb * entry.z;
+    weight += entry.z;
+  }
+  return weight > 0.0 ? sum / weight : vec3(0.0);
+}
+
 void main() {
   ivec3 id = ivec3(gl_GlobalInvocationID);
   int size = push.target.y;
+  if (push.target.x == IBL_MODE_GGX_SAMPLES) {
+    // One invocation per sample: x the sample index, y = z = 0.
+    uint i = uint(id.y * size + id.x);
+    if (id.x >= size || id.z != 0 || i >= uint(push.target.w)) return;
+    output_texels[uint(push.target.z) + i] =
+        GgxSampleEntry(i, uint(push.target.w), push.lobe.x, push.source.x, push.source.y, push.lobe.y);
+    return;
+  }
   if (id.x >= size || id.y >= size) return;
   uint samples = uint(push.target.w);
   uint index = uint(push.target.z + (id.z * size + id.y) * size + id.x);
@@ -29,7 +52,7 @@ void main() {
   vec3 n = DirectionFromVulkanCubeTexel(id.z, id.x, id.y, size);
   vec3 radiance;
   if (mode == IBL_MODE_SPECULAR) {
-    radiance = PrefilterGgx(source_cube, n, push.lobe.x, samples, push.source.x, push.source.y, push.lobe.y);
+    radiance = push.lobe.x > 0.0 ? PrefilterWithTable(n, uint(push.source.z), samples) : textureLod(source_cube, n, 0.0).rgb;
     if (push.lobe.w != 0.0)
       radiance += SunThroughGgx(n, push.sun_direction.xyz, push.sun_irradiance.xyz, push.lobe.x, push.lobe.z);
   } else {

@@ -6,6 +6,7 @@
 // (engine_blender_test.cc, engine_threejs_test.cc). And the CLI: unknown
 // names and impossible combinations refused before any GPU work; the files
 // of a bake listed in its manifest, kept by --resume.
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <string>
@@ -17,6 +18,8 @@
 
 #include "skybake/input/config.h"
 #include "skybake/input/engine_preset.h"
+#include "skybake/output/exr_io.h"
+#include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/test_pattern.h"
 #include "test_support.h"
 
@@ -292,6 +295,55 @@ TEST(EnginePresetCliTest, BakeWritesThePresetsFiles) {
       }
     }
   }
+}
+
+// The engine files' half scale (EngineFileScale): the bake's own while they
+// fit in it, else a smaller power of two of their own.
+TEST(EnginePresetTest, EngineFileScaleIsTheBakesUnlessTheyNeedASmallerOne) {
+  EXPECT_EQ(EngineFileScale(1000.0, 1.0, PixelType::kHalf, OverflowPolicy::kScale), 1.0);
+  EXPECT_EQ(EngineFileScale(65504.0 * 4.0, 0.25, PixelType::kHalf, OverflowPolicy::kScale), 0.25);
+  EXPECT_EQ(EngineFileScale(65504.0 * 4.0 + 1.0, 0.25, PixelType::kHalf, OverflowPolicy::kScale), 0.125);
+  EXPECT_EQ(EngineFileScale(1e9, 1.0, PixelType::kFloat, OverflowPolicy::kScale), 1.0);
+  EXPECT_THROW(EngineFileScale(1e9, 1.0, PixelType::kHalf, OverflowPolicy::kRefuse), OutputError);
+}
+
+// A preset never changes the half-float scale of the bake's own files. Here
+// the bake writes 16 x 16 faces only, whose texels are far wider than the sun
+// disc (each holds a fraction of its light, so the faces fit in half floats
+// unscaled), while Godot's 2048 x 1024 panorama has texels inside the disc
+// (its full radiance, above the half maximum). Before EngineFileScale the
+// panorama's brightest texel set the scale of every file of the frame: the
+// faces went from 1 to 2^-16.
+TEST(EnginePresetCliTest, PresetKeepsTheHalfScaleOfTheBakesOwnFiles) {
+  const std::string dir = testing::FreshTempDir("engine_scale");
+  const std::string sizes = " --set output.latlong=false --set output.preview=false --set output.cube_strip=false "
+                            "--set gltf.enabled=false --set render.cube_size=16 --set render.latlong_height=1024";
+  for (const char* engine : {"", "godot"}) {
+    const std::string out = dir + "/" + (*engine ? engine : "none");
+    testing::CommandRun r = testing::RunSkybake("bake " + Style() + sizes + " -q --out " + out +
+                                                (*engine ? std::string(" --engine ") + engine : std::string()));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const std::string none = dir + "/none", godot = dir + "/godot";
+  EXPECT_NE(testing::ReadFileBytes(none + "/manifest.json").find("\"half_scale\": 1.0"), std::string::npos);
+  EXPECT_NE(testing::ReadFileBytes(godot + "/manifest.json").find("\"half_scale\": 1.0"), std::string::npos);
+  for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"}) {
+    Exr a = ReadExr(none + "/sky_" + std::string(face) + ".exr"), b = ReadExr(godot + "/sky_" + std::string(face) + ".exr");
+    EXPECT_EQ(b.attributes["skybake:scale"], "1") << face;
+    EXPECT_EQ(a.rgb, b.rgb) << face << ": the same pixels with the preset as without";
+  }
+  Exr pano = ReadExr(godot + "/sky_godot_latlong.exr");
+  ASSERT_FALSE(pano.rgb.empty());
+  const double scale = std::stod(pano.attributes["skybake:scale"]);
+  EXPECT_LT(scale, 1.0) << "the panorama's own, smaller scale";
+  double brightest = 0.0;
+  for (float v : pano.rgb) {
+    ASSERT_TRUE(std::isfinite(v));
+    brightest = std::max(brightest, double(v));
+  }
+  EXPECT_LE(brightest, 65504.0);
+  std::printf("panorama: skybake:scale %g, brightest %g cd/m^2 unscaled\n", scale, brightest / scale);
+  EXPECT_GT(brightest / scale, 65504.0) << "the disc's radiance, which needs the scale";
 }
 
 // A sequence with a preset resumes: every frame's engine files verified by checksum.

@@ -193,17 +193,28 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   // into its cube and blurs the thin bright band along the horizon; the
   // zenith agrees to four digits; measured 21%, docs/ibl.md). Both tools
   // then average the sky with the same GGX kernel, and a weighted average
-  // does not increase a difference between its inputs, so each filtered
-  // level must differ by no more than level 0 does, plus 1% for the two
-  // tools' different sample sets (1024 samples each).
-  const double level0 = level_difference("cmgen_mirror", 0, kSame);
+  // does not increase a difference between its inputs, and a wider one
+  // averages more of level 0's texel-scale differences away: each level
+  // must differ by no more than the level before it, plus 1% for the two
+  // tools' different sample sets (1024 samples each). Both tools are
+  // deterministic, so each level is also held to its measured difference
+  // rounded up (measured mean relative 0.2102, 0.1084, 0.0609, 0.0329 and
+  // sky-only relative L1 0.1326, 0.1061, 0.0608, 0.0231 at cmgen's
+  // roughness 0, 0.18, 0.42, 1; docs/ibl.md).
+  const double kMeanBound[4] = {0.22, 0.12, 0.07, 0.04};
+  const double kSkyBound[4] = {0.14, 0.12, 0.07, 0.03};
+  ASSERT_EQ(levels, 4);
+  double previous = 1e30;
   for (int level = 0; level < levels; ++level) {
     const double d = level_difference("cmgen_mirror", level, kSame);
     const double sky = level_difference("cmgen_mirror", level, kSame, true);
     std::printf("level %d, roughness %.4f, %d^2: mean relative difference %.4f; above 3 deg, relative L1 %.4f\n",
                 level, request.roughness[level], n >> level, d, sky);
     RecordProperty("level" + std::to_string(level), std::to_string(d));
-    EXPECT_LE(d, level0 + 0.01) << "level " << level;
+    EXPECT_LE(d, previous + 0.01) << "level " << level << " differs more than the sharper level before it";
+    EXPECT_LE(d, kMeanBound[level]) << "level " << level;
+    EXPECT_LE(sky, kSkyBound[level]) << "level " << level;
+    previous = d;
   }
   testing::ExpectNoValidationMessages();
 }

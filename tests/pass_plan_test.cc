@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "skybake/model/aoas.h"
+#include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/gpu/sky_renderer.h"
@@ -60,6 +61,46 @@ TEST(PassPlanTest, DefaultStyleRunsEveryPhysicalPass) {
   EXPECT_NE(plan.variant.find("sky_render from the built-in sky-view variant"), std::string::npos) << plan.variant;
   EXPECT_NE(plan.variant.find("LUT shaders from the built-in analytic variants"), std::string::npos) << plan.variant;
   EXPECT_NE(plan.variant.find("sun disc: compiled out of sky_render"), std::string::npos) << plan.variant;
+}
+
+// An engine preset's images are rendered once more along the engine's
+// directions (engine_files.h): the plan lists each, the estimate counts
+// their samples and memory, and the budget check sees them.
+TEST(PassPlanTest, EngineImagesAreInThePlanTheEstimateAndTheBudget) {
+  const std::string outputs = "[render]\ncube_size = 256\nlatlong_height = 512\n";
+  const SkyStyle plain = Style(outputs);
+  const SkyStyle unity = Style(outputs + "[output]\nengine = 'unity'\n");
+  const SkyStyle godot = Style(outputs + "[output]\nengine = 'godot'\n");
+  EXPECT_TRUE(PlanEngineImages(plain).empty());
+  const std::vector<EngineImageSize> faces = PlanEngineImages(unity);
+  ASSERT_EQ(faces.size(), 6u);
+  for (const EngineImageSize& e : faces) EXPECT_EQ(e.width * e.height, 256 * 256) << e.suffix;
+  const std::vector<EngineImageSize> panorama = PlanEngineImages(godot);
+  ASSERT_EQ(panorama.size(), 1u);
+  EXPECT_EQ(panorama[0].width, 1024);
+  EXPECT_EQ(panorama[0].height, 512);
+
+  const PassPlan with = PlanPasses({unity}), without = PlanPasses({plain});
+  const std::vector<std::string> names = PassNames(with);
+  for (const EngineImageSize& e : faces)
+    EXPECT_NE(std::find(names.begin(), names.end(), "render engine " + e.suffix), names.end()) << e.suffix;
+  // Six faces more, each texel one sky-view LUT read (the default style).
+  EXPECT_DOUBLE_EQ(with.total_samples - without.total_samples, 6.0 * 256 * 256);
+  EXPECT_DOUBLE_EQ(EstimateResources(unity).samples - EstimateResources(plain).samples, 6.0 * 256 * 256);
+  // Memory: directions (24 bytes) and RGBA float pixels (16) a texel.
+  const double extra = EstimateResources(unity).memory_mib - EstimateResources(plain).memory_mib;
+  EXPECT_NEAR(extra, 40.0 * 6 * 256 * 256 / (1024.0 * 1024.0), 1e-9);
+  std::printf("engine unity at 256: +%.1f MiB estimated\n", extra);
+
+  BakeOptions options;
+  options.max_memory_mib = 0.5 * (EstimateResources(unity).memory_mib + EstimateResources(plain).memory_mib);
+  EXPECT_NO_THROW(CheckBudget(plain, options));
+  EXPECT_THROW(CheckBudget(unity, options), BudgetError) << "the preset's images are over the budget";
+
+  const testing::CommandRun run =
+      testing::RunSkybake("plan " + testing::SourceDir() + "/configs/default.toml --set output.engine=godot");
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("render engine " + panorama[0].suffix), std::string::npos) << run.output;
 }
 
 // A glTF-only bake (no latlong EXR, no preview) still renders the latlong:

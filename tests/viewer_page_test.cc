@@ -6,7 +6,10 @@
 // face's red 10 degrees below the horizon after turning to East, the white
 // horizon facing North; the exposure slider darkens; on a two-frame
 // sequence the frame slider shows the other frame (the night one, darker).
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -120,6 +123,57 @@ TEST(ViewerPageTest, ScrubsTheFramesOfASequence) {
   std::printf("upper-half mean sRGB: frame 1 %.1f, frame 2 %.1f\n", day.UpperMean(), night.UpperMean());
   EXPECT_GT(day.UpperMean(), 40.0) << "the day sky at the bake's exposure";
   EXPECT_LT(night.UpperMean(), 0.5 * day.UpperMean()) << "sun 10 degrees below the horizon, same exposure";
+}
+
+// A long sequence: with --embed-mib 0 only the first frame is inside the
+// page; the others are referenced by file name and fetched when the slider
+// reaches them (the harness serves the folder over HTTP).
+TEST(ViewerPageTest, LaterFramesBeyondTheCapAreReferencedNotEmbedded) {
+  const std::string dir = testing::FreshTempDir("view_capped");
+  const std::string schedule = dir + "/schedule.toml";
+  FILE* f = std::fopen(schedule.c_str(), "w");
+  ASSERT_TRUE(f);
+  std::fputs("[schedule]\nsun = { elevation_deg = { start = 30, end = -10, step = -20 }, azimuth_deg = 135 }\n", f);
+  std::fclose(f);
+  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --schedule " +
+                                                 schedule + " --size 32 -q --out " + dir + "/out");
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  ASSERT_EQ(testing::RunSkybake("view " + dir + "/out").exit_code, 0);
+  const auto full = std::filesystem::file_size(dir + "/out/view.html");
+  ASSERT_EQ(testing::RunSkybake("view --force --embed-mib 0 " + dir + "/out").exit_code, 0);
+  const auto capped = std::filesystem::file_size(dir + "/out/view.html");
+  // Each latlong EXR of the sequence, base64 (4/3 of its bytes).
+  double latlongs = 0.0;
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir + "/out"))
+    if (e.path().extension() == ".exr" && e.path().filename().string().find("_latlong") != std::string::npos) {
+      latlongs += double(e.file_size());
+      names.push_back(e.path().filename().string());
+    }
+  std::sort(names.begin(), names.end());
+  ASSERT_EQ(names.size(), 3u);
+  std::printf("view.html: %ju bytes with every frame inside, %ju with the first only\n", uintmax_t(full),
+              uintmax_t(capped));
+  const double second_and_third = double(std::filesystem::file_size(dir + "/out/" + names[1]) +
+                                         std::filesystem::file_size(dir + "/out/" + names[2]));
+  EXPECT_NEAR(double(full - capped), second_and_third * 4.0 / 3.0, 64.0) << "two frames' base64 left out";
+  EXPECT_GT(latlongs, 0.0);
+
+  Shot first = Open(dir + "/out", "drag:0,40");
+  ASSERT_EQ(first.report.value("ok", false), true) << first.report.dump();
+  EXPECT_EQ(first.report["embedded"], 1);
+  EXPECT_EQ(first.report["frames"], 3);
+  EXPECT_EQ(first.requests, nlohmann::json({"/bake/view.html", "/report", "/favicon.ico"}))
+      << "the embedded first frame needs no request";
+  Shot third = Open(dir + "/out", "drag:0,40;frame:2");
+  ASSERT_EQ(third.report.value("ok", false), true) << third.report.dump();
+  EXPECT_EQ(third.report["label"], "frame 3");
+  EXPECT_EQ(third.report["shown"], "frame 3");
+  bool fetched = false;
+  for (const auto& r : third.requests) fetched = fetched || r == "/bake/" + names[2];
+  EXPECT_TRUE(fetched) << third.requests.dump() << " should ask for " << names[2];
+  std::printf("upper-half mean sRGB: frame 1 %.1f, frame 3 %.1f\n", first.UpperMean(), third.UpperMean());
+  EXPECT_LT(third.UpperMean(), 0.5 * first.UpperMean()) << "frame 3 (sun 10 degrees down) is what is shown";
 }
 
 TEST(ViewerPageTest, NothingToShowIsRefused) {

@@ -434,6 +434,11 @@ int main(int argc, char** argv) {
               "to look around, exposure, frames");
   view->add_option("dir", view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
   view->add_flag("--force", view_options.force, "Replace an existing view.html");
+  view->add_option("--embed-mib", view_options.embed_mib,
+                   "Frames inside the page while their files total at most this many MiB (the first always); "
+                   "later ones are loaded from their files when the page is served over HTTP")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
 
   MergeOptions merge_options;
   bool sizes_only = false;

@@ -290,6 +290,14 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
     passes.push_back({IBL_MODE_DFG, s.dfg_size, 0, texels});
     texels += VkDeviceSize(s.dfg_size) * s.dfg_size;
   }
+  // Each specular level's GGX sample table (GgxSampleEntry, one vec4 a
+  // sample) after the maps, in the same buffer.
+  std::vector<VkDeviceSize> table_first(passes.size(), 0);
+  for (size_t i = 0; i < passes.size(); ++i)
+    if (passes[i].mode == IBL_MODE_SPECULAR) {
+      table_first[i] = texels;
+      texels += VkDeviceSize(IblLevelSamples(s, roughness_of(passes[i].level)));
+    }
   const uint64_t max_range = context_.properties().limits.maxStorageBufferRange;
   if (texels * 16 > max_range)
     throw VulkanError(fmt::format("the IBL maps need {} MiB in one storage buffer; {} allows {} MiB: lower ibl.size",
@@ -418,7 +426,51 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
                        nullptr, 1, &to_read);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
   vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set, 0, nullptr);
-  // Passes write disjoint texels and read only the image: no barrier between them.
+  auto push_for = [&](const Pass& p, size_t index) {
+    gpu::IblPush push{};
+    const double roughness = roughness_of(p.level);
+    const double alpha = roughness * roughness;
+    const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
+                        : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
+                                                        : s.dfg_samples;
+    push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
+    push.source = {source.size, int32_t(source_levels), int32_t(table_first[index]), 0};
+    push.lobe = {float(alpha), float(s.lod_bias),
+                 p.mode == IBL_MODE_SPECULAR ? float(IblSunKernelNormalization(alpha)) : 0.0f,
+                 s.include_sun ? 1.0f : 0.0f};
+    push.sun_direction = {float(request.sun_direction.x), float(request.sun_direction.y),
+                          float(request.sun_direction.z), 0.0f};
+    push.sun_irradiance = {float(request.sun_irradiance[0]), float(request.sun_irradiance[1]),
+                           float(request.sun_irradiance[2]), 0.0f};
+    return push;
+  };
+  // The sample tables first (rows of 64 samples), then a barrier: the
+  // specular passes read them.
+  bool tables = false;
+  for (size_t i = 0; i < passes.size(); ++i) {
+    if (passes[i].mode != IBL_MODE_SPECULAR) continue;
+    gpu::IblPush push = push_for(passes[i], i);
+    const int width = 64, rows = (push.target.w + width - 1) / width;
+    push.target.x = IBL_MODE_GGX_SAMPLES;
+    push.target.y = width;
+    push.target.z = int32_t(table_first[i]);
+    vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cmd, uint32_t((width + SKYBAKE_LOCAL_SIZE_X - 1) / SKYBAKE_LOCAL_SIZE_X),
+                  uint32_t((rows + SKYBAKE_LOCAL_SIZE_Y - 1) / SKYBAKE_LOCAL_SIZE_Y), 1);
+    tables = true;
+  }
+  if (tables) {
+    VkBufferMemoryBarrier written{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+    written.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+    written.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
+    written.srcQueueFamilyIndex = written.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    written.buffer = r.output;
+    written.size = VK_WHOLE_SIZE;
+    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
+                         nullptr, 1, &written, 0, nullptr);
+  }
+  // Passes write disjoint texels and read only the image and the tables: no
+  // barrier between them.
   int open_mode = -1;
   std::vector<int> modes;  // the mode of each timestamp pair
   for (const Pass& p : passes) {
@@ -428,21 +480,7 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
       vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 2));
       open_mode = p.mode;
     }
-    gpu::IblPush push{};
-    const double roughness = roughness_of(p.level);
-    const double alpha = roughness * roughness;
-    const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
-                        : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
-                                                        : s.dfg_samples;
-    push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
-    push.source = {source.size, int32_t(source_levels), 0, 0};
-    push.lobe = {float(alpha), float(s.lod_bias),
-                 p.mode == IBL_MODE_SPECULAR ? float(IblSunKernelNormalization(alpha)) : 0.0f,
-                 s.include_sun ? 1.0f : 0.0f};
-    push.sun_direction = {float(request.sun_direction.x), float(request.sun_direction.y),
-                          float(request.sun_direction.z), 0.0f};
-    push.sun_irradiance = {float(request.sun_irradiance[0]), float(request.sun_irradiance[1]),
-                           float(request.sun_irradiance[2]), 0.0f};
+    const gpu::IblPush push = push_for(p, size_t(&p - passes.data()));
     vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     const uint32_t groups = uint32_t((p.size + SKYBAKE_LOCAL_SIZE_X - 1) / SKYBAKE_LOCAL_SIZE_X);
     vkCmdDispatch(cmd, groups, groups, p.mode == IBL_MODE_DFG ? 1 : 6);

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
 
@@ -23,6 +24,17 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
     texels += double(v.width) * v.height;
     largest = std::max(largest, double(v.width) * v.height);
   }
+  // The engine preset's images (engine_files.h): their directions (3
+  // doubles) while they render, then their RGBA float pixels until written.
+  // The renderer's output buffer (32 bytes a texel) grows when one of them
+  // needs more than the views.
+  double engine_texels = 0.0, largest_engine = 0.0;
+  for (const EngineImageSize& i : PlanEngineImages(style)) {
+    engine_texels += double(i.width) * i.height;
+    largest_engine = std::max(largest_engine, double(i.width) * i.height);
+  }
+  const double engine_growth = 32.0 * std::max(0.0, largest_engine - texels);
+  largest = std::max(largest, largest_engine);
   const QualitySettings& q = style.quality;
   const double luts = 16.0 * (double(q.transmittance_width) * q.transmittance_height +
                               double(q.multiscattering_size) * q.multiscattering_size +
@@ -30,9 +42,11 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   const double channel = style.output.pixel_type == PixelType::kHalf ? 2.0 : 4.0;
   ResourceEstimate e;
   // Device output buffer and its host copy (RGBA float each), the largest
-  // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG.
+  // image's RGB copy and encoded file, the preview's luminance, sRGB and PNG,
+  // the engine images.
   const bool preview = WritesLatlongPng(style);
-  const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts;
+  const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts +
+                       (24.0 + 16.0) * engine_texels + engine_growth;
   e.memory_mib = bytes / (1024.0 * 1024.0);
   // Samples: the pass plan's count for one frame (each ray-marched texel
   // marches view_steps, times light_steps when the Sun's transmittance is

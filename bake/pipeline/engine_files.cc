@@ -2,9 +2,23 @@
 
 #include <filesystem>
 
+#include <fmt/format.h>
+
 #include "skybake/output/sha256.h"
 
 namespace skybake {
+
+std::vector<EngineImageSize> PlanEngineImages(const SkyStyle& style) {
+  std::vector<EngineImageSize> sizes;
+  const EnginePreset* preset = FindEnginePreset(style.output.engine);
+  if (!preset) return sizes;
+  const int n = style.render.cube_size, h = style.render.latlong_height;
+  // The layout of a 1 x 1 bake (no directions worth computing): its kinds.
+  for (const EngineImage& e : EngineImages(*preset, 1, 1))
+    sizes.push_back({e.suffix, e.kind == "latlong" ? 2 * h : n,
+                     e.kind == "latlong" ? h : e.kind == "cube strip" ? 6 * n : n});
+  return sizes;
+}
 
 std::vector<RgbaImage> RenderEngineImages(SkyRenderer& renderer, const glm::dvec3& sun, const SkyStyle& style) {
   std::vector<RgbaImage> images;
@@ -15,6 +29,11 @@ std::vector<RgbaImage> RenderEngineImages(SkyRenderer& renderer, const glm::dvec
   return images;
 }
 
+double EngineFileScale(double max_value, double bake_scale, PixelType pixel_type, OverflowPolicy overflow) {
+  if (pixel_type != PixelType::kHalf || max_value * bake_scale <= kHalfMax) return bake_scale;
+  return bake_scale * HalfRangeScale(max_value * bake_scale, overflow);
+}
+
 std::vector<BakedFile> WriteEngineFiles(const SkyStyle& style, const std::vector<RgbaImage>& images,
                                         const ExrWriteOptions& exr, const std::string& out_dir,
                                         const std::vector<std::string>& names) {
@@ -22,9 +41,18 @@ std::vector<BakedFile> WriteEngineFiles(const SkyStyle& style, const std::vector
   if (!preset) return {};
   // Only the layout is needed here: the directions of a 1 x 1 bake.
   const std::vector<EngineImage> layout = EngineImages(*preset, 1, 1);
+  std::vector<const RgbaImage*> all;
+  for (const RgbaImage& image : images) all.push_back(&image);
+  const double scale =
+      all.empty() ? exr.scale : EngineFileScale(CheckedMaxValue(all), exr.scale, exr.pixel_type, style.output.overflow);
   std::vector<ExrFile> files;
   for (size_t i = 0; i < images.size(); ++i) {
     ExrWriteOptions options = exr;
+    if (scale != exr.scale) {
+      options.scale = scale;
+      options.attributes["skybake:scale"] = fmt::format("{:.9g}", scale);
+      if (exr.white_luminance > 0.0) options.white_luminance = 1.0 / scale;
+    }
     options.envmap = layout[i].envmap;
     options.attributes["skybake:engine"] = preset->title;
     options.attributes["skybake:engine_mapping"] = layout[i].mapping;

@@ -26,7 +26,8 @@ double FrameHalfScale(const FrameJob& job, bool sequence) {
   for (const RgbaImage& image : job.images) all.push_back(&image);
   const std::vector<RgbaImage> ibl_images = job.ibl ? IblImagesForRangeCheck(*job.ibl) : std::vector<RgbaImage>();
   for (const RgbaImage& image : ibl_images) all.push_back(&image);
-  for (const RgbaImage& image : job.engine) all.push_back(&image);
+  // Not the engine images: a preset never changes the scale of the bake's
+  // own files (WriteEngineFiles gives them a smaller one when they need it).
   const double max_value = CheckedMaxValue(all);
   if (style.output.pixel_type != PixelType::kHalf) return job.half_scale;
   if (!sequence) return HalfRangeScale(max_value, style.output.overflow);

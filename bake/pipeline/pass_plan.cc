@@ -9,6 +9,7 @@
 
 #include "skybake/model/aoas.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "skybake/pipeline/engine_files.h"
 
 namespace skybake {
 namespace {
@@ -178,6 +179,11 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
     plan.passes.push_back({name, Size(v.width, v.height), sky_view ? "once per frame (LUT reads)" : "once per frame",
                            plan.frames, double(v.width) * v.height * per_texel});
   }
+  // The engine preset's images (engine_files.h): the sky pass again along the engine's directions.
+  for (const EngineImageSize& e : PlanEngineImages(first))
+    plan.passes.push_back({"render engine " + e.suffix, Size(e.width, e.height),
+                           sky_view ? "once per frame (LUT reads)" : "once per frame", plan.frames,
+                           double(e.width) * e.height * per_texel});
 }
 
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).

@@ -120,36 +120,67 @@ const material = new THREE.ShaderMaterial({
 scene.add(new THREE.Mesh(new THREE.BoxGeometry(2, 2, 2), material));
 
 const exr = new EXRLoader().setDataType(THREE.FloatType);
-const textures = frames.map((f) => {
+// A frame's texture: from the page's own base64 (f.data), or fetched from its file beside the page
+// (f.url; a long sequence's later frames), once, when the frame is first shown.
+function load(f) {
+  if (!f.pending) f.pending = loadTexture(f);
+  return f.pending;
+}
+async function loadTexture(f) {
   let texture;
   if (f.type === 'exr') {
-    const data = exr.parse(bytes(f.data).buffer);
+    let buffer = null;
+    if (f.data) buffer = bytes(f.data).buffer;
+    else {
+      try {
+        const response = await fetch(f.url);
+        if (response.ok) buffer = await response.arrayBuffer();
+      } catch (e) { /* file:// pages cannot fetch */ }
+    }
+    if (!buffer) {
+      f.missing = true;
+      return null;
+    }
+    const data = exr.parse(buffer);
     texture = new THREE.DataTexture(data.data, data.width, data.height, data.format, data.type);
     texture.colorSpace = THREE.LinearSRGBColorSpace;
   } else {
     const image = new Image();
-    image.src = 'data:image/png;base64,' + f.data;
+    const loaded = new Promise((resolve) => { image.onload = () => resolve(true); image.onerror = () => resolve(false); });
+    image.src = f.data ? 'data:image/png;base64,' + f.data : f.url;
+    if (!(await loaded)) {
+      f.missing = true;
+      return null;
+    }
     texture = new THREE.Texture(image);
     texture.colorSpace = THREE.SRGBColorSpace;
     texture.flipY = true;
-    image.onload = () => { texture.needsUpdate = true; draw(); };
   }
   texture.magFilter = THREE.LinearFilter;
   texture.minFilter = THREE.LinearFilter;
   texture.generateMipmaps = false;
-  texture.needsUpdate = f.type === 'exr';
-  return { texture, width: f.width, height: f.height, scale: f.scale, label: f.label, type: f.type };
-});
+  texture.needsUpdate = true;
+  f.texture = texture;
+  return texture;
+}
+const textures = frames;
 
 let yaw = 0, pitch = 0;  // degrees; yaw 0 faces North (-Z), positive turns towards East
 const ev = document.getElementById('ev'), frame = document.getElementById('frame'), tonemap = document.getElementById('tonemap');
 frame.max = String(frames.length - 1);
+let shown = null;  // the frame on screen
 function draw() {
   const f = textures[Number(frame.value)];
-  material.uniforms.sky.value = f.texture;
-  material.uniforms.size.value.set(f.width, f.height);
+  if (!f.texture && !f.missing) {
+    load(f).then(draw);
+    if (!shown) return;
+  }
+  if (f.texture) shown = f;
+  const g = shown;
+  material.uniforms.sky.value = g.texture;
+  material.uniforms.size.value.set(g.width, g.height);
   // The bake's exposure (EV100) for EXRs, in cd/m^2 once skybake:scale is undone; PNGs are already exposed.
-  const base = f.type === 'exr' ? meta.exposure / f.scale : 1;
+  const base = g.type === 'exr' ? meta.exposure / g.scale : 1;
   material.uniforms.gain.value = base * Math.pow(2, Number(ev.value));
   renderer.toneMapping = tonemap.value === 'aces' ? THREE.ACESFilmicToneMapping : THREE.NoToneMapping;
   material.needsUpdate = true;
@@ -158,7 +189,9 @@ function draw() {
   camera.lookAt(Math.sin(y) * Math.cos(p), Math.sin(p), -Math.cos(y) * Math.cos(p));
   renderer.render(scene, camera);
   document.getElementById('evText').textContent = (Number(ev.value) >= 0 ? '+' : '') + ev.value;
-  document.getElementById('frameText').textContent = f.label;
+  document.getElementById('frameText').textContent = f.missing
+    ? f.label + ': ' + f.url + ' is not inside the page; serve this folder over HTTP (python3 -m http.server) to see it'
+    : f.label;
   document.getElementById('view').textContent = `azimuth ${((yaw % 360) + 360) % 360}°, elevation ${pitch}°`;
 }
 // Dragging moves the sky with the pointer: right turns the view left, 0.25 degree per pixel.
@@ -199,9 +232,12 @@ if (test) {
     else if (name === 'frame') set(frame, arg);
     else if (name === 'tonemap') set(tonemap, arg);
   }
+  const f = textures[Number(frame.value)];
+  await load(f);
   draw();
-  await fetch('/report', { method: 'POST', body: JSON.stringify({ ok: true, yaw, pitch, frames: frames.length,
-    frame: Number(frame.value), label: textures[Number(frame.value)].label }) });
+  await fetch('/report', { method: 'POST', body: JSON.stringify({ ok: !f.missing, yaw, pitch, frames: frames.length,
+    frame: Number(frame.value), label: f.label, embedded: frames.filter((g) => g.data).length,
+    shown: shown ? shown.label : null }) });
 }
 </script>
 </body>
@@ -266,8 +302,11 @@ std::string WriteViewPage(const ViewPageOptions& options) {
                                   "preview, no BASE_latlong.exr): bake into it first", options.dir));
 
   json list = json::array();
+  double embedded_bytes = 0.0;
   for (const Frame& f : frames) {
     const std::string data = Slurp(dir / f.file);
+    embedded_bytes += double(data.size());
+    const bool embed = list.empty() || embedded_bytes <= options.embed_mib * 1024.0 * 1024.0;
     int width = 0, height = 0;
     if (f.type == "png") {
       if (data.size() < 24) throw OutputError(fmt::format("{} is not a PNG", f.file));
@@ -279,8 +318,12 @@ std::string WriteViewPage(const ViewPageOptions& options) {
       width = window.max.x - window.min.x + 1;
       height = window.max.y - window.min.y + 1;
     }
-    list.push_back({{"type", f.type}, {"label", f.label}, {"scale", f.scale}, {"width", width}, {"height", height},
-                    {"data", Base64(data)}});
+    json entry = {{"type", f.type}, {"label", f.label}, {"scale", f.scale}, {"width", width}, {"height", height}};
+    if (embed)
+      entry["data"] = Base64(data);
+    else
+      entry["url"] = f.file;  // the manifest's names are plain file names of DIR
+    list.push_back(entry);
   }
   // Exposure of the bake's EV100 (ISO 2720 calibration K = 12.5: H = 1 / (1.2 2^EV100)), 1 unmetered.
   const double exposure = metered ? 1.0 / (1.2 * std::exp2(exposure_ev100)) : 1.0;

@@ -11,6 +11,7 @@ reported. Blender (Cycles, Nishita sky, 1 sample; tests/benchmark/
 blender_sky.py) renders the same frames in the same run when it is installed.
 
     python3 tests/benchmark/performance.py [--reps 3] [--no-blender]
+    python3 tests/benchmark/performance.py --only-ibl [--reps 5] [--skybake-before OLD/skybake]
 
 Every case but one runs with Mesa's shader disk cache as a second bake on a
 machine finds it; "W1 half, Mesa shader cache off" is a machine's first bake.
@@ -97,6 +98,10 @@ def main():
     parser.add_argument("--reps-w3", type=int, default=1, help="runs of W3 (W1 with one cumulus layer)")
     parser.add_argument("--w3-sequence", action="store_true", help="also W3's 96-frame time-lapse (slow)")
     parser.add_argument("--only-clouds", action="store_true", help="W1 and W3 single frames only (no W2, no Blender)")
+    parser.add_argument("--only-ibl", action="store_true",
+                        help="the IBL prefilter's share of a bake: default.toml with a 512 specular cube, float files")
+    parser.add_argument("--skybake-before", default=None,
+                        help="--only-ibl: a second skybake build, run alternately with --skybake (before / after)")
     args = parser.parse_args()
     work = args.work or tempfile.mkdtemp(prefix="skybake-bench-")
     os.makedirs(work, exist_ok=True)
@@ -106,6 +111,10 @@ def main():
 
     def bake(extra, out):
         return [args.skybake, "bake", *extra, "--out", os.path.join(work, out), "--force", "--quiet"]
+
+    if args.only_ibl:
+        print_ibl(args, work)
+        return
 
     results = {}
     w1_stage_runs = []  # stage seconds of each W1 run, from its timings.json
@@ -227,6 +236,36 @@ def main():
     print(f"| encode + write + checksum 8 EXRs | {write_s * 1e3:.0f} ms | {raw_mb:.1f} MB of half RGB in, "
           f"{frame_mb:.2f} MB written | {raw_mb / write_s:.0f} MB/s in, {frame_mb / write_s:.1f} MB/s out |")
     print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs)
+
+
+def print_ibl(args, work):
+    """The specular prefilter (GPU timestamps of its passes) against the whole
+    bake (timings.json total_s) in each run, for one build or two run
+    alternately (so that both see the same load); medians of --reps runs."""
+    ibl = ["configs/default.toml", "--size", "512", "--set", 'output.pixel_type="float"', "--set",
+           "ibl.specular=true", "--set", "ibl.size=512"]
+    builds = [("after", args.skybake)] + ([("before", args.skybake_before)] if args.skybake_before else [])
+    runs = {label: [] for label, _ in builds}
+    for i in range(args.reps):
+        for label, binary in builds:
+            out = os.path.join(work, "ibl_" + label)
+            wall, _ = run([binary, "bake", *ibl, "--out", out, "--force", "--quiet"])
+            t = json.load(open(os.path.join(out, "timings.json")))
+            spec = sum(p["gpu_ms"] for f in t["frames"] for p in f["gpu_passes"] if p["name"] == "IBL specular") / 1e3
+            stages = {st["stage"]: st["seconds"] for st in t["stages"]}
+            runs[label].append({"spec": spec, "ibl": stages.get("IBL", 0.0), "render": stages.get("render", 0.0),
+                                "write": stages.get("write EXR", 0.0), "total": t["total_s"], "wall": wall,
+                                "load": os.getloadavg()[0]})
+            sys.stderr.write(f"IBL {label} run {i + 1}/{args.reps}: specular {spec:.2f} s of {t['total_s']:.2f} s\n")
+    print("| build | specular pass (s) | IBL stage (s) | render (s) | write EXR (s) | whole bake total_s (s) | "
+          "specular / whole (median of the runs' ratios) | load average (1 min) |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    med = lambda label, key: statistics.median(r[key] for r in runs[label])
+    for label, binary in builds:
+        ratio = statistics.median(r["spec"] / r["total"] for r in runs[label])
+        print(f"| {label} ({binary}) | {med(label, 'spec'):.2f} | {med(label, 'ibl'):.2f} | {med(label, 'render'):.2f} | "
+              f"{med(label, 'write'):.2f} | {med(label, 'total'):.2f} | {100 * ratio:.0f}% | "
+              f"{min(r['load'] for r in runs[label]):.1f}-{max(r['load'] for r in runs[label]):.1f} |")
 
 
 def print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs):

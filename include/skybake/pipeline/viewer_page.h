@@ -4,7 +4,12 @@
 // frames. Everything is inside the page: three.js, its EXRLoader and fflate
 // (copied from the project's npm packages, tests/viewer/node_modules, as
 // data: modules of an import map) and each frame's latlong (the EXR when
-// the bake wrote one, else its PNG preview), base64.
+// the bake wrote one, else its PNG preview), base64, as long as the frames
+// so far fit in `embed_mib`: a long sequence's later frames are referenced
+// by their file names instead, and the page loads them when the frame
+// slider reaches them, which a browser allows when the folder is served
+// over HTTP (`python3 -m http.server` in DIR), not from file://. The first
+// frame is always inside.
 //
 // The sky is drawn by a shader that reads the OpenEXR latlong with
 // Imf::LatLongMap's own mapping (not three.js's equirect, which centres +X),
@@ -21,6 +26,7 @@ struct ViewPageOptions {
   std::string dir;          // the bake's folder; the page is written there
   std::string three_dir;    // three.js's npm package folder (empty: the project's, or $SKYBAKE_THREE_DIR)
   bool force = false;       // replace an existing view.html
+  double embed_mib = 64.0;  // frames inside the page while their files total at most this, MiB (the first always)
 };
 
 // Writes DIR/view.html; returns its path. Throws OutputError (no frames,
