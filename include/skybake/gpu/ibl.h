@@ -48,7 +48,7 @@ int IblLevelCount(const IblSettings& settings);
 double IblRoughness(int level, int levels);
 
 // The integral of (n.l) D(h) / 4 over the directions l with n.l > 0, for
-// N = V and GGX alpha: the normalization of PrefilterGgx's kernel, in closed
+// N = V and GGX alpha: the normalization of the specular filter's kernel, in closed
 // form (ibl.cc derives it).
 double IblSunKernelNormalization(double alpha);
 
