@@ -338,6 +338,51 @@ TEST(CloudShadow, GroundShadowAndMapBesideTheCloudPanorama) {
   testing::ExpectNoValidationMessages();
 }
 
+// A formation that supplies the layer's whole density (formation.density):
+// a lattice that is cloud everywhere (humidity and transition always,
+// extinction never) makes the layer a uniform slab whatever its shape
+// noise, so the map is exp(-tau / cos) at every texel; the same lattice
+// supplying the coverage only leaves the shape noise carving the layer.
+TEST(CloudShadow, FormationSuppliesTheWholeDensity) {
+  const std::string toml = R"(
+[quality]
+preset = "draft"
+[[cloud_layer]]
+altitude_m = 1000
+thickness_m = 500
+type = "custom"
+profile = [0.0, 0.0, 1.0, 1.0]
+coverage = 1.0
+density_per_m = 0.002
+shape_amount = 1.0
+detail_amount = 0.0
+[cloud_layer.formation]
+enabled = true
+cells = [8, 8, 4]
+warmup_steps = 4
+extinction_probability = 0.0
+humidity_probability = 1.0
+phase_probability = 1.0
+initial_humidity = 1.0
+DENSITY
+[cloud_shadow]
+enabled = true
+resolution = 32
+)";
+  auto map_of = [&](bool density) {
+    std::string t = toml;
+    t.replace(t.find("DENSITY"), 7, density ? "density = true" : "density = false");
+    const SkyStyle style = PrunedStyle(Style(t));
+    return RendererOf(style)->RenderCloudShadow(Sun(40.0), style.cloud_shadow);
+  };
+  const std::vector<float> whole = map_of(true), coverage = map_of(false);
+  const double expected = std::exp(-1.0 / Sun(40.0).y);
+  for (float t : whole) ASSERT_NEAR(t, expected, 2e-5);
+  const auto [lo, hi] = std::minmax_element(coverage.begin(), coverage.end());
+  EXPECT_GT(*hi - *lo, 0.05) << "with the coverage only, the shape noise carves the layer";
+  testing::ExpectNoValidationMessages();
+}
+
 // A bake writes BASE_cloudshadow.exr (frame-numbered in a sequence) with
 // its placement in the header and in manifest.json, and the shadow map
 // changes nothing else: the sky files are the same bytes as without it but
