@@ -208,19 +208,29 @@ float LayerExtinction(int l, vec2 xz, float h, bool detail) {
   float coverage_key = layer.weather.x;
   // Wind moves the whole layer (shear: more with height).
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
-  float weather = SampleMap(layer.noise.z, gpu_clouds.resolution.z,
-                            (q - layer.weather_origin.xy) * layer.weather.yz);
-  // Local coverage: coverage 0.5 is the weather map as it is, 0 none, 1 all.
-  float coverage = clamp(2.0 * coverage_key - 1.0 + weather, 0.0, 1.0);
-  // Schneider 2015: remap(shape x profile, 1 - coverage, 1) x coverage; the
-  // shape is at most 1, so where the profile alone is below 1 - coverage
-  // there is no cloud and no volume is read.
-  if (coverage <= 0.0 || profile <= 1.0 - coverage) return 0.0;
-  float lift = h - layer.shell.x;
-  float shape = SampleVolume(layer.noise.x, gpu_clouds.resolution.x, vec3(q.x, lift, q.y) * layer.shape.y);
-  float base = mix(1.0, shape, layer.shape.x) * profile;
-  float d = clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage;
+  vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
+  float d;
+  if (layer.weather.w > 1.5) {
+    // A formation's whole density (cloud_formation.h): its volume, x and y
+    // over the lattice as the weather map, z the height fraction (texel
+    // centres at the bottom and the top: clamped, not wrapped).
+    float n = float(gpu_clouds.resolution.x);
+    d = SampleVolume(layer.noise.x, gpu_clouds.resolution.x,
+                     vec3(weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), weather_uv.y));
+  } else {
+    float weather = SampleMap(layer.noise.z, gpu_clouds.resolution.z, weather_uv);
+    // Local coverage: coverage 0.5 is the weather map as it is, 0 none, 1 all.
+    float coverage = clamp(2.0 * coverage_key - 1.0 + weather, 0.0, 1.0);
+    // Schneider 2015: remap(shape x profile, 1 - coverage, 1) x coverage; the
+    // shape is at most 1, so where the profile alone is below 1 - coverage
+    // there is no cloud and no volume is read.
+    if (coverage <= 0.0 || profile <= 1.0 - coverage) return 0.0;
+    float shape = SampleVolume(layer.noise.x, gpu_clouds.resolution.x, vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y);
+    float base = mix(1.0, shape, layer.shape.x) * profile;
+    d = clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage;
+  }
   if (d <= 0.0) return 0.0;
+  float lift = h - layer.shell.x;
   if (detail && layer.shape.z > 0.0) {
     float n = SampleVolume(layer.noise.y, gpu_clouds.resolution.y, vec3(q.x, lift, q.y) * layer.shape.w);
     // Wispy at the base (inverted noise), billowy above (Schneider 2015).

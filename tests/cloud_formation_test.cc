@@ -225,6 +225,38 @@ void WriteImage(const std::string& path, int w, int h, int channels,
 // stays; where red (humidity) and green (readiness) are 0 none forms; where
 // all three allow it, clouds form. Two layers: velocity z moves from the
 // first to the second.
+// The density volume (FormationDensityAt) is the smoothed lattice itself
+// when its size matches the lattice's: texel (column c, row r, level k) is
+// cell (c, ny - 1 - r, k) (row 0 north), for a whole step; between two
+// steps it is linear in time.
+TEST(CloudFormationRules, DensityVolumeIsTheSmoothedLattice) {
+  CloudFormation f;
+  f.enabled = true;
+  f.density = true;
+  f.cells = {8, 8, 8};
+  f.steps_per_hour = 10.0;
+  f.warmup_steps = 6;
+  f.humidity_probability = 0.3;
+  f.phase_probability = 0.05;
+  f.extinction_probability = 0.1;
+  const uint32_t seed = 7;
+  const CloudLattice at6 = SimulateFormation(f, nullptr, seed, 6), at7 = SimulateFormation(f, nullptr, seed, 7);
+  const std::vector<float> d6 = SmoothFormation(at6, f.smoothing_cells), d7 = SmoothFormation(at7, f.smoothing_cells);
+  const std::vector<float> v6 = FormationDensityAt(f, nullptr, seed, 0.0, 8);
+  const std::vector<float> half = FormationDensityAt(f, nullptr, seed, 0.05 * 3600.0, 8);  // step 6.5
+  ASSERT_EQ(v6.size(), 512u);
+  float lo = 1.0f, hi = 0.0f;
+  for (int r = 0; r < 8; ++r)
+    for (int k = 0; k < 8; ++k)
+      for (int c = 0; c < 8; ++c) {
+        const size_t i = (size_t(r) * 8 + k) * 8 + c, cell = at6.Index(c, 7 - r, k);
+        ASSERT_NEAR(v6[i], d6[cell], 1e-6) << c << " " << r << " " << k;
+        ASSERT_NEAR(half[i], 0.5f * (d6[cell] + d7[cell]), 1e-6);
+        lo = std::min(lo, v6[i]), hi = std::max(hi, v6[i]);
+      }
+  EXPECT_LT(lo, hi) << "a lattice with structure";
+}
+
 TEST(CloudFormationMask, ChannelsSetTheProbabilitiesPerColumn) {
   const std::string dir = testing::FreshTempDir("cloud_mask");
   // Layer 0: west half humid and ready, east half dry; layer 1 the reverse.

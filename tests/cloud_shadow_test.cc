@@ -5,8 +5,11 @@
 // header and manifest.json.
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <set>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -17,6 +20,7 @@
 #include "skybake/gpu/cloud_panorama.h"
 #include "skybake/model/cloud_shadow.h"
 #include "skybake/model/clouds.h"
+#include "skybake/model/tonemap.h"
 #include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/pipeline/pass_plan.h"
@@ -334,6 +338,51 @@ TEST(CloudShadow, GroundShadowAndMapBesideTheCloudPanorama) {
   testing::ExpectNoValidationMessages();
 }
 
+// A formation that supplies the layer's whole density (formation.density):
+// a lattice that is cloud everywhere (humidity and transition always,
+// extinction never) makes the layer a uniform slab whatever its shape
+// noise, so the map is exp(-tau / cos) at every texel; the same lattice
+// supplying the coverage only leaves the shape noise carving the layer.
+TEST(CloudShadow, FormationSuppliesTheWholeDensity) {
+  const std::string toml = R"(
+[quality]
+preset = "draft"
+[[cloud_layer]]
+altitude_m = 1000
+thickness_m = 500
+type = "custom"
+profile = [0.0, 0.0, 1.0, 1.0]
+coverage = 1.0
+density_per_m = 0.002
+shape_amount = 1.0
+detail_amount = 0.0
+[cloud_layer.formation]
+enabled = true
+cells = [8, 8, 4]
+warmup_steps = 4
+extinction_probability = 0.0
+humidity_probability = 1.0
+phase_probability = 1.0
+initial_humidity = 1.0
+DENSITY
+[cloud_shadow]
+enabled = true
+resolution = 32
+)";
+  auto map_of = [&](bool density) {
+    std::string t = toml;
+    t.replace(t.find("DENSITY"), 7, density ? "density = true" : "density = false");
+    const SkyStyle style = PrunedStyle(Style(t));
+    return RendererOf(style)->RenderCloudShadow(Sun(40.0), style.cloud_shadow);
+  };
+  const std::vector<float> whole = map_of(true), coverage = map_of(false);
+  const double expected = std::exp(-1.0 / Sun(40.0).y);
+  for (float t : whole) ASSERT_NEAR(t, expected, 2e-5);
+  const auto [lo, hi] = std::minmax_element(coverage.begin(), coverage.end());
+  EXPECT_GT(*hi - *lo, 0.05) << "with the coverage only, the shape noise carves the layer";
+  testing::ExpectNoValidationMessages();
+}
+
 // A bake writes BASE_cloudshadow.exr (frame-numbered in a sequence) with
 // its placement in the header and in manifest.json, and the shadow map
 // changes nothing else: the sky files are the same bytes as without it but
@@ -395,6 +444,112 @@ receiver_altitude_m = 20.0
   for (const nlohmann::json& f : frame["files"])
     listed = listed || (f["file"] == "sky_cloudshadow.exr" && f["kind"] == "cloud_shadow");
   EXPECT_TRUE(listed);
+  std::filesystem::remove_all(root);
+}
+
+// The glTF scene carries a ground plane textured with the cloud shadow map
+// (gltf_scene.h "ground"), validator-clean: node "cloud_shadow_ground", a
+// square whose UV (0, 0) corner is the map's origin and (1, 1) corner its
+// origin + extent (axis_u + axis_v); its base colour texture sky_ground.png
+// is the EXR's transmittance sRGB-encoded texel for texel (row 0 north);
+// the manifest lists it with the scene. Without [cloud_shadow]: no plane.
+TEST(CloudShadowFile, GltfGroundPlaneCarriesTheMap) {
+  const std::string root = testing::FreshTempDir("cloud_shadow_gltf");
+  const std::string style = testing::SourceDir() + "/configs/styles/afternoon_buildup.toml";
+  testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size 16 -q --vulkan-validation "
+                                                "--set cloud_shadow.resolution=32 --out '" + root + "/out'");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const std::string out = root + "/out";
+  auto [status, report] = testing::RunCommand("cd '" + testing::SourceDir() + "/tests/viewer' && node validate.mjs '" +
+                                              out + "/sky.gltf' '" + out + "/sky.glb'");
+  EXPECT_EQ(status, 0) << report;
+  EXPECT_NE(report.find("sky.gltf: 0 errors, 0 warnings"), std::string::npos) << report;
+  EXPECT_NE(report.find("sky.glb: 0 errors, 0 warnings"), std::string::npos) << report;
+
+  const nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
+  const nlohmann::json& info = manifest["frames"][0]["cloud_shadow"];
+  bool listed = false;
+  for (const nlohmann::json& f : manifest["scene"]) listed = listed || (f["file"] == "sky_ground.png" && f["kind"] == "gltf_ground");
+  EXPECT_TRUE(listed) << manifest["scene"].dump();
+
+  const nlohmann::json gltf = nlohmann::json::parse(std::ifstream(out + "/sky.gltf"));
+  int node = -1;
+  for (size_t i = 0; i < gltf["nodes"].size(); ++i)
+    if (gltf["nodes"][i].value("name", "") == "cloud_shadow_ground") node = int(i);
+  ASSERT_GE(node, 0) << gltf["nodes"].dump();
+  bool in_scene = false;
+  for (const nlohmann::json& n : gltf["scenes"][0]["nodes"]) in_scene = in_scene || n.get<int>() == node;
+  EXPECT_TRUE(in_scene);
+  const nlohmann::json& primitive = gltf["meshes"][gltf["nodes"][node]["mesh"].get<int>()]["primitives"][0];
+  const nlohmann::json& material = gltf["materials"][primitive["material"].get<int>()];
+  const int texture = material["pbrMetallicRoughness"]["baseColorTexture"]["index"];
+  const int image = gltf["textures"][texture]["source"];
+  EXPECT_EQ(gltf["images"][image]["uri"], "sky_ground.png");
+  EXPECT_FALSE(material.contains("extensions")) << "lit, not unlit";
+
+  // The corners: read POSITION and TEXCOORD_0 from sky.bin.
+  std::ifstream bin_file(out + "/sky.bin", std::ios::binary);
+  const std::string bin((std::istreambuf_iterator<char>(bin_file)), std::istreambuf_iterator<char>());
+  auto floats = [&](const std::string& attribute, int components) {
+    const nlohmann::json& a = gltf["accessors"][primitive["attributes"][attribute].get<int>()];
+    const nlohmann::json& view = gltf["bufferViews"][a["bufferView"].get<int>()];
+    std::vector<float> v(a["count"].get<size_t>() * components);
+    std::memcpy(v.data(), bin.data() + view.value("byteOffset", size_t(0)) + a.value("byteOffset", size_t(0)),
+                v.size() * 4);
+    return v;
+  };
+  const std::vector<float> positions = floats("POSITION", 3), uvs = floats("TEXCOORD_0", 2);
+  ASSERT_EQ(positions.size(), 12u);
+  const double extent = info["extent_m"];
+  for (int k = 0; k < 4; ++k)
+    for (int c = 0; c < 3; ++c) {
+      const double expected = info["origin_m"][c].get<double>() +
+                              extent * (uvs[2 * k] * info["axis_u"][c].get<double>() +
+                                        uvs[2 * k + 1] * info["axis_v"][c].get<double>());
+      EXPECT_NEAR(positions[3 * k + c], expected, 1e-3 * extent) << "corner " << k << " axis " << c;
+    }
+  using Uv = std::pair<float, float>;
+  const std::set<Uv> corners = {{uvs[0], uvs[1]}, {uvs[2], uvs[3]}, {uvs[4], uvs[5]}, {uvs[6], uvs[7]}};
+  const std::set<Uv> unit_square = {{0.f, 0.f}, {1.f, 0.f}, {0.f, 1.f}, {1.f, 1.f}};
+  EXPECT_EQ(corners, unit_square);
+
+  // The texture is the map, texel for texel.
+  auto read = [](const std::string& path, OIIO::TypeDesc type, int& channels) {
+    std::vector<float> v;
+    auto in = OIIO::ImageInput::open(path);
+    EXPECT_TRUE(in) << path;
+    if (!in) return v;
+    channels = in->spec().nchannels;
+    v.resize(size_t(in->spec().width) * in->spec().height * channels);
+    if (type == OIIO::TypeDesc::UINT8) {
+      std::vector<uint8_t> bytes(v.size());
+      in->read_image(0, 0, 0, channels, type, bytes.data());
+      v.assign(bytes.begin(), bytes.end());
+    } else {
+      in->read_image(0, 0, 0, channels, type, v.data());
+    }
+    return v;
+  };
+  int exr_channels = 0, png_channels = 0;
+  const std::vector<float> map = read(out + "/sky_cloudshadow.exr", OIIO::TypeDesc::FLOAT, exr_channels);
+  const std::vector<float> png = read(out + "/sky_ground.png", OIIO::TypeDesc::UINT8, png_channels);
+  ASSERT_EQ(map.size() / exr_channels, 32u * 32u);
+  ASSERT_EQ(png.size() / png_channels, 32u * 32u);
+  float lo = 1.0f, hi = 0.0f;
+  for (size_t i = 0; i < 32 * 32; ++i) {
+    const float t = map[i * exr_channels];
+    lo = std::min(lo, t), hi = std::max(hi, t);
+    ASSERT_EQ(png[i * png_channels], std::lround(SrgbEncode(std::clamp(double(t), 0.0, 1.0)) * 255.0)) << i;
+  }
+  EXPECT_LT(lo, hi) << "the map has structure (broken clouds)";
+
+  // Without the shadow map: no ground plane, no PNG.
+  testing::CommandRun off = testing::RunSkybake("bake '" + style + "' --size 16 -q --set cloud_shadow.enabled=false --out '" +
+                                                root + "/off'");
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  EXPECT_FALSE(std::filesystem::exists(root + "/off/sky_ground.png"));
+  const std::string off_gltf = nlohmann::json::parse(std::ifstream(root + "/off/sky.gltf")).dump();
+  EXPECT_EQ(off_gltf.find("cloud_shadow_ground"), std::string::npos);
   std::filesystem::remove_all(root);
 }
 

@@ -194,7 +194,10 @@ int RunBake(const BakeArgs& args, Mode mode) {
     // The part that --frames / --shard select, when given.
     const RenderPlan bake_plan =
         schedule ? PlanSequenceBake(frame_styles, *schedule, part) : PlanSingleBake(config.style);
-    PassPlan plan = PlanPasses(bake_plan.BakedStyles(), args.shaders);
+    std::vector<double> planned_hours;  // the cloud formation's steps follow the clock
+    for (const FramePlan& f : bake_plan.frames)
+      if (bake_plan.Bakes(f)) planned_hours.push_back(f.hours_from_start);
+    PassPlan plan = PlanPasses(bake_plan.BakedStyles(), args.shaders, planned_hours);
     std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
     if (part)
       what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,

@@ -545,9 +545,7 @@ void SkyRenderer::GenerateCloudNoise() {
   // The weather images first (host writes to the mapped buffer; the
   // submission below makes them visible to the device), then the volumes
   // and procedural maps, from the seeds alone.
-  float* noise = static_cast<float*>(cloud_noise_buffer_.mapped);
   const int n_weather = gpu_clouds_.resolution.z;
-  size_t image = 0;
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
   for (int l = 0; l < cloud_layers_; ++l) {
@@ -555,21 +553,20 @@ void SkyRenderer::GenerateCloudNoise() {
     gpu::SkyPush push{};
     push.view = {CLOUD_PASS_SHAPE, 0, 0, l};
     const int ns = gpu_clouds_.resolution.x, nd = gpu_clouds_.resolution.y;
-    dispatches.push_back({"cloud shape noise", cloud_lut_pipeline_, push, GroupCount(ns, SKYBAKE_LOCAL_SIZE_X),
-                          GroupCount(ns * ns, SKYBAKE_LOCAL_SIZE_Y)});
+    // A formation's density volume takes the shape volume's place (GpuCloudLayer.weather.w = 2).
+    if (layer.weather.w < 1.5f)
+      dispatches.push_back({"cloud shape noise", cloud_lut_pipeline_, push, GroupCount(ns, SKYBAKE_LOCAL_SIZE_X),
+                            GroupCount(ns * ns, SKYBAKE_LOCAL_SIZE_Y)});
     push.view.x = CLOUD_PASS_DETAIL;
     dispatches.push_back({"cloud detail noise", cloud_lut_pipeline_, push, GroupCount(nd, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(nd * nd, SKYBAKE_LOCAL_SIZE_Y)});
-    if (layer.weather.w > 0.5f) {
-      const size_t count = size_t(n_weather) * n_weather;
-      std::memcpy(noise + layer.noise.z, cloud_weather_images_.data() + image * count, count * sizeof(float));
-      ++image;
-    } else {
+    if (layer.weather.w < 0.5f) {
       push.view.x = CLOUD_PASS_WEATHER;
       dispatches.push_back({"cloud weather map", cloud_lut_pipeline_, push,
                             GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_X), GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_Y)});
     }
   }
+  CopyCloudWeatherImages();
   // Each dispatch writes its own range of the noise buffer: no barriers
   // between them; the submission's end orders them before later reads.
   barriers.assign(dispatches.size(), false);
@@ -579,13 +576,22 @@ void SkyRenderer::GenerateCloudNoise() {
 }
 
 void SkyRenderer::CopyCloudWeatherImages() {
+  // CloudInputs::weather_images: per image layer its map, and after a
+  // formation volume's map its volume (clouds.h).
   float* noise = static_cast<float*>(cloud_noise_buffer_.mapped);
   const size_t count = size_t(gpu_clouds_.resolution.z) * gpu_clouds_.resolution.z;
-  size_t image = 0;
-  for (int l = 0; l < cloud_layers_; ++l)
-    if (gpu_clouds_.layers[l].weather.w > 0.5f)
-      std::memcpy(noise + gpu_clouds_.layers[l].noise.z, cloud_weather_images_.data() + image++ * count,
-                  count * sizeof(float));
+  const size_t volume = size_t(gpu_clouds_.resolution.x) * gpu_clouds_.resolution.x * gpu_clouds_.resolution.x;
+  const float* next = cloud_weather_images_.data();
+  for (int l = 0; l < cloud_layers_; ++l) {
+    const gpu::GpuCloudLayer& layer = gpu_clouds_.layers[l];
+    if (layer.weather.w < 0.5f) continue;
+    std::memcpy(noise + layer.noise.z, next, count * sizeof(float));
+    next += count;
+    if (layer.weather.w > 1.5f) {
+      std::memcpy(noise + layer.noise.x, next, volume * sizeof(float));
+      next += volume;
+    }
+  }
 }
 
 void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
@@ -840,7 +846,7 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   bool layout_same = true;
   for (int l = 0; l < cloud_layers_; ++l)
     layout_same = layout_same && same(c.layers[l].noise, gpu_clouds_.layers[l].noise) &&
-                  (c.layers[l].weather.w > 0.5f) == (gpu_clouds_.layers[l].weather.w > 0.5f);
+                  c.layers[l].weather.w == gpu_clouds_.layers[l].weather.w;
   const bool noise_same = images_same && layout_same;
   if (same(c, gpu_clouds_) && noise_same) return true;
   // Every submission waits for its fence, so no dispatch reads the buffers now.

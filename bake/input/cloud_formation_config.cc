@@ -44,6 +44,9 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
     if (k == "enabled") {
       if (!value.is_boolean()) error(&value, p, "expected true or false");
       else f.enabled = value.as_boolean()->get();
+    } else if (k == "density") {
+      if (!value.is_boolean()) error(&value, p, "expected true (the automaton's whole density) or false (its coverage)");
+      else f.density = value.as_boolean()->get();
     } else if (k == "cells") {
       numbers(value, p, 3, "[east, north, up] cell counts", [&](const toml::node& v, const std::string& q, size_t j) {
         integer(v, q, j < 2 ? 4 : 1, j < 2 ? 512 : 64, f.cells[j]);
@@ -87,7 +90,7 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
             fmt::format("unknown key '{}' (a formation has enabled, cells, size_m, origin_m, steps_per_hour, "
                         "warmup_steps, extinction_probability, humidity_probability, phase_probability, "
                         "initial_humidity, smoothing_cells, mask_image, mask_layers, mask_layer, "
-                        "velocity_cells_per_hour)",
+                        "velocity_cells_per_hour, density)",
                         k));
     }
   }
@@ -121,6 +124,7 @@ toml::table CloudFormationToml(const CloudFormation& f) {
   }
   t.insert("velocity_cells_per_hour",
            toml::array{f.velocity_cells_per_hour[0], f.velocity_cells_per_hour[1], f.velocity_cells_per_hour[2]});
+  if (f.density) t.insert("density", true);  // absent: coverage only, as before the key existed
   return t;
 }
 

@@ -312,8 +312,50 @@ FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* 
   return out;
 }
 
+std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
+                                      int n) {
+  const double step = f.warmup_steps + f.steps_per_hour * std::max(time_s, 0.0) / 3600.0;
+  const uint64_t s0 = uint64_t(std::floor(step));
+  const float w = float(step - double(s0));
+  CloudLattice lattice = SimulateFormation(f, mask, seed, s0);
+  std::vector<float> density = SmoothFormation(lattice, f.smoothing_cells);
+  if (w > 0.0f) {
+    lattice = SimulateFormation(f, mask, seed, s0 + 1);
+    const std::vector<float> next = SmoothFormation(lattice, f.smoothing_cells);
+    for (size_t i = 0; i < density.size(); ++i) density[i] += (next[i] - density[i]) * w;
+  }
+  const int nx = lattice.nx, ny = lattice.ny, nz = lattice.nz;
+  auto at = [&](int x, int y, int z) {
+    return density[lattice.Index(((x % nx) + nx) % nx, ((y % ny) + ny) % ny, std::clamp(z, 0, nz - 1))];
+  };
+  std::vector<float> volume(size_t(n) * n * n);
+  for (int row = 0; row < n; ++row) {
+    const double v = (1.0 - (row + 0.5) / n) * ny - 0.5;
+    const int y0 = int(std::floor(v));
+    const double fy = v - y0;
+    for (int k = 0; k < n; ++k) {
+      const double z = std::clamp((k + 0.5) / n * nz - 0.5, 0.0, double(nz - 1));
+      const int z0 = int(std::floor(z));
+      const double fz = z - z0;
+      for (int col = 0; col < n; ++col) {
+        const double u = (col + 0.5) / n * nx - 0.5;
+        const int x0 = int(std::floor(u));
+        const double fx = u - x0;
+        double value = 0.0;
+        for (int dz = 0; dz < 2; ++dz)
+          for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx)
+              value += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz) * at(x0 + dx, y0 + dy, z0 + dz);
+        volume[(size_t(row) * n + k) * n + col] = float(value);
+      }
+    }
+  }
+  return volume;
+}
+
 void ApplyCloudFormation(const CloudLayer& layer, uint32_t seed, int resolution, double time_s,
-                         const std::string& style_dir, gpu::GpuCloudLayer& o, std::vector<float>& weather_images) {
+                         const std::string& style_dir, gpu::GpuCloudLayer& o, std::vector<float>& weather_images,
+                         int volume_resolution) {
   const CloudFormation& f = layer.formation;
   CloudMask mask;
   if (!f.mask_image.empty()) {
@@ -327,6 +369,12 @@ void ApplyCloudFormation(const CloudLayer& layer, uint32_t seed, int resolution,
   o.weather = {float(layer.coverage), float(1e3 / c.extent_m[0]), float(1e3 / c.extent_m[1]), 1.0f};
   o.weather_origin = {float(c.origin_m[0] * 1e-3), float(-(c.origin_m[1] + c.extent_m[1]) * 1e-3), 0.0f, 0.0f};
   weather_images.insert(weather_images.end(), c.map.begin(), c.map.end());
+  if (f.density) {
+    o.weather.w = 2.0f;
+    const std::vector<float> volume =
+        FormationDensityAt(f, f.mask_image.empty() ? nullptr : &mask, seed, time_s, volume_resolution);
+    weather_images.insert(weather_images.end(), volume.begin(), volume.end());
+  }
 }
 
 }  // namespace skybake

@@ -186,7 +186,8 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
                      float(l.shear_m_s_per_km[0] * seconds * 1e-3), float(-l.shear_m_s_per_km[1] * seconds * 1e-3)};
     if (l.formation.enabled) {
-      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, time_s, style_dir, o, in.weather_images);
+      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, time_s, style_dir, o, in.weather_images,
+                          q.shape_resolution);
     } else if (l.weather_image.empty()) {
       o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};
       o.weather_origin = {0.0f, 0.0f, 0.0f, 0.0f};

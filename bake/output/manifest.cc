@@ -382,11 +382,11 @@ void CheckNames(const std::string& path, const Manifest& m) {
     }
   }
   static const std::map<std::string, std::string> kSceneExtension = {
-      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}};
+      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}, {"gltf_ground", "_ground.png"}};
   for (const ManifestFile& file : m.scene) {
     auto it = kSceneExtension.find(file.kind);
     if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
-      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb)", m.gltf.name));
+      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png)", m.gltf.name));
   }
 }
 
@@ -536,6 +536,14 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
         for (const ManifestFile& file : f.files)
           if (file.kind == "ibl_gltf") scene.ibl_images.push_back(file.file);
         scene.ibl_sh = f.sh_irradiance_without_sun;
+        // The ground plane: the texture frame's cloud shadow map (gltf_scene.h "ground").
+        for (const ManifestFile& file : f.files)
+          if (file.kind == "cloud_shadow" && f.cloud_shadow) {
+            scene.ground_texture_file = manifest.gltf.name + "_ground.png";
+            WriteCloudShadowGroundPng((fs::path(out_dir) / file.file).string(),
+                                      (fs::path(out_dir) / scene.ground_texture_file).string());
+            scene.ground = f.cloud_shadow;
+          }
       }
       SceneSun sun;
       sun.time_s = f.animation_time_s;
@@ -562,8 +570,10 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
                        {"sh_basis", kShBasis},              {"frames", frame_extras}};
     scene.extras_json = provenance.dump();
     WrittenScene written = WriteGltfScene(scene);
-    for (auto [path, kind] : {std::pair{written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"},
-                              {written.glb_path, "glb"}}) {
+    std::vector<std::pair<std::string, const char*>> files = {
+        {written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"}, {written.glb_path, "glb"}};
+    if (scene.ground) files.push_back({(fs::path(out_dir) / scene.ground_texture_file).string(), "gltf_ground"});
+    for (auto [path, kind] : files) {
       scene_files.push_back({path, kind, fs::file_size(path), Sha256OfFile(path)});
       manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
                                 scene_files.back().sha256});

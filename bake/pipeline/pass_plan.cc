@@ -1,4 +1,5 @@
 #include "skybake/pipeline/pass_plan.h"
+#include "cloud_plan.h"
 
 #include "skybake/gpu/ibl.h"
 
@@ -334,7 +335,8 @@ void PlanReuse(PassPlan& plan) {
 
 }  // namespace
 
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders) {
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders,
+                    const std::vector<double>& hours_from_start) {
   PassPlan plan;
   plan.frames = int(frames.size());
   if (frames.empty()) return plan;
@@ -348,7 +350,9 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   if (disc_pass) plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
   PlanCloudPasses(first, plan);
   PlanMoonlitPasses(first, pruned, plan);
+  AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+  AddCloudFormationPlan(first, hours_from_start, plan);  // CPU cell updates, not medium samples
   PlanIblPasses(first, pruned, plan);
   plan.variant = DescribeVariant(first, pruned, disc_pass, shaders);
   PlanReuse(plan);

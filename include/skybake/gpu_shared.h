@@ -159,6 +159,8 @@ SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 profile;         // height-profile stops (bottom in, bottom full, top full, top out), fractions of the thickness
   vec4 shape;           // x: shape amount; y: 1 / shape tile, km^-1; z: detail amount; w: 1 / detail tile, km^-1
   vec4 weather;         // x: coverage; y: 1 / weather extent along x, km^-1; z: along z; w: 1 = user image
+                        // (or a formation's coverage); 2 = also a formation's whole density, its volume in
+                        // the shape volume's place (cloud_formation.h)
   vec4 wind_offset;     // xy: world x, z moved by the wind at the bottom, km; zw: more per km of height (shear), km/km
   vec4 weather_origin;  // xy: world x, z of the weather map's corner, km; zw: unused
   ivec4 noise;          // x, y, z: first float of the shape volume, detail volume, weather map; w: seed

@@ -20,7 +20,7 @@ std::string CheckCloudMask(const std::string&, const CloudFormation&) {
 
 // ToCloudInputs (model/clouds.cc) is never called by the parsers.
 void ApplyCloudFormation(const CloudLayer&, uint32_t, int, double, const std::string&, gpu::GpuCloudLayer&,
-                         std::vector<float>&) {
+                         std::vector<float>&, int) {
   throw std::logic_error("cloud formations are not simulated in the fuzz build");
 }
 

@@ -62,6 +62,10 @@ struct CloudFormation {
   int mask_layers = 1;                   // layers stacked top to bottom in the mask image
   double mask_layer = 0.0;               // the layer used at time 0 (fractions blend two layers)
   std::array<double, 3> velocity_cells_per_hour = {0.0, 0.0, 0.0};  // drift east, north; z: mask layers per hour
+  // true: the automaton supplies the layer's whole density (its smoothed
+  // lattice, FormationDensityAt), in place of the shape noise, the coverage
+  // remap and the height profile; false: its coverage only.
+  bool density = false;
 };
 
 // The density mask: per lattice column and layer, R = humidity, G = readiness
@@ -132,11 +136,23 @@ struct FormationCoverage {
 FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int resolution);
 
+// The smoothed density at clock time `time_s` (linear between the steps
+// around it), resampled trilinearly to an n^3 volume over the lattice: x, y
+// wrapping as the coverage map (column c east, row r from the north edge),
+// z the layer's height fraction (level k at (k + 0.5) / n, clamped to the
+// lattice's bottom and top cells); index (r * n + k) * n + c, the layout
+// clouds.glsl's SampleVolume reads with (u, height fraction, v).
+std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
+                                      int n);
+
 // A layer with formation.enabled: its weather map becomes the formation's
 // coverage at `time_s` (appended to `weather_images`, placed by `out`'s
-// weather and weather_origin as a weather image is). `style_dir` resolves a
-// relative mask path.
+// weather and weather_origin as a weather image is); with formation.density
+// also its density volume (FormationDensityAt, volume_resolution^3, after
+// the map; out.weather.w = 2: it takes the shape volume's place).
+// `style_dir` resolves a relative mask path.
 void ApplyCloudFormation(const CloudLayer& layer, uint32_t seed, int resolution, double time_s,
-                         const std::string& style_dir, gpu::GpuCloudLayer& out, std::vector<float>& weather_images);
+                         const std::string& style_dir, gpu::GpuCloudLayer& out, std::vector<float>& weather_images,
+                         int volume_resolution);
 
 }  // namespace skybake
