@@ -19,7 +19,7 @@ namespace skybake {
 
 struct ViewPageOptions {
   std::string dir;          // the bake's folder; the page is written there
-  std::string three_dir;    // three.js's npm package folder (empty: the project's, or $SKYBAKE_THREE_DIR)
+  std::string three_dir;    // three.js's npm package folder (empty: the project's; main: $SKYBAKE_THREE_DIR)
   bool force = false;       // replace an existing view.html
 };
 
