@@ -28,36 +28,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The cube map face selection of the OpenGL 4.6 / Vulkan specifications
-// ("Cube Map Face Selection", table of major axis, sc, tc): the face a
-// lookup vector selects and its (s, t) in [0, 1].
-struct FaceHit {
-  int face;
-  double s, t;
-};
-FaceHit SelectFace(glm::dvec3 r) {
-  const double ax = std::abs(r.x), ay = std::abs(r.y), az = std::abs(r.z);
-  int face;
-  double sc, tc, ma;
-  if (ax >= ay && ax >= az) {
-    face = r.x > 0 ? 0 : 1;
-    sc = r.x > 0 ? -r.z : r.z;
-    tc = -r.y;
-    ma = ax;
-  } else if (ay >= az) {
-    face = r.y > 0 ? 2 : 3;
-    sc = r.x;
-    tc = r.y > 0 ? r.z : -r.z;
-    ma = ay;
-  } else {
-    face = r.z > 0 ? 4 : 5;
-    sc = r.z > 0 ? r.x : -r.x;
-    tc = -r.y;
-    ma = az;
-  }
-  return {face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)};
-}
-
 // Each preset: the engine's lookup vector for a skybake world direction,
 // and the cube face (OpenGL numbering) each of its face files must hold.
 struct FaceConvention {
@@ -134,7 +104,7 @@ TEST(EnginePresetTest, EveryFaceTexelIsWhereTheEngineLooksItUp) {
       ASSERT_EQ(image.width, n);
       for (int y = 0; y < n; ++y)
         for (int x = 0; x < n; ++x) {
-          const FaceHit hit = SelectFace(c.lookup(image.directions[size_t(y) * n + x]));
+          const testing::CubeFaceHit hit = testing::SpecCubeFace(c.lookup(image.directions[size_t(y) * n + x]));
           ASSERT_EQ(hit.face, c.faces[f]) << preset.name << " " << preset.faces[f] << " texel " << x << "," << y;
           EXPECT_NEAR(hit.s, (x + 0.5) / n, 1e-12) << preset.name << " " << preset.faces[f];
           EXPECT_NEAR(hit.t, (y + 0.5) / n, 1e-12) << preset.name << " " << preset.faces[f];

@@ -20,36 +20,6 @@ double MaxAngleError(const std::vector<glm::dvec3>& a, const std::vector<glm::dv
   return worst;
 }
 
-// Vulkan spec "Cube Map Face Selection": the major axis picks the face, then
-// (sc, tc) from the table give s, t in [0, 1]. Written from the table,
-// independently of the mapping code under test.
-struct FaceTexel {
-  int face;
-  double s, t;
-};
-FaceTexel VulkanFaceFromDirection(const glm::dvec3& d) {
-  double ax = std::abs(d.x), ay = std::abs(d.y), az = std::abs(d.z);
-  int face;
-  double sc, tc, ma;
-  if (ax >= ay && ax >= az) {
-    face = d.x > 0 ? 0 : 1;
-    sc = d.x > 0 ? -d.z : d.z;
-    tc = -d.y;
-    ma = ax;
-  } else if (ay >= az) {
-    face = d.y > 0 ? 2 : 3;
-    sc = d.x;
-    tc = d.y > 0 ? d.z : -d.z;
-    ma = ay;
-  } else {
-    face = d.z > 0 ? 4 : 5;
-    sc = d.z > 0 ? d.x : -d.x;
-    tc = -d.y;
-    ma = az;
-  }
-  return {face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)};
-}
-
 std::vector<glm::dvec3> ImfLatLong(int w, int h) {
   std::vector<glm::dvec3> dirs;
   for (int y = 0; y < h; ++y)
@@ -96,7 +66,7 @@ TEST(EnvmapTest, VulkanFacesRoundTripThroughTheSpecTable) {
       for (int x = 0; x < n; ++x) {
         const glm::dvec3& d = dirs[size_t(y) * n + x];
         EXPECT_NEAR(glm::length(d), 1.0, 1e-12);
-        FaceTexel ft = VulkanFaceFromDirection(d);
+        testing::CubeFaceHit ft = testing::SpecCubeFace(d);
         ASSERT_EQ(ft.face, face) << x << "," << y;
         EXPECT_NEAR(ft.s, (x + 0.5) / n, 1e-9);
         EXPECT_NEAR(ft.t, (y + 0.5) / n, 1e-9);

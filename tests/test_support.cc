@@ -1,5 +1,7 @@
 #include "test_support.h"
 
+#include <cmath>
+
 #include <cstdio>
 #include <cstdlib>
 #include <array>
@@ -98,6 +100,29 @@ std::set<std::string> FileNames(const std::string& dir) {
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) names.insert(e.path().filename().string());
   return names;
+}
+
+CubeFaceHit SpecCubeFace(const glm::dvec3& r) {
+  const double ax = std::abs(r.x), ay = std::abs(r.y), az = std::abs(r.z);
+  int face;
+  double sc, tc, ma;
+  if (ax >= ay && ax >= az) {
+    face = r.x > 0 ? 0 : 1;
+    sc = r.x > 0 ? -r.z : r.z;
+    tc = -r.y;
+    ma = ax;
+  } else if (ay >= az) {
+    face = r.y > 0 ? 2 : 3;
+    sc = r.x;
+    tc = r.y > 0 ? r.z : -r.z;
+    ma = ay;
+  } else {
+    face = r.z > 0 ? 4 : 5;
+    sc = r.z > 0 ? r.x : -r.x;
+    tc = -r.y;
+    ma = az;
+  }
+  return {face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)};
 }
 
 }  // namespace skybake::testing

@@ -8,6 +8,7 @@
 #include <string>
 #include <utility>
 
+#include <glm/vec3.hpp>
 #include <gtest/gtest.h>
 
 #include "skybake/gpu/vulkan_context.h"
@@ -49,5 +50,15 @@ std::string FreshTempDir(const std::string& name);
 // (none when it does not exist).
 std::string ReadFileBytes(const std::string& path);
 std::set<std::string> FileNames(const std::string& dir);
+
+// The OpenGL 4.6 / Vulkan specifications' "Cube Map Face Selection": the
+// major axis of `r` picks the face (0..5: +X -X +Y -Y +Z -Z), then (sc, tc)
+// from the table give s, t in [0, 1]. Written from the table,
+// independently of the mapping code the tests check.
+struct CubeFaceHit {
+  int face;
+  double s, t;
+};
+CubeFaceHit SpecCubeFace(const glm::dvec3& r);
 
 }  // namespace skybake::testing

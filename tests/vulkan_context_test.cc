@@ -77,7 +77,10 @@ TEST(VulkanDriversTest, OnlyLavapipeWithoutAGpuDeviceNodeUnlessTheUserChose) {
 // calls for it, the loader then skips every other driver, and the bake's
 // files are the same bytes as with every driver loaded.
 TEST(VulkanDriversTest, CliLoadsOnlyTheSoftwareDriverWhenTheMachineHasNoGpu) {
-  const bool expected = !SoftwareDriverSelection(ProbeDriverEnvironment()).empty();
+  EnvironmentVariables environment;  // this process's, as main reads them
+  for (const std::string& name : DriverEnvironmentVariableNames())
+    if (const char* value = std::getenv(name.c_str())) environment[name] = value;
+  const bool expected = !SoftwareDriverSelection(ProbeDriverEnvironment(environment)).empty();
   testing::CommandRun selected = testing::RunSkybake("devices", "VK_LOADER_DEBUG=driver");
   ASSERT_EQ(selected.exit_code, 0) << selected.output;
   EXPECT_EQ(selected.output.find("software driver only") != std::string::npos, expected) << selected.output;

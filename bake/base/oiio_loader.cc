@@ -1,11 +1,11 @@
-// Loading libskybake_oiio.so (oiio_module.h) on first use: from
-// $SKYBAKE_MODULE_DIR, beside the executable, the build tree's top folder, or
+// Loading libskybake_oiio.so (oiio_module.h) on first use: from the folder
+// main passes in ($SKYBAKE_MODULE_DIR), beside the executable, the build tree's top folder, or
 // the folder it was built in.
 #include <dlfcn.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,13 +16,31 @@
 
 namespace skybake {
 
-const OiioModule& LoadOiioModule() {
+namespace {
+
+std::mutex& LoaderMutex() {
   static std::mutex mutex;
+  return mutex;
+}
+
+std::optional<std::string>& FirstModuleDir() {
+  static std::optional<std::string> dir;  // SetOiioModuleDir
+  return dir;
+}
+
+}  // namespace
+
+void SetOiioModuleDir(const std::string& dir) {
+  std::lock_guard<std::mutex> lock(LoaderMutex());
+  FirstModuleDir() = dir;
+}
+
+const OiioModule& LoadOiioModule() {
   static const OiioModule* module = nullptr;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::lock_guard<std::mutex> lock(LoaderMutex());
   if (module) return *module;
   std::vector<std::filesystem::path> dirs;
-  if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) dirs.emplace_back(dir);
+  if (FirstModuleDir()) dirs.emplace_back(*FirstModuleDir());
   std::error_code ec;
   const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
   if (!ec) {

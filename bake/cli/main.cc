@@ -33,6 +33,7 @@
 #include "skybake/pipeline/render_plan.h"
 #include "skybake/input/schedule.h"
 #include "skybake/input/shard.h"
+#include "skybake/base/oiio_module.h"
 #include "skybake/gpu/vulkan_context.h"
 #include "skybake/input/engine_preset.h"
 #include "skybake/pipeline/test_pattern.h"
@@ -71,7 +72,7 @@ bool EnvIs(const char* name, const char* value) {
   return v && std::string(v) == value;
 }
 
-int RunDevices() {
+int RunDevices(const std::string& software_driver_selection) {
   std::vector<DeviceInfo> devices = VulkanContext::ListDevices();
   if (devices.empty()) {
     std::fprintf(stderr,
@@ -83,7 +84,7 @@ int RunDevices() {
     std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(),
                 d.api_version.c_str(), d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
   }
-  if (!DriverSelection().empty())
+  if (!software_driver_selection.empty())
     std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
                 "every installed driver)\n");
   return kExitOk;
@@ -107,6 +108,10 @@ struct BakeArgs {
   std::string shard;     // --shard I/N, empty: no split
   ShaderSwitches shaders;  // from the environment (main)
   std::string engine;    // --engine NAME: output.engine
+  // From the environment (main, ReadEnvironment): the loader's driver
+  // choice, the default star catalogue.
+  std::string software_driver_selection;
+  std::string star_catalogue = DefaultStarCataloguePath();
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -159,7 +164,7 @@ int RunBake(const BakeArgs& args, Mode mode) {
       for (const SkyStyle& style : frame_styles) styles.push_back(&style);
     else
       styles.push_back(&config.style);
-    const std::vector<ConfigError> night_errors = CheckNightSky(styles, schedule ? &*schedule : nullptr);
+    const std::vector<ConfigError> night_errors = CheckNightSky(styles, schedule ? &*schedule : nullptr, args.star_catalogue);
     if (!night_errors.empty()) {
       PrintErrors(night_errors);
       return kExitConfig;
@@ -223,7 +228,9 @@ int RunBake(const BakeArgs& args, Mode mode) {
   options.frames = part;
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation;
+  options.vulkan.software_driver_selection = args.software_driver_selection;
   options.shaders = args.shaders;
+  options.star_catalogue = args.star_catalogue;
   if (!args.quiet) {
     options.progress = [](const StageReport& s) {
       std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
@@ -290,7 +297,9 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.overrides = args.overrides;
   options.bake.vulkan.device_index = args.device;
   options.bake.vulkan.validation = args.validation;
+  options.bake.vulkan.software_driver_selection = args.software_driver_selection;
   options.bake.shaders = args.shaders;
+  options.bake.star_catalogue = args.star_catalogue;
   options.bake.force = args.force;
   size_t done = 0;
   if (!args.quiet) {
@@ -315,23 +324,10 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   return kExitOk;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  KeepFrameMemoryInHeap();
-  CLI::App app{"skybake " SKYBAKE_VERSION
-               ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
-               "into OpenEXR environment maps with Vulkan compute.\n"
-               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
-               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
-               "manifests that do not merge."};
-  app.require_subcommand(1);
-  app.get_formatter()->column_width(34);
-
-  BakeArgs args;
-  // A budget is a finite number above 0 (nan compares false with every
-  // bound and would switch the budget off).
-  const CLI::Validator finite_positive(
+// A budget is a finite number above 0 (nan compares false with every
+// bound and would switch the budget off).
+CLI::Validator FinitePositive() {
+  return CLI::Validator(
       [](std::string& text) -> std::string {
         double value = 0.0;
         if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
@@ -339,176 +335,203 @@ int main(int argc, char** argv) {
         return "";
       },
       "POSITIVE");
-  auto add_style_options = [&](CLI::App* cmd) {
-    cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
-        ->required();
-    cmd->add_option("--set", args.overrides,
-                    "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
-    cmd->add_option("--schedule", args.schedule_path,
-                    "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
-                    "[schedule], if it has one)");
-    cmd->add_option("--max-memory-mib", args.max_memory_mib,
-                    "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
-        ->capture_default_str()
-        ->check(finite_positive);
-    cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
-                    "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
-        ->capture_default_str()
-        ->check(finite_positive);
-  };
+}
 
-  CLI::App* bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
+void AddStyleOptions(CLI::App* cmd, BakeArgs& args) {
+  const CLI::Validator finite_positive = FinitePositive();
+  cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
+      ->required();
+  cmd->add_option("--set", args.overrides,
+                  "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
+  cmd->add_option("--schedule", args.schedule_path,
+                  "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
+                  "[schedule], if it has one)");
+  cmd->add_option("--max-memory-mib", args.max_memory_mib,
+                  "Memory budget per frame in MiB; larger bakes are refused (README \"Limits\")")
+      ->capture_default_str()
+      ->check(finite_positive);
+  cmd->add_option("--max-frame-seconds", args.max_frame_seconds,
+                  "Time budget per frame in estimated lavapipe seconds; longer bakes are refused")
+      ->capture_default_str()
+      ->check(finite_positive);
+}
+
+// The command line: every subcommand's options, and which one was given.
+struct Cli {
+  BakeArgs args;
+  GalleryArgs gallery_args;
+  TestPatternOptions pattern;
+  ViewPageOptions view_options;
+  MergeOptions merge_options;
+  bool sizes_only = false;
+  AccuracyStudyOptions study;
+  CLI::App *bake = nullptr, *check = nullptr, *plan = nullptr, *gallery = nullptr, *testpattern = nullptr,
+           *view = nullptr, *merge = nullptr, *devices = nullptr, *accuracy = nullptr;
+};
+
+// bake, check and plan: a style (and its schedule) each.
+void AddBakeCommands(CLI::App& app, Cli& cli) {
+  cli.bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
       "preview, a glTF scene and manifest.json");
-  add_style_options(bake);
-  bake->add_option("--out", args.out_dir, "Output folder")->capture_default_str();
-  bake->add_option("--size", args.size,
+  AddStyleOptions(cli.bake, cli.args);
+  cli.bake->add_option("--out", cli.args.out_dir, "Output folder")->capture_default_str();
+  cli.bake->add_option("--size", cli.args.size,
                    "Cube face size N; also sets the latlong to 2N x N (default: the style's, 512)")
       ->check(CLI::Range(1, 8192));
-  bake->add_option("--device", args.device, "Vulkan device index from 'skybake devices' (default: best)");
-  CLI::Option* force = bake->add_flag(
-      "--force", args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
-  bake->add_flag("--resume", args.resume,
+  cli.bake->add_option("--device", cli.args.device, "Vulkan device index from 'skybake devices' (default: best)");
+  CLI::Option* force = cli.bake->add_flag(
+      "--force", cli.args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
+  cli.bake->add_flag("--resume", cli.args.resume,
                  "Sequence: keep the frames whose files match their checksums in the manifest in --out (manifest.json, or "
                  "the shard's), bake the rest")
       ->excludes(force);
-  bake->add_option("--frames", args.frames,
+  cli.bake->add_option("--frames", cli.args.frames,
                    "Sequence: bake only frames FIRST to LAST (inclusive), numbered as in file names (from "
                    "schedule.first_frame); writes manifest.shard-FIRST-LAST.json, no scene")
       ->type_name("FIRST:LAST");
-  bake->add_option("--shard", args.shard,
+  cli.bake->add_option("--shard", cli.args.shard,
                    "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
                    "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
       ->type_name("I/N");
   {
     std::string engines;
     for (const std::string& name : EngineNames()) engines += (engines.empty() ? "" : "|") + name;
-    bake->add_option("--engine", args.engine,
+    cli.bake->add_option("--engine", cli.args.engine,
                      "Also write the files one engine loads the right way up (output.engine; docs/engines.md)")
         ->type_name(engines)
         ->check(CLI::IsMember(EngineNames()));
   }
-  bake->add_flag("--dry-run", args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
-  bake->add_flag("--quiet,-q", args.quiet, "No progress lines (errors and warnings still print)");
-  bake->add_flag("--vulkan-validation", args.validation,
+  cli.bake->add_flag("--dry-run", cli.args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
+  cli.bake->add_flag("--quiet,-q", cli.args.quiet, "No progress lines (errors and warnings still print)");
+  cli.bake->add_flag("--vulkan-validation", cli.args.validation,
                  "Load the Khronos validation layer; any message fails the bake (also "
                  "SKYBAKE_VULKAN_VALIDATION=1)");
 
-  CLI::App* check = app.add_subcommand("check", "Validate a style without baking");
-  add_style_options(check);
+  cli.check = app.add_subcommand("check", "Validate a style without baking");
+  AddStyleOptions(cli.check, cli.args);
 
-  CLI::App* plan = app.add_subcommand(
+  cli.plan = app.add_subcommand(
       "plan", "Print the passes, LUT sizes, shader variant, estimated work and reuse of a bake, and why each "
               "effect is on (also: bake --dry-run)");
-  add_style_options(plan);
+  AddStyleOptions(cli.plan, cli.args);
+}
 
-  GalleryArgs gallery_args;
-  CLI::App* gallery = app.add_subcommand(
+void AddGalleryCommand(CLI::App& app, Cli& cli) {
+  cli.gallery = app.add_subcommand(
       "gallery", "Bake every style of a folder and write one labelled contact sheet (gallery.png)");
-  gallery->add_option("styles", gallery_args.styles_dir, "Folder of style TOML files")
+  cli.gallery->add_option("styles", cli.gallery_args.styles_dir, "Folder of style TOML files")
       ->capture_default_str();
-  gallery->add_option("--out", gallery_args.out_dir, "Output folder")->capture_default_str();
-  gallery->add_option("--size", gallery_args.size, "Latlong height H of each style (2H x H)")
+  cli.gallery->add_option("--out", cli.gallery_args.out_dir, "Output folder")->capture_default_str();
+  cli.gallery->add_option("--size", cli.gallery_args.size, "Latlong height H of each style (2H x H)")
       ->capture_default_str()
       ->check(CLI::Range(8, 2048));
-  gallery->add_option("--columns", gallery_args.columns, "Tiles per row")
+  cli.gallery->add_option("--columns", cli.gallery_args.columns, "Tiles per row")
       ->capture_default_str()
       ->check(CLI::Range(1, 16));
-  gallery->add_option("--set", args.overrides, "Override a key in every style (repeatable)");
-  gallery->add_option("--device", args.device, "Vulkan device index from 'skybake devices'");
-  gallery->add_flag("--force", args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
-  gallery->add_flag("--quiet,-q", args.quiet, "No progress lines");
-  gallery->add_flag("--vulkan-validation", args.validation, "Load the Khronos validation layer");
+  cli.gallery->add_option("--set", cli.args.overrides, "Override a key in every style (repeatable)");
+  cli.gallery->add_option("--device", cli.args.device, "Vulkan device index from 'skybake devices'");
+  cli.gallery->add_flag("--force", cli.args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
+  cli.gallery->add_flag("--quiet,-q", cli.args.quiet, "No progress lines");
+  cli.gallery->add_flag("--vulkan-validation", cli.args.validation, "Load the Khronos validation layer");
+}
 
-  TestPatternOptions pattern;
-  CLI::App* testpattern = app.add_subcommand(
+// testpattern, view, merge-manifest, devices, accuracy.
+void AddToolCommands(CLI::App& app, Cli& cli) {
+  cli.testpattern = app.add_subcommand(
       "testpattern", "Write an orientation test pattern (faces named, axes, horizon, N E S W) as a bake's files, "
                      "through an engine preset: check the preset in your engine (docs/engines.md)");
-  testpattern->add_option("--out", pattern.out_dir, "Output folder")->capture_default_str();
-  testpattern->add_option("--engine", pattern.engine, "Engine preset whose files to write too")
+  cli.testpattern->add_option("--out", cli.pattern.out_dir, "Output folder")->capture_default_str();
+  cli.testpattern->add_option("--engine", cli.pattern.engine, "Engine preset whose files to write too")
       ->check(CLI::IsMember(EngineNames()));
-  testpattern->add_option("--size", pattern.size, "Cube face size N; the latlong is 2N x N")
+  cli.testpattern->add_option("--size", cli.pattern.size, "Cube face size N; the latlong is 2N x N")
       ->capture_default_str()
       ->check(CLI::Range(8, 4096));
-  testpattern->add_flag("--force", pattern.force, "Overwrite the pattern's files in --out");
+  cli.testpattern->add_flag("--force", cli.pattern.force, "Overwrite the pattern's files in --out");
 
-  ViewPageOptions view_options;
-  CLI::App* view = app.add_subcommand(
+  cli.view = app.add_subcommand(
       "view", "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
               "to look around, exposure, frames");
-  view->add_option("dir", view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
-  view->add_flag("--force", view_options.force, "Replace an existing view.html");
-  view->add_option("--embed-mib", view_options.embed_mib,
-                   "Frames inside the page while their files total at most this many MiB (the first always); "
-                   "later ones are loaded from their files when the page is served over HTTP")
+  cli.view->add_option("dir", cli.view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
+  cli.view->add_flag("--force", cli.view_options.force, "Replace an existing view.html");
+  cli.view->add_option("--embed-mib", cli.view_options.embed_mib,
+                       "Frames inside the page while their files total at most this many MiB (the first always); "
+                       "later ones are loaded from their files when the page is served over HTTP")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
 
-  MergeOptions merge_options;
-  bool sizes_only = false;
-  CLI::App* merge = app.add_subcommand(
+  cli.merge = app.add_subcommand(
       "merge-manifest",
       "Join the shard manifests (manifest.shard-FIRST-LAST.json, from bake --shard or --frames) of a folder into "
       "manifest.json and write the glTF scene, equal to an unsharded bake's; checks that the parts are of one "
       "bake, cover every frame once, and that every listed file is there with its SHA-256");
-  merge->add_option("dir", merge_options.dir, "Folder holding every part's files and shard manifest")->required();
-  merge->add_flag("--force", merge_options.force, "Replace an existing manifest.json and glTF scene");
-  merge->add_flag("--sizes-only", sizes_only, "Check listed files by size only, without reading them for SHA-256");
+  cli.merge->add_option("dir", cli.merge_options.dir, "Folder holding every part's files and shard manifest")->required();
+  cli.merge->add_flag("--force", cli.merge_options.force, "Replace an existing manifest.json and glTF scene");
+  cli.merge->add_flag("--sizes-only", cli.sizes_only, "Check listed files by size only, without reading them for SHA-256");
 
-  CLI::App* devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
+  cli.devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
 
-  AccuracyStudyOptions study;
-  CLI::App* accuracy = app.add_subcommand(
+  cli.accuracy = app.add_subcommand(
       "accuracy", "Run the accuracy-versus-time study of every integrator and write its tables and plot");
-  accuracy->add_option("--out", study.out_dir, "Folder for accuracy_results.md, accuracy.csv, accuracy.png")
+  cli.accuracy->add_option("--out", cli.study.out_dir, "Folder for accuracy_results.md, accuracy.csv, accuracy.png")
       ->capture_default_str();
-  accuracy->add_option("--shared", study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
-  accuracy->add_flag("--quick", study.quick, "Fewer cases and directions (a smoke run)");
-  accuracy->add_option("--only", study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
-  accuracy->add_option("--observer-altitude-m", study.observer_altitude_m, "Observer altitude of the study (m)")
+  cli.accuracy->add_option("--shared", cli.study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
+  cli.accuracy->add_flag("--quick", cli.study.quick, "Fewer cases and directions (a smoke run)");
+  cli.accuracy->add_option("--only", cli.study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
+  cli.accuracy->add_option("--observer-altitude-m", cli.study.observer_altitude_m, "Observer altitude of the study (m)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));
+}
 
-  // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
-  // like a full disk, instead of killing the process mid-file.
-  std::signal(SIGXFSZ, SIG_IGN);
-
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    int code = app.exit(e);
-    return code == 0 ? kExitOk : kExitUsage;
-  }
-
-  // Single-threaded still: the only point where the environment may change.
-  SelectSoftwareDriversWithoutGpu();
-  // The environment's switches, read once here and passed in (README).
+// The environment, read here alone and passed in (docs/architecture.md).
+// Single-threaded still: the only point where the environment may change.
+// The Vulkan loader reads VK_LOADER_DRIVERS_SELECT when the first instance
+// is made, so the driver choice is set here, before any Vulkan call.
+void ReadEnvironment(BakeArgs& args) {
+  EnvironmentVariables variables;
+  for (const std::string& name : DriverEnvironmentVariableNames())
+    if (const char* value = std::getenv(name.c_str())) variables[name] = value;
+  args.software_driver_selection = SoftwareDriverSelection(ProbeDriverEnvironment(variables));
+  if (!args.software_driver_selection.empty())
+    ::setenv("VK_LOADER_DRIVERS_SELECT", args.software_driver_selection.c_str(), 1);
+  if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) SetOiioModuleDir(dir);
+  if (const char* catalogue = std::getenv("SKYBAKE_STAR_CATALOGUE"); catalogue && *catalogue)
+    args.star_catalogue = catalogue;
   args.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
   args.shaders.generic = EnvIs("SKYBAKE_GENERIC_SHADERS", "1");
   args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");
+}
+
+int RunCommand(Cli& cli) {
+  if (cli.devices->parsed()) return RunDevices(cli.args.software_driver_selection);
+  if (cli.accuracy->parsed()) {
+    cli.study.progress = [](const std::string& line) { std::fprintf(stderr, "skybake: %s\n", line.c_str()); };
+    std::string report = RunAccuracyStudy(cli.study);
+    std::printf("%s", report.c_str());
+    return kExitOk;
+  }
+  if (cli.check->parsed()) return RunBake(cli.args, Mode::kCheck);
+  if (cli.plan->parsed()) return RunBake(cli.args, Mode::kPlan);
+  if (cli.gallery->parsed()) return RunGallery(cli.gallery_args, cli.args);
+  if (cli.view->parsed()) {
+    if (const char* three = std::getenv("SKYBAKE_THREE_DIR")) cli.view_options.three_dir = three;
+    std::printf("%s\n", WriteViewPage(cli.view_options).c_str());
+    return kExitOk;
+  }
+  if (cli.testpattern->parsed()) {
+    for (const std::string& path : WriteTestPattern(cli.pattern)) std::printf("%s\n", path.c_str());
+    return kExitOk;
+  }
+  if (cli.merge->parsed()) {
+    cli.merge_options.verify_checksums = !cli.sizes_only;
+    return RunMergeManifest(cli.merge_options);
+  }
+  return RunBake(cli.args, Mode::kBake);
+}
+
+// Runs the command given; maps every error to its exit code.
+int RunReportingErrors(Cli& cli) {
   try {
-    if (devices->parsed()) return RunDevices();
-    if (accuracy->parsed()) {
-      study.progress = [](const std::string& line) { std::fprintf(stderr, "skybake: %s\n", line.c_str()); };
-      std::string report = RunAccuracyStudy(study);
-      std::printf("%s", report.c_str());
-      return kExitOk;
-    }
-    if (check->parsed()) return RunBake(args, Mode::kCheck);
-    if (plan->parsed()) return RunBake(args, Mode::kPlan);
-    if (gallery->parsed()) return RunGallery(gallery_args, args);
-    if (view->parsed()) {
-      std::printf("%s\n", WriteViewPage(view_options).c_str());
-      return kExitOk;
-    }
-    if (testpattern->parsed()) {
-      for (const std::string& path : WriteTestPattern(pattern)) std::printf("%s\n", path.c_str());
-      return kExitOk;
-    }
-    if (merge->parsed()) {
-      merge_options.verify_checksums = !sizes_only;
-      return RunMergeManifest(merge_options);
-    }
-    return RunBake(args, Mode::kBake);
+    return RunCommand(cli);
   } catch (const Error& e) {
     // Every user error of every layer (base/errors.h): its message, its exit code.
     if (const auto* config = dynamic_cast<const ConfigFailure*>(&e)) PrintErrors(config->errors);
@@ -525,4 +548,35 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());
     return kExitInternal;
   }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  KeepFrameMemoryInHeap();
+  CLI::App app{"skybake " SKYBAKE_VERSION
+               ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
+               "into OpenEXR environment maps with Vulkan compute.\n"
+               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
+               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
+               "manifests that do not merge."};
+  app.require_subcommand(1);
+  app.get_formatter()->column_width(34);
+  Cli cli;
+  AddBakeCommands(app, cli);
+  AddGalleryCommand(app, cli);
+  AddToolCommands(app, cli);
+
+  // A file-size limit (ulimit -f) makes write() fail with EFBIG, reported
+  // like a full disk, instead of killing the process mid-file.
+  std::signal(SIGXFSZ, SIG_IGN);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitUsage;
+  }
+  ReadEnvironment(cli.args);
+  return RunReportingErrors(cli);
 }

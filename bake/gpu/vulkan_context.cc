@@ -127,16 +127,15 @@ std::vector<VkPhysicalDevice> EnumerateDevices(VkInstance instance) {
 }  // namespace
 
 namespace {
-std::string driver_selection;  // SelectSoftwareDriversWithoutGpu
 
 bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
 // The folders the Vulkan loader searches for driver manifests on Linux
 // (its LoaderInterfaceArchitecture.md, "Driver Discovery on Linux").
-std::vector<std::filesystem::path> ManifestFolders() {
-  auto env = [](const char* name, const char* fallback) {
-    const char* v = std::getenv(name);
-    return std::string(v && *v ? v : fallback);
+std::vector<std::filesystem::path> ManifestFolders(const EnvironmentVariables& environment) {
+  auto env = [&](const char* name, const char* fallback) {
+    auto it = environment.find(name);
+    return it != environment.end() && !it->second.empty() ? it->second : std::string(fallback);
   };
   const std::string home = env("HOME", "");
   std::vector<std::filesystem::path> folders;
@@ -154,15 +153,23 @@ std::vector<std::filesystem::path> ManifestFolders() {
 }
 }  // namespace
 
-DriverEnvironment ProbeDriverEnvironment() {
+const std::vector<std::string>& DriverEnvironmentVariableNames() {
+  static const std::vector<std::string> names = {
+      "VK_ICD_FILENAMES", "VK_DRIVER_FILES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
+      "VK_LOADER_DRIVERS_DISABLE", "SKYBAKE_ALL_VULKAN_DRIVERS", "HOME", "XDG_CONFIG_HOME", "XDG_CONFIG_DIRS",
+      "XDG_DATA_HOME", "XDG_DATA_DIRS"};
+  return names;
+}
+
+DriverEnvironment ProbeDriverEnvironment(const EnvironmentVariables& environment) {
   DriverEnvironment e;
   for (const char* name : {"VK_ICD_FILENAMES", "VK_DRIVER_FILES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
                            "VK_LOADER_DRIVERS_DISABLE"}) {
-    const char* v = std::getenv(name);
-    if (v && *v) e.drivers_chosen_by_user = true;
+    auto it = environment.find(name);
+    if (it != environment.end() && !it->second.empty()) e.drivers_chosen_by_user = true;
   }
-  const char* all = std::getenv("SKYBAKE_ALL_VULKAN_DRIVERS");
-  if (all && std::strcmp(all, "1") == 0) e.drivers_chosen_by_user = true;
+  auto all = environment.find("SKYBAKE_ALL_VULKAN_DRIVERS");
+  if (all != environment.end() && all->second == "1") e.drivers_chosen_by_user = true;
   auto gpu_node = [](const std::string& folder, const std::string& name) {
     if (folder == "/dev/dri") return StartsWith(name, "renderD") || StartsWith(name, "card");
     return StartsWith(name, "nvidia") || name == "dxg" || StartsWith(name, "kgsl") || StartsWith(name, "mali");
@@ -173,7 +180,7 @@ DriverEnvironment ProbeDriverEnvironment() {
       for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
         if (e.gpu_device_node.empty() && gpu_node(folder, entry.path().filename().string()))
           e.gpu_device_node = entry.path().string();
-    for (const std::filesystem::path& folder : ManifestFolders())
+    for (const std::filesystem::path& folder : ManifestFolders(environment))
       for (const auto& entry : std::filesystem::directory_iterator(folder, ec))
         if (entry.path().extension() == ".json") e.manifests.push_back(entry.path().filename().string());
   } catch (const std::filesystem::filesystem_error&) {
@@ -188,14 +195,6 @@ std::string SoftwareDriverSelection(const DriverEnvironment& environment) {
     if (StartsWith(manifest, "lvp_icd")) return "*lvp_icd*";
   return "";
 }
-
-std::string SelectSoftwareDriversWithoutGpu() {
-  driver_selection = SoftwareDriverSelection(ProbeDriverEnvironment());
-  if (!driver_selection.empty()) ::setenv("VK_LOADER_DRIVERS_SELECT", driver_selection.c_str(), 1);
-  return driver_selection;
-}
-
-const std::string& DriverSelection() { return driver_selection; }
 
 const char* VkResultName(VkResult result) {
   switch (result) {

@@ -126,7 +126,6 @@ std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::str
 }
 
 std::string DefaultStarCataloguePath() {
-  if (const char* env = std::getenv("SKYBAKE_STAR_CATALOGUE"); env && *env) return env;
 #ifdef SKYBAKE_SOURCE_DIR
   return std::string(SKYBAKE_SOURCE_DIR) + "/configs/stars/node_modules/d3-celestial/data/stars.8.json";
 #else

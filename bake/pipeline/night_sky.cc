@@ -104,15 +104,16 @@ ConfigError NightKeyError(const SkyStyle& style, const std::vector<std::string>&
 
 }  // namespace
 
-std::string StarCataloguePathOf(const SkyStyle& style) {
+std::string StarCataloguePathOf(const SkyStyle& style, const std::string& default_catalogue) {
   const std::string& given = style.night.star_catalogue;
-  if (given.empty()) return DefaultStarCataloguePath();
+  if (given.empty()) return default_catalogue;
   std::filesystem::path p(given);
   if (p.is_absolute() || style.source_path.empty()) return given;
   return (std::filesystem::path(style.source_path).parent_path() / p).string();
 }
 
-std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& styles, const Schedule* schedule) {
+std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
+                                       const std::string& default_catalogue) {
   std::vector<ConfigError> errors;
   const SkyStyle* night = nullptr;
   for (const SkyStyle* s : styles)
@@ -135,7 +136,7 @@ std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& style
   std::vector<std::string> checked;
   for (const SkyStyle* s : styles) {
     if (!s->night.stars) continue;
-    const std::string path = StarCataloguePathOf(*s);
+    const std::string path = StarCataloguePathOf(*s, default_catalogue);
     if (std::find(checked.begin(), checked.end(), path) != checked.end()) continue;
     checked.push_back(path);
     std::string error;
@@ -530,14 +531,16 @@ const StarCatalogue& StarCatalogues::Get(const std::string& path) {
   return loaded_.emplace(path, std::move(*c)).first->second;
 }
 
-std::unique_ptr<NightSkyBake> NightSkyBake::For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule) {
+std::unique_ptr<NightSkyBake> NightSkyBake::For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
+                                                const std::string& default_catalogue) {
   if (std::none_of(styles.begin(), styles.end(), [](const SkyStyle* s) { return s->night.Any(); })) return nullptr;
-  const std::vector<ConfigError> errors = CheckNightSky(styles, schedule);
+  const std::vector<ConfigError> errors = CheckNightSky(styles, schedule, default_catalogue);
   if (!errors.empty()) throw ConfigFailure(errors.front().message, errors);
   auto bake = std::unique_ptr<NightSkyBake>(new NightSkyBake());
   bake->place_ = *schedule->place;
+  bake->default_catalogue_ = default_catalogue;
   for (const SkyStyle* s : styles)
-    if (s->night.stars) bake->catalogues_.Get(StarCataloguePathOf(*s));
+    if (s->night.stars) bake->catalogues_.Get(StarCataloguePathOf(*s, default_catalogue));
   return bake;
 }
 
@@ -559,7 +562,7 @@ std::optional<NightFrame> NightSkyBake::Frame(const SkyStyle& unpruned, const st
     tables_.emplace_back(key, std::make_unique<TransmittanceTable>(atmosphere, style.quality, style.effects));
     table = tables_.back().second.get();
   }
-  const StarCatalogue* catalogue = style.night.stars ? &catalogues_.Get(StarCataloguePathOf(style)) : nullptr;
+  const StarCatalogue* catalogue = style.night.stars ? &catalogues_.Get(StarCataloguePathOf(style, default_catalogue_)) : nullptr;
   NightFrame frame = ComputeNightFrame(style, catalogue, *table, JulianDayUt(*time), place_, sun);
   // The glow's zenith luminance is the floor's, which the pruned style has
   // taken out of the shaders (PrunedStyle).

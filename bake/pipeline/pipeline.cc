@@ -196,7 +196,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   // below still comes from every frame of the plan); the night sky's
   // catalogues read and its input checked (night_sky.h).
   const OutputLock lock = ClaimOutputs(plan, options);
-  std::unique_ptr<NightSkyBake> night = NightSkyBake::For(plan.styles(), plan.schedule);
+  std::unique_ptr<NightSkyBake> night = NightSkyBake::For(plan.styles(), plan.schedule, options.star_catalogue);
   const PreviousBake previous = PrepareOutputs(plan, options, timer, result);
 
   // Device: headless Vulkan, best device or the one asked for; one for the whole bake.
@@ -204,7 +204,8 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   std::optional<NightSkyRenderer> night_renderer;  // the moonlit sky's renderer, destroyed before the device
   if (night) night_renderer.emplace(context);
   timer.Finish("device", fmt::format("{} ({}){}", context.device_info().name, context.device_info().type,
-                                     DriverSelection().empty() ? "" : ", software driver only (no GPU device node)"));
+                                     options.vulkan.software_driver_selection.empty() ? ""
+                                                                         : ", software driver only (no GPU device node)"));
   CheckDeviceLimits(plan, context);
 
   RendererCache renderers(context, result, options.shaders);

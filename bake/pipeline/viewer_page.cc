@@ -57,7 +57,6 @@ std::string ScriptSafe(std::string text) {
 
 fs::path ThreeDir(const ViewPageOptions& options) {
   if (!options.three_dir.empty()) return options.three_dir;
-  if (const char* env = std::getenv("SKYBAKE_THREE_DIR")) return env;
   return SKYBAKE_THREE_DEFAULT_DIR;
 }
 

@@ -4,7 +4,7 @@
 // costs about 0.3 s per process on the 2-core machine (docs/performance.md),
 // more than the whole W1 budget's share for it; a bake that writes no PNG
 // never loads them. The module is built beside the binaries
-// (libskybake_oiio.so) and found from SKYBAKE_MODULE_DIR or the directory of
+// (libskybake_oiio.so) and found from SetOiioModuleDir (main: SKYBAKE_MODULE_DIR) or the directory of
 // the running executable.
 #pragma once
 
@@ -40,6 +40,11 @@ struct OiioModule {
 // Loads the module once (thread-safe); throws OutputError naming the file
 // and the fix when it cannot.
 const OiioModule& LoadOiioModule();
+
+// The folder LoadOiioModule looks in first, before the executable's: main
+// passes $SKYBAKE_MODULE_DIR here before any thread starts (the library
+// reads no environment). Has no effect once the module is loaded.
+void SetOiioModuleDir(const std::string& dir);
 
 }  // namespace skybake
 

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -65,20 +66,24 @@ struct DriverEnvironment {
   std::vector<std::string> manifests;   // file names of the installed driver manifests (vulkan/icd.d)
 };
 
-// This machine's: environment variables, /dev, the loader's manifest folders.
-DriverEnvironment ProbeDriverEnvironment();
+// The environment variables the driver choice reads (VK_ICD_FILENAMES,
+// VK_DRIVER_FILES, VK_ADD_DRIVER_FILES, VK_LOADER_DRIVERS_SELECT/_DISABLE,
+// SKYBAKE_ALL_VULKAN_DRIVERS, and HOME and XDG_* for the manifest folders),
+// by name; a name that is not set is absent. main reads them (the library
+// reads no environment).
+using EnvironmentVariables = std::map<std::string, std::string>;
+const std::vector<std::string>& DriverEnvironmentVariableNames();
+
+// This machine's, with `environment`: /dev and the loader's manifest folders.
+DriverEnvironment ProbeDriverEnvironment(const EnvironmentVariables& environment);
 
 // The loader's VK_LOADER_DRIVERS_SELECT that loads only lavapipe, or "" to
 // load every driver: when the user chose none, no GPU device node exists
-// and lavapipe's manifest is installed.
+// and lavapipe's manifest is installed. The loader reads it from the
+// environment when the first Vulkan instance is made, so main sets it
+// before any Vulkan call and any thread starts, and passes it in as
+// VulkanOptions::software_driver_selection.
 std::string SoftwareDriverSelection(const DriverEnvironment& environment);
-
-// Sets VK_LOADER_DRIVERS_SELECT to SoftwareDriverSelection of this machine
-// (call it before any Vulkan call and any thread: it changes the
-// environment); returns the value set, or "". DriverSelection() returns it
-// afterwards.
-std::string SelectSoftwareDriversWithoutGpu();
-const std::string& DriverSelection();
 
 // The layouts of a compute pipeline with one descriptor set of `bindings`
 // and one push-constant block of `push_bytes` bytes; the caller destroys both.
@@ -93,6 +98,9 @@ struct VulkanOptions {
   int device_index = -1;      // -1: choose the best usable device
   bool validation = false;    // load VK_LAYER_KHRONOS_validation
   bool print_messages = true; // print validation messages to stderr
+  // The VK_LOADER_DRIVERS_SELECT main set (SoftwareDriverSelection), or ""
+  // when every driver is loaded; reported with the device.
+  std::string software_driver_selection;
 };
 
 class VulkanContext {

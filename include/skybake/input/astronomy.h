@@ -76,9 +76,11 @@ struct StarCatalogue {
 // the fix.
 std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::string& error);
 
-// The catalogue night.star_catalogue = "" means: $SKYBAKE_STAR_CATALOGUE when
-// set, else d3-celestial's stars.8.json (41,411 stars to V = 8) where
-// .ci/setup installs it (configs/stars/node_modules, in the source tree).
+// The catalogue night.star_catalogue = "" means unless the command line
+// gives another (main: $SKYBAKE_STAR_CATALOGUE, passed in as
+// BakeOptions::star_catalogue): d3-celestial's stars.8.json (41,411 stars
+// to V = 8) where .ci/setup installs it (configs/stars/node_modules, in the
+// source tree).
 std::string DefaultStarCataloguePath();
 
 // A direction in the observer's sky.

@@ -67,15 +67,17 @@ struct Schedule;
 // Relative addition below which a splat is left out (see above).
 inline constexpr double kNightSplatMinRelative = 1.0 / 8192.0;
 
-// The catalogue path a style names (resolved against its folder).
-std::string StarCataloguePathOf(const SkyStyle& style);
+// The catalogue path a style names (resolved against its folder), or
+// `default_catalogue` when it names none (night.star_catalogue = "").
+std::string StarCataloguePathOf(const SkyStyle& style, const std::string& default_catalogue);
 
 // Errors of the night sky found before any GPU work: a catalogue that is
 // missing, unreadable or not a star file; night features in a bake whose
 // frames have no clock time and place (a single bake, or a schedule of sun
 // positions). `styles`: every frame's style; `schedule`: null for a single
 // bake. Each error is located at the style's [night] key.
-std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& styles, const Schedule* schedule);
+std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
+                                       const std::string& default_catalogue);
 
 // A point source at the observer: unit direction and irradiance (output
 // units x sr), after the atmosphere.
@@ -207,7 +209,10 @@ class StarCatalogues {
 // serves each frame. Null when no frame has any of it.
 class NightSkyBake {
  public:
-  static std::unique_ptr<NightSkyBake> For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule);
+  // `default_catalogue`: the catalogue of a style that names none
+  // (BakeOptions::star_catalogue).
+  static std::unique_ptr<NightSkyBake> For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
+                                           const std::string& default_catalogue);
 
   // The frame's night (CPU), or nothing when its style has none. `style`
   // as given (pruned here), `time` the frame's clock time.
@@ -231,6 +236,7 @@ class NightSkyBake {
  private:
   double seconds_ = 0.0;
   GeoLocation place_;
+  std::string default_catalogue_;
   StarCatalogues catalogues_;
   std::vector<std::pair<std::vector<unsigned char>, std::unique_ptr<TransmittanceTable>>> tables_;
 };

@@ -14,6 +14,7 @@
 #include "skybake/base/errors.h"
 #include "skybake/gpu/sky_renderer.h"
 #include "skybake/gpu/vulkan_context.h"
+#include "skybake/input/astronomy.h"
 #include "skybake/input/config.h"
 #include "skybake/input/schedule.h"
 #include "skybake/input/shard.h"
@@ -30,6 +31,9 @@ struct BakeOptions {
   std::string out_dir = "out";
   VulkanOptions vulkan;
   ShaderSwitches shaders;     // the CLI's diagnostic switches (from the environment, read in main)
+  // The star catalogue of a style whose night.star_catalogue is "" (main:
+  // $SKYBAKE_STAR_CATALOGUE when set).
+  std::string star_catalogue = DefaultStarCataloguePath();
   ProgressCallback progress;  // may be empty
   bool force = false;   // overwrite files of a previous bake in out_dir
   bool resume = false;  // sequence: keep frames verified against its manifest in out_dir, bake the rest

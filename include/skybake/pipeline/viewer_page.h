@@ -24,7 +24,7 @@ namespace skybake {
 
 struct ViewPageOptions {
   std::string dir;          // the bake's folder; the page is written there
-  std::string three_dir;    // three.js's npm package folder (empty: the project's, or $SKYBAKE_THREE_DIR)
+  std::string three_dir;    // three.js's npm package folder (empty: the project's; main: $SKYBAKE_THREE_DIR)
   bool force = false;       // replace an existing view.html
   double embed_mib = 64.0;  // frames inside the page while their files total at most this, MiB (the first always)
 };
