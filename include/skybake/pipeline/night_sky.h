@@ -107,6 +107,30 @@ std::vector<TexelAdd> SplatPointSources(const ViewRequest& view, const std::vect
 // largest channel is dropped; returns how many were applied.
 size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, float* rgba_out, double min_relative);
 
+// The bound that spares a frame the splat when it cannot change the maps
+// (a day frame's stars and Moon under a bright sky). A texel's load is the
+// sum of the largest channel of the irradiance of every source that has it
+// among its targets (a latlong's repeated meridian with column 0); a
+// texel's addition (largest channel) is at most its load over its solid
+// angle (a source's weights are at most 1), so where the load is under
+// min_relative x (the texel's largest channel) x (its solid angle)
+// ApplyTexelAdds drops the addition. Only the sources that reach the other
+// ("open") texels need the splat, and only their additions to open texels
+// are kept: each texel kept gets the same sum, formed in the same order, as
+// in the whole splat, so the maps are byte for byte the same
+// (tests/night_sky_test.cc). No open texel: nothing to splat. The bound
+// costs the texel lookups of the splat (shared with it), a sort of the
+// texels reached and one solid angle per texel.
+struct SplatBound {
+  std::vector<size_t> sources;  // the indices of those that reach an open texel, increasing
+  std::vector<size_t> open;     // the open texels, increasing
+};
+// SplatPointSources through the bound: its additions to the open texels.
+// `rgba`: the view's texels as they are before the splat; `bound`: what it
+// found, when wanted.
+std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources, const float* rgba,
+                                   double min_relative, SplatBound* bound = nullptr);
+
 // The atmosphere's transmittance from the observer to space along a
 // direction, as a table over mu = cos(zenith angle): the shared integral
 // (ReferenceModel::TransmittanceDirect, 256 steps) at 4096 values of mu,
@@ -130,6 +154,7 @@ struct NightFrame {
   Rgb moon_irradiance{0.0, 0.0, 0.0}; // the Moon at the observer, output units x sr (after the atmosphere)
   double moon_illuminance_lux = 0.0;  // the same as illuminance
   double moonlight_scale = 0.0;       // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
+  bool daylight = false;              // the Sun above the horizon: splats go through SplatBound
   // With night.airglow: the glow's radiance by mu = cos(zenith angle) of
   // the view (output units), AirglowTable.
   std::vector<Rgb> airglow;
@@ -177,6 +202,13 @@ class NightSkyRenderer {
                   std::vector<std::vector<float>>& faces);
 
   int moonlight_renders() const { return moonlight_renders_; }
+  // With false, every splat runs whole (SplatBound off; by night it always
+  // does): for the test that the bound changes no byte.
+  void set_splat_bound(bool on) { splat_bound_ = on; }
+  // Views (and faces) whose splat the bound skipped altogether, and those
+  // splatted (in part or whole), since construction.
+  size_t splats_skipped() const { return splats_skipped_; }
+  size_t splats_run() const { return splats_run_; }
   double last_moonlight_seconds() const { return last_moonlight_seconds_; }
 
  private:
@@ -184,6 +216,12 @@ class NightSkyRenderer {
                                              const std::vector<ViewRequest>& views);
   // mu = cos(zenith angle) of every texel of a view, computed once.
   const std::vector<float>& TexelMu(const ViewRequest& view);
+  // The splat of `sources` into `view` over `rgba`, through the bound while
+  // the Sun is up (SplatBound).
+  std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources,
+                                     const float* rgba, bool daylight);
+  bool splat_bound_ = true;
+  size_t splats_skipped_ = 0, splats_run_ = 0;
   VulkanContext& context_;
   std::map<std::array<int, 4>, std::vector<float>> texel_mu_;
   std::unique_ptr<SkyRenderer> moonlight_;
