@@ -414,6 +414,18 @@ TEST_F(NightBake, RefusesBadInputWithTheFix) {
   EXPECT_NE(missing.output.find("cannot read the star catalogue '/no/such/stars.json'"), std::string::npos)
       << missing.output;
   EXPECT_NE(missing.output.find("bash .ci/setup"), std::string::npos);
+  // Given with --set, the error points at the argument, not at the style.
+  EXPECT_EQ(missing.output.find("skybake: error: --set night.star_catalogue=\"/no/such/stars.json\":1:1: "
+                                "night.star_catalogue: cannot read"),
+            0u)
+      << missing.output;
+  // A relative path given with --set is taken from the working directory.
+  testing::CommandRun relative = RunSkybake(
+      fmt::format("check '{}' --schedule '{}' --set night.star_catalogue=night.toml", style, schedule),
+      fmt::format("cd '{}' &&", dir_));
+  EXPECT_EQ(relative.exit_code, 3) << relative.output;
+  EXPECT_NE(relative.output.find("--set night.star_catalogue=night.toml:1:1: night.star_catalogue:"), std::string::npos)
+      << relative.output;
   testing::CommandRun limit =
       RunSkybake(fmt::format("check '{}' --schedule '{}' --set night.star_magnitude_limit=20", style, schedule));
   EXPECT_EQ(limit.exit_code, 3) << limit.output;

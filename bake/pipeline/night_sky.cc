@@ -108,7 +108,7 @@ std::string StarCataloguePathOf(const SkyStyle& style) {
   const std::string& given = style.night.star_catalogue;
   if (given.empty()) return DefaultStarCataloguePath();
   std::filesystem::path p(given);
-  if (p.is_absolute() || style.source_path.empty()) return given;
+  if (p.is_absolute() || style.source_path.empty() || !style.night.star_catalogue_set.empty()) return given;
   return (std::filesystem::path(style.source_path).parent_path() / p).string();
 }
 
@@ -139,7 +139,19 @@ std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& style
     if (std::find(checked.begin(), checked.end(), path) != checked.end()) continue;
     checked.push_back(path);
     std::string error;
-    if (!LoadStarCatalogue(path, error)) errors.push_back(NightKeyError(*s, {"night.star_catalogue", "night.stars"}, error));
+    if (LoadStarCatalogue(path, error)) continue;
+    if (!s->night.star_catalogue_set.empty()) {
+      // Given on the command line: the error points at the argument.
+      ConfigError e;
+      e.file = s->night.star_catalogue_set;
+      e.line = 1;
+      e.column = 1;
+      e.key = "night.star_catalogue";
+      e.message = error;
+      errors.push_back(e);
+      continue;
+    }
+    errors.push_back(NightKeyError(*s, {"night.star_catalogue", "night.stars"}, error));
   }
   return errors;
 }
