@@ -734,6 +734,13 @@ void NightSkyBake::AddToFaces(NightSkyRenderer& renderer, const SkyStyle& style,
   seconds_ += SecondsSince(start);
 }
 
+void NightSkyBake::AddMoonToIbl(const SkyStyle& style, const NightFrame& night, IblRequest& request) {
+  if (!night.moon || !style.ibl.include_sun || !(style.night.moon || style.night.moonlight)) return;
+  request.moon = true;
+  request.moon_direction = night.moon->sky.direction;
+  request.moon_irradiance = night.moon_irradiance;
+}
+
 double NightSkyBake::TakeSeconds() {
   const double s = seconds_;
   seconds_ = 0.0;

@@ -815,6 +815,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       source.size = n;
       for (int face = 0; face < 6; ++face) source.faces[face] = std::move(source_faces[face]);
       IblRequest request{style.ibl, plan.sun, frame.sun_irradiance, style.ibl.dfg && names.with_dfg};
+      if (night_frame) NightSkyBake::AddMoonToIbl(style, *night_frame, request);
       ibl_maps = ibl_baker->Bake(request, source);
       ibl_maps->gltf_scale = GltfIblScale(frame.sh_irradiance_without_sun);
       for (const PassTiming& t : ibl_baker->last_timings()) frame.gpu_passes.push_back(t);

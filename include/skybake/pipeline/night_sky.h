@@ -16,7 +16,8 @@
 //   are added to every frame: by day they fall below the sky's radiance by
 //   the physics alone; an addition under 2^-13 of a texel's own value (a
 //   quarter of half float's resolution) is left out, so a day frame's maps
-//   are not copied at all.
+//   are not copied at all; while the Sun is up a bound (SplatBound) finds
+//   the texels where that is certain and splats only what reaches the others.
 // - The Moon (night.moon): its disc, of the angular radius from its
 //   topocentric distance, lit by the Sun with the Lommel-Seeliger law
 //   L ~ mu0 / (mu0 + mu) (mu0, mu: cosines of incidence and emission; the
@@ -56,6 +57,7 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/input/night_settings.h"
 #include "skybake/model/sh.h"
+#include "skybake/gpu/ibl.h"
 #include "skybake/gpu/sky_renderer.h"
 
 namespace skybake {
@@ -255,6 +257,10 @@ class NightSkyBake {
   // Sun's) when night.moonlight.
   void RecordMoon(const SkyStyle& style, const NightFrame& night, ShRgb& sh_radiance_with_lights,
                   std::optional<MoonRecord>& record) const;
+  // The Moon as the IBL's second point source (IblRequest::moon) when the
+  // style has the Moon (night.moon or night.moonlight) and
+  // ibl.include_sun: the maps then hold the Moon's energy as the Sun's.
+  static void AddMoonToIbl(const SkyStyle& style, const NightFrame& night, IblRequest& request);
   // Host time spent in Frame, AddToViews and AddToFaces (the moonlit
   // renders included) since the last call, s; and what a frame adds, for
   // the progress line.
