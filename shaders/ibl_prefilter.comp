@@ -55,10 +55,14 @@ void main() {
     radiance = push.lobe.x > 0.0 ? PrefilterWithTable(n, uint(push.source.z), samples) : textureLod(source_cube, n, 0.0).rgb;
     if (push.lobe.w != 0.0)
       radiance += SunThroughGgx(n, push.sun_direction.xyz, push.sun_irradiance.xyz, push.lobe.x, push.lobe.z);
+    if (push.lobe.w != 0.0 && push.moon_irradiance.w != 0.0)
+      radiance += SunThroughGgx(n, push.moon_direction.xyz, push.moon_irradiance.xyz, push.lobe.x, push.lobe.z);
   } else {
     radiance = FilterCosine(source_cube, n, samples, push.source.x, push.source.y, push.lobe.y);
     if (push.lobe.w != 0.0)
       radiance += push.sun_irradiance.xyz * (max(dot(n, push.sun_direction.xyz), 0.0) / kIblPi);
+    if (push.lobe.w != 0.0 && push.moon_irradiance.w != 0.0)
+      radiance += push.moon_irradiance.xyz * (max(dot(n, push.moon_direction.xyz), 0.0) / kIblPi);
   }
   output_texels[index] = vec4(radiance, 1.0);
 }

@@ -168,6 +168,58 @@ TEST(IblTest, SunEnergyIsKeptInEveryLevel) {
   testing::ExpectNoValidationMessages();
 }
 
+// The Moon (night sky) goes into the maps as the Sun does: a black sky with
+// the Sun and the Moon holds both energies in every level, the Moon's peak
+// where it is; without IblRequest::moon the maps are the Sun's alone, byte
+// for byte those of a request that never had a Moon.
+TEST(IblTest, MoonEnergyIsKeptBesideTheSuns) {
+  VulkanContext& vk = testing::Vulkan();
+  IblBaker baker(vk);
+  IblRequest sun_only;
+  sun_only.settings = Settings(128);
+  sun_only.settings.include_sun = true;
+  sun_only.sun_direction = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+  sun_only.sun_irradiance = {1000.0, 2000.0, 3000.0};
+  const CubeLevel black = CubeOf(128, [](const glm::dvec3&) { return glm::dvec3(0.0); });
+  IblRequest with_moon = sun_only;
+  with_moon.moon = true;
+  with_moon.moon_direction = glm::normalize(glm::dvec3(-0.6, 0.5, 0.4));
+  with_moon.moon_irradiance = {300.0, 200.0, 100.0};
+  IblRequest moon_off = with_moon;
+  moon_off.moon = false;
+  const IblMaps a = baker.Bake(sun_only, black), b = baker.Bake(with_moon, black), c = baker.Bake(moon_off, black);
+  ASSERT_EQ(b.specular.size(), 5u);
+  for (size_t level = 0; level < b.specular.size(); ++level) {
+    const glm::dvec3 both = SphereIntegral(b.specular[level]);
+    for (int ch = 0; ch < 3; ++ch) {
+      const double expected = sun_only.sun_irradiance[ch] + with_moon.moon_irradiance[ch];
+      EXPECT_NEAR(both[ch], expected, (level == 0 ? 1e-6 : 1e-2) * expected) << "level " << level << " channel " << ch;
+    }
+    for (int face = 0; face < 6; ++face) EXPECT_EQ(a.specular[level].faces[face], c.specular[level].faces[face]);
+  }
+  const glm::dvec3 e = SphereIntegral(b.irradiance);
+  for (int ch = 0; ch < 3; ++ch) {
+    const double expected = sun_only.sun_irradiance[ch] + with_moon.moon_irradiance[ch];
+    EXPECT_NEAR(e[ch], expected, 5e-3 * expected);
+  }
+  // Level 1: the Moon's peak where the Moon is (the Sun's energy removed).
+  const CubeTexel t = VulkanCubeTexelFromDirection(with_moon.moon_direction, b.specular[1].size);
+  float peak = 0.0f;
+  CubeTexel at{};
+  for (int face = 0; face < 6; ++face)
+    for (int i = 0; i < b.specular[1].size * b.specular[1].size; ++i) {
+      const float moon_only = b.specular[1].faces[face][4 * i] - a.specular[1].faces[face][4 * i];
+      if (moon_only > peak) {
+        peak = moon_only;
+        at = {face, i % b.specular[1].size, i / b.specular[1].size};
+      }
+    }
+  EXPECT_EQ(at.face, t.face);
+  EXPECT_LE(std::abs(at.x - t.x), 1);
+  EXPECT_LE(std::abs(at.y - t.y), 1);
+  testing::ExpectNoValidationMessages();
+}
+
 // The split-sum second factor by a deterministic quadrature over the half
 // vector (theta_h, phi_h), written here from its definition:
 //   A = integral D G (1 - Fc) / (4 N.V) dl,  B = the same with Fc,

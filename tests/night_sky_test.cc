@@ -4,9 +4,13 @@
 // manifest, glTF, SH, bad input, byte identity when off).
 #include "skybake/pipeline/night_sky.h"
 
+#include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <cstring>
 #include <fstream>
+#include <random>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -410,6 +414,18 @@ TEST_F(NightBake, RefusesBadInputWithTheFix) {
   EXPECT_NE(missing.output.find("cannot read the star catalogue '/no/such/stars.json'"), std::string::npos)
       << missing.output;
   EXPECT_NE(missing.output.find("bash .ci/setup"), std::string::npos);
+  // Given with --set, the error points at the argument, not at the style.
+  EXPECT_EQ(missing.output.find("skybake: error: --set night.star_catalogue=\"/no/such/stars.json\":1:1: "
+                                "night.star_catalogue: cannot read"),
+            0u)
+      << missing.output;
+  // A relative path given with --set is taken from the working directory.
+  testing::CommandRun relative = RunSkybake(
+      fmt::format("check '{}' --schedule '{}' --set night.star_catalogue=night.toml", style, schedule),
+      fmt::format("cd '{}' &&", dir_));
+  EXPECT_EQ(relative.exit_code, 3) << relative.output;
+  EXPECT_NE(relative.output.find("--set night.star_catalogue=night.toml:1:1: night.star_catalogue:"), std::string::npos)
+      << relative.output;
   testing::CommandRun limit =
       RunSkybake(fmt::format("check '{}' --schedule '{}' --set night.star_magnitude_limit=20", style, schedule));
   EXPECT_EQ(limit.exit_code, 3) << limit.output;
@@ -509,6 +525,126 @@ TEST(NightSkyGpu, MoonlightIsBelowHalfFloatResolutionWhileTheSunIsUp) {
     EXPECT_LT(worst, 1.0 / 2048.0) << moon_elevation;
   }
   testing::ExpectNoValidationMessages();
+}
+
+// The splat bound (SplatBound) skips only what cannot change a byte: the
+// maps of one frame's stars and Moon, with the bound and with every splat
+// run whole, are the same bytes, under a high sun (every view skipped), a
+// low sun with the first-quarter Moon up (its disc shows in daylight: the
+// bound opens only the texels around it), and at night (stars everywhere).
+TEST(NightSkyGpu, SplatBoundChangesNoByte) {
+  SkyStyle style;
+  style.night.stars = true;
+  style.night.moon = true;
+  style.effects.night_dimming = true;
+  std::string error;
+  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
+  ASSERT_TRUE(catalogue) << error;
+  const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
+  const Rgb scale = OutputScale(style.output.units);
+  SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, scale);
+  NightSkyRenderer bounded(testing::Vulkan()), whole(testing::Vulkan());
+  whole.set_splat_bound(false);
+  std::vector<ViewRequest> views = ViewsOfSize(64);
+  for (const ViewRequest& v : ViewsOfSize(256)) views.push_back(v);
+  // Cerro Paranal, 2024-04-15 22:20 UT: the first-quarter Moon 60 deg up
+  // in the East; 2024-04-16 08:20 UT: the Moon down.
+  const GeoLocation paranal{-24.6272, -70.4042};
+  const double moon_up = 2460415.5 + 22.0 / 24.0 + 20.0 / 1440.0, moon_down = moon_up + 10.0 / 24.0;
+  struct Case {
+    double sun_elevation_deg;
+    double julian_day_ut;
+    const char* what;
+  };
+  for (const Case& c : {Case{50.0, moon_down, "high sun"}, Case{4.0, moon_up, "low sun, Moon up"},
+                        Case{-40.0, moon_up, "night"}}) {
+    const glm::dvec3 sun = SunDirectionFromElevationAzimuth(c.sun_elevation_deg, 290.0);
+    const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
+    const NightFrame night = ComputeNightFrame(style, &*catalogue, table, c.julian_day_ut, paranal, sun);
+    ASSERT_GT(night.stars, 1000u);
+    ASSERT_TRUE(night.moon);
+    if (c.julian_day_ut == moon_up) ASSERT_GT(night.moon->sky.elevation_deg, 30.0);
+    else ASSERT_LT(night.moon->sky.elevation_deg, -5.0);
+    std::vector<RgbaImage> a, b;
+    for (size_t i = 0; i < views.size(); ++i) {
+      a.push_back({views[i].width, views[i].height, sky[i], nullptr});
+      b.push_back({views[i].width, views[i].height, sky[i], nullptr});
+    }
+    const size_t skipped_before = bounded.splats_skipped();
+    const auto t0 = std::chrono::steady_clock::now();
+    bounded.AddToViews(style, night, views, a);
+    const auto t1 = std::chrono::steady_clock::now();
+    whole.AddToViews(style, night, views, b);
+    const auto t2 = std::chrono::steady_clock::now();
+    // For the record (docs/performance.md), not a target.
+    std::printf("%s: the night's splat with the bound %.1f ms, whole %.1f ms\n", c.what,
+                std::chrono::duration<double, std::milli>(t1 - t0).count(),
+                std::chrono::duration<double, std::milli>(t2 - t1).count());
+    const size_t skipped = bounded.splats_skipped() - skipped_before;
+    size_t changed = 0;
+    for (size_t i = 0; i < views.size(); ++i) {
+      ASSERT_EQ(a[i].rgba.size(), b[i].rgba.size());
+      EXPECT_EQ(std::memcmp(a[i].rgba.data(), b[i].rgba.data(), a[i].rgba.size() * sizeof(float)), 0)
+          << c.what << ", view " << i;
+      changed += a[i].rgba != sky[i];
+    }
+    if (c.sun_elevation_deg > 40.0) {
+      EXPECT_EQ(skipped, views.size()) << c.what;  // nothing to splat anywhere
+      EXPECT_EQ(changed, 0u) << c.what;
+    } else if (c.sun_elevation_deg > 0.0) {
+      EXPECT_GT(changed, 0u) << c.what;  // the Moon in daylight
+      EXPECT_GT(skipped, 0u) << c.what;  // the faces without it
+    } else {
+      // Stars on every view but the faces below the horizon (-Y); by night
+      // the splats run whole.
+      EXPECT_EQ(skipped, 0u) << c.what;
+      EXPECT_EQ(changed, views.size() - 2) << c.what;
+      EXPECT_EQ(a[3].rgba, sky[3]);
+    }
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+// The bound is conservative for any sky: random skies and random sources,
+// the additions the bound keeps are exactly those ApplyTexelAdds applies.
+TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), log10(-9.0, -3.0), sky(-1.0, 4.0);
+  int nothing_applied = 0, some_applied = 0, skipped_sources = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    // Every other trial a bright sky (10^3 to 10^5) and faint sources.
+    sky = std::uniform_real_distribution<double>(trial % 2 ? 3.0 : -1.0, trial % 2 ? 5.0 : 4.0);
+    log10 = std::uniform_real_distribution<double>(-9.0, trial % 2 ? -6.0 : -3.0);
+    for (const ViewRequest& view : ViewsOfSize(32 + 7 * trial)) {
+      std::vector<PointSource> sources(400);
+      for (PointSource& p : sources) {
+        p.direction = glm::normalize(glm::dvec3(unit(rng), unit(rng), unit(rng)));
+        const double e = std::pow(10.0, log10(rng));
+        p.irradiance = {e, e * 0.8, e * 1.1};
+      }
+      std::vector<float> rgba(size_t(view.width) * view.height * 4, 1.0f);
+      for (size_t i = 0; i < rgba.size(); ++i)
+        if (i % 4 != 3) rgba[i] = float(std::pow(10.0, sky(rng)));
+      SplatBound bound;
+      const std::vector<TexelAdd> bounded = BoundedSplat(view, sources, rgba.data(), kNightSplatMinRelative, &bound);
+      std::vector<float> whole = rgba, kept = rgba;
+      const size_t applied = ApplyTexelAdds(SplatPointSources(view, sources), rgba.data(), whole.data(),
+                                            kNightSplatMinRelative);
+      ApplyTexelAdds(bounded, rgba.data(), kept.data(), kNightSplatMinRelative);
+      EXPECT_EQ(std::memcmp(whole.data(), kept.data(), whole.size() * sizeof(float)), 0) << trial << " " << view.mapping;
+      if (applied == 0) {
+        ++nothing_applied;
+        continue;
+      }
+      ++some_applied;
+      EXPECT_FALSE(bound.open.empty());
+      skipped_sources += bound.sources.size() < sources.size();
+    }
+  }
+  // Both kinds of sky were met, and the bound left sources out of some.
+  EXPECT_GT(nothing_applied, 0);
+  EXPECT_GT(some_applied, 0);
+  EXPECT_GT(skipped_sources, 0);
 }
 
 }  // namespace

@@ -378,6 +378,12 @@ set = { "sun.elevation_deg " = 5 }
     {"SetReplacesATableByANumber", "", nullptr, "--set sun=1", 3,
          "skybake: error: --set sun=1:1:5: sun: expected a table ([sun] with its keys), got an integer\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"SetUnknownKeyIsLocatedAtTheSet", "", nullptr, "--set render.cube_sizes=64", 3,
+         "skybake: error: --set render.cube_sizes=64:1:8: render.cube_sizes: unknown key 'cube_sizes' (did you mean 'render.cube_size'?)\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetUnknownTableIsLocatedAtTheSet", "", nullptr, "--set nosuch.key=1", 3,
+         "skybake: error: --set nosuch.key=1:1:1: nosuch: unknown key 'nosuch'\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"SetReplacesATableByAnArray", "", nullptr, "--set render=[]", 3,
          "skybake: error: --set render=[]:1:5: render: expected a table ([render] with its keys), got an array\n"
          "skybake: 1 error; nothing was baked\n"},

@@ -442,6 +442,10 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
                           float(request.sun_direction.z), 0.0f};
     push.sun_irradiance = {float(request.sun_irradiance[0]), float(request.sun_irradiance[1]),
                            float(request.sun_irradiance[2]), 0.0f};
+    push.moon_direction = {float(request.moon_direction.x), float(request.moon_direction.y),
+                           float(request.moon_direction.z), 0.0f};
+    push.moon_irradiance = {float(request.moon_irradiance[0]), float(request.moon_irradiance[1]),
+                            float(request.moon_irradiance[2]), request.moon ? 1.0f : 0.0f};
     return push;
   };
   // The sample tables first (rows of 64 samples), then a barrier: the
@@ -537,6 +541,12 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
       const double solid_angle = CubeTexelSolidAngle(t.x, t.y, source.size);
       float* texel = &maps.specular[0].faces[t.face][(size_t(t.y) * source.size + t.x) * 4];
       for (int c = 0; c < 3; ++c) texel[c] += float(request.sun_irradiance[c] / solid_angle);
+      if (request.moon) {
+        const CubeTexel m = VulkanCubeTexelFromDirection(request.moon_direction, source.size);
+        const double moon_solid_angle = CubeTexelSolidAngle(m.x, m.y, source.size);
+        float* moon_texel = &maps.specular[0].faces[m.face][(size_t(m.y) * source.size + m.x) * 4];
+        for (int c = 0; c < 3; ++c) moon_texel[c] += float(request.moon_irradiance[c] / moon_solid_angle);
+      }
     }
   }
   for (const Pass& p : passes) {

@@ -923,6 +923,16 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
       return;
     }
   }
+  // Keys and tables made here are located at the --set argument (column:
+  // where the key part starts), so errors about them name it, not the file.
+  const toml::source_path_ptr where = std::make_shared<const std::string>(name);
+  auto region_at = [&](size_t offset) {
+    toml::source_region r;
+    r.begin = {1, toml::source_index(offset + 1)};
+    r.end = r.begin;
+    r.path = where;
+    return r;
+  };
   toml::table* table = &root;
   std::string_view path = key;
   size_t dot;
@@ -932,7 +942,9 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
       fail("empty part in the key path (two dots, or a leading dot): e.g. --set sun.elevation_deg=10");
       return;
     }
-    auto [it, inserted] = table->insert(part, toml::table{});
+    toml::table made_in = toml::parse("t = {}", name);
+    toml::table made = std::move(*made_in.get("t")->as_table());
+    auto [it, inserted] = table->insert(toml::key(part, region_at(key.size() - path.size())), std::move(made));
     if (!it->second.is_table()) {
       fail(fmt::format("'{}' is not a table", part));
       return;
@@ -944,7 +956,7 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
     fail("empty key");
     return;
   }
-  table->insert_or_assign(path, std::move(*parsed.get("v")));
+  table->insert_or_assign(toml::key(path, region_at(key.size() - path.size())), std::move(*parsed.get("v")));
 }
 
 }  // namespace
@@ -1205,6 +1217,8 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   StyleReader reader(root, name, result.errors);
   VisitStyle(result.style, reader);
   reader.ReportUnknownKeys({"schedule"});  // read by LoadSchedule (schedule.h)
+  if (const toml::node* c = root.at_path("night.star_catalogue").node(); c && c->source().path && *c->source().path != name)
+    result.style.night.star_catalogue_set = *c->source().path;
 
   // Cross-field checks, located at the second key.
   StyleChecks checks{root, name, result.errors, result.warnings};

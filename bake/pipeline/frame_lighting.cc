@@ -73,6 +73,7 @@ IblMaps RenderFrameIbl(SkyRenderer& renderer, std::unique_ptr<IblBaker>& baker, 
   source.size = n;
   for (int face = 0; face < 6; ++face) source.faces[face] = std::move(source_faces[face]);
   IblRequest request{style.ibl, plan.sun, frame.sun_irradiance, style.ibl.dfg && plan.names.with_dfg};
+  if (night) NightSkyBake::AddMoonToIbl(style, night->frame, request);
   IblMaps maps = baker->Bake(request, source);
   maps.gltf_scale = GltfIblScale(frame.sh_irradiance_without_sun);
   for (const PassTiming& t : baker->last_timings()) frame.gpu_passes.push_back(t);

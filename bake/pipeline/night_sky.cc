@@ -108,7 +108,7 @@ std::string StarCataloguePathOf(const SkyStyle& style, const std::string& defaul
   const std::string& given = style.night.star_catalogue;
   if (given.empty()) return default_catalogue;
   std::filesystem::path p(given);
-  if (p.is_absolute() || style.source_path.empty()) return given;
+  if (p.is_absolute() || style.source_path.empty() || !style.night.star_catalogue_set.empty()) return given;
   return (std::filesystem::path(style.source_path).parent_path() / p).string();
 }
 
@@ -140,7 +140,19 @@ std::vector<ConfigError> CheckNightSky(const std::vector<const SkyStyle*>& style
     if (std::find(checked.begin(), checked.end(), path) != checked.end()) continue;
     checked.push_back(path);
     std::string error;
-    if (!LoadStarCatalogue(path, error)) errors.push_back(NightKeyError(*s, {"night.star_catalogue", "night.stars"}, error));
+    if (LoadStarCatalogue(path, error)) continue;
+    if (!s->night.star_catalogue_set.empty()) {
+      // Given on the command line: the error points at the argument.
+      ConfigError e;
+      e.file = s->night.star_catalogue_set;
+      e.line = 1;
+      e.column = 1;
+      e.key = "night.star_catalogue";
+      e.message = error;
+      errors.push_back(e);
+      continue;
+    }
+    errors.push_back(NightKeyError(*s, {"night.star_catalogue", "night.stars"}, error));
   }
   return errors;
 }
@@ -180,72 +192,107 @@ double ViewTexelSolidAngle(const ViewRequest& view, int x, int y) {
   return 0.0;
 }
 
-std::vector<TexelAdd> SplatPointSources(const ViewRequest& view, const std::vector<PointSource>& sources) {
-  std::map<size_t, std::array<double, 3>> sums;
+namespace {
+
+// The texels a source at unit `d` lands on in `view`, with their bilinear
+// weights (before the renormalization within the view); none when it falls
+// on another face.
+struct SplatTarget {
+  size_t index;
+  double weight, solid_angle;
+  int x, y;
+};
+void SplatTargets(const ViewRequest& view, const glm::dvec3& d, std::vector<SplatTarget>& targets) {
+  targets.clear();
   const int w = view.width, h = view.height;
-  for (const PointSource& s : sources) {
-    if (s.irradiance[0] <= 0.0 && s.irradiance[1] <= 0.0 && s.irradiance[2] <= 0.0) continue;
-    const glm::dvec3 d = glm::normalize(s.direction);
-    // (texel index, weight, solid angle) of the up to four neighbours.
-    struct Target {
-      size_t index;
-      double weight, solid_angle;
-      int x, y;
-    };
-    std::vector<Target> targets;
-    if (view.mapping == MAPPING_VULKAN_FACE) {
-      int face;
-      double u, v;
-      VulkanFaceAndTexel(d, w, face, u, v);
-      if (face != view.face) continue;
-      const Bilinear b = BilinearAt(u, v);
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i)
-          if (b.x[i] >= 0 && b.x[i] < w && b.y[j] >= 0 && b.y[j] < w && b.w[j][i] > 0.0)
-            targets.push_back({size_t(b.y[j]) * w + b.x[i], b.w[j][i], 0.0, b.x[i], b.y[j]});
-    } else if (view.mapping == MAPPING_CUBE_STRIP) {
-      const Imath::Box2i window = Window(w, h);
-      Imf::CubeMapFace face;
-      Imath::V2f pif;
-      Imf::CubeMap::faceAndPixelPosition(Imath::V3f(float(d.x), float(d.y), float(d.z)), window, face, pif);
-      const Bilinear b = BilinearAt(pif.x, pif.y);
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i)
-          if (b.x[i] >= 0 && b.x[i] < w && b.y[j] >= 0 && b.y[j] < w && b.w[j][i] > 0.0) {
-            const Imath::V2f p = Imf::CubeMap::pixelPosition(face, window, Imath::V2f(float(b.x[i]), float(b.y[j])));
-            const int px = int(std::lround(p.x)), py = int(std::lround(p.y));
-            targets.push_back({size_t(py) * w + px, b.w[j][i], 0.0, px, py});
-          }
-    } else if (view.mapping == MAPPING_LATLONG) {
-      const Imath::V2f p =
-          Imf::LatLongMap::pixelPosition(Window(w, h), Imath::V3f(float(d.x), float(d.y), float(d.z)));
-      const int period = w - 1;  // columns 0 and w - 1 are the same meridian
-      double u = std::fmod(double(p.x), double(period));
-      if (u < 0.0) u += period;
-      const Bilinear b = BilinearAt(u, std::clamp(double(p.y), 0.0, double(h - 1)));
-      for (int j = 0; j < 2; ++j)
-        for (int i = 0; i < 2; ++i) {
-          const int x = b.x[i] % period;
-          if (b.y[j] >= 0 && b.y[j] < h && b.w[j][i] > 0.0)
-            targets.push_back({size_t(b.y[j]) * w + x, b.w[j][i], 0.0, x, b.y[j]});
+  if (view.mapping == MAPPING_VULKAN_FACE) {
+    int face;
+    double u, v;
+    VulkanFaceAndTexel(d, w, face, u, v);
+    if (face != view.face) return;
+    const Bilinear b = BilinearAt(u, v);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        if (b.x[i] >= 0 && b.x[i] < w && b.y[j] >= 0 && b.y[j] < w && b.w[j][i] > 0.0)
+          targets.push_back({size_t(b.y[j]) * w + b.x[i], b.w[j][i], 0.0, b.x[i], b.y[j]});
+  } else if (view.mapping == MAPPING_CUBE_STRIP) {
+    const Imath::Box2i window = Window(w, h);
+    Imf::CubeMapFace face;
+    Imath::V2f pif;
+    Imf::CubeMap::faceAndPixelPosition(Imath::V3f(float(d.x), float(d.y), float(d.z)), window, face, pif);
+    const Bilinear b = BilinearAt(pif.x, pif.y);
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i)
+        if (b.x[i] >= 0 && b.x[i] < w && b.y[j] >= 0 && b.y[j] < w && b.w[j][i] > 0.0) {
+          const Imath::V2f p = Imf::CubeMap::pixelPosition(face, window, Imath::V2f(float(b.x[i]), float(b.y[j])));
+          const int px = int(std::lround(p.x)), py = int(std::lround(p.y));
+          targets.push_back({size_t(py) * w + px, b.w[j][i], 0.0, px, py});
         }
-    } else {
-      continue;
-    }
+  } else if (view.mapping == MAPPING_LATLONG) {
+    const Imath::V2f p = Imf::LatLongMap::pixelPosition(Window(w, h), Imath::V3f(float(d.x), float(d.y), float(d.z)));
+    const int period = w - 1;  // columns 0 and w - 1 are the same meridian
+    double u = std::fmod(double(p.x), double(period));
+    if (u < 0.0) u += period;
+    const Bilinear b = BilinearAt(u, std::clamp(double(p.y), 0.0, double(h - 1)));
+    for (int j = 0; j < 2; ++j)
+      for (int i = 0; i < 2; ++i) {
+        const int x = b.x[i] % period;
+        if (b.y[j] >= 0 && b.y[j] < h && b.w[j][i] > 0.0)
+          targets.push_back({size_t(b.y[j]) * w + x, b.w[j][i], 0.0, x, b.y[j]});
+      }
+  }
+}
+
+double LargestChannel(const Rgb& c) { return std::max({c[0], c[1], c[2]}); }
+
+}  // namespace
+
+namespace {
+
+// Every source's targets in a view: targets[first[k], first[k + 1]) for
+// source k (none for a dark source or one on another face).
+struct ViewTargets {
+  std::vector<SplatTarget> targets;
+  std::vector<size_t> first;
+};
+ViewTargets TargetsOf(const ViewRequest& view, const std::vector<PointSource>& sources) {
+  ViewTargets v;
+  v.first.reserve(sources.size() + 1);
+  std::vector<SplatTarget> one;
+  for (const PointSource& s : sources) {
+    v.first.push_back(v.targets.size());
+    if (s.irradiance[0] <= 0.0 && s.irradiance[1] <= 0.0 && s.irradiance[2] <= 0.0) continue;
+    SplatTargets(view, glm::normalize(s.direction), one);
+    v.targets.insert(v.targets.end(), one.begin(), one.end());
+  }
+  v.first.push_back(v.targets.size());
+  return v;
+}
+
+// The splat of the sources `which` (increasing indices; all when null).
+std::vector<TexelAdd> SplatFromTargets(const ViewRequest& view, const std::vector<PointSource>& sources,
+                                       ViewTargets& v, const std::vector<size_t>* which) {
+  std::map<size_t, std::array<double, 3>> sums;
+  const int w = view.width;
+  const size_t count = which ? which->size() : sources.size();
+  for (size_t n = 0; n < count; ++n) {
+    const size_t k = which ? (*which)[n] : n;
+    const PointSource& s = sources[k];
+    const auto begin = v.targets.begin() + long(v.first[k]), end = v.targets.begin() + long(v.first[k + 1]);
     double total = 0.0;
-    for (Target& t : targets) {
-      t.solid_angle = ViewTexelSolidAngle(view, t.x, t.y);
-      if (t.solid_angle > 0.0) total += t.weight;
+    for (auto t = begin; t != end; ++t) {
+      t->solid_angle = ViewTexelSolidAngle(view, t->x, t->y);
+      if (t->solid_angle > 0.0) total += t->weight;
     }
     if (total <= 0.0) continue;
-    for (const Target& t : targets) {
-      if (t.solid_angle <= 0.0) continue;
-      std::array<double, 3>& sum = sums[t.index];
-      for (int c = 0; c < 3; ++c) sum[c] += s.irradiance[c] * t.weight / total / t.solid_angle;
+    for (auto t = begin; t != end; ++t) {
+      if (t->solid_angle <= 0.0) continue;
+      std::array<double, 3>& sum = sums[t->index];
+      for (int c = 0; c < 3; ++c) sum[c] += s.irradiance[c] * t->weight / total / t->solid_angle;
       // The latlong's repeated meridian shows the same radiance.
-      if (view.mapping == MAPPING_LATLONG && t.x == 0) {
-        std::array<double, 3>& twin = sums[size_t(t.y) * w + (w - 1)];
-        for (int c = 0; c < 3; ++c) twin[c] += s.irradiance[c] * t.weight / total / t.solid_angle;
+      if (view.mapping == MAPPING_LATLONG && t->x == 0) {
+        std::array<double, 3>& twin = sums[size_t(t->y) * w + (w - 1)];
+        for (int c = 0; c < 3; ++c) twin[c] += s.irradiance[c] * t->weight / total / t->solid_angle;
       }
     }
   }
@@ -257,6 +304,67 @@ std::vector<TexelAdd> SplatPointSources(const ViewRequest& view, const std::vect
     for (int c = 0; c < 3; ++c) a.rgb[c] = float(rgb[c]);
     adds.push_back(a);
   }
+  return adds;
+}
+
+}  // namespace
+
+std::vector<TexelAdd> SplatPointSources(const ViewRequest& view, const std::vector<PointSource>& sources) {
+  ViewTargets v = TargetsOf(view, sources);
+  return SplatFromTargets(view, sources, v, nullptr);
+}
+
+std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources, const float* rgba,
+                                   double min_relative, SplatBound* bound_out) {
+  const int w = view.width;
+  ViewTargets v = TargetsOf(view, sources);
+  // (texel, source) for every texel a source reaches, its twin included.
+  struct Reach {
+    size_t texel, source;
+  };
+  std::vector<Reach> reach;
+  reach.reserve(v.targets.size() + v.targets.size() / 8);
+  for (size_t k = 0; k < sources.size(); ++k)
+    for (size_t i = v.first[k]; i < v.first[k + 1]; ++i) {
+      const SplatTarget& t = v.targets[i];
+      reach.push_back({t.index, k});
+      if (view.mapping == MAPPING_LATLONG && t.x == 0) reach.push_back({size_t(t.y) * w + (w - 1), k});
+    }
+  std::sort(reach.begin(), reach.end(),
+            [](const Reach& a, const Reach& b) { return a.texel != b.texel ? a.texel < b.texel : a.source < b.source; });
+  // Each texel's load against its capacity (less a margin far wider than
+  // float's rounding of the sums); the latlong's repeated meridian has
+  // column 0's solid angle (it receives column 0's additions).
+  SplatBound bound;
+  std::vector<char> wanted(sources.size(), 0);
+  for (size_t i = 0; i < reach.size();) {
+    size_t j = i;
+    double load = 0.0;
+    for (; j < reach.size() && reach[j].texel == reach[i].texel; ++j)
+      if (j == i || reach[j].source != reach[j - 1].source) load += LargestChannel(sources[reach[j].source].irradiance);
+    const size_t texel = reach[i].texel;
+    const int x = int(texel % w), y = int(texel / w);
+    const double omega = ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG && x == w - 1 ? 0 : x, y);
+    const float* t = rgba + 4 * texel;
+    const double capacity = min_relative * std::max({double(t[0]), double(t[1]), double(t[2])}) * omega * (1.0 - 1e-4);
+    if (!(load < capacity)) {
+      bound.open.push_back(texel);
+      for (size_t m = i; m < j; ++m) wanted[reach[m].source] = 1;
+    }
+    i = j;
+  }
+  // The sources that reach an open texel, in their order (so each kept
+  // texel's sum is formed as the whole splat forms it).
+  for (size_t k = 0; k < sources.size(); ++k)
+    if (wanted[k]) bound.sources.push_back(k);
+  std::vector<TexelAdd> adds;
+  if (!bound.sources.empty()) {
+    adds = SplatFromTargets(view, sources, v, &bound.sources);
+    std::erase_if(adds, [&](const TexelAdd& a) {
+      return !std::binary_search(bound.open.begin(), bound.open.end(), a.texel);
+    });
+  }
+  if (bound_out) *bound_out = std::move(bound);
   return adds;
 }
 
@@ -371,6 +479,7 @@ std::vector<PointSource> MoonDiscSources(const glm::dvec3& moon_direction, doubl
 NightFrame ComputeNightFrame(const SkyStyle& style, const StarCatalogue* catalogue, const TransmittanceTable& t,
                              double julian_day_ut, const GeoLocation& place, const glm::dvec3& sun) {
   NightFrame night;
+  night.daylight = sun.y > 0.0;
   const NightSettings& n = style.night;
   const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
   const Rgb output = OutputScale(style.output.units);
@@ -450,6 +559,20 @@ const std::vector<float>& NightSkyRenderer::TexelMu(const ViewRequest& view) {
   return texel_mu_.emplace(key, std::move(mu)).first->second;
 }
 
+std::vector<TexelAdd> NightSkyRenderer::BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources,
+                                                     const float* rgba, bool daylight) {
+  // By night nearly every source shows: the bound would find them all and
+  // only add its own cost.
+  if (!splat_bound_ || !daylight) {
+    ++splats_run_;
+    return SplatPointSources(view, sources);
+  }
+  SplatBound bound;
+  std::vector<TexelAdd> adds = skybake::BoundedSplat(view, sources, rgba, kNightSplatMinRelative, &bound);
+  ++(bound.sources.empty() ? splats_skipped_ : splats_run_);
+  return adds;
+}
+
 namespace {
 
 // Adds the airglow where it is at least kNightSplatMinRelative of the
@@ -494,7 +617,7 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
         AddAirglow(night.airglow, mu, image.rgba.data(), image.rgba.data());
       }
     }
-    const std::vector<TexelAdd> adds = SplatPointSources(views[i], night.sources);
+    const std::vector<TexelAdd> adds = BoundedSplat(views[i], night.sources, image.data(), night.daylight);
     if (ApplyTexelAdds(adds, image.data(), nullptr, kNightSplatMinRelative) == 0) continue;
     own();
     ApplyTexelAdds(adds, image.rgba.data(), image.rgba.data(), kNightSplatMinRelative);
@@ -512,7 +635,8 @@ void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night
       for (size_t k = 0; k < faces[i].size(); ++k)
         if (k % 4 != 3) faces[i][k] += moonlit[i][k];
     if (!night.airglow.empty()) AddAirglow(night.airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
-    ApplyTexelAdds(SplatPointSources(views[i], stars), faces[i].data(), faces[i].data(), kNightSplatMinRelative);
+    ApplyTexelAdds(BoundedSplat(views[i], stars, faces[i].data(), night.daylight), faces[i].data(), faces[i].data(),
+                   kNightSplatMinRelative);
   }
 }
 
@@ -611,6 +735,13 @@ void NightSkyBake::AddToFaces(NightSkyRenderer& renderer, const SkyStyle& style,
   const auto start = std::chrono::steady_clock::now();
   renderer.AddToFaces(PrunedStyle(style), night, views, faces);
   seconds_ += SecondsSince(start);
+}
+
+void NightSkyBake::AddMoonToIbl(const SkyStyle& style, const NightFrame& night, IblRequest& request) {
+  if (!night.moon || !style.ibl.include_sun || !(style.night.moon || style.night.moonlight)) return;
+  request.moon = true;
+  request.moon_direction = night.moon->sky.direction;
+  request.moon_irradiance = night.moon_irradiance;
 }
 
 double NightSkyBake::TakeSeconds() {

@@ -199,12 +199,14 @@ SKYBAKE_GPU_STRUCT(IblPush) {
                         // z: normalization W of the sun's kernel (IblSunKernelNormalization); w: 1 = add the sun
   vec4 sun_direction;   // xyz: unit vector towards the Sun; w: unused
   vec4 sun_irradiance;  // xyz: the Sun's irradiance at normal incidence (output units x sr); w: unused
+  vec4 moon_direction;  // xyz: unit vector towards the Moon; w: unused
+  vec4 moon_irradiance; // xyz: the Moon's irradiance, as sun_irradiance; w: 1 = add the Moon too (with lobe.w)
 };
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
 static_assert(sizeof(GpuClouds) == (7 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
-static_assert(sizeof(IblPush) == 5 * 16, "IblPush must be vec4-packed");
+static_assert(sizeof(IblPush) == 7 * 16, "IblPush must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,

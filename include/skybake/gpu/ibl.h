@@ -19,7 +19,8 @@
 // filtered without the sun disc: the Sun travels as the glTF scene's
 // KHR_lights_punctual light, which an engine shades exactly, and 16-bit
 // formats cannot hold the disc. ibl.include_sun adds the Sun's energy as a
-// point source through each level's kernel, not clamped.
+// point source through each level's kernel, not clamped, and with the
+// night sky the Moon's (IblRequest::moon) the same way.
 //
 // The filtering runs on the Vulkan device (shaders/ibl_prefilter.comp):
 // importance sampling whose samples read the source cube at the mip their
@@ -83,6 +84,12 @@ struct IblRequest {
   // comparison with another tool's mapping; empty: IblRoughness of
   // IblLevelCount(settings) levels.
   std::vector<double> roughness;
+  // The Moon as a second point source (night sky, pipeline/night_sky.h):
+  // with ibl.include_sun it goes into the maps as the Sun does; the Moon's
+  // disc is, like the Sun's, left out of the filtered source.
+  bool moon = false;
+  glm::dvec3 moon_direction{0, 1, 0};
+  Rgb moon_irradiance{0, 0, 0};       // after the atmosphere, output units x sr
 };
 
 struct IblMaps {

@@ -12,6 +12,10 @@ namespace skybake {
 struct NightSettings {
   bool stars = false;
   std::string star_catalogue;          // "" = DefaultStarCataloguePath(); relative to the style's folder
+  // The --set argument that gave star_catalogue ("--set night.star_catalogue=..."),
+  // or "" when the style file did: its errors point there, and a relative
+  // path is then taken from the working directory, as any command-line path.
+  std::string star_catalogue_set;
   double star_magnitude_limit = 6.5;   // V; stars fainter are left out; [-1.5, 14]
   bool moon = false;                   // the Moon's disc
   bool moonlight = false;              // the Moon as a second light (sky, SH, IBL, glTF)

@@ -16,7 +16,8 @@
 //   are added to every frame: by day they fall below the sky's radiance by
 //   the physics alone; an addition under 2^-13 of a texel's own value (a
 //   quarter of half float's resolution) is left out, so a day frame's maps
-//   are not copied at all.
+//   are not copied at all; while the Sun is up a bound (SplatBound) finds
+//   the texels where that is certain and splats only what reaches the others.
 // - The Moon (night.moon): its disc, of the angular radius from its
 //   topocentric distance, lit by the Sun with the Lommel-Seeliger law
 //   L ~ mu0 / (mu0 + mu) (mu0, mu: cosines of incidence and emission; the
@@ -56,6 +57,7 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/input/night_settings.h"
 #include "skybake/model/sh.h"
+#include "skybake/gpu/ibl.h"
 #include "skybake/gpu/sky_renderer.h"
 
 namespace skybake {
@@ -109,6 +111,30 @@ std::vector<TexelAdd> SplatPointSources(const ViewRequest& view, const std::vect
 // largest channel is dropped; returns how many were applied.
 size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, float* rgba_out, double min_relative);
 
+// The bound that spares a frame the splat when it cannot change the maps
+// (a day frame's stars and Moon under a bright sky). A texel's load is the
+// sum of the largest channel of the irradiance of every source that has it
+// among its targets (a latlong's repeated meridian with column 0); a
+// texel's addition (largest channel) is at most its load over its solid
+// angle (a source's weights are at most 1), so where the load is under
+// min_relative x (the texel's largest channel) x (its solid angle)
+// ApplyTexelAdds drops the addition. Only the sources that reach the other
+// ("open") texels need the splat, and only their additions to open texels
+// are kept: each texel kept gets the same sum, formed in the same order, as
+// in the whole splat, so the maps are byte for byte the same
+// (tests/night_sky_test.cc). No open texel: nothing to splat. The bound
+// costs the texel lookups of the splat (shared with it), a sort of the
+// texels reached and one solid angle per texel.
+struct SplatBound {
+  std::vector<size_t> sources;  // the indices of those that reach an open texel, increasing
+  std::vector<size_t> open;     // the open texels, increasing
+};
+// SplatPointSources through the bound: its additions to the open texels.
+// `rgba`: the view's texels as they are before the splat; `bound`: what it
+// found, when wanted.
+std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources, const float* rgba,
+                                   double min_relative, SplatBound* bound = nullptr);
+
 // The atmosphere's transmittance from the observer to space along a
 // direction, as a table over mu = cos(zenith angle): the shared integral
 // (ReferenceModel::TransmittanceDirect, 256 steps) at 4096 values of mu,
@@ -132,6 +158,7 @@ struct NightFrame {
   Rgb moon_irradiance{0.0, 0.0, 0.0}; // the Moon at the observer, output units x sr (after the atmosphere)
   double moon_illuminance_lux = 0.0;  // the same as illuminance
   double moonlight_scale = 0.0;       // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
+  bool daylight = false;              // the Sun above the horizon: splats go through SplatBound
   // With night.airglow: the glow's radiance by mu = cos(zenith angle) of
   // the view (output units), AirglowTable.
   std::vector<Rgb> airglow;
@@ -179,6 +206,13 @@ class NightSkyRenderer {
                   std::vector<std::vector<float>>& faces);
 
   int moonlight_renders() const { return moonlight_renders_; }
+  // With false, every splat runs whole (SplatBound off; by night it always
+  // does): for the test that the bound changes no byte.
+  void set_splat_bound(bool on) { splat_bound_ = on; }
+  // Views (and faces) whose splat the bound skipped altogether, and those
+  // splatted (in part or whole), since construction.
+  size_t splats_skipped() const { return splats_skipped_; }
+  size_t splats_run() const { return splats_run_; }
   double last_moonlight_seconds() const { return last_moonlight_seconds_; }
 
  private:
@@ -186,6 +220,12 @@ class NightSkyRenderer {
                                              const std::vector<ViewRequest>& views);
   // mu = cos(zenith angle) of every texel of a view, computed once.
   const std::vector<float>& TexelMu(const ViewRequest& view);
+  // The splat of `sources` into `view` over `rgba`, through the bound while
+  // the Sun is up (SplatBound).
+  std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources,
+                                     const float* rgba, bool daylight);
+  bool splat_bound_ = true;
+  size_t splats_skipped_ = 0, splats_run_ = 0;
   VulkanContext& context_;
   std::map<std::array<int, 4>, std::vector<float>> texel_mu_;
   std::unique_ptr<SkyRenderer> moonlight_;
@@ -222,6 +262,10 @@ class NightSkyBake {
   // Sun's) when night.moonlight.
   void RecordMoon(const SkyStyle& style, const NightFrame& night, ShRgb& sh_radiance_with_lights,
                   std::optional<MoonRecord>& record) const;
+  // The Moon as the IBL's second point source (IblRequest::moon) when the
+  // style has the Moon (night.moon or night.moonlight) and
+  // ibl.include_sun: the maps then hold the Moon's energy as the Sun's.
+  static void AddMoonToIbl(const SkyStyle& style, const NightFrame& night, IblRequest& request);
   // Host time spent in Frame, AddToViews and AddToFaces (the moonlit
   // renders included) since the last call, s; and what a frame adds, for
   // the progress line.
