@@ -412,6 +412,18 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   EXPECT_EQ(typed.exit_code, 0) << typed.output;
   EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
 
+  // --resume reads through merge-manifest's reader (ReadManifest), which
+  // type-checks sizes: a size that is not a byte count proves no frame.
+  m = nlohmann::json::parse(good);
+  m["frames"][0]["files"][0]["bytes"] = -1;
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun sized = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 --out '" + out +
+                                "' --resume");
+  EXPECT_EQ(sized.exit_code, 0) << sized.output;
+  EXPECT_NE(sized.output.find("resuming from 0 frame(s) in manifest.json"), std::string::npos) << sized.output;
+  EXPECT_EQ(sized.output.find("files verified by checksum"), std::string::npos) << sized.output;
+  EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
+
   m = nlohmann::json::parse(good);
   m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
   std::ofstream(manifest_path) << m.dump(2);

@@ -110,6 +110,26 @@ colour = "red"
   EXPECT_NE(steps.errors[0].Format().find("s.toml:2:25"), std::string::npos) << steps.errors[0].Format();
 }
 
+// A number or an RGB triple is refused as in a style (the shared readers of
+// bake/input/toml_reader.h): what the value is instead, a value that is not
+// finite, a triple of the wrong length.
+TEST(Schedule, NumbersAndTriplesAreRefusedAsInAStyle) {
+  ScheduleResult r = ParseSchedule(R"([schedule]
+sun = { elevation_deg = ["low", 20], azimuth_deg = nan }
+ramp = { "atmosphere.ground_albedo" = [[0.1, 0.2], 0.3] }
+)",
+                                   "n.toml");
+  ASSERT_FALSE(r.ok());
+  std::string all;
+  for (const ConfigError& e : r.errors) all += e.Format() + "\n";
+  EXPECT_NE(all.find("n.toml:2:26: schedule.sun.elevation_deg[0]: expected a number, got a string\n"),
+            std::string::npos) << all;
+  EXPECT_NE(all.find("schedule.sun.azimuth_deg: must be a finite number (got nan)\n"), std::string::npos) << all;
+  EXPECT_NE(all.find("n.toml:3:40: schedule.ramp.atmosphere.ground_albedo[0]: expected a number or an array of 3 "
+                     "numbers [680 nm, 550 nm, 440 nm]\n"),
+            std::string::npos) << all;
+}
+
 // A schedule typo gets the same answer as a style typo: located, with the
 // nearest known key (the shared TOML reader, bake/input/toml_reader.h), in
 // [schedule], its sun table and its ramps; no suggestion for a key near none.

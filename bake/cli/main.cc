@@ -30,6 +30,7 @@
 #include "skybake/output/manifest.h"
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/pipeline/pass_plan.h"
+#include "skybake/pipeline/render_plan.h"
 #include "skybake/input/schedule.h"
 #include "skybake/input/shard.h"
 #include "skybake/gpu/vulkan_context.h"
@@ -191,14 +192,9 @@ int RunBake(const BakeArgs& args, Mode mode) {
   if (mode == Mode::kPlan || args.dry_run) {
     // The passes, LUTs and shader variant the bake would run, and why.
     // The part that --frames / --shard select, when given.
-    std::vector<SkyStyle> planned;
-    if (schedule) {
-      for (size_t i = 0; i < frame_styles.size(); ++i)
-        if (!part || part->Contains(schedule->frames[i].number)) planned.push_back(frame_styles[i]);
-    } else {
-      planned.push_back(config.style);
-    }
-    PassPlan plan = PlanPasses(planned, args.shaders);
+    const RenderPlan bake_plan =
+        schedule ? PlanSequenceBake(frame_styles, *schedule, part) : PlanSingleBake(config.style);
+    PassPlan plan = PlanPasses(bake_plan.BakedStyles(), args.shaders);
     std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
     if (part)
       what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,

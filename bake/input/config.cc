@@ -5,6 +5,7 @@
 // resolved TOML for provenance (StyleWriter), and the unknown-key check.
 #include "skybake/input/config.h"
 #include "skybake/input/engine_preset.h"
+#include "cloud_formation_config.h"
 
 #include <algorithm>
 #include <cmath>
@@ -33,25 +34,9 @@ namespace {
 
 // --------------------------------------------------------------- ranges
 
-struct Range {
-  double min;
-  double max;
-  bool min_open;
-  bool max_open;
-  bool Contains(double v) const {
-    if (min_open ? !(v > min) : !(v >= min)) return false;
-    if (max_open ? !(v < max) : !(v <= max)) return false;
-    return true;
-  }
-  std::string Describe() const {
-    return fmt::format("{}{}, {}{}", min_open ? '(' : '[', min, max, max_open ? ')' : ']');
-  }
-};
-
 constexpr double kInf = HUGE_VAL;
 constexpr Range kPositive{0.0, kInf, true, true};
 constexpr Range kNonNegative{0.0, kInf, false, true};
-constexpr Range kAnyFinite{-kInf, kInf, true, true};
 constexpr Range kUnit{0.0, 1.0, false, false};
 constexpr Range kOpenUnitSymmetric{-1.0, 1.0, true, true};
 constexpr Range kElevation{-90.0, 90.0, false, false};
@@ -212,6 +197,24 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
   // Volumetric cloud layers (clouds.h, docs/clouds.md).
   v.CloudLayers("cloud_layer", s.clouds.layers);
+  // The cloud shadow map (cloud_shadow.h): written into the resolved style
+  // only when on, so a style without it resolves as before it existed.
+  CloudShadowSettings& cs = s.cloud_shadow;
+  if (v.kReads || cs.enabled) {
+    static constexpr Range kShadowExtent{10.0, 1e7, false, false}, kShadowCenter{-1e7, 1e7, false, false};
+    static constexpr Range kShadowAltitude{0.0, 1e5, false, false}, kShadowStrength{0.0, 10.0, false, false};
+    v.Bool("cloud_shadow.enabled", cs.enabled);
+    v.Int("cloud_shadow.resolution", cs.resolution, 8, 4096);
+    v.Real("cloud_shadow.extent_m", cs.extent_m, kShadowExtent);
+    v.Real("cloud_shadow.center_east_m", cs.center_east_m, kShadowCenter);
+    v.Real("cloud_shadow.center_north_m", cs.center_north_m, kShadowCenter);
+    v.Real("cloud_shadow.receiver_altitude_m", cs.receiver_altitude_m, kShadowAltitude);
+    v.Real("cloud_shadow.strength", cs.strength, kShadowStrength);
+    // At most 256: 4 bands x 256 x 5 loop iterations stay within the 5535 lavapipe
+    // leaves the cloud pass above its own 60000 (CloudLoopIterationsPerTexel).
+    v.Int("cloud_shadow.steps", cs.steps, 1, 256);
+    v.Bool("cloud_shadow.ground", cs.ground);
+  }
 
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
@@ -259,76 +262,31 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
 // --------------------------------------------------------------- reading
 
-class StyleReader {
+class StyleReader : public TomlReader {
  public:
   static constexpr bool kReads = true;
   StyleReader(const toml::table& root, std::string file, std::vector<ConfigError>& errors)
-      : root_(root), file_(std::move(file)), errors_(errors) {}
+      : TomlReader(std::move(file), errors), root_(root) {}
 
   void Real(const char* path, double& out, const Range& range) {
     const toml::node* node = Find(path);
     if (!node) return;
-    std::optional<double> value = node->value<double>();  // accepts integers too
-    // An integer beyond 2^53 is still a number (toml++ refuses the inexact
-    // conversion): the nearest double.
-    if (!value && node->is_integer()) value = double(node->as_integer()->get());
-    if (!value || node->is_boolean()) {
-      Error(node, path, fmt::format("expected a number, got {}", TypeName(*node)));
-      return;
-    }
-    if (!std::isfinite(*value)) {
-      Error(node, path, "must be a finite number (got " + FormatNumber(*value) + ")");
-      return;
-    }
-    if (!range.Contains(*value)) {
-      Error(node, path, fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
-      return;
-    }
-    out = *value;
+    if (std::optional<double> value = Number(*node, path, range)) out = *value;
   }
 
+  // A scalar sets all three channels.
   void Triple(const char* path, Rgb& out, const Range& range) {
     const toml::node* node = Find(path);
     if (!node) return;
-    if (node->is_number()) {  // a scalar sets all three channels
-      double value = 0.0;
-      Real(path, value, range);
-      out = {value, value, value};
-      return;
-    }
-    const toml::array* array = node->as_array();
-    if (!array || array->size() != 3) {
-      Error(node, path, "expected a number or an array of 3 numbers [680 nm, 550 nm, 440 nm]");
-      return;
-    }
-    Rgb result = out;
-    for (size_t i = 0; i < 3; ++i) {
-      const toml::node& item = *array->get(i);
-      std::optional<double> value = item.value<double>();
-      std::string item_path = fmt::format("{}[{}]", path, i);
-      if (!value || item.is_boolean()) {
-        Error(&item, item_path, fmt::format("expected a number, got {}", TypeName(item)));
-        return;
-      }
-      if (!std::isfinite(*value)) {
-        Error(&item, item_path, "must be a finite number (got " + FormatNumber(*value) + ")");
-        return;
-      }
-      if (!range.Contains(*value)) {
-        Error(&item, item_path,
-              fmt::format("{} is out of range {}", FormatNumber(*value), range.Describe()));
-        return;
-      }
-      result[i] = *value;
-    }
-    out = result;
+    if (std::optional<std::vector<double>> v = NumberOrTriple(*node, path, range))
+      out = v->size() == 1 ? Rgb{(*v)[0], (*v)[0], (*v)[0]} : Rgb{(*v)[0], (*v)[1], (*v)[2]};
   }
 
   void Int(const char* path, int& out, int min, int max) {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_integer()) {
-      Error(node, path, fmt::format("expected an integer, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected an integer, got {}", TomlTypeName(*node)));
       return;
     }
     int64_t value = node->as_integer()->get();
@@ -343,7 +301,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_boolean()) {
-      Error(node, path, fmt::format("expected true or false, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected true or false, got {}", TomlTypeName(*node)));
       return;
     }
     out = node->as_boolean()->get();
@@ -356,7 +314,7 @@ class StyleReader {
     std::vector<std::string> names;
     for (const auto& c : choices) names.push_back(c.first);
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(names), TypeName(*node)));
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(names), TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -374,7 +332,7 @@ class StyleReader {
     if (!node) return;
     std::vector<std::string> list = QualityPresetNames();
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TypeName(*node)));
+      Error(node, path, fmt::format("expected one of {}, got {}", JoinNames(list), TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -391,7 +349,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected a string, got {}", TomlTypeName(*node)));
       return;
     }
     const std::string& text = node->as_string()->get();
@@ -412,7 +370,7 @@ class StyleReader {
     const toml::node* node = Find(path);
     if (!node) return;
     if (!node->is_string()) {
-      Error(node, path, fmt::format("expected a string, got {}", TypeName(*node)));
+      Error(node, path, fmt::format("expected a string, got {}", TomlTypeName(*node)));
       return;
     }
     out = node->as_string()->get();
@@ -632,6 +590,12 @@ class StyleReader {
           } else {
             layer.seed = uint32_t(value.as_integer()->get());
           }
+        } else if (k == "formation") {
+          ReadCloudFormation(value, key_path, layer.formation,
+                             [&](const toml::node* n, const std::string& at, const std::string& message) {
+                               ok = false;
+                               Error(n, at, message);
+                             });
         } else if (k == "weather_image") {
           if (!value.is_string() || value.as_string()->get().empty()) {
             ok = false;
@@ -645,7 +609,7 @@ class StyleReader {
                 fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
                             "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
                             "wind_m_s, shear_m_s_per_km, seed, weather_size_m, weather_image, weather_extent_m, "
-                            "weather_origin_m)",
+                            "weather_origin_m, formation)",
                             k));
         }
       }
@@ -703,7 +667,7 @@ class StyleReader {
       // A table replaced by a value (`--set sun=1`) would drop every key of
       // it silently: refused.
       if (tables_.count(path) && !node.is_table()) {
-        Error(&node, path, fmt::format("expected a table ([{}] with its keys), got {}", path, TypeName(node)));
+        Error(&node, path, fmt::format("expected a table ([{}] with its keys), got {}", path, TomlTypeName(node)));
         continue;
       }
       if (const toml::table* sub = node.as_table()) WalkUnknown(*sub, path + ".");
@@ -712,31 +676,7 @@ class StyleReader {
 
   std::string Suggest(const std::string& path) const { return DidYouMean(path, known_); }
 
-  static std::string TypeName(const toml::node& node) {
-    switch (node.type()) {
-      case toml::node_type::string: return "a string";
-      case toml::node_type::integer: return "an integer";
-      case toml::node_type::floating_point: return "a number";
-      case toml::node_type::boolean: return "a boolean";
-      case toml::node_type::array: return "an array";
-      case toml::node_type::table: return "a table";
-      default: return "a date or time";
-    }
-  }
-
-  static std::string FormatNumber(double v) { return fmt::format("{}", v); }
-
-  void Error(const toml::node* node, const std::string& path, const std::string& message) {
-    ErrorAt(node ? node->source() : toml::source_region{}, path, message);
-  }
-
-  void ErrorAt(const toml::source_region& where, const std::string& path, const std::string& message) {
-    errors_.push_back(LocatedError(file_, where, path, message));
-  }
-
   const toml::table& root_;
-  std::string file_;
-  std::vector<ConfigError>& errors_;
   std::set<std::string> known_;
   std::set<std::string> tables_;  // prefixes of known keys: tables
   std::set<std::string> given_;
@@ -803,6 +743,7 @@ class StyleWriter {
       t.insert("shear_m_s_per_km", toml::array{l.shear_m_s_per_km[0], l.shear_m_s_per_km[1]});
       if (l.seed) t.insert("seed", int64_t(*l.seed));
       t.insert("weather_size_m", l.weather_size_m);
+      if (l.formation.enabled) t.insert("formation", CloudFormationToml(l.formation));
       if (!l.weather_image.empty()) {
         t.insert("weather_image", l.weather_image);
         t.insert("weather_extent_m", toml::array{l.weather_extent_m[0], l.weather_extent_m[1]});
@@ -1039,6 +980,219 @@ Rgb OutputScale(OutputUnits units) {
   return {114974.916437, 71305.954816, 65310.548555};
 }
 
+namespace {
+
+// The cross-field checks of a style, each located at the key it names
+// (the second key of a pair), as the reader's own errors are.
+struct StyleChecks {
+  const toml::table& root;
+  const std::string& name;
+  std::vector<ConfigError>& errors;
+  std::vector<ConfigError>& warnings;
+  ConfigError Locate(const char* path) const {
+    ConfigError e;
+    e.file = name;
+    e.key = path;
+    if (const toml::node* node = root.at_path(path).node(); node && node->source().begin) {
+      e.line = int(node->source().begin.line);
+      e.column = int(node->source().begin.column);
+      if (node->source().path) e.file = *node->source().path;
+    }
+    return e;
+  }
+};
+
+void CheckAtmosphere(const SkyStyle& style, StyleChecks& c) {
+  const AtmosphereParams& a = style.atmosphere;
+  if (!(a.top_radius_km > a.bottom_radius_km)) {
+    ConfigError e = c.Locate("atmosphere.top_radius_km");
+    e.message = fmt::format("top radius {} km must be above the bottom radius {} km",
+                            a.top_radius_km, a.bottom_radius_km);
+    c.errors.push_back(e);
+  }
+  for (int channel = 0; channel < 3; ++channel) {
+    if (a.mie_extinction_per_km[channel] < a.mie_scattering_per_km[channel]) {
+      ConfigError e = c.Locate("atmosphere.mie.extinction_per_km");
+      e.message = fmt::format("extinction {} must be at least the scattering {} (channel {})",
+                              a.mie_extinction_per_km[channel], a.mie_scattering_per_km[channel], channel);
+      c.errors.push_back(e);
+      break;
+    }
+  }
+}
+
+// The skydome's viewer, the shapes' arcs.
+void CheckAoas(const SkyStyle& style, StyleChecks& c) {
+  const AoasSettings& x = style.aoas;
+  if (x.skydome.enabled) {
+    const glm::dvec3& p = x.skydome.viewer_position;
+    if (!(glm::length(p) < 0.99 * x.skydome.radius)) {
+      ConfigError e = c.Locate("skydome.viewer_position");
+      e.message = fmt::format("the viewer must be inside the dome: |position| = {} must be below "
+                              "0.99 x radius = {}",
+                              glm::length(p), 0.99 * x.skydome.radius);
+      c.errors.push_back(e);
+    }
+    if (p.y < 0.0) {
+      ConfigError e = c.Locate("skydome.viewer_position");
+      e.message = fmt::format("the viewer must be on or above the ground plane (y = {} < 0)", p.y);
+      c.errors.push_back(e);
+    }
+  }
+  if (x.shapes.enabled) {
+    size_t arcs = ShapeArcs(x.shapes).size();
+    if (arcs == 0) {
+      ConfigError e = c.Locate("shapes.enabled");
+      e.message = "shapes are enabled but there is no [[shapes.shape]]";
+      c.errors.push_back(e);
+    } else if (arcs > AOAS_MAX_SHAPE_SEGMENTS) {
+      ConfigError e = c.Locate("shapes.shape");
+      e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
+                              arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
+      c.errors.push_back(e);
+    }
+  }
+}
+
+// Volumetric cloud layers: counts, the atmosphere's top, weather images.
+void CheckCloudLayers(const SkyStyle& style, StyleChecks& c) {
+  const AtmosphereParams& a = style.atmosphere;
+  const std::string style_dir = std::filesystem::path(c.name).parent_path().string();
+  for (const CloudProblem& p : ValidateClouds(style.clouds, a, style_dir)) {
+    std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
+    if (p.layer == -2) {  // the sampling settings
+      ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
+                                                                              : "quality.cloud_view_steps");
+      e.message = p.message;
+      c.errors.push_back(e);
+      continue;
+    }
+    ConfigError e = c.Locate("cloud_layer");
+    if (const toml::array* layers = c.root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
+                                                                    size_t(p.layer) < layers->size()) {
+      const toml::node* at = layers->get(size_t(p.layer));
+      if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->at_path(p.key).node()) at = t->at_path(p.key).node();
+      if (at->source().begin) {
+        e.line = int(at->source().begin.line);
+        e.column = int(at->source().begin.column);
+      }
+    }
+    e.key = p.key.empty() ? key : key + "." + p.key;
+    e.message = p.message;
+    c.errors.push_back(e);
+  }
+}
+
+// Every file of a bake has its own name: face names differ from each other
+// and from the cube strip's and latlong's suffixes.
+// Compared without case: on a case-insensitive file system (macOS,
+// Windows shares) "PX" and "px" are one file.
+void CheckFaceNames(const SkyStyle& style, StyleChecks& c) {
+  const std::vector<std::string>& faces = style.output.face_names;
+  auto folded = [](std::string name) {
+    for (char& ch : name) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    return name;
+  };
+  for (size_t i = 0; i < faces.size(); ++i) {
+    bool reserved = folded(faces[i]) == "cube" || folded(faces[i]) == "latlong";
+    size_t twin = 0;
+    while (twin < i && folded(faces[twin]) != folded(faces[i])) ++twin;
+    bool repeated = twin < i;
+    if (reserved || repeated) {
+      ConfigError e = c.Locate("output.face_names");
+      e.key = fmt::format("output.face_names[{}]", i);
+      e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
+                  : faces[twin] == faces[i]
+                      ? fmt::format("'{}' is given twice: each face is its own file", faces[i])
+                      : fmt::format("'{}' and '{}' differ only in case, one file on a case-insensitive file "
+                                    "system: each face is its own file", faces[twin], faces[i]);
+      c.errors.push_back(e);
+      break;
+    }
+  }
+}
+
+// What the glTF scene's image-based light and an engine preset need.
+void CheckSceneAndEngine(const SkyStyle& style, StyleChecks& c) {
+  if (style.gltf.image_based_light && (!style.ibl.specular || !style.gltf.enabled)) {
+    ConfigError e = c.Locate("gltf.image_based_light");
+    e.message = "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
+                "(and gltf.enabled = true), or gltf.image_based_light = false";
+    c.errors.push_back(e);
+  }
+  if (std::optional<std::string> engine = EngineStyleError(style)) {
+    ConfigError e = c.Locate("output.engine");
+    e.message = *engine;
+    c.errors.push_back(e);
+  }
+}
+
+// IBL: a cube mip chain needs a power-of-two level 0 and at most one
+// level per halving; some file format must be asked for.
+void CheckIbl(const SkyStyle& style, StyleChecks& c) {
+  const IblSettings& ibl = style.ibl;
+  if (ibl.Requested()) {
+    int log2_size = 0;
+    while ((2 << log2_size) <= ibl.size) ++log2_size;
+    if ((1 << log2_size) != ibl.size) {
+      ConfigError e = c.Locate("ibl.size");
+      e.message = fmt::format("{} is not a power of two: use {} or {}", ibl.size, 1 << log2_size, 2 << log2_size);
+      c.errors.push_back(e);
+    } else if (ibl.levels > log2_size + 1) {
+      ConfigError e = c.Locate("ibl.levels");
+      e.message = fmt::format("a {} cube has at most {} mip levels (down to 1 x 1): lower ibl.levels or raise ibl.size",
+                              ibl.size, log2_size + 1);
+      c.errors.push_back(e);
+    }
+    if (!ibl.exr && !ibl.ktx2) {
+      ConfigError e = c.Locate("ibl.exr");
+      e.message = "IBL maps are asked for but neither ibl.exr nor ibl.ktx2 is true: set one of them";
+      c.errors.push_back(e);
+    }
+    if (ibl.ktx2_zstd_level > 0 && !ibl.ktx2) {
+      ConfigError e = c.Locate("ibl.ktx2_zstd_level");
+      e.message = "zstd supercompression applies to KTX2 files: set ibl.ktx2 = true or ibl.ktx2_zstd_level = 0";
+      c.errors.push_back(e);
+    }
+  }
+}
+
+// A preset that every explicit key overrides changes nothing: say so.
+void WarnPresetChangesNothing(const SkyStyle& style, const StyleReader& reader, StyleChecks& c) {
+  if (reader.Given("quality.preset")) {
+    std::vector<std::string> keys = PresetKeys();
+    bool all_given = std::all_of(keys.begin(), keys.end(), [&](const std::string& k) { return reader.Given(k); });
+    if (all_given) {
+      ConfigError w = c.Locate("quality.preset");
+      std::string list;
+      for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
+      w.message = fmt::format("preset '{}' changes nothing: every key it sets is given explicitly ({}), and "
+                              "explicit keys refine the preset; remove or comment out those keys to use it",
+                              style.quality_preset, list);
+      c.warnings.push_back(w);
+    }
+  }
+}
+
+// The style as the bake records it (every EXR's skybake:config): every key
+// resolved, in the writer's order.
+std::string ResolvedToml(SkyStyle& style) {
+  StyleWriter writer;
+  VisitStyle(style, writer);
+  // Without IBL outputs their keys are left out of the record, so such a
+  // bake's files are the same bytes as before the keys existed.
+  toml::table recorded = writer.table();
+  if (!style.ibl.Requested()) recorded.erase("ibl");
+  else if (style.ibl.full_samples_roughness == 0.0) recorded["ibl"].as_table()->erase("full_samples_roughness");
+  if (style.output.engine == "none") recorded["output"].as_table()->erase("engine");
+  if (!style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
+  std::ostringstream resolved;
+  resolved << recorded;
+  return resolved.str();
+}
+
+}  // namespace
+
 ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
                            const std::vector<std::string>& overrides) {
   ConfigResult result;
@@ -1053,189 +1207,25 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   reader.ReportUnknownKeys({"schedule"});  // read by LoadSchedule (schedule.h)
 
   // Cross-field checks, located at the second key.
-  const AtmosphereParams& a = result.style.atmosphere;
-  auto locate = [&](const char* path) {
-    ConfigError e;
-    e.file = name;
-    e.key = path;
-    if (const toml::node* node = root.at_path(path).node(); node && node->source().begin) {
-      e.line = int(node->source().begin.line);
-      e.column = int(node->source().begin.column);
-      if (node->source().path) e.file = *node->source().path;
-    }
-    return e;
-  };
-  if (!(a.top_radius_km > a.bottom_radius_km)) {
-    ConfigError e = locate("atmosphere.top_radius_km");
-    e.message = fmt::format("top radius {} km must be above the bottom radius {} km",
-                            a.top_radius_km, a.bottom_radius_km);
-    result.errors.push_back(e);
-  }
-  for (int c = 0; c < 3; ++c) {
-    if (a.mie_extinction_per_km[c] < a.mie_scattering_per_km[c]) {
-      ConfigError e = locate("atmosphere.mie.extinction_per_km");
-      e.message = fmt::format("extinction {} must be at least the scattering {} (channel {})",
-                              a.mie_extinction_per_km[c], a.mie_scattering_per_km[c], c);
-      result.errors.push_back(e);
-      break;
-    }
-  }
-  const AoasSettings& x = result.style.aoas;
-  if (x.skydome.enabled) {
-    const glm::dvec3& p = x.skydome.viewer_position;
-    if (!(glm::length(p) < 0.99 * x.skydome.radius)) {
-      ConfigError e = locate("skydome.viewer_position");
-      e.message = fmt::format("the viewer must be inside the dome: |position| = {} must be below "
-                              "0.99 x radius = {}",
-                              glm::length(p), 0.99 * x.skydome.radius);
-      result.errors.push_back(e);
-    }
-    if (p.y < 0.0) {
-      ConfigError e = locate("skydome.viewer_position");
-      e.message = fmt::format("the viewer must be on or above the ground plane (y = {} < 0)", p.y);
-      result.errors.push_back(e);
-    }
-  }
-  if (x.shapes.enabled) {
-    size_t arcs = ShapeArcs(x.shapes).size();
-    if (arcs == 0) {
-      ConfigError e = locate("shapes.enabled");
-      e.message = "shapes are enabled but there is no [[shapes.shape]]";
-      result.errors.push_back(e);
-    } else if (arcs > AOAS_MAX_SHAPE_SEGMENTS) {
-      ConfigError e = locate("shapes.shape");
-      e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
-                              arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
-      result.errors.push_back(e);
-    }
-  }
-  // Volumetric cloud layers: counts, the atmosphere's top, weather images.
-  {
-    const std::string style_dir = std::filesystem::path(name).parent_path().string();
-    for (const CloudProblem& p : ValidateClouds(result.style.clouds, a, style_dir)) {
-      std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
-      if (p.layer == -2) {  // the sampling settings
-        ConfigError e = locate(root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
-                                                                                : "quality.cloud_view_steps");
-        e.message = p.message;
-        result.errors.push_back(e);
-        continue;
-      }
-      ConfigError e = locate("cloud_layer");
-      if (const toml::array* layers = root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
-                                                                      size_t(p.layer) < layers->size()) {
-        const toml::node* at = layers->get(size_t(p.layer));
-        if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->get(p.key)) at = t->get(p.key);
-        if (at->source().begin) {
-          e.line = int(at->source().begin.line);
-          e.column = int(at->source().begin.column);
-        }
-      }
-      e.key = p.key.empty() ? key : key + "." + p.key;
-      e.message = p.message;
-      result.errors.push_back(e);
-    }
-  }
-  // Every file of a bake has its own name: face names differ from each other
-  // and from the cube strip's and latlong's suffixes.
-  // Compared without case: on a case-insensitive file system (macOS,
-  // Windows shares) "PX" and "px" are one file.
-  const std::vector<std::string>& faces = result.style.output.face_names;
-  auto folded = [](std::string name) {
-    for (char& c : name) c = char(std::tolower(static_cast<unsigned char>(c)));
-    return name;
-  };
-  for (size_t i = 0; i < faces.size(); ++i) {
-    bool reserved = folded(faces[i]) == "cube" || folded(faces[i]) == "latlong";
-    size_t twin = 0;
-    while (twin < i && folded(faces[twin]) != folded(faces[i])) ++twin;
-    bool repeated = twin < i;
-    if (reserved || repeated) {
-      ConfigError e = locate("output.face_names");
-      e.key = fmt::format("output.face_names[{}]", i);
-      e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
-                  : faces[twin] == faces[i]
-                      ? fmt::format("'{}' is given twice: each face is its own file", faces[i])
-                      : fmt::format("'{}' and '{}' differ only in case, one file on a case-insensitive file "
-                                    "system: each face is its own file", faces[twin], faces[i]);
-      result.errors.push_back(e);
-      break;
-    }
-  }
-  if (result.style.gltf.image_based_light && (!result.style.ibl.specular || !result.style.gltf.enabled)) {
-    ConfigError e = locate("gltf.image_based_light");
-    e.message = "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
-                "(and gltf.enabled = true), or gltf.image_based_light = false";
-    result.errors.push_back(e);
-  }
-  if (std::optional<std::string> engine = EngineStyleError(result.style)) {
-    ConfigError e = locate("output.engine");
-    e.message = *engine;
-    result.errors.push_back(e);
-  }
-  // IBL: a cube mip chain needs a power-of-two level 0 and at most one
-  // level per halving; some file format must be asked for.
-  const IblSettings& ibl = result.style.ibl;
-  if (ibl.Requested()) {
-    int log2_size = 0;
-    while ((2 << log2_size) <= ibl.size) ++log2_size;
-    if ((1 << log2_size) != ibl.size) {
-      ConfigError e = locate("ibl.size");
-      e.message = fmt::format("{} is not a power of two: use {} or {}", ibl.size, 1 << log2_size, 2 << log2_size);
-      result.errors.push_back(e);
-    } else if (ibl.levels > log2_size + 1) {
-      ConfigError e = locate("ibl.levels");
-      e.message = fmt::format("a {} cube has at most {} mip levels (down to 1 x 1): lower ibl.levels or raise ibl.size",
-                              ibl.size, log2_size + 1);
-      result.errors.push_back(e);
-    }
-    if (!ibl.exr && !ibl.ktx2) {
-      ConfigError e = locate("ibl.exr");
-      e.message = "IBL maps are asked for but neither ibl.exr nor ibl.ktx2 is true: set one of them";
-      result.errors.push_back(e);
-    }
-    if (ibl.ktx2_zstd_level > 0 && !ibl.ktx2) {
-      ConfigError e = locate("ibl.ktx2_zstd_level");
-      e.message = "zstd supercompression applies to KTX2 files: set ibl.ktx2 = true or ibl.ktx2_zstd_level = 0";
-      result.errors.push_back(e);
-    }
-  }
-  // A preset that every explicit key overrides changes nothing: say so.
-  if (reader.Given("quality.preset")) {
-    std::vector<std::string> keys = PresetKeys();
-    bool all_given = std::all_of(keys.begin(), keys.end(), [&](const std::string& k) { return reader.Given(k); });
-    if (all_given) {
-      ConfigError w = locate("quality.preset");
-      std::string list;
-      for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
-      w.message = fmt::format("preset '{}' changes nothing: every key it sets is given explicitly ({}), and "
-                              "explicit keys refine the preset; remove or comment out those keys to use it",
-                              result.style.quality_preset, list);
-      result.warnings.push_back(w);
-    }
-  }
+  StyleChecks checks{root, name, result.errors, result.warnings};
+  CheckAtmosphere(result.style, checks);
+  CheckAoas(result.style, checks);
+  CheckCloudLayers(result.style, checks);
+  CheckFaceNames(result.style, checks);
+  CheckSceneAndEngine(result.style, checks);
+  CheckIbl(result.style, checks);
+  WarnPresetChangesNothing(result.style, reader, checks);
   if (!result.ok()) return result;
 
   // A target colour decides the hue vector (README "Styles").
-  if (!x.hue.color.empty()) {
+  if (!result.style.aoas.hue.color.empty()) {
     Rgb target;
-    ParseHexColor(x.hue.color, target);
+    ParseHexColor(result.style.aoas.hue.color, target);
     result.style.aoas.hue.rayleigh_per_km =
         RayleighForTargetColor(target, result.style.atmosphere, OutputScale(OutputUnits::kLuminance));
   }
 
-  StyleWriter writer;
-  VisitStyle(result.style, writer);
-  // Without IBL outputs their keys are left out of the record, so such a
-  // bake's files are the same bytes as before the keys existed.
-  toml::table recorded = writer.table();
-  if (!result.style.ibl.Requested()) recorded.erase("ibl");
-  else if (result.style.ibl.full_samples_roughness == 0.0) recorded["ibl"].as_table()->erase("full_samples_roughness");
-  if (result.style.output.engine == "none") recorded["output"].as_table()->erase("engine");
-  if (!result.style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
-  std::ostringstream resolved;
-  resolved << recorded;
-  result.style.resolved_toml = resolved.str();
+  result.style.resolved_toml = ResolvedToml(result.style);
   return result;
 }
 

@@ -19,29 +19,19 @@ namespace {
 
 constexpr int kMaxFrames = 100000;
 
-class ScheduleReader {
+class ScheduleReader : public TomlReader {
  public:
-  ScheduleReader(std::string file, std::vector<ConfigError>& errors)
-      : file_(std::move(file)), errors_(errors) {}
+  using TomlReader::Number;
+  ScheduleReader(std::string file, std::vector<ConfigError>& errors) : TomlReader(std::move(file), errors) {}
 
   ConfigError Origin(const toml::node* node, const std::string& key) const {
-    return LocatedError(file_, node ? node->source() : toml::source_region{}, key, "");
+    return LocatedError(file(), node ? node->source() : toml::source_region{}, key, "");
   }
 
-  void Error(const toml::node* node, const std::string& key, const std::string& message) {
-    ConfigError e = Origin(node, key);
-    e.message = message;
-    errors_.push_back(std::move(e));
-  }
-
+  // A finite number (TomlReader::Number), when the key is given.
   std::optional<double> Number(const toml::node* node, const std::string& key) {
     if (!node) return std::nullopt;
-    std::optional<double> v = node->value<double>();
-    if (!v || node->is_boolean() || !std::isfinite(*v)) {
-      Error(node, key, "expected a finite number");
-      return std::nullopt;
-    }
-    return v;
+    return Number(*node, key);
   }
 
   // A number, a list of numbers, or a {start, end, step} range.
@@ -173,27 +163,6 @@ class ScheduleReader {
     }
   }
 
-  // A number or an array of 3 numbers.
-  std::optional<std::vector<double>> Values(const toml::node& node, const std::string& key) {
-    if (node.is_number()) {
-      std::optional<double> v = Number(&node, key);
-      if (!v) return std::nullopt;
-      return std::vector<double>{*v};
-    }
-    const toml::array* array = node.as_array();
-    if (!array || array->size() != 3) {
-      Error(&node, key, "expected a number or an RGB triple [680 nm, 550 nm, 440 nm]");
-      return std::nullopt;
-    }
-    std::vector<double> values;
-    for (size_t i = 0; i < 3; ++i) {
-      std::optional<double> v = Number(array->get(i), fmt::format("{}[{}]", key, i));
-      if (!v) return std::nullopt;
-      values.push_back(*v);
-    }
-    return values;
-  }
-
   static std::string ValueText(const toml::node& node) {
     if (node.is_floating_point()) return fmt::format("{:.17g}", node.as_floating_point()->get());
     std::ostringstream out;
@@ -201,11 +170,6 @@ class ScheduleReader {
     return out.str();
   }
 
-  const std::string& file() const { return file_; }
-
- private:
-  std::string file_;
-  std::vector<ConfigError>& errors_;
 };
 
 CivilTime MakeCivilTime(const toml::date& date, const toml::time& time, double offset) {
@@ -218,6 +182,323 @@ CivilTime MakeCivilTime(const toml::date& date, const toml::time& time, double o
 }
 
 std::string FormatReal(double v) { return fmt::format("{:.17g}", v); }
+
+}  // namespace
+
+namespace {
+
+// One [schedule] table read into its frames: where and when, the frames of
+// its one source (times, sun or [[schedule.frames]]), their numbers, hours
+// and places along the schedule, and the per-frame changes of style keys.
+class ScheduleParser {
+ public:
+  ScheduleParser(ScheduleReader& r, const toml::table& s, Schedule& schedule) : r_(r), s_(s), schedule_(schedule) {}
+
+  int FirstFrame() {
+    int first_frame = 1;
+    if (const toml::node* n = s_.get("first_frame")) {
+      if (!n->is_integer() || n->as_integer()->get() < 1 || n->as_integer()->get() > 9999999)
+        r_.Error(n, "schedule.first_frame", "expected an integer in [1, 9999999]");
+      else
+        first_frame = int(n->as_integer()->get());
+    }
+    return first_frame;
+  }
+
+  // Where and when, for clock times.
+  void ReadPlace() {
+    date_ = r_.Date(s_.get("date"), "schedule.date");
+    latitude_ = r_.Number(s_.get("latitude_deg"), "schedule.latitude_deg");
+    longitude_ = r_.Number(s_.get("longitude_deg"), "schedule.longitude_deg");
+    offset_ = r_.Number(s_.get("utc_offset_hours"), "schedule.utc_offset_hours");
+    if (latitude_ && std::abs(*latitude_) > 90.0)
+      r_.Error(s_.get("latitude_deg"), "schedule.latitude_deg", "latitude must be within [-90, 90]");
+    if (longitude_ && std::abs(*longitude_) > 180.0)
+      r_.Error(s_.get("longitude_deg"), "schedule.longitude_deg", "longitude must be within [-180, 180], east positive");
+    if (offset_ && std::abs(*offset_) > 14.0)
+      r_.Error(s_.get("utc_offset_hours"), "schedule.utc_offset_hours", "UTC offset must be within [-14, 14] hours");
+    if (date_ && (date_->month < 1 || date_->month > 12 || date_->day < 1 ||
+                  date_->day > DaysInMonth(date_->year, date_->month)))
+      r_.Error(s_.get("date"), "schedule.date", "not a calendar date");
+    if (latitude_ && longitude_) schedule_.place = GeoLocation{*latitude_, *longitude_};
+  }
+
+  // `times`: a list of clock times, or { start, end, step_minutes }.
+  void ReadTimes(const toml::node& times) {
+    const std::string key = "schedule.times";
+    if (!date_ && !s_.get("date")) r_.Error(&times, key, "clock times need schedule.date, e.g. date = 2013-05-27");
+    bool place_ok = NeedPlace(&times, key);
+    if (const toml::array* list = times.as_array()) {
+      if (list->empty()) r_.Error(&times, key, "the list is empty");
+      for (size_t i = 0; i < list->size(); ++i) {
+        std::optional<toml::time> t = r_.Time(list->get(i), fmt::format("{}[{}]", key, i));
+        if (t && date_ && place_ok) frames_.push_back(TimeFrame(*date_, *t));
+      }
+    } else if (const toml::table* range = times.as_table()) {
+      ReadTimeRange(times, *range, key, place_ok);
+    } else {
+      r_.Error(&times, key, "expected a list of times or { start, end, step_minutes }");
+    }
+    schedule_.clock_times = true;
+  }
+
+  // `sun`: elevation_deg and azimuth_deg, each a number, a list or a range.
+  void ReadSun(const toml::node& sun) {
+    const std::string key = "schedule.sun";
+    const toml::table* table = sun.as_table();
+    if (!table) {
+      r_.Error(&sun, key, "expected { elevation_deg = ..., azimuth_deg = ... }");
+      return;
+    }
+    r_.CheckKeys(*table, key, {"elevation_deg", "azimuth_deg"});
+    std::optional<std::vector<double>> elevation = r_.Series(table->get("elevation_deg"), key + ".elevation_deg");
+    std::optional<std::vector<double>> azimuth = r_.Series(table->get("azimuth_deg"), key + ".azimuth_deg");
+    if (!table->get("elevation_deg") || !table->get("azimuth_deg"))
+      r_.Error(&sun, key, "needs both elevation_deg and azimuth_deg (a number, a list or a range each)");
+    if (!elevation || !azimuth) return;
+    size_t n = std::max(elevation->size(), azimuth->size());
+    if (elevation->size() != n && elevation->size() != 1) {
+      r_.Error(&sun, key, fmt::format("elevation_deg has {} values and azimuth_deg {}: give equal counts, or one "
+                                      "value for all", elevation->size(), azimuth->size()));
+      return;
+    }
+    if (azimuth->size() != n && azimuth->size() != 1) {
+      r_.Error(&sun, key, fmt::format("azimuth_deg has {} values and elevation_deg {}: give equal counts, or one "
+                                      "value for all", azimuth->size(), elevation->size()));
+      return;
+    }
+    for (size_t i = 0; i < n; ++i) {
+      ScheduleFrame f;
+      f.elevation_deg = (*elevation)[elevation->size() == 1 ? 0 : i];
+      f.azimuth_deg = (*azimuth)[azimuth->size() == 1 ? 0 : i];
+      if (std::abs(f.elevation_deg) > 90.0) {
+        r_.Error(table->get("elevation_deg"), key + ".elevation_deg",
+                 fmt::format("{} is out of range [-90, 90]", f.elevation_deg));
+        break;
+      }
+      f.sun_direction = SunDirectionFromElevationAzimuth(f.elevation_deg, f.azimuth_deg);
+      frames_.push_back(std::move(f));
+    }
+  }
+
+  // [[schedule.frames]]: each a clock time or a sun position, with its
+  // style changes; one kind per schedule.
+  void ReadFrameList(const toml::node& list) {
+    const std::string key = "schedule.frames";
+    const toml::array* array = list.as_array();
+    if (!array || array->empty()) r_.Error(&list, key, "expected [[schedule.frames]] tables");
+    bool any_time = false, all_time = true;
+    for (size_t i = 0; array && i < array->size(); ++i) {
+      const std::string fkey = fmt::format("{}[{}]", key, i);
+      const toml::table* t = array->get(i)->as_table();
+      if (!t) {
+        r_.Error(array->get(i), fkey, "expected a table");
+        continue;
+      }
+      r_.CheckKeys(*t, fkey, {"time", "date", "elevation_deg", "azimuth_deg", "set"});
+      if (t->get("time")) any_time = true;
+      else all_time = false;
+      std::optional<ScheduleFrame> f = t->get("time") ? ListedTimeFrame(*t, fkey) : ListedSunFrame(*t, fkey);
+      if (!f) continue;
+      if (const toml::node* set = t->get("set")) {
+        if (const toml::table* st = set->as_table())
+          r_.Flatten(*st, "", f->overrides, fkey + ".set");
+        else
+          r_.Error(set, fkey + ".set", "expected a table of style keys, e.g. set = { \"atmosphere.mie.g\" = 0.7 }");
+      }
+      frames_.push_back(std::move(*f));
+    }
+    schedule_.clock_times = any_time && all_time;
+    if (any_time && !all_time)
+      r_.Error(&list, key, "mix of clock-time and elevation/azimuth frames: use one kind per schedule");
+  }
+
+  // Frame numbers, hours since the first frame, position along the schedule.
+  void NumberFrames(int first_frame) {
+    std::vector<ScheduleFrame>& frames = frames_;
+    if (frames.size() > size_t(kMaxFrames))
+      r_.Error(&s_, "schedule", fmt::format("{} frames is more than the limit of {}", frames.size(), kMaxFrames));
+    for (size_t i = 0; i < frames.size(); ++i) {
+      ScheduleFrame& f = frames[i];
+      f.number = first_frame + int(i);
+      if (schedule_.clock_times) f.hours_from_start = HoursBetween(*frames[0].time, *f.time);
+    }
+    // Clock times run forward: the glTF sun animation's keys (hours) must
+    // increase strictly, and a ramp by time needs an order.
+    if (schedule_.clock_times) {
+      const char* list = s_.get("times") ? "times" : "frames";
+      for (size_t i = 1; i < frames.size(); ++i) {
+        if (frames[i].hours_from_start > frames[i - 1].hours_from_start) continue;
+        r_.Error(s_.get(list), std::string("schedule.") + list,
+                 fmt::format("frame {} ({}) is not after frame {} ({}): give clock times in increasing order, each "
+                             "once", i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
+        break;
+      }
+    }
+    const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
+    for (size_t i = 0; i < frames.size(); ++i) {
+      if (schedule_.clock_times && span_hours != 0.0)
+        frames[i].fraction = frames[i].hours_from_start / span_hours;
+      else
+        frames[i].fraction = frames.size() > 1 ? double(i) / double(frames.size() - 1) : 0.0;
+    }
+    schedule_.frames = std::move(frames);
+  }
+
+  // `ramp`: "style.key" = [from, to], numbers or RGB triples.
+  void ReadRamps() {
+    const toml::node* ramp = s_.get("ramp");
+    if (!ramp) return;
+    const toml::table* t = ramp->as_table();
+    if (!t) {
+      r_.Error(ramp, "schedule.ramp", "expected a table: \"style.key\" = [from, to]");
+      return;
+    }
+    r_.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
+      const std::string where = "schedule.ramp." + key;
+      const toml::array* pair = node.as_array();
+      if (!pair || pair->size() != 2) {
+        r_.Error(&node, where, "expected [from, to]: two numbers, or two RGB triples");
+        return;
+      }
+      std::optional<std::vector<double>> from = r_.NumberOrTriple(*pair->get(0), where + "[0]");
+      std::optional<std::vector<double>> to = r_.NumberOrTriple(*pair->get(1), where + "[1]");
+      if (!from || !to) return;
+      if (from->size() != to->size()) {
+        r_.Error(&node, where, "from and to must both be numbers or both RGB triples");
+        return;
+      }
+      schedule_.ramps.push_back({key, *from, *to, r_.Origin(&node, key)});
+    }, "schedule.ramp");
+  }
+
+  // `per_hour`: "style.key" = rate, for clock-time frames.
+  void ReadRates() {
+    const toml::node* per_hour = s_.get("per_hour");
+    if (!per_hour) return;
+    const toml::table* t = per_hour->as_table();
+    if (!t) {
+      r_.Error(per_hour, "schedule.per_hour", "expected a table: \"style.key\" = rate");
+      return;
+    }
+    if (!schedule_.clock_times && !t->empty())
+      r_.Error(per_hour, "schedule.per_hour", "rates per hour need clock-time frames (`times`)");
+    r_.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
+      std::optional<std::vector<double>> rate = r_.NumberOrTriple(node, "schedule.per_hour." + key);
+      if (rate) schedule_.rates.push_back({key, *rate, r_.Origin(&node, key)});
+    }, "schedule.per_hour");
+  }
+
+ private:
+  // Whether the place and offset that clock times need are given (each
+  // missing one reported at `where`).
+  bool NeedPlace(const toml::node* where, const std::string& key) {
+    bool ok = true;
+    for (auto [field, value] : {std::pair{"latitude_deg", latitude_.has_value()},
+                                {"longitude_deg", longitude_.has_value()},
+                                {"utc_offset_hours", offset_.has_value()}}) {
+      if (!value && !s_.get(field)) {
+        r_.Error(where, key, fmt::format("clock times need schedule.{} (and date, latitude_deg, longitude_deg, "
+                                         "utc_offset_hours)", field));
+        ok = false;
+      }
+    }
+    return ok && latitude_ && longitude_ && offset_;
+  }
+
+  // The frame at a clock time: the Sun from the place (NeedPlace).
+  ScheduleFrame TimeFrame(const toml::date& d, const toml::time& t) const {
+    ScheduleFrame f;
+    f.time = MakeCivilTime(d, t, *offset_);
+    SolarPosition p = ComputeSolarPosition(*f.time, *schedule_.place);
+    f.elevation_deg = p.elevation_deg;
+    f.azimuth_deg = p.azimuth_deg;
+    f.sun_direction = p.direction;
+    return f;
+  }
+
+  void ReadTimeRange(const toml::node& times, const toml::table& range, const std::string& key, bool place_ok) {
+    r_.CheckKeys(range, key, {"start", "end", "step_minutes"});
+    std::optional<toml::time> start = r_.Time(range.get("start"), key + ".start");
+    std::optional<toml::time> end = r_.Time(range.get("end"), key + ".end");
+    std::optional<double> step = r_.Number(range.get("step_minutes"), key + ".step_minutes");
+    if (!range.get("start") || !range.get("end") || !range.get("step_minutes"))
+      r_.Error(&times, key, "a time range needs start, end and step_minutes, e.g. "
+                            "{ start = 06:00:00, end = 20:00:00, step_minutes = 15 }");
+    if (!start || !end || !step) return;
+    auto seconds = [](const toml::time& t) { return t.hour * 3600.0 + t.minute * 60.0 + t.second + t.nanosecond * 1e-9; };
+    double s0 = seconds(*start), s1 = seconds(*end);
+    if (!(*step > 0.0)) {
+      r_.Error(range.get("step_minutes"), key + ".step_minutes", "must be above 0");
+    } else if (s1 < s0) {
+      r_.Error(range.get("end"), key + ".end", "end is before start: a range stays within one day");
+    } else if (std::optional<std::vector<double>> steps = r_.Steps(&times, key, s0, s1, *step * 60.0);
+               steps && date_ && place_ok) {
+      for (double sec : *steps) {
+        toml::time t;
+        double whole = std::floor(sec + 1e-6);
+        t.hour = uint8_t(int(whole) / 3600);
+        t.minute = uint8_t((int(whole) % 3600) / 60);
+        t.second = uint8_t(int(whole) % 60);
+        t.nanosecond = uint32_t(std::max(0.0, sec - whole) * 1e9);
+        frames_.push_back(TimeFrame(*date_, t));
+      }
+    }
+  }
+
+  // A [[schedule.frames]] entry with a clock time (and its own date or the schedule's).
+  std::optional<ScheduleFrame> ListedTimeFrame(const toml::table& t, const std::string& fkey) {
+    if (t.get("elevation_deg") || t.get("azimuth_deg"))
+      r_.Error(&t, fkey, "give either time or elevation_deg/azimuth_deg, not both");
+    std::optional<toml::time> tm = r_.Time(t.get("time"), fkey + ".time");
+    std::optional<toml::date> d = t.get("date") ? r_.Date(t.get("date"), fkey + ".date") : date_;
+    if (!d) r_.Error(&t, fkey, "a clock time needs a date (schedule.date or the frame's date)");
+    if (tm && d && NeedPlace(&t, fkey)) return TimeFrame(*d, *tm);
+    return std::nullopt;
+  }
+
+  // A [[schedule.frames]] entry with the Sun's elevation and azimuth.
+  std::optional<ScheduleFrame> ListedSunFrame(const toml::table& t, const std::string& fkey) {
+    std::optional<double> e = r_.Number(t.get("elevation_deg"), fkey + ".elevation_deg");
+    std::optional<double> a = r_.Number(t.get("azimuth_deg"), fkey + ".azimuth_deg");
+    if (!t.get("elevation_deg") || !t.get("azimuth_deg")) {
+      r_.Error(&t, fkey, "a frame needs time, or elevation_deg and azimuth_deg");
+      return std::nullopt;
+    }
+    if (!e || !a) return std::nullopt;
+    if (std::abs(*e) > 90.0) {
+      r_.Error(t.get("elevation_deg"), fkey + ".elevation_deg", fmt::format("{} is out of range [-90, 90]", *e));
+      return std::nullopt;
+    }
+    ScheduleFrame f;
+    f.elevation_deg = *e;
+    f.azimuth_deg = *a;
+    f.sun_direction = SunDirectionFromElevationAzimuth(*e, *a);
+    return f;
+  }
+
+  // Hours of clock time from `first` to `t`: whole days from the Julian
+  // days of the two midnights (exact in double), then the clock difference,
+  // so that 15 minutes is 0.25 h exactly.
+  static double HoursBetween(const CivilTime& first, const CivilTime& t) {
+    auto midnight = [](CivilTime c) {
+      c.hour = c.minute = 0;
+      c.second = 0.0;
+      return JulianDayUt(c) + c.utc_offset_hours / 24.0;
+    };
+    auto clock_hours = [](const CivilTime& c) {
+      return c.hour + c.minute / 60.0 + c.second / 3600.0 - c.utc_offset_hours;
+    };
+    return std::round(midnight(t) - midnight(first)) * 24.0 + clock_hours(t) - clock_hours(first);
+  }
+
+  ScheduleReader& r_;
+  const toml::table& s_;
+  Schedule& schedule_;
+  std::optional<toml::date> date_;
+  std::optional<double> latitude_, longitude_, offset_;
+  std::vector<ScheduleFrame> frames_;
+};
 
 }  // namespace
 
@@ -237,44 +518,11 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
   r.CheckKeys(*s, "schedule",
               {"first_frame", "date", "latitude_deg", "longitude_deg", "utc_offset_hours", "times", "sun",
                "frames", "ramp", "per_hour"});
+  ScheduleParser parser(r, *s, schedule);
+  const int first_frame = parser.FirstFrame();
+  parser.ReadPlace();
 
-  int first_frame = 1;
-  if (const toml::node* n = s->get("first_frame")) {
-    if (!n->is_integer() || n->as_integer()->get() < 1 || n->as_integer()->get() > 9999999)
-      r.Error(n, "schedule.first_frame", "expected an integer in [1, 9999999]");
-    else
-      first_frame = int(n->as_integer()->get());
-  }
-
-  // Where and when, for clock times.
-  std::optional<toml::date> date = r.Date(s->get("date"), "schedule.date");
-  std::optional<double> latitude = r.Number(s->get("latitude_deg"), "schedule.latitude_deg");
-  std::optional<double> longitude = r.Number(s->get("longitude_deg"), "schedule.longitude_deg");
-  std::optional<double> offset = r.Number(s->get("utc_offset_hours"), "schedule.utc_offset_hours");
-  if (latitude && std::abs(*latitude) > 90.0)
-    r.Error(s->get("latitude_deg"), "schedule.latitude_deg", "latitude must be within [-90, 90]");
-  if (longitude && std::abs(*longitude) > 180.0)
-    r.Error(s->get("longitude_deg"), "schedule.longitude_deg", "longitude must be within [-180, 180], east positive");
-  if (offset && std::abs(*offset) > 14.0)
-    r.Error(s->get("utc_offset_hours"), "schedule.utc_offset_hours", "UTC offset must be within [-14, 14] hours");
-  if (date && (date->month < 1 || date->month > 12 || date->day < 1 ||
-               date->day > DaysInMonth(date->year, date->month)))
-    r.Error(s->get("date"), "schedule.date", "not a calendar date");
-  auto need_place = [&](const toml::node* where, const std::string& key) {
-    bool ok = true;
-    for (auto [field, value] : {std::pair{"latitude_deg", latitude.has_value()},
-                                {"longitude_deg", longitude.has_value()},
-                                {"utc_offset_hours", offset.has_value()}}) {
-      if (!value && !s->get(field)) {
-        r.Error(where, key, fmt::format("clock times need schedule.{} (and date, latitude_deg, longitude_deg, "
-                                        "utc_offset_hours)", field));
-        ok = false;
-      }
-    }
-    return ok && latitude && longitude && offset;
-  };
-  if (latitude && longitude) schedule.place = GeoLocation{*latitude, *longitude};
-
+  // The frames, from exactly one source.
   const int sources = int(s->contains("times")) + int(s->contains("sun")) + int(s->contains("frames"));
   if (sources != 1) {
     r.Error(s, "schedule",
@@ -282,231 +530,14 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
                          : "give only one of `times`, `sun` and [[schedule.frames]]");
     return result;
   }
-
-  std::vector<ScheduleFrame> frames;
-  auto add_time_frame = [&](const toml::date& d, const toml::time& t, const toml::node* where) {
-    ScheduleFrame f;
-    f.time = MakeCivilTime(d, t, *offset);
-    SolarPosition p = ComputeSolarPosition(*f.time, *schedule.place);
-    f.elevation_deg = p.elevation_deg;
-    f.azimuth_deg = p.azimuth_deg;
-    f.sun_direction = p.direction;
-    (void)where;
-    frames.push_back(std::move(f));
-  };
-
-  if (const toml::node* times = s->get("times")) {
-    const std::string key = "schedule.times";
-    if (!date && !s->get("date")) r.Error(times, key, "clock times need schedule.date, e.g. date = 2013-05-27");
-    bool place_ok = need_place(times, key);
-    if (const toml::array* list = times->as_array()) {
-      if (list->empty()) r.Error(times, key, "the list is empty");
-      for (size_t i = 0; i < list->size(); ++i) {
-        std::optional<toml::time> t = r.Time(list->get(i), fmt::format("{}[{}]", key, i));
-        if (t && date && place_ok) add_time_frame(*date, *t, list->get(i));
-      }
-    } else if (const toml::table* range = times->as_table()) {
-      r.CheckKeys(*range, key, {"start", "end", "step_minutes"});
-      std::optional<toml::time> start = r.Time(range->get("start"), key + ".start");
-      std::optional<toml::time> end = r.Time(range->get("end"), key + ".end");
-      std::optional<double> step = r.Number(range->get("step_minutes"), key + ".step_minutes");
-      if (!range->get("start") || !range->get("end") || !range->get("step_minutes"))
-        r.Error(times, key, "a time range needs start, end and step_minutes, e.g. "
-                            "{ start = 06:00:00, end = 20:00:00, step_minutes = 15 }");
-      if (start && end && step) {
-        auto seconds = [](const toml::time& t) { return t.hour * 3600.0 + t.minute * 60.0 + t.second + t.nanosecond * 1e-9; };
-        double s0 = seconds(*start), s1 = seconds(*end);
-        if (!(*step > 0.0)) {
-          r.Error(range->get("step_minutes"), key + ".step_minutes", "must be above 0");
-        } else if (s1 < s0) {
-          r.Error(range->get("end"), key + ".end", "end is before start: a range stays within one day");
-        } else if (std::optional<std::vector<double>> steps = r.Steps(times, key, s0, s1, *step * 60.0);
-                   steps && date && place_ok) {
-          for (double sec : *steps) {
-            toml::time t;
-            double whole = std::floor(sec + 1e-6);
-            t.hour = uint8_t(int(whole) / 3600);
-            t.minute = uint8_t((int(whole) % 3600) / 60);
-            t.second = uint8_t(int(whole) % 60);
-            t.nanosecond = uint32_t(std::max(0.0, sec - whole) * 1e9);
-            add_time_frame(*date, t, times);
-          }
-        }
-      }
-    } else {
-      r.Error(times, key, "expected a list of times or { start, end, step_minutes }");
-    }
-    schedule.clock_times = true;
-  } else if (const toml::node* sun = s->get("sun")) {
-    const std::string key = "schedule.sun";
-    const toml::table* table = sun->as_table();
-    if (!table) {
-      r.Error(sun, key, "expected { elevation_deg = ..., azimuth_deg = ... }");
-    } else {
-      r.CheckKeys(*table, key, {"elevation_deg", "azimuth_deg"});
-      std::optional<std::vector<double>> elevation = r.Series(table->get("elevation_deg"), key + ".elevation_deg");
-      std::optional<std::vector<double>> azimuth = r.Series(table->get("azimuth_deg"), key + ".azimuth_deg");
-      if (!table->get("elevation_deg") || !table->get("azimuth_deg"))
-        r.Error(sun, key, "needs both elevation_deg and azimuth_deg (a number, a list or a range each)");
-      if (elevation && azimuth) {
-        size_t n = std::max(elevation->size(), azimuth->size());
-        if (elevation->size() != n && elevation->size() != 1)
-          r.Error(sun, key, fmt::format("elevation_deg has {} values and azimuth_deg {}: give equal counts, or one "
-                                        "value for all", elevation->size(), azimuth->size()));
-        else if (azimuth->size() != n && azimuth->size() != 1)
-          r.Error(sun, key, fmt::format("azimuth_deg has {} values and elevation_deg {}: give equal counts, or one "
-                                        "value for all", azimuth->size(), elevation->size()));
-        else
-          for (size_t i = 0; i < n; ++i) {
-            ScheduleFrame f;
-            f.elevation_deg = (*elevation)[elevation->size() == 1 ? 0 : i];
-            f.azimuth_deg = (*azimuth)[azimuth->size() == 1 ? 0 : i];
-            if (std::abs(f.elevation_deg) > 90.0) {
-              r.Error(table->get("elevation_deg"), key + ".elevation_deg",
-                      fmt::format("{} is out of range [-90, 90]", f.elevation_deg));
-              break;
-            }
-            f.sun_direction = SunDirectionFromElevationAzimuth(f.elevation_deg, f.azimuth_deg);
-            frames.push_back(std::move(f));
-          }
-      }
-    }
-  } else if (const toml::node* list = s->get("frames")) {
-    const std::string key = "schedule.frames";
-    const toml::array* array = list->as_array();
-    if (!array || array->empty()) r.Error(list, key, "expected [[schedule.frames]] tables");
-    bool any_time = false, all_time = true;
-    for (size_t i = 0; array && i < array->size(); ++i) {
-      const std::string fkey = fmt::format("{}[{}]", key, i);
-      const toml::table* t = array->get(i)->as_table();
-      if (!t) {
-        r.Error(array->get(i), fkey, "expected a table");
-        continue;
-      }
-      r.CheckKeys(*t, fkey, {"time", "date", "elevation_deg", "azimuth_deg", "set"});
-      ScheduleFrame f;
-      if (t->get("time")) {
-        any_time = true;
-        if (t->get("elevation_deg") || t->get("azimuth_deg"))
-          r.Error(t, fkey, "give either time or elevation_deg/azimuth_deg, not both");
-        std::optional<toml::time> tm = r.Time(t->get("time"), fkey + ".time");
-        std::optional<toml::date> d = t->get("date") ? r.Date(t->get("date"), fkey + ".date") : date;
-        if (!d) r.Error(t, fkey, "a clock time needs a date (schedule.date or the frame's date)");
-        if (tm && d && need_place(t, fkey)) {
-          add_time_frame(*d, *tm, t);
-          f = frames.back();
-          frames.pop_back();
-        } else {
-          continue;
-        }
-      } else {
-        all_time = false;
-        std::optional<double> e = r.Number(t->get("elevation_deg"), fkey + ".elevation_deg");
-        std::optional<double> a = r.Number(t->get("azimuth_deg"), fkey + ".azimuth_deg");
-        if (!t->get("elevation_deg") || !t->get("azimuth_deg")) {
-          r.Error(t, fkey, "a frame needs time, or elevation_deg and azimuth_deg");
-          continue;
-        }
-        if (!e || !a) continue;
-        if (std::abs(*e) > 90.0) {
-          r.Error(t->get("elevation_deg"), fkey + ".elevation_deg", fmt::format("{} is out of range [-90, 90]", *e));
-          continue;
-        }
-        f.elevation_deg = *e;
-        f.azimuth_deg = *a;
-        f.sun_direction = SunDirectionFromElevationAzimuth(*e, *a);
-      }
-      if (const toml::node* set = t->get("set")) {
-        if (const toml::table* st = set->as_table())
-          r.Flatten(*st, "", f.overrides, fkey + ".set");
-        else
-          r.Error(set, fkey + ".set", "expected a table of style keys, e.g. set = { \"atmosphere.mie.g\" = 0.7 }");
-      }
-      frames.push_back(std::move(f));
-    }
-    schedule.clock_times = any_time && all_time;
-    if (any_time && !all_time)
-      r.Error(list, key, "mix of clock-time and elevation/azimuth frames: use one kind per schedule");
-  }
-
-  if (frames.size() > size_t(kMaxFrames))
-    r.Error(s, "schedule", fmt::format("{} frames is more than the limit of {}", frames.size(), kMaxFrames));
-
-  // Frame numbers, hours since the first frame, position along the schedule.
-  for (size_t i = 0; i < frames.size(); ++i) {
-    ScheduleFrame& f = frames[i];
-    f.number = first_frame + int(i);
-    if (schedule.clock_times) {
-      // Whole days from the Julian days of the two midnights (exact in
-      // double), then the clock difference, so that 15 minutes is 0.25 h exactly.
-      auto midnight = [](CivilTime t) {
-        t.hour = t.minute = 0;
-        t.second = 0.0;
-        return JulianDayUt(t) + t.utc_offset_hours / 24.0;
-      };
-      auto clock_hours = [](const CivilTime& t) {
-        return t.hour + t.minute / 60.0 + t.second / 3600.0 - t.utc_offset_hours;
-      };
-      f.hours_from_start = std::round(midnight(*f.time) - midnight(*frames[0].time)) * 24.0 +
-                           clock_hours(*f.time) - clock_hours(*frames[0].time);
-    }
-  }
-  // Clock times run forward: the glTF sun animation's keys (hours) must
-  // increase strictly, and a ramp by time needs an order.
-  if (schedule.clock_times) {
-    const char* list = s->get("times") ? "times" : "frames";
-    for (size_t i = 1; i < frames.size(); ++i) {
-      if (frames[i].hours_from_start > frames[i - 1].hours_from_start) continue;
-      r.Error(s->get(list), std::string("schedule.") + list,
-              fmt::format("frame {} ({}) is not after frame {} ({}): give clock times in increasing order, each "
-                          "once", i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
-      break;
-    }
-  }
-  const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
-  for (size_t i = 0; i < frames.size(); ++i) {
-    if (schedule.clock_times && span_hours != 0.0)
-      frames[i].fraction = frames[i].hours_from_start / span_hours;
-    else
-      frames[i].fraction = frames.size() > 1 ? double(i) / double(frames.size() - 1) : 0.0;
-  }
-  schedule.frames = std::move(frames);
+  if (const toml::node* times = s->get("times")) parser.ReadTimes(*times);
+  else if (const toml::node* sun = s->get("sun")) parser.ReadSun(*sun);
+  else if (const toml::node* list = s->get("frames")) parser.ReadFrameList(*list);
+  parser.NumberFrames(first_frame);
 
   // Per-frame changes of style keys.
-  if (const toml::node* ramp = s->get("ramp")) {
-    if (const toml::table* t = ramp->as_table()) {
-      r.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
-        const std::string where = "schedule.ramp." + key;
-        const toml::array* pair = node.as_array();
-        if (!pair || pair->size() != 2) {
-          r.Error(&node, where, "expected [from, to]: two numbers, or two RGB triples");
-          return;
-        }
-        std::optional<std::vector<double>> from = r.Values(*pair->get(0), where + "[0]");
-        std::optional<std::vector<double>> to = r.Values(*pair->get(1), where + "[1]");
-        if (!from || !to) return;
-        if (from->size() != to->size()) {
-          r.Error(&node, where, "from and to must both be numbers or both RGB triples");
-          return;
-        }
-        schedule.ramps.push_back({key, *from, *to, r.Origin(&node, key)});
-      }, "schedule.ramp");
-    } else {
-      r.Error(ramp, "schedule.ramp", "expected a table: \"style.key\" = [from, to]");
-    }
-  }
-  if (const toml::node* per_hour = s->get("per_hour")) {
-    if (const toml::table* t = per_hour->as_table()) {
-      if (!schedule.clock_times && !t->empty())
-        r.Error(per_hour, "schedule.per_hour", "rates per hour need clock-time frames (`times`)");
-      r.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
-        std::optional<std::vector<double>> rate = r.Values(node, "schedule.per_hour." + key);
-        if (rate) schedule.rates.push_back({key, *rate, r.Origin(&node, key)});
-      }, "schedule.per_hour");
-    } else {
-      r.Error(per_hour, "schedule.per_hour", "expected a table: \"style.key\" = rate");
-    }
-  }
+  parser.ReadRamps();
+  parser.ReadRates();
   return result;
 }
 

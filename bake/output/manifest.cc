@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/output/cloud_shadow_json.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/output_lock.h"
@@ -67,7 +68,7 @@ json FrameJson(const ManifestFrame& f) {
 json FrameJsonWithoutMoon(const ManifestFrame& f) {
   json files = json::array();
   for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
-  return {{"frame", f.number},
+  json frame = {{"frame", f.number},
           {"style_sha256", f.style_sha256},
           {"time", f.time ? json(*f.time) : json(nullptr)},
           {"hours_from_start", f.hours_from_start},
@@ -80,6 +81,8 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
           {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
           {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
           {"files", files}};
+  if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
+  return frame;
 }
 
 json ManifestJson(const Manifest& m) {
@@ -286,8 +289,8 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 
 // Every name of a manifest is a plain file name and the one the bake gives
 // its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
-// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_latlong.NNNN.png, in that order, one BASE per
-// frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
+// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png,
+// in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
   if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
@@ -340,10 +343,12 @@ void CheckNames(const std::string& path, const Manifest& m) {
         stage = 4;
       } else if (file.kind == "preview" || file.kind == "gltf_texture") {
         with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
+      } else if (file.kind == "cloud_shadow") {
+        with_suffix(file, stem_of(file, ".exr", "cloud shadow"), "_cloudshadow", "cloud shadow", 3);
       } else {
         FailName(path, where, file.kind,
                  "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, ibl_gltf, "
-                 "engine, preview, gltf_texture)");
+                 "engine, preview, gltf_texture, cloud_shadow)");
       }
     }
     if (!faces.empty() && faces.size() != 6)
@@ -414,6 +419,7 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
   for (const BakedFile& file : frame.files)
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+  f.cloud_shadow = frame.cloud_shadow;
   return f;
 }
 
@@ -421,12 +427,71 @@ void WriteManifest(const Manifest& manifest, const std::string& path) {
   WriteFileAtomically(path, ManifestJson(manifest).dump(2) + "\n");
 }
 
-Manifest ReadManifest(const std::string& path) {
+namespace {
+
+MoonRecord MoonOf(const Reader& r, const json& moon) {
+  MoonRecord mr;
+  mr.direction = r.Vector(moon, "direction");
+  mr.elevation_deg = r.Get<double>(moon, "elevation_deg");
+  mr.azimuth_deg = r.Get<double>(moon, "azimuth_deg");
+  mr.phase_angle_deg = r.Get<double>(moon, "phase_angle_deg");
+  mr.illuminated_fraction = r.Get<double>(moon, "illuminated_fraction");
+  mr.bright_limb_deg = r.Get<double>(moon, "bright_limb_deg");
+  mr.angular_radius_rad = r.Get<double>(moon, "angular_radius_rad");
+  mr.top_illuminance_lux = r.Get<double>(moon, "top_illuminance_lux");
+  mr.illuminance_lux = r.Get<double>(moon, "illuminance_lux");
+  mr.irradiance = r.RgbOf(moon, "irradiance");
+  mr.light = r.Get<bool>(moon, "light");
+  return mr;
+}
+
+ManifestFrame FrameOf(const Reader& r, const json& f) {
+  ManifestFrame frame;
+  frame.number = r.Int(f, "frame");
+  frame.style_sha256 = r.Get<std::string>(f, "style_sha256");
+  if (f.contains("time") && !f["time"].is_null()) frame.time = r.Get<std::string>(f, "time");
+  frame.hours_from_start = r.Get<double>(f, "hours_from_start");
+  frame.animation_time_s = r.Get<double>(f, "animation_time_s");
+  const json& sun = r.Get<json>(f, "sun");
+  frame.sun_elevation_deg = r.Get<double>(sun, "elevation_deg");
+  frame.sun_azimuth_deg = r.Get<double>(sun, "azimuth_deg");
+  frame.sun_direction = r.Vector(sun, "direction");
+  frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
+  frame.sun_irradiance = r.RgbOf(sun, "irradiance");
+  frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
+  frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
+  if (f.contains("moon")) frame.moon = MoonOf(r, r.Get<json>(f, "moon"));
+  frame.files = FilesOf(r, r.Get<json>(f, "files"));
+  if (f.contains("cloud_shadow")) frame.cloud_shadow = CloudShadowFromJson(f["cloud_shadow"]);
+  return frame;
+}
+
+ManifestScene SceneOf(const Reader& r, const json& gltf) {
+  ManifestScene scene;
+  scene.enabled = r.Get<bool>(gltf, "enabled");
+  scene.name = r.Get<std::string>(gltf, "name");
+  scene.dome.dome = r.Get<std::string>(gltf, "dome") == "hemisphere" ? DomeShape::kHemisphere : DomeShape::kSphere;
+  scene.dome.radius_m = r.Get<double>(gltf, "radius_m");
+  scene.dome.flattening = r.Get<double>(gltf, "flattening");
+  scene.dome.segments = int(r.Integer(gltf, "segments", 3, 4096));
+  scene.dome.enabled = scene.enabled;
+  const json& texture = r.Get<json>(gltf, "texture");
+  scene.texture_file = r.Get<std::string>(texture, "file");
+  scene.texture_width = int(r.Integer(texture, "width", 1, 16384));
+  scene.texture_height = int(r.Integer(texture, "height", 1, 8192));
+  return scene;
+}
+
+}  // namespace
+
+Manifest ReadManifest(const std::string& path, ManifestNames names) {
   std::ifstream in(path, std::ios::binary);
-  if (!in) throw ManifestError(fmt::format("cannot read {}", path));
+  if (!in) throw ManifestSyntaxError(fmt::format("cannot read {}", path));
   json j = json::parse(in, nullptr, false);
   Reader r(path);
-  if (j.is_discarded() || !j.is_object()) r.Fail("invalid JSON");
+  if (j.is_discarded() || !j.is_object())
+    throw ManifestSyntaxError(
+        fmt::format("{}: invalid JSON: not a skybake manifest, or one from another version", path));
   Manifest m;
   m.version = r.Get<std::string>(j, "version");
   m.style = r.Get<std::string>(j, "style");
@@ -437,59 +502,15 @@ Manifest ReadManifest(const std::string& path) {
   m.exposure_source = r.Get<std::string>(j, "exposure_source");
   m.texture_frame = r.Int(j, "texture_frame");
   m.half_scale = r.Get<double>(j, "half_scale");
-  const json& gltf = r.Get<json>(j, "gltf");
-  m.gltf.enabled = r.Get<bool>(gltf, "enabled");
-  m.gltf.name = r.Get<std::string>(gltf, "name");
-  m.gltf.dome.dome = r.Get<std::string>(gltf, "dome") == "hemisphere" ? DomeShape::kHemisphere : DomeShape::kSphere;
-  m.gltf.dome.radius_m = r.Get<double>(gltf, "radius_m");
-  m.gltf.dome.flattening = r.Get<double>(gltf, "flattening");
-  m.gltf.dome.segments = int(r.Integer(gltf, "segments", 3, 4096));
-  m.gltf.dome.enabled = m.gltf.enabled;
-  const json& texture = r.Get<json>(gltf, "texture");
-  m.gltf.texture_file = r.Get<std::string>(texture, "file");
-  m.gltf.texture_width = int(r.Integer(texture, "width", 1, 16384));
-  m.gltf.texture_height = int(r.Integer(texture, "height", 1, 8192));
+  m.gltf = SceneOf(r, r.Get<json>(j, "gltf"));
   if (j.contains("place"))
     m.place = GeoLocation{r.Get<double>(j["place"], "latitude_deg"), r.Get<double>(j["place"], "longitude_deg")};
   if (j.contains("sequence")) m.sequence = r.Range(j, "sequence");
   if (j.contains("part")) m.part = r.Range(j, "part");
-  for (const json& f : r.Get<json>(j, "frames")) {
-    ManifestFrame frame;
-    frame.number = r.Int(f, "frame");
-    frame.style_sha256 = r.Get<std::string>(f, "style_sha256");
-    if (f.contains("time") && !f["time"].is_null()) frame.time = r.Get<std::string>(f, "time");
-    frame.hours_from_start = r.Get<double>(f, "hours_from_start");
-    frame.animation_time_s = r.Get<double>(f, "animation_time_s");
-    const json& sun = r.Get<json>(f, "sun");
-    frame.sun_elevation_deg = r.Get<double>(sun, "elevation_deg");
-    frame.sun_azimuth_deg = r.Get<double>(sun, "azimuth_deg");
-    frame.sun_direction = r.Vector(sun, "direction");
-    frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
-    frame.sun_irradiance = r.RgbOf(sun, "irradiance");
-    frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
-    frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
-    if (f.contains("moon")) {
-      const json& moon = r.Get<json>(f, "moon");
-      MoonRecord mr;
-      mr.direction = r.Vector(moon, "direction");
-      mr.elevation_deg = r.Get<double>(moon, "elevation_deg");
-      mr.azimuth_deg = r.Get<double>(moon, "azimuth_deg");
-      mr.phase_angle_deg = r.Get<double>(moon, "phase_angle_deg");
-      mr.illuminated_fraction = r.Get<double>(moon, "illuminated_fraction");
-      mr.bright_limb_deg = r.Get<double>(moon, "bright_limb_deg");
-      mr.angular_radius_rad = r.Get<double>(moon, "angular_radius_rad");
-      mr.top_illuminance_lux = r.Get<double>(moon, "top_illuminance_lux");
-      mr.illuminance_lux = r.Get<double>(moon, "illuminance_lux");
-      mr.irradiance = r.RgbOf(moon, "irradiance");
-      mr.light = r.Get<bool>(moon, "light");
-      frame.moon = mr;
-    }
-    frame.files = FilesOf(r, r.Get<json>(f, "files"));
-    m.frames.push_back(std::move(frame));
-  }
+  for (const json& f : r.Get<json>(j, "frames")) m.frames.push_back(FrameOf(r, f));
   m.complete = r.Get<bool>(j, "complete");
   m.scene = FilesOf(r, r.Get<json>(j, "scene"));
-  CheckNames(path, m);
+  if (names == ManifestNames::kChecked) CheckNames(path, m);
   return m;
 }
 

@@ -70,17 +70,13 @@ std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
   return views;
 }
 
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders) {
-  PassPlan plan;
-  plan.frames = int(frames.size());
-  if (frames.empty()) return plan;
-  const SkyStyle& first = frames.front();
-  const SkyStyle pruned = PrunedStyle(first);
+namespace {
+
+// Effects, with the keys that decided them.
+void PlanEffects(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) {
   const EffectSettings& r = first.effects;
   const EffectSettings& p = pruned.effects;
   const AtmosphereParams& a = first.atmosphere;
-
-  // Effects, with the keys that decided them.
   auto decide = [&](const std::string& name, bool requested, bool on, const std::string& why_off,
                     const std::string& why_on) {
     plan.effects.push_back({name, requested, on, on ? why_on : (requested ? why_off : "switched off in the style")});
@@ -131,7 +127,10 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
          fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}, night.airglow = {}",
                      night.stars, night.star_magnitude_limit, night.moon, night.moonlight, night.airglow));
 
-  // Distinct atmospheres over the frames: each one rebuilds the LUTs.
+}
+
+// Distinct atmospheres over the frames: each one rebuilds the LUTs.
+int DistinctAtmospheres(const std::vector<SkyStyle>& frames) {
   std::vector<gpu::GpuAtmosphere> keys;
   for (const SkyStyle& f : frames) {
     SkyStyle fp = PrunedStyle(f);
@@ -142,8 +141,20 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
     });
     if (!seen) keys.push_back(key);
   }
-  plan.atmospheres = int(keys.size());
+  return int(keys.size());
 
+}
+
+// Samples per rendered texel: one LUT read with the sky-view LUT, else the
+// ray march (times the light march when the Sun's transmittance is marched).
+double SamplesPerTexel(const SkyStyle& first, const SkyStyle& pruned) {
+  const QualitySettings& q = first.quality;
+  return NeedsSkyViewLut(pruned) ? 1.0 : double(q.view_steps) * std::max(q.light_steps, 1);
+}
+
+// The sky: the LUTs and the render of every view.
+void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) {
+  const EffectSettings& p = pruned.effects;
   const QualitySettings& q = first.quality;
   const int light = std::max(q.light_steps, 1);
   if (NeedsTransmittanceLut(q, p) || !ActiveCloudLayers(first.clouds).empty())
@@ -167,14 +178,21 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
     plan.passes.push_back({name, Size(v.width, v.height), sky_view ? "once per frame (LUT reads)" : "once per frame",
                            plan.frames, double(v.width) * v.height * per_texel});
   }
+}
+
+// Whether the sun disc is a pass of its own (UsesSunDiscPass).
+bool PlansSunDiscPass(const SkyStyle& first, const SkyStyle& pruned, const ShaderSwitches& shaders) {
+  const AoasSettings& xp = pruned.aoas;
   AoasSwitches switches;
   switches.skydome = xp.skydome.enabled;
   switches.ambiguity = xp.ambiguity.enabled;
   switches.cloud_noise = xp.clouds.enabled;
   switches.cloud_shapes = xp.shapes.enabled;
-  const bool disc_pass = UsesSunDiscPass(q, p, switches, shaders);
-  if (disc_pass)
-    plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
+  return UsesSunDiscPass(first.quality, pruned.effects, switches, shaders);
+}
+
+// Volumetric cloud layers: the noise volumes, the tables, every view.
+void PlanCloudPasses(const SkyStyle& first, PassPlan& plan) {
   const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
   const CloudQuality& cq = first.clouds.quality;
   if (!cloud_layers.empty()) {
@@ -199,6 +217,15 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                              double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
     }
   }
+}
+
+// Moonlight: a second render of the sky with the Moon as the light.
+void PlanMoonlitPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) {
+  const NightSettings& night = first.night;
+  const QualitySettings& q = first.quality;
+  const int light = std::max(q.light_steps, 1);
+  const bool sky_view = NeedsSkyViewLut(pruned);
+  const double per_texel = SamplesPerTexel(first, pruned);
   if (night.moonlight && sky_view)
     plan.passes.push_back({"moonlit sky-view LUT", Size(q.sky_view_width, q.sky_view_height),
                            "per frame with the Sun down and the Moon above -10 deg", plan.frames,
@@ -210,9 +237,12 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                                                                                  : fmt::format("face {}", v.face)),
                              Size(v.width, v.height), "per frame with the Sun down and the Moon above -10 deg",
                              plan.frames, double(v.width) * v.height * per_texel});
-  for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
-  // Image-based lighting (ibl.h): only when an IBL output is asked for.
-  // Its samples are filtered cube reads, not medium samples: not in the total.
+}
+
+// Image-based lighting (ibl.h): only when an IBL output is asked for.
+// Its samples are filtered cube reads, not medium samples: not in the total.
+void PlanIblPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) {
+  const double per_texel = SamplesPerTexel(first, pruned);
   const IblSettings& ibl = first.ibl;
   if (ibl.Requested()) {
     const double source_texels = 6.0 * ibl.size * ibl.size;
@@ -243,29 +273,47 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                              double(ibl.dfg_size) * ibl.dfg_size * ibl.dfg_samples});
   }
 
+}
+
+// The specialization constants of the render shader, the SPIR-V it comes
+// from, the sun-disc and cloud passes.
+std::string DescribeVariant(const SkyStyle& first, const SkyStyle& pruned, bool disc_pass,
+                            const ShaderSwitches& shaders) {
+  const EffectSettings& p = pruned.effects;
+  const AoasSettings& xp = pruned.aoas;
+  const QualitySettings& q = first.quality;
+  const bool sky_view = NeedsSkyViewLut(pruned);
+  const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
+  const CloudQuality& cq = first.clouds.quality;
+  std::string variant;
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
-  plan.variant = fmt::format(
+  variant = fmt::format(
       "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} night={} skydome={} ambiguity={} "
       "cloud_noise={} cloud_shapes={} integrator={} sky_view={}",
       p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
       xp.ambiguity.enabled,
       xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
   const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled, shaders);
-  plan.variant += fmt::format(
+  variant += fmt::format(
       "\n  SPIR-V: sky_render {}; LUT shaders {}", sources.sky_view_render
           ? "from the built-in sky-view variant (ray march compiled out)"
           : "generic, specialized at pipeline creation",
       sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
   if (disc_pass)
-    plan.variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
+    variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
   if (!cloud_layers.empty())
-    plan.variant += fmt::format(
+    variant += fmt::format(
         "\n  clouds: cloud_render with {} layer(s) compiled in (constant 20), after the sky and sun-disc passes; "
         "per texel at most {} view steps per layer crossing (a third of them for a vertical crossing), {} light "
         "steps per lit sample, {} scattering octaves, no cloud beyond {} km",
         cloud_layers.size(), cq.view_steps, cq.light_steps, cq.octaves, cq.max_distance_km);
   else
-    plan.variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
+    variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
+  return variant;
+}
+
+// What a sequence computes once and reuses.
+void PlanReuse(PassPlan& plan) {
   if (plan.frames > 1) {
     if (plan.atmospheres == 1)
       plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +
@@ -276,6 +324,28 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                                         plan.atmospheres));
     plan.reused.push_back("pipelines: compiled once per atmosphere, never per frame");
   }
+}
+
+}  // namespace
+
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders) {
+  PassPlan plan;
+  plan.frames = int(frames.size());
+  if (frames.empty()) return plan;
+  const SkyStyle& first = frames.front();
+  const SkyStyle pruned = PrunedStyle(first);
+  PlanEffects(first, pruned, plan);
+  plan.atmospheres = DistinctAtmospheres(frames);
+  // The passes in the order they run; medium samples over the bake.
+  PlanSkyPasses(first, pruned, plan);
+  const bool disc_pass = PlansSunDiscPass(first, pruned, shaders);
+  if (disc_pass) plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
+  PlanCloudPasses(first, plan);
+  PlanMoonlitPasses(first, pruned, plan);
+  for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+  PlanIblPasses(first, pruned, plan);
+  plan.variant = DescribeVariant(first, pruned, disc_pass, shaders);
+  PlanReuse(plan);
   return plan;
 }
 

@@ -21,6 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/input/config.h"
 #include "skybake/input/frame_numbering.h"
 #include "skybake/base/errors.h"
@@ -53,6 +54,7 @@ struct ManifestFrame {
   ShRgb sh_irradiance_without_sun{};
   std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
   std::vector<ManifestFile> files;  // in the order they are written
+  std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
 };
 
 // What the glTF scene takes from the style, decided from the whole sequence
@@ -102,13 +104,28 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame);
 // Writes `manifest` as JSON to `path`, atomically. Throws OutputError.
 void WriteManifest(const Manifest& manifest, const std::string& path);
 
-// Reads a manifest written by WriteManifest. Throws ManifestError naming the
-// file and the entry that is missing, malformed (a `bytes` that is not an
-// integer in [0, 2^53], a frame number that is not an int) or a name that
+// ReadManifest's error for a file that cannot be read or is not a JSON
+// object (a ManifestError, exit 8, as any other): apart, so that --resume
+// can say what to do instead.
+class ManifestSyntaxError : public ManifestError {
+ public:
+  using ManifestError::ManifestError;
+};
+
+// Whether ReadManifest checks the names it reads against the ones skybake
+// gives (kUnchecked: the caller compares them with the exact names of its
+// own bake, as --resume does, before opening anything under them).
+enum class ManifestNames { kChecked, kUnchecked };
+
+// Reads a manifest written by WriteManifest: the one reader, for
+// merge-manifest and --resume. Throws ManifestSyntaxError when the file
+// cannot be read or is not a JSON object, ManifestError naming the file and
+// the entry that is missing, malformed (a `bytes` that is not an integer in
+// [0, 2^53], a frame number that is not an int) or (kChecked) a name that
 // is not the one skybake gives that frame and kind (a plain file name,
 // BASE_FACE.NNNN.exr, BASE_cube.NNNN.exr, BASE_latlong.NNNN.exr,
 // BASE_latlong.NNNN.png in that order; the scene NAME.gltf/.bin/.glb).
-Manifest ReadManifest(const std::string& path);
+Manifest ReadManifest(const std::string& path, ManifestNames names = ManifestNames::kChecked);
 
 // How a whole bake ends, and a merge: writes the glTF scene (when
 // manifest.gltf.enabled) from the frames' suns and SH and the texture PNG in

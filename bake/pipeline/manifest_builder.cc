@@ -1,0 +1,93 @@
+#include "manifest_builder.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "bake_outputs.h"
+#include "skybake/output/sha256.h"
+
+namespace skybake {
+
+ManifestBuilder::ManifestBuilder(const RenderPlan& plan, const BakeOptions& options, const BakeExposure& exposure,
+                                 BakeResult& result)
+    : plan_(plan), options_(options), exposure_(exposure), result_(result), written_(Clock::now()) {
+  for (size_t i = 0; i < plan.frames.size(); ++i) {
+    const FramePlan& frame = plan.frames[i];
+    style_sha256_.push_back(Sha256OfText(frame.style->resolved_toml));
+    sequence_identity_ +=
+        SequenceIdentityLine(frame.number, frame.time ? frame.time->Iso8601() : "", frame.sun, style_sha256_.back());
+    frame_index_[frame.number] = i;
+  }
+}
+
+Manifest ManifestBuilder::Build() const {
+  const SkyStyle& first = plan_.first();
+  const Schedule* schedule = plan_.schedule;
+  Manifest m;
+  m.version = SKYBAKE_VERSION;
+  m.style = first.source_path;
+  m.schedule = schedule ? schedule->source_path : "";
+  m.sequence_sha256 = Sha256OfText(sequence_identity_);
+  m.units = first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
+                                                          : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm";
+  m.exposure_ev100 = exposure_.ev100.value_or(0.0);
+  m.exposure_source = exposure_.source;
+  const FramePlan& reference = plan_.frames[plan_.reference];
+  m.texture_frame = reference.number;
+  m.half_scale = exposure_.half_scale;
+  if (schedule) {
+    m.place = schedule->place;
+    m.sequence = FrameRange{plan_.frames.front().number, plan_.frames.back().number};
+  }
+  m.part = plan_.part;
+  // The scene's texture: the reference frame's PNG, a 2h x h latlong.
+  const SkyStyle& ref = *reference.style;
+  m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, reference.names.png,
+            2 * ref.render.latlong_height, ref.render.latlong_height};
+  for (const FrameResult& f : result_.frames) {
+    const size_t i = frame_index_.at(f.number);
+    ManifestFrame frame = ManifestFrameOf(f);
+    frame.style_sha256 = style_sha256_[i];
+    frame.hours_from_start = plan_.frames[i].hours_from_start;
+    frame.animation_time_s = schedule && schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
+    m.frames.push_back(std::move(frame));
+  }
+  return m;
+}
+
+void ManifestBuilder::Write(const std::vector<BakedFile>& scene, bool complete) {
+  Manifest m = Build();
+  for (const BakedFile& f : scene)
+    m.scene.push_back({std::filesystem::path(f.path).filename().string(), f.kind, f.bytes, f.sha256});
+  m.complete = complete;
+  result_.manifest_path = OutputPath(options_, plan_.manifest_name);
+  WriteManifest(m, result_.manifest_path);
+  ++result_.manifest_writes;
+  std::error_code ec;
+  result_.manifest_bytes_written += std::filesystem::file_size(result_.manifest_path, ec);
+}
+
+// A write costs time in proportion to the frames done, so rewriting the
+// manifest after every frame grew as frames squared. It is rewritten after
+// a frame when the frames done have grown by a tenth since its last write
+// (so after each of the first twenty; the bytes written add up to about 11
+// times the final manifest), or when kManifestSeconds have passed since
+// the last write and at least kManifestSpacing times what it took (writes
+// stay under a tenth of the bake). Both keep the cost linear; a killed
+// bake loses at most the frames since the last write (--resume bakes them
+// again).
+void ManifestBuilder::WriteProgress() {
+  constexpr double kManifestSpacing = 9.0;
+  constexpr double kManifestSeconds = 30.0;
+  const size_t done = result_.frames.size();
+  if (done - written_frames_ < std::max<size_t>(1, written_frames_ / 10) &&
+      SecondsSince(written_) < std::max(kManifestSeconds, kManifestSpacing * write_seconds_))
+    return;
+  const Clock::time_point start = Clock::now();
+  Write({}, false);
+  written_frames_ = done;
+  written_ = Clock::now();
+  write_seconds_ = std::chrono::duration<double>(written_ - start).count();
+}
+
+}  // namespace skybake
