@@ -507,35 +507,30 @@ struct InScattering {
   vec3 transmittance;  // along the whole ray
 };
 
-// Where the view samples go: t(u) for u in [0, 1], uniform or quadratic
-// (u^2 puts them near the observer, where a horizontal ray's density is:
-// its altitude grows as t^2 / 2R). dt/du is the Jacobian of the mapping.
-Real StepPosition(IN(AtmosphereParameters) atm, Real t_max, Real u) {
-  return atm.step_distribution == STEPS_QUADRATIC ? t_max * u * u : t_max * u;
+// Where the view samples go: t(u) for u in [0, 1] over a segment of length
+// `len`, uniform or quadratic (u^2 puts them near the segment's start, where
+// a horizontal ray's density is: its altitude grows as t^2 / 2R). dt/du is
+// the Jacobian of the mapping.
+Real StepPosition(IN(AtmosphereParameters) atm, Real len, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? len * u * u : len * u;
 }
-Real StepJacobian(IN(AtmosphereParameters) atm, Real t_max, Real u) {
-  return atm.step_distribution == STEPS_QUADRATIC ? 2.0 * t_max * u : t_max;
+Real StepJacobian(IN(AtmosphereParameters) atm, Real len, Real u) {
+  return atm.step_distribution == STEPS_QUADRATIC ? 2.0 * len * u : len;
 }
 
-// The single-scattering integral L = int_0^t_max T(t) S(t) dt with
-// `view_steps` steps placed by StepPosition, with the rule atm.integrator.
-InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray, vec3 view,
-                                   vec3 sun) {
-  InScattering result;
-  result.radiance = vec3(0.0);
-  result.transmittance = vec3(1.0);
-  int n = atm.view_steps;
-  if (atm.integrator == INTEGRATOR_SIMPSON) n += n % 2;  // Simpson needs an even count
+// The integral L = int_{t_a}^{t_b} T(t_a, t) S(t) dt with n steps placed by
+// StepPosition from t_a, with the rule atm.integrator, added to `result`
+// (its transmittance is T(0, t_a) on entry and T(0, t_b) on return).
+InScattering IntegrateInScatteringSegment(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
+                                          Real rayleigh_phase, Real mie_phase, Real t_a,
+                                          Real t_b, int n, InScattering result) {
   Real du = 1.0 / Real(n);
-  Real t_max = ray.t_max;
-  Real rayleigh_phase = RayleighPhase(ray.nu);
-  Real mie_phase = atm.mie ? MiePhase(atm.mie_g, view, sun) : 0.0;
-
+  Real len = t_b - t_a;
   if (atm.integrator == INTEGRATOR_ANALYTIC || atm.integrator == INTEGRATOR_MIDPOINT) {
-    Real t_start = 0.0;
+    Real t_start = t_a;
     for (int i = 0; i < n; ++i) {
-      Real t_end = StepPosition(atm, t_max, Real(i + 1) * du);
-      Real t_mid = StepPosition(atm, t_max, (Real(i) + 0.5) * du);
+      Real t_end = t_a + StepPosition(atm, len, Real(i + 1) * du);
+      Real t_mid = t_a + StepPosition(atm, len, (Real(i) + 0.5) * du);
       Real dt = t_end - t_start;
       ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_mid);
       if (atm.integrator == INTEGRATOR_ANALYTIC) {
@@ -553,51 +548,114 @@ InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
   } else if (atm.integrator == INTEGRATOR_TRAPEZOID) {
     // Nodes u_i = i du in the mapped variable, integrand f(t(u)) dt/du; the
     // optical depth to each node by the same rule.
-    ScatteringSample previous = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
-    Real w_previous = StepJacobian(atm, t_max, 0.0);
+    ScatteringSample previous = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_a);
+    Real w_previous = StepJacobian(atm, len, 0.0);
     vec3 depth = vec3(0.0);
-    result.radiance = 0.5 * du * w_previous * previous.source;
+    vec3 radiance = 0.5 * du * w_previous * previous.source;
     for (int i = 1; i <= n; ++i) {
       Real u = Real(i) * du;
-      Real w = StepJacobian(atm, t_max, u);
-      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u));
+      Real w = StepJacobian(atm, len, u);
+      ScatteringSample s = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_a + StepPosition(atm, len, u));
       depth += 0.5 * du * (w_previous * previous.extinction + w * s.extinction);
       Real weight = i == n ? 0.5 * du : du;
-      result.radiance += weight * w * exp(-depth) * s.source;
+      radiance += weight * w * exp(-depth) * s.source;
       previous = s;
       w_previous = w;
     }
-    result.transmittance = exp(-depth);
+    result.radiance += result.transmittance * radiance;
+    result.transmittance *= exp(-depth);
   } else {
     // Simpson: weights du/3 (1, 4, 2, 4, ..., 4, 1) on nodes u_i = i du. The
     // optical depth to each node is integrated to the same order: over a
     // pair of steps by Simpson, to the middle node by the three-point rule
     // int_{u0}^{u1} f = du/12 (5 f0 + 8 f1 - f2).
-    ScatteringSample s0 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, 0.0);
-    Real w0 = StepJacobian(atm, t_max, 0.0);
+    ScatteringSample s0 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_a);
+    Real w0 = StepJacobian(atm, len, 0.0);
     vec3 depth = vec3(0.0);
-    result.radiance = (du / 3.0) * w0 * s0.source;
+    vec3 radiance = (du / 3.0) * w0 * s0.source;
     for (int i = 0; i < n; i += 2) {
       Real u1 = Real(i + 1) * du;
       Real u2 = Real(i + 2) * du;
-      Real w1 = StepJacobian(atm, t_max, u1);
-      Real w2 = StepJacobian(atm, t_max, u2);
-      ScatteringSample s1 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u1));
-      ScatteringSample s2 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, StepPosition(atm, t_max, u2));
+      Real w1 = StepJacobian(atm, len, u1);
+      Real w2 = StepJacobian(atm, len, u2);
+      ScatteringSample s1 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_a + StepPosition(atm, len, u1));
+      ScatteringSample s2 = SampleScattering(atm, ray, rayleigh_phase, mie_phase, t_a + StepPosition(atm, len, u2));
       vec3 e0 = w0 * s0.extinction;
       vec3 e1 = w1 * s1.extinction;
       vec3 e2 = w2 * s2.extinction;
       vec3 depth_mid = depth + (du / 12.0) * (5.0 * e0 + 8.0 * e1 - e2);
       depth += (du / 3.0) * (e0 + 4.0 * e1 + e2);
       Real end_weight = i + 2 == n ? 1.0 : 2.0;
-      result.radiance += (du / 3.0) * (4.0 * w1 * exp(-max(depth_mid, vec3(0.0))) * s1.source +
-                                       end_weight * w2 * exp(-depth) * s2.source);
+      radiance += (du / 3.0) * (4.0 * w1 * exp(-max(depth_mid, vec3(0.0))) * s1.source +
+                                end_weight * w2 * exp(-depth) * s2.source);
       s0 = s2;
       w0 = w2;
     }
-    result.transmittance = exp(-depth);
+    result.radiance += result.transmittance * radiance;
+    result.transmittance *= exp(-depth);
   }
   return result;
+}
+
+// Where the ray leaves the planet's umbra: g(t) = mu_s(t) - cos(theta_h(t))
+// + (R_b / r_t) alpha is negative where no part of the solar disc is above
+// the horizon (SunTransmittance's visibility is 0 there). Returns t with
+// g(t) < 0 <= g(t + 1e-6 t_max), or 0 when the ray starts outside the umbra
+// or never leaves it. The umbra is convex, so a ray that starts inside it
+// crosses its edge at most once, and bisection finds the crossing.
+Real UmbraValue(IN(AtmosphereParameters) atm, IN(SkyRay) ray, Real t) {
+  Real h = AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, t);
+  Real r_t = atm.bottom_radius + h;
+  Real mu_s_t = (ray.r * ray.mu_s + t * ray.nu) / r_t;
+  Real cos_theta_h = -sqrt(max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
+  return mu_s_t - cos_theta_h + (atm.bottom_radius / r_t) * atm.sun_angular_radius;
+}
+
+Real UmbraExitDistance(IN(AtmosphereParameters) atm, IN(SkyRay) ray) {
+  if (UmbraValue(atm, ray, 0.0) >= 0.0 || UmbraValue(atm, ray, ray.t_max) < 0.0) return 0.0;
+  Real lo = 0.0;
+  Real hi = ray.t_max;
+  for (int i = 0; i < 20; ++i) {  // 1e-6 of the ray: under a metre on a 1000 km ray
+    Real mid = 0.5 * (lo + hi);
+    if (UmbraValue(atm, ray, mid) < 0.0) lo = mid;
+    else hi = mid;
+  }
+  return lo;
+}
+
+// The single-scattering integral L = int_0^t_max T(t) S(t) dt with
+// `view_steps` steps placed by StepPosition, with the rule atm.integrator.
+// A ray that starts in the planet's umbra (twilight) is split where it
+// leaves it: the steps that the unsplit mapping puts before that point stay
+// there, up to half of them (the shadowed medium still scatters multiply and
+// attenuates), the rest are placed from the umbra's edge, so that no step straddles the
+// Earth's shadow, where the source rises by orders of magnitude within a
+// few km (docs/accuracy.md, "Twilight").
+InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray, vec3 view,
+                                   vec3 sun) {
+  InScattering result;
+  result.radiance = vec3(0.0);
+  result.transmittance = vec3(1.0);
+  int n = atm.view_steps;
+  bool simpson = atm.integrator == INTEGRATOR_SIMPSON;
+  if (simpson) n += n % 2;  // Simpson needs an even count
+  Real rayleigh_phase = RayleighPhase(ray.nu);
+  Real mie_phase = atm.mie ? MiePhase(atm.mie_g, view, sun) : 0.0;
+  int granule = simpson ? 2 : 1;
+  Real t_split = 0.0;
+  if (n >= 2 * granule) t_split = UmbraExitDistance(atm, ray);
+  if (t_split <= 0.0)
+    return IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, 0.0, ray.t_max, n, result);
+  Real fraction = t_split / ray.t_max;
+  if (atm.step_distribution == STEPS_QUADRATIC) fraction = sqrt(fraction);
+  // At most half the steps in the shadow: a ray nearly parallel to the
+  // shadow's axis leaves it far out, where the unsplit mapping has only a
+  // step or two left for the lit part and its penumbra.
+  int n_shadow = int(floor(fraction * Real(n / granule) + 0.5)) * granule;
+  n_shadow = clamp(n_shadow, granule, (n / (2 * granule)) * granule);
+  result = IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, 0.0, t_split, n_shadow, result);
+  return IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, t_split, ray.t_max, n - n_shadow,
+                                      result);
 }
 
 // Radiance of the sunlit Lambertian ground at the end of a ray that hits it,

@@ -4,6 +4,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
@@ -91,7 +95,9 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
 // this build with a margin of 10% (docs/accuracy.md, "Twilight"), draft's
 // its 5% budget: the linear mix of the sky-view LUT gave 2.9e-1 for
 // production here, the logarithmic mix 9.0e-2; production's 1% budget needs
-// 576 rows (1.0e-2, measured); draft's 216 rows give 4.6e-2.
+// 576 rows (1.0e-2, measured); draft's 216 rows give 4.7e-2. The reference
+// preset (ray march) meets its 0.1% since the view ray is split at the edge
+// of the planet's umbra (9.9e-4; 4.6e-3 before).
 TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
   AtmosphereParams a;
   EffectSettings single;
@@ -110,7 +116,7 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
     const char* preset;
     double max_relative;
   };
-  for (const Bound& b : {Bound{"draft", 0.05}, Bound{"production", 0.099}, Bound{"reference", 5.0e-3}}) {
+  for (const Bound& b : {Bound{"draft", 0.05}, Bound{"production", 0.099}, Bound{"reference", 1.0e-3}}) {
     SkyRenderer renderer(testing::Vulkan(), a, QualityPreset(b.preset), single, {1, 1, 1});
     std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
     double worst = 0.0, max_value = 0.0;
@@ -122,6 +128,85 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
       }
     std::printf("twilight -3 deg, %s: max relative error %.3e\n", b.preset, worst);
     EXPECT_LT(worst, b.max_relative) << b.preset;
+  }
+}
+
+// Every preset against its budget (draft 5%, production 1%, reference
+// 0.1%: QualityPreset, README) at every twilight sun elevation of the study
+// (-10 .. 1 deg), observer on the ground: single scattering (the study's
+// integral), GPU on lavapipe, against the converged reference, over values
+// above 1e-4 of the maximum (the study's criterion). The directions are the
+// low sky, where twilight errors are (docs/accuracy.md, "Twilight"), on one
+// side of the Sun's vertical plane (the sky is symmetric about it).
+// Where a preset still misses its budget, the bound is this build's
+// measured error with a margin of 10% (README's preset table names each
+// miss), so that the test fails if it grows; the budget itself wherever the
+// preset meets it.
+TEST(ConvergedReferenceTest, PresetsAgainstTheirBudgetsAtTwilight) {
+  EffectSettings single;
+  single.multiple_scattering = false;
+  single.sun_disc = false;
+  single.ground = false;
+  std::vector<glm::dvec3> dirs;
+  for (double elevation : {0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 30.0})
+    for (double azimuth : {0.0, 30.0, 60.0, 75.0, 90.0, 120.0, 150.0, 180.0})
+      dirs.push_back(SunDirectionFromElevationAzimuth(elevation, azimuth));
+  dirs.push_back({0.0, 1.0, 0.0});
+  struct Budget {
+    const char* preset;
+    double max_relative;
+  };
+  const Budget budgets[] = {{"draft", 0.05}, {"production", 0.01}, {"reference", 1e-3}};
+  // Measured misses (preset, sun elevation in deg, error), docs/accuracy.md.
+  struct Miss {
+    const char* preset;
+    double sun_elevation;
+    double measured;
+  };
+  const Miss misses[] = {{"draft", -3.0, 1.18e-1},      {"draft", -1.0, 1.73e-1},
+                         {"production", -10.0, 1.35e-2}, {"production", -6.0, 1.13e-2},
+                         {"production", -3.0, 5.80e-2},  {"production", -1.0, 5.21e-1},
+                         {"production", 0.0, 1.89e-2},   {"production", 1.0, 1.43e-2},
+                         {"reference", -10.0, 2.21e-3},  {"reference", -6.0, 2.39e-3},
+                         {"reference", -3.0, 1.25e-3}};
+  AtmosphereParams a;
+  ConvergedReference ref(a, 4.0);
+  std::vector<std::unique_ptr<SkyRenderer>> renderers;
+  for (const Budget& b : budgets)
+    renderers.push_back(
+        std::make_unique<SkyRenderer>(testing::Vulkan(), a, QualityPreset(b.preset), single, Rgb{1, 1, 1}));
+  for (double sun_elevation : {-10.0, -6.0, -3.0, -1.0, 0.0, 1.0}) {
+    const glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 180.0);
+    std::vector<glm::dvec3> expected(dirs.size());
+    {
+      std::vector<std::thread> pool;
+      for (size_t t = 0; t < 2; ++t)
+        pool.emplace_back([&, t] {
+          for (size_t i = t; i < dirs.size(); i += 2) expected[i] = ref.Radiance(dirs[i], sun);
+        });
+      for (std::thread& th : pool) th.join();
+    }
+    double max_value = 0.0;
+    for (const glm::dvec3& l : expected) max_value = std::max({max_value, l.x, l.y, l.z});
+    for (size_t p = 0; p < renderers.size(); ++p) {
+      std::vector<float> gpu = renderers[p]->RenderDirections(sun, dirs);
+      double worst = 0.0;
+      size_t worst_i = 0;
+      for (size_t i = 0; i < dirs.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+          if (!(expected[i][c] > 1e-4 * max_value)) continue;
+          double e = std::abs(gpu[4 * i + c] - expected[i][c]) / expected[i][c];
+          if (e > worst) worst = e, worst_i = i;
+        }
+      double bound = budgets[p].max_relative;
+      for (const Miss& m : misses)
+        if (std::string(m.preset) == budgets[p].preset && m.sun_elevation == sun_elevation) bound = 1.1 * m.measured;
+      std::printf("sun %5.1f deg, %-10s max relative error %.2e (budget %.0e%s) at view (%.3f, %.3f, %.3f)\n",
+                  sun_elevation, budgets[p].preset, worst, budgets[p].max_relative,
+                  bound > budgets[p].max_relative ? ", missed" : "", dirs[worst_i].x, dirs[worst_i].y,
+                  dirs[worst_i].z);
+      EXPECT_LT(worst, bound) << budgets[p].preset << ", sun " << sun_elevation << " deg";
+    }
   }
 }
 
