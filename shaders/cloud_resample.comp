@@ -22,7 +22,7 @@ void main() {
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   // A latlong of the panorama's own size reads its own texel.
   vec4 c = push.view.x == MAPPING_LATLONG && push.view.y == push.rect.y && push.view.z == push.rect.z
-               ? cloud_lut[push.rect.x + texel.y * push.rect.y + texel.x]
+               ? CloudPanoramaTexel(push.rect.x, push.rect.y, texel.y * push.rect.y + texel.x, texel.y)
                : CloudPanoramaRead(push.rect.x, push.rect.y, push.rect.z, ViewDirection(texel));
   if (c.w == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
   uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
