@@ -8,6 +8,7 @@
 #include "common.glsl"
 #include "clouds.glsl"
 #include "cloud_panorama.glsl"
+#include "cloud_shadow.glsl"
 
 vec3 ViewDirection(ivec2 texel) {
   int mapping = push.view.x;
@@ -28,14 +29,19 @@ void main() {
   }
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   AtmosphereParameters atm = AtmosphereFromUniform();
-  CloudMarch m = MarchClouds(atm, ViewDirection(texel), push.sun_direction.xyz);
+  vec3 view = ViewDirection(texel);
+  CloudMarch m = MarchClouds(atm, view, push.sun_direction.xyz);
   if (push.rect.w == CLOUD_MODE_PANORAMA) {
     cloud_lut[push.rect.x + texel.y * push.view.y + texel.x] = vec4(m.radiance, m.transmittance);
     return;
   }
-  if (m.transmittance == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
+  // The clouds' shadow on the ground below the horizon (cloud_shadow.glsl; off: 0).
+  vec3 ground_loss = GroundCloudShadowLoss(atm, view, push.sun_direction.xyz);
+  if (m.transmittance == 1.0 && ground_loss == vec3(0.0)) return;  // the sky as the sky pass wrote it
   uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
   vec4 sky = output_texels[index];
+  if (ground_loss != vec3(0.0))
+    sky.xyz = max(sky.xyz - ground_loss * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz, vec3(0.0));
   output_texels[index] = vec4(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
                                   m.transmittance * sky.xyz, sky.w);
 }

@@ -8,6 +8,7 @@
 #include "common.glsl"
 #include "clouds.glsl"
 #include "cloud_panorama.glsl"
+#include "cloud_shadow.glsl"
 
 vec3 ViewDirection(ivec2 texel) {
   int mapping = push.view.x;
@@ -24,9 +25,13 @@ void main() {
   vec4 c = push.view.x == MAPPING_LATLONG && push.view.y == push.rect.y && push.view.z == push.rect.z
                ? CloudPanoramaTexel(push.rect.x, push.rect.y, texel.y * push.rect.y + texel.x, texel.y)
                : CloudPanoramaRead(push.rect.x, push.rect.y, push.rect.z, ViewDirection(texel));
-  if (c.w == 1.0) return;  // no cloud along this texel: the sky as the sky pass wrote it
+  // The clouds' shadow on the ground below the horizon, per texel (cloud_shadow.glsl; off: 0).
+  vec3 ground_loss = GroundCloudShadowLoss(AtmosphereFromUniform(), ViewDirection(texel), push.sun_direction.xyz);
+  if (c.w == 1.0 && ground_loss == vec3(0.0)) return;  // the sky as the sky pass wrote it
   uint index = uint(push.offsets.x + texel.y * push.view.y + texel.x);
   vec4 sky = output_texels[index];
+  if (ground_loss != vec3(0.0))
+    sky.xyz = max(sky.xyz - ground_loss * gpu_atmosphere.solar_irradiance.xyz * gpu_atmosphere.output_scale.xyz, vec3(0.0));
   output_texels[index] = vec4(c.xyz * gpu_atmosphere.solar_irradiance.xyz * gpu_atmosphere.output_scale.xyz +
                                   c.w * sky.xyz, sky.w);
 }

@@ -229,6 +229,82 @@ struct Equivalence {
   std::string zero_strength_toml;
 };
 
+// The cloud formation's CPU step and the cloud shadow map's pass are listed
+// with their cost: the formation simulates from step 0 to the last planned
+// frame's step (warm-up 5 + 10 per hour x 1.25 h = 17.5: 18 steps) of
+// 16 x 16 x 4 = 1024 cells, outside the medium-sample total; the map's pass
+// reads the density 64^2 x 8 steps x the merged bands per frame. Off, or
+// with every layer pruned, neither is planned.
+TEST(PassPlanTest, CloudFormationAndShadowMapAreListedWithTheirCost) {
+  const std::string layer = R"(
+[[cloud_layer]]
+altitude_m = 1000
+thickness_m = 500
+coverage = COVERAGE
+[cloud_layer.formation]
+enabled = FORMATION
+cells = [16, 16, 4]
+steps_per_hour = 10.0
+warmup_steps = 5
+)";
+  auto style = [&](const std::string& coverage, bool formation, bool shadow, const std::string& more = "") {
+    std::string t = layer;
+    t.replace(t.find("COVERAGE"), 8, coverage);
+    t.replace(t.find("FORMATION"), 9, formation ? "true" : "false");
+    if (shadow) t += "\n[cloud_shadow]\nenabled = true\nresolution = 64\nsteps = 8\n";
+    return Style(t + more);
+  };
+  const std::vector<double> hours = {0.0, 0.5, 1.25};
+  const SkyStyle on = style("0.5", true, true);
+  const PassPlan plan = PlanPasses({on, on, on}, ShaderSwitches(), hours);
+  auto pass = [](const PassPlan& p, const std::string& name) -> const PlannedPass* {
+    for (const PlannedPass& x : p.passes)
+      if (x.name == name) return &x;
+    return nullptr;
+  };
+  const PlannedPass* formation = pass(plan, "cloud formation (CPU) at 1000 m");
+  ASSERT_NE(formation, nullptr) << FormatPlan(plan, "on");
+  EXPECT_EQ(formation->runs, 18);
+  EXPECT_EQ(formation->samples, 1024.0);
+  const PlannedPass* map = pass(plan, "cloud shadow map");
+  ASSERT_NE(map, nullptr);
+  EXPECT_EQ(map->runs, 3);
+  EXPECT_EQ(map->samples, 64.0 * 64.0 * 8.0);
+  EXPECT_TRUE(Effect(plan, "cloud formation").on);
+  EXPECT_TRUE(Effect(plan, "cloud shadow map").on);
+  EXPECT_TRUE(Effect(plan, "ground cloud shadow").on);
+  EXPECT_NE(FormatPlan(plan, "on").find("cloud formation (CPU) at 1000 m"), std::string::npos);
+  // The map's samples are in the total, the formation's cell updates are not.
+  const PassPlan no_shadow = PlanPasses({style("0.5", true, false)}, ShaderSwitches(), {1.25});
+  const PassPlan no_formation = PlanPasses({style("0.5", false, false)}, ShaderSwitches(), {1.25});
+  EXPECT_EQ(PlanPasses({on}, ShaderSwitches(), {1.25}).total_samples, no_shadow.total_samples + 64.0 * 64.0 * 8.0);
+  EXPECT_EQ(no_shadow.total_samples, no_formation.total_samples);
+  // Without a clock (a single style): the warm-up alone.
+  EXPECT_EQ(pass(PlanPasses({on}), "cloud formation (CPU) at 1000 m")->runs, 5);
+  // A second, separate layer is a second band of the map's march.
+  const SkyStyle two = style("0.5", true, true, "[[cloud_layer]]\naltitude_m = 6000\nthickness_m = 300\n");
+  EXPECT_EQ(pass(PlanPasses({two}), "cloud shadow map")->samples, 64.0 * 64.0 * 8.0 * 2.0);
+
+  // Pruned: coverage 0 removes the layer, its formation and the map's pass.
+  const PassPlan pruned = PlanPasses({style("0.0", true, true)});
+  EXPECT_EQ(pass(pruned, "cloud formation (CPU) at 1000 m"), nullptr);
+  EXPECT_EQ(pass(pruned, "cloud shadow map"), nullptr);
+  EXPECT_TRUE(Effect(pruned, "cloud formation").requested);
+  EXPECT_FALSE(Effect(pruned, "cloud formation").on);
+  EXPECT_FALSE(Effect(pruned, "cloud shadow map").on);
+  EXPECT_NE(Effect(pruned, "cloud shadow map").reason.find("all ones"), std::string::npos);
+  // Off: neither, and the effects say so.
+  const PassPlan off = PlanPasses({style("0.5", false, false)});
+  EXPECT_EQ(pass(off, "cloud shadow map"), nullptr);
+  EXPECT_FALSE(Effect(off, "cloud formation").requested);
+  EXPECT_EQ(Effect(off, "cloud shadow map").reason, "switched off in the style");
+  // A ground shadow needs a ground the sky shows.
+  const PassPlan no_ground = PlanPasses({style("0.5", true, true, "[atmosphere]\nground_albedo = 0.0\n")});
+  EXPECT_FALSE(Effect(no_ground, "ground cloud shadow").on);
+  EXPECT_TRUE(Effect(no_ground, "cloud shadow map").on);
+}
+
+
 class PruningEquivalenceTest : public ::testing::TestWithParam<Equivalence> {};
 
 TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {

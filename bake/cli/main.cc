@@ -192,13 +192,17 @@ int RunBake(const BakeArgs& args, Mode mode) {
     // The passes, LUTs and shader variant the bake would run, and why.
     // The part that --frames / --shard select, when given.
     std::vector<SkyStyle> planned;
+    std::vector<double> planned_hours;  // the cloud formation's steps follow the clock
     if (schedule) {
       for (size_t i = 0; i < frame_styles.size(); ++i)
-        if (!part || part->Contains(schedule->frames[i].number)) planned.push_back(frame_styles[i]);
+        if (!part || part->Contains(schedule->frames[i].number)) {
+          planned.push_back(frame_styles[i]);
+          planned_hours.push_back(schedule->frames[i].hours_from_start);
+        }
     } else {
       planned.push_back(config.style);
     }
-    PassPlan plan = PlanPasses(planned, args.shaders);
+    PassPlan plan = PlanPasses(planned, args.shaders, planned_hours);
     std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
     if (part)
       what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,

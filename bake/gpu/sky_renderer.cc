@@ -250,7 +250,7 @@ void SkyRenderer::DestroyAll() {
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
                         &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
-                        &cloud_resample_pipeline_}) {
+                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -578,6 +578,16 @@ void SkyRenderer::GenerateCloudNoise() {
   ++counters_.cloud_noise_builds;
 }
 
+void SkyRenderer::CopyCloudWeatherImages() {
+  float* noise = static_cast<float*>(cloud_noise_buffer_.mapped);
+  const size_t count = size_t(gpu_clouds_.resolution.z) * gpu_clouds_.resolution.z;
+  size_t image = 0;
+  for (int l = 0; l < cloud_layers_; ++l)
+    if (gpu_clouds_.layers[l].weather.w > 0.5f)
+      std::memcpy(noise + gpu_clouds_.layers[l].noise.z, cloud_weather_images_.data() + image++ * count,
+                  count * sizeof(float));
+}
+
 void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
                                  std::vector<bool>& barriers) {
   if (cloud_tables_ready_ && cloud_sun_ == sun) return;
@@ -837,15 +847,20 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
       !same(c.lut, gpu_clouds_.lut))
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.
-  bool noise_same = clouds.weather_images == cloud_weather_images_;
+  const bool images_same = clouds.weather_images == cloud_weather_images_;
+  bool layout_same = true;
   for (int l = 0; l < cloud_layers_; ++l)
-    noise_same = noise_same && same(c.layers[l].noise, gpu_clouds_.layers[l].noise) &&
-                 (c.layers[l].weather.w > 0.5f) == (gpu_clouds_.layers[l].weather.w > 0.5f);
+    layout_same = layout_same && same(c.layers[l].noise, gpu_clouds_.layers[l].noise) &&
+                  (c.layers[l].weather.w > 0.5f) == (gpu_clouds_.layers[l].weather.w > 0.5f);
+  const bool noise_same = images_same && layout_same;
   if (same(c, gpu_clouds_) && noise_same) return true;
   // Every submission waits for its fence, so no dispatch reads the buffers now.
   if (!noise_same) {
-    cloud_noise_ready_ = false;
     cloud_weather_images_ = clouds.weather_images;
+    // Only the weather images changed (a cloud formation's coverage of a
+    // new frame): the volumes stay, the images are copied in place.
+    if (layout_same && cloud_noise_ready_) CopyCloudWeatherImages();
+    else cloud_noise_ready_ = false;
   }
   // The tables depend on the layers' top (the ambient table's range) and distances.
   if (!same(c.range, gpu_clouds_.range)) cloud_tables_ready_ = false;

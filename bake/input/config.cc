@@ -5,6 +5,7 @@
 // resolved TOML for provenance (StyleWriter), and the unknown-key check.
 #include "skybake/input/config.h"
 #include "skybake/input/engine_preset.h"
+#include "cloud_formation_config.h"
 
 #include <algorithm>
 #include <cmath>
@@ -212,6 +213,24 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
   // Volumetric cloud layers (clouds.h, docs/clouds.md).
   v.CloudLayers("cloud_layer", s.clouds.layers);
+  // The cloud shadow map (cloud_shadow.h): written into the resolved style
+  // only when on, so a style without it resolves as before it existed.
+  CloudShadowSettings& cs = s.cloud_shadow;
+  if (v.kReads || cs.enabled) {
+    static constexpr Range kShadowExtent{10.0, 1e7, false, false}, kShadowCenter{-1e7, 1e7, false, false};
+    static constexpr Range kShadowAltitude{0.0, 1e5, false, false}, kShadowStrength{0.0, 10.0, false, false};
+    v.Bool("cloud_shadow.enabled", cs.enabled);
+    v.Int("cloud_shadow.resolution", cs.resolution, 8, 4096);
+    v.Real("cloud_shadow.extent_m", cs.extent_m, kShadowExtent);
+    v.Real("cloud_shadow.center_east_m", cs.center_east_m, kShadowCenter);
+    v.Real("cloud_shadow.center_north_m", cs.center_north_m, kShadowCenter);
+    v.Real("cloud_shadow.receiver_altitude_m", cs.receiver_altitude_m, kShadowAltitude);
+    v.Real("cloud_shadow.strength", cs.strength, kShadowStrength);
+    // At most 256: 4 bands x 256 x 5 loop iterations stay within the 5535 lavapipe
+    // leaves the cloud pass above its own 60000 (CloudLoopIterationsPerTexel).
+    v.Int("cloud_shadow.steps", cs.steps, 1, 256);
+    v.Bool("cloud_shadow.ground", cs.ground);
+  }
 
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
@@ -632,6 +651,12 @@ class StyleReader {
           } else {
             layer.seed = uint32_t(value.as_integer()->get());
           }
+        } else if (k == "formation") {
+          ReadCloudFormation(value, key_path, layer.formation,
+                             [&](const toml::node* n, const std::string& at, const std::string& message) {
+                               ok = false;
+                               Error(n, at, message);
+                             });
         } else if (k == "weather_image") {
           if (!value.is_string() || value.as_string()->get().empty()) {
             ok = false;
@@ -645,7 +670,7 @@ class StyleReader {
                 fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
                             "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
                             "wind_m_s, shear_m_s_per_km, seed, weather_size_m, weather_image, weather_extent_m, "
-                            "weather_origin_m)",
+                            "weather_origin_m, formation)",
                             k));
         }
       }
@@ -803,6 +828,7 @@ class StyleWriter {
       t.insert("shear_m_s_per_km", toml::array{l.shear_m_s_per_km[0], l.shear_m_s_per_km[1]});
       if (l.seed) t.insert("seed", int64_t(*l.seed));
       t.insert("weather_size_m", l.weather_size_m);
+      if (l.formation.enabled) t.insert("formation", CloudFormationToml(l.formation));
       if (!l.weather_image.empty()) {
         t.insert("weather_image", l.weather_image);
         t.insert("weather_extent_m", toml::array{l.weather_extent_m[0], l.weather_extent_m[1]});
@@ -1125,7 +1151,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
       if (const toml::array* layers = root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
                                                                       size_t(p.layer) < layers->size()) {
         const toml::node* at = layers->get(size_t(p.layer));
-        if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->get(p.key)) at = t->get(p.key);
+        if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->at_path(p.key).node()) at = t->at_path(p.key).node();
         if (at->source().begin) {
           e.line = int(at->source().begin.line);
           e.column = int(at->source().begin.column);

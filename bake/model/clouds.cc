@@ -113,6 +113,12 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
                           fmt::format("[{}, {}, {}, {}]: expected [bottom_in, bottom_full, top_full, top_out], "
                                       "non-decreasing fractions in [0, 1] with top_out > bottom_in",
                                       p[0], p[1], p[2], p[3])});
+    if (l.formation.enabled && !l.formation.mask_image.empty()) {
+      const std::string path = ResolvePath(l.formation.mask_image, style_dir);
+      std::string problem = CheckCloudMask(path, l.formation);
+      if (!problem.empty())
+        problems.push_back({index, "formation.mask_image", fmt::format("{}: {}", path, problem)});
+    }
     if (!l.weather_image.empty()) {
       const std::string path = ResolvePath(l.weather_image, style_dir);
       std::string problem = CheckWeatherImage(path);
@@ -179,7 +185,9 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     const double seconds = time_s;
     o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
                      float(l.shear_m_s_per_km[0] * seconds * 1e-3), float(-l.shear_m_s_per_km[1] * seconds * 1e-3)};
-    if (l.weather_image.empty()) {
+    if (l.formation.enabled) {
+      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, time_s, style_dir, o, in.weather_images);
+    } else if (l.weather_image.empty()) {
       o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};
       o.weather_origin = {0.0f, 0.0f, 0.0f, 0.0f};
     } else {

@@ -219,10 +219,15 @@ int64_t WriteToSink(exr_const_context_t, void* user_data, const void* buffer, ui
   return int64_t(size);
 }
 
-void RecordError(exr_const_context_t context, exr_result_t code, const char* message) {
-  void* user_data = nullptr;
-  if (exr_get_user_data(context, &user_data) == EXR_ERR_SUCCESS && user_data)
-    static_cast<Sink*>(user_data)->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
+// The sink of the file this thread assembles. The error handler must not
+// ask the context for its user data: OpenEXRCore calls it with the
+// context's lock held (exr_attr_set_string with a name too long, say), and
+// exr_get_user_data takes the same lock, so the bake would hang.
+thread_local Sink* assembling_sink = nullptr;
+
+void RecordError(exr_const_context_t, exr_result_t code, const char* message) {
+  if (assembling_sink)
+    assembling_sink->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
 }
 
 // The file around its encoded chunks: OpenEXRCore writes the header, the
@@ -239,6 +244,10 @@ std::string AssembleExr(const ExrFile& file, const std::vector<Chunk>& chunks) {
   init.user_data = &sink;
   init.write_fn = &WriteToSink;
   init.error_handler_fn = &RecordError;
+  assembling_sink = &sink;
+  struct Unset {
+    ~Unset() { assembling_sink = nullptr; }
+  } unset;
   exr_context_t context = nullptr;
   auto check = [&](exr_result_t result, const char* what) {
     if (result == EXR_ERR_SUCCESS) return;

@@ -1,6 +1,7 @@
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/gltf_ibl.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -25,6 +26,9 @@
 #define TINYGLTF_NO_INCLUDE_JSON
 #include <tiny_gltf.h>
 
+#include <OpenEXR/ImfRgbaFile.h>
+
+#include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
 
 namespace skybake {
@@ -102,6 +106,73 @@ std::string ReadFile(const std::string& path) {
   return bytes;
 }
 
+
+// The ground plane under the dome (gltf_scene.h "ground"): a square at the
+// receiver altitude over the cloud shadow map's extent, UV (0, 0) at the
+// map's north-west corner (row 0, column 0), u along its axis_u (east),
+// v along axis_v (south); normal +Y, counter-clockwise seen from above.
+void AddCloudShadowGround(const SceneDescription& scene, tinygltf::Model& model, tinygltf::Scene& gltf_scene) {
+  const CloudShadowInfo& g = *scene.ground;
+  const glm::dvec3 o(g.origin_m[0], g.origin_m[1], g.origin_m[2]);
+  const glm::dvec3 u = glm::dvec3(g.axis_u[0], g.axis_u[1], g.axis_u[2]) * g.extent_m;
+  const glm::dvec3 v = glm::dvec3(g.axis_v[0], g.axis_v[1], g.axis_v[2]) * g.extent_m;
+  const glm::vec3 corners[4] = {glm::vec3(o), glm::vec3(o + u), glm::vec3(o + v), glm::vec3(o + u + v)};
+  const std::vector<glm::vec3> positions(corners, corners + 4);
+  const std::vector<glm::vec3> normals(4, glm::vec3(0.0f, 1.0f, 0.0f));
+  const std::vector<glm::vec2> uvs = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, {1.0f, 1.0f}};
+  const std::vector<uint32_t> indices = {0, 2, 3, 0, 3, 1};
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] =
+      AddAccessor(model, AddBufferView(model, positions.data(), positions.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                  TINYGLTF_COMPONENT_TYPE_FLOAT, positions.size(), TINYGLTF_TYPE_VEC3, {lo.x, lo.y, lo.z},
+                  {hi.x, hi.y, hi.z});
+  primitive.attributes["NORMAL"] =
+      AddAccessor(model, AddBufferView(model, normals.data(), normals.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                  TINYGLTF_COMPONENT_TYPE_FLOAT, normals.size(), TINYGLTF_TYPE_VEC3);
+  primitive.attributes["TEXCOORD_0"] =
+      AddAccessor(model, AddBufferView(model, uvs.data(), uvs.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
+                  TINYGLTF_COMPONENT_TYPE_FLOAT, uvs.size(), TINYGLTF_TYPE_VEC2);
+  primitive.indices =
+      AddAccessor(model,
+                  AddBufferView(model, indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, indices.size(), TINYGLTF_TYPE_SCALAR);
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+
+  tinygltf::Image image;
+  image.name = "cloud_shadow";
+  image.uri = scene.ground_texture_file;
+  image.mimeType = "image/png";
+  model.images.push_back(image);
+  // A map that tiles repeats beyond its edges; one that does not is clamped.
+  tinygltf::Sampler sampler;
+  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.wrapS = sampler.wrapT = g.tiles ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  model.samplers.push_back(sampler);
+  tinygltf::Texture texture;
+  texture.source = int(model.images.size()) - 1;
+  texture.sampler = int(model.samplers.size()) - 1;
+  model.textures.push_back(texture);
+  tinygltf::Material material;
+  material.name = "cloud_shadow_ground";
+  material.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size()) - 1;
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 1.0;
+  model.materials.push_back(material);
+  primitive.material = int(model.materials.size()) - 1;
+
+  tinygltf::Mesh mesh;
+  mesh.name = "cloud_shadow_ground";
+  mesh.primitives.push_back(primitive);
+  model.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.name = "cloud_shadow_ground";
+  node.mesh = int(model.meshes.size()) - 1;
+  model.nodes.push_back(node);
+  gltf_scene.nodes.push_back(int(model.nodes.size()) - 1);
+}
 
 // EXT_lights_image_based: the RGBD faces as images (by file name; the .glb
 // embeds them), the SH times the PNGs' scale k, intensity 1 / k, and the
@@ -410,6 +481,7 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
   gltf_scene.nodes = {0, 1};
   if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
   if (!scene.moons.empty()) AddMoonLight(model, scene.moons, gltf_scene);
+  if (scene.ground) AddCloudShadowGround(scene, model, gltf_scene);
   json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
   gltf_scene.extras = ToValue(json{{"skybake", extras}});
   model.scenes.push_back(gltf_scene);
@@ -454,6 +526,28 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
     WriteFileAtomically(written.glb_path, out.str());
   }
   return written;
+}
+
+void WriteCloudShadowGroundPng(const std::string& exr_path, const std::string& png_path) {
+  std::vector<uint8_t> rgb;
+  int width = 0, height = 0;
+  try {
+    Imf::RgbaInputFile in(exr_path.c_str());
+    const Imath::Box2i window = in.dataWindow();
+    width = window.max.x - window.min.x + 1;
+    height = window.max.y - window.min.y + 1;
+    std::vector<Imf::Rgba> pixels(size_t(width) * height);
+    in.setFrameBuffer(pixels.data() - window.min.x - size_t(window.min.y) * width, 1, size_t(width));
+    in.readPixels(window.min.y, window.max.y);
+    rgb.resize(pixels.size() * 3);
+    for (size_t i = 0; i < pixels.size(); ++i) {
+      const double t = std::clamp(double(float(pixels[i].r)), 0.0, 1.0);
+      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = uint8_t(std::lround(SrgbEncode(t) * 255.0));
+    }
+  } catch (const std::exception& e) {
+    throw OutputError(fmt::format("{}: cannot read the cloud shadow map for the glTF ground: {}", exr_path, e.what()));
+  }
+  WritePng(png_path, width, height, rgb);
 }
 
 }  // namespace skybake

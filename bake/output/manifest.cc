@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/output/cloud_shadow_json.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/output_lock.h"
@@ -67,7 +68,7 @@ json FrameJson(const ManifestFrame& f) {
 json FrameJsonWithoutMoon(const ManifestFrame& f) {
   json files = json::array();
   for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
-  return {{"frame", f.number},
+  json frame = {{"frame", f.number},
           {"style_sha256", f.style_sha256},
           {"time", f.time ? json(*f.time) : json(nullptr)},
           {"hours_from_start", f.hours_from_start},
@@ -80,6 +81,8 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
           {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
           {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
           {"files", files}};
+  if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
+  return frame;
 }
 
 json ManifestJson(const Manifest& m) {
@@ -286,8 +289,8 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 
 // Every name of a manifest is a plain file name and the one the bake gives
 // its frame and kind: BASE_FACE.NNNN.exr (six faces), BASE_cube.NNNN.exr,
-// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_latlong.NNNN.png, in that order, one BASE per
-// frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
+// BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png,
+// in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
   if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
@@ -340,10 +343,12 @@ void CheckNames(const std::string& path, const Manifest& m) {
         stage = 4;
       } else if (file.kind == "preview" || file.kind == "gltf_texture") {
         with_suffix(file, stem_of(file, ".png", "preview"), "_latlong", "preview", 4);
+      } else if (file.kind == "cloud_shadow") {
+        with_suffix(file, stem_of(file, ".exr", "cloud shadow"), "_cloudshadow", "cloud shadow", 3);
       } else {
         FailName(path, where, file.kind,
                  "a kind of file skybake writes (face, cube, latlong, ibl_specular, ibl_irradiance, ibl_dfg, ibl_gltf, "
-                 "engine, preview, gltf_texture)");
+                 "engine, preview, gltf_texture, cloud_shadow)");
       }
     }
     if (!faces.empty() && faces.size() != 6)
@@ -377,11 +382,11 @@ void CheckNames(const std::string& path, const Manifest& m) {
     }
   }
   static const std::map<std::string, std::string> kSceneExtension = {
-      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}};
+      {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}, {"gltf_ground", "_ground.png"}};
   for (const ManifestFile& file : m.scene) {
     auto it = kSceneExtension.find(file.kind);
     if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
-      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb)", m.gltf.name));
+      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png)", m.gltf.name));
   }
 }
 
@@ -414,6 +419,7 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
   for (const BakedFile& file : frame.files)
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+  f.cloud_shadow = frame.cloud_shadow;
   return f;
 }
 
@@ -485,6 +491,7 @@ Manifest ReadManifest(const std::string& path) {
       frame.moon = mr;
     }
     frame.files = FilesOf(r, r.Get<json>(f, "files"));
+    if (f.contains("cloud_shadow")) frame.cloud_shadow = CloudShadowFromJson(f["cloud_shadow"]);
     m.frames.push_back(std::move(frame));
   }
   m.complete = r.Get<bool>(j, "complete");
@@ -515,6 +522,14 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
         for (const ManifestFile& file : f.files)
           if (file.kind == "ibl_gltf") scene.ibl_images.push_back(file.file);
         scene.ibl_sh = f.sh_irradiance_without_sun;
+        // The ground plane: the texture frame's cloud shadow map (gltf_scene.h "ground").
+        for (const ManifestFile& file : f.files)
+          if (file.kind == "cloud_shadow" && f.cloud_shadow) {
+            scene.ground_texture_file = manifest.gltf.name + "_ground.png";
+            WriteCloudShadowGroundPng((fs::path(out_dir) / file.file).string(),
+                                      (fs::path(out_dir) / scene.ground_texture_file).string());
+            scene.ground = f.cloud_shadow;
+          }
       }
       SceneSun sun;
       sun.time_s = f.animation_time_s;
@@ -541,8 +556,10 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
                        {"sh_basis", kShBasis},              {"frames", frame_extras}};
     scene.extras_json = provenance.dump();
     WrittenScene written = WriteGltfScene(scene);
-    for (auto [path, kind] : {std::pair{written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"},
-                              {written.glb_path, "glb"}}) {
+    std::vector<std::pair<std::string, const char*>> files = {
+        {written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"}, {written.glb_path, "glb"}};
+    if (scene.ground) files.push_back({(fs::path(out_dir) / scene.ground_texture_file).string(), "gltf_ground"});
+    for (auto [path, kind] : files) {
       scene_files.push_back({path, kind, fs::file_size(path), Sha256OfFile(path)});
       manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
                                 scene_files.back().sha256});

@@ -1,4 +1,5 @@
 #include "skybake/pipeline/pass_plan.h"
+#include "cloud_plan.h"
 
 #include "skybake/gpu/ibl.h"
 
@@ -70,7 +71,8 @@ std::vector<ViewRequest> PlanViews(const SkyStyle& style) {
   return views;
 }
 
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders) {
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders,
+                    const std::vector<double>& hours_from_start) {
   PassPlan plan;
   plan.frames = int(frames.size());
   if (frames.empty()) return plan;
@@ -210,7 +212,9 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                                                                                  : fmt::format("face {}", v.face)),
                              Size(v.width, v.height), "per frame with the Sun down and the Moon above -10 deg",
                              plan.frames, double(v.width) * v.height * per_texel});
+  AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
+  AddCloudFormationPlan(first, hours_from_start, plan);  // CPU cell updates, not medium samples
   // Image-based lighting (ibl.h): only when an IBL output is asked for.
   // Its samples are filtered cube reads, not medium samples: not in the total.
   const IblSettings& ibl = first.ibl;

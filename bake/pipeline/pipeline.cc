@@ -24,6 +24,7 @@
 #include "skybake/output/ibl_files.h"
 #include "skybake/output/sha256.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/output/cloud_shadow_file.h"
 #include "skybake/output/gltf_scene.h"
 #include "skybake/gpu/ibl.h"
 #include "skybake/model/sh.h"
@@ -126,11 +127,13 @@ struct FrameNames {
   std::vector<IblFileName> ibl;    // the IBL maps' files (ibl.h), when asked for
   std::vector<std::string> engine;  // the engine preset's files (engine_preset.h), when one is set
   bool with_dfg = false;           // the bake's first frame carries the DFG table
+  std::string cloud_shadow;        // the cloud shadow map (cloud_shadow.h), when asked for
   std::vector<std::string> All() const {
     std::vector<std::string> all = faces;
     for (const std::string* n : {&cube, &latlong})
       if (!n->empty()) all.push_back(*n);
     for (const IblFileName& n : ibl) all.push_back(n.name);
+    if (!cloud_shadow.empty()) all.push_back(cloud_shadow);
     for (const std::string& n : engine) all.push_back(n);
     if (!png.empty()) all.push_back(png);
     return all;
@@ -149,6 +152,7 @@ FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_d
   names.ibl = IblFileNames(style, number_in_name, with_dfg);
   names.with_dfg = with_dfg;
   names.engine = EngineFileNames(style, number_in_name);
+  if (style.cloud_shadow.enabled) names.cloud_shadow = CloudShadowFileName(o.basename, number_in_name);
   return names;
 }
 
@@ -238,6 +242,7 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   if (!names.cube.empty()) kinds.push_back("cube");
   if (!names.latlong.empty()) kinds.push_back("latlong");
   for (const IblFileName& n : names.ibl) kinds.push_back(n.kind);
+  if (!names.cloud_shadow.empty()) kinds.push_back("cloud_shadow");
   kinds.insert(kinds.end(), names.engine.size(), "engine");
   if (!names.png.empty()) kinds.push_back(plan.style->output.preview ? "preview" : "gltf_texture");
   size_t index = 0;
@@ -279,6 +284,8 @@ struct FrameJob {
   std::optional<double> ev100;    // a sequence's; a single bake's is found from the latlong
   std::optional<IblMaps> ibl;     // the frame's IBL maps, when asked for
   std::vector<RgbaImage> engine;  // the engine preset's images (engine_preset.h)
+  std::vector<float> cloud_shadow;  // the frame's cloud shadow map (cloud_shadow.h), when asked for
+  std::optional<CloudShadowInfo> cloud_shadow_info;
 };
 
 // What it gives back.
@@ -664,6 +671,8 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
         w.files.push_back({path, names.ibl[i].kind, ibl_files[i].size(), Sha256OfText(ibl_files[i])});
       }
     }
+    if (job.cloud_shadow_info) w.files.push_back(WriteCloudShadowFile(path_of(names.cloud_shadow), job.cloud_shadow,
+                                                                      *job.cloud_shadow_info, exr.attributes));
     if (!job.engine.empty()) {
       const std::vector<BakedFile> engine = WriteEngineFiles(style, job.engine, exr, options.out_dir, names.engine);
       w.files.insert(w.files.end(), engine.begin(), engine.end());
@@ -830,6 +839,16 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
       engine_images = RenderEngineImages(renderer, plan.sun, style);
       timer.Finish("engine", fmt::format("{}: {} images for {}", label, engine_images.size(), style.output.engine));
     }
+    // The cloud shadow map (cloud_shadow.h): its placement follows from the
+    // style, the sun and the time alone (recorded for verified frames too).
+    std::vector<float> cloud_shadow;
+    if (style.cloud_shadow.enabled) {
+      frame.cloud_shadow = CloudShadowInfoOf(PrunedStyle(style).clouds, style.cloud_shadow, plan.sun, CloudTimeOf(plan));
+      if (!verified) {
+        cloud_shadow = renderer.RenderCloudShadow(plan.sun, style.cloud_shadow);
+        for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
+      }
+    }
     if (verified) {
       collect_pending();
       frame.files = *verified;
@@ -849,7 +868,7 @@ BakeResult BakeFrames(const std::vector<FramePlan>& plans, const Schedule* sched
     if (night_frame) timer.Report("night sky", night->TakeSeconds(), label + ": " + NightSkyBake::Describe(*night_frame));
     collect_pending();
     FrameJob job{plan, names, std::move(images), std::move(rendered.hold), half_scale, ev100, std::move(ibl_maps),
-                 std::move(engine_images)};
+                 std::move(engine_images), std::move(cloud_shadow), frame.cloud_shadow};
     pending.emplace(std::move(frame),
                     std::async(std::launch::async, [&write_frame, job = std::move(job)]() mutable {
                       return write_frame(job);

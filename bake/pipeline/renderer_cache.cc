@@ -17,9 +17,9 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   // The pass plan's pruning: zero-strength and unused effects compiled out.
   const SkyStyle style = PrunedStyle(unpruned);
   StyledInputs in = StyledInputsOf(style);
-  const CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
-                                           std::filesystem::path(style.source_path).parent_path().string(),
-                                           cloud_time_s);
+  CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
+                                     std::filesystem::path(style.source_path).parent_path().string(), cloud_time_s);
+  ApplyGroundCloudShadow(style.cloud_shadow, clouds);  // the ground below the horizon in the clouds' shadow
   // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
   const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
   gpu::GpuAtmosphere key =

@@ -172,6 +172,8 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   vec4 phase;        // x: forward g; y: backward g; z: forward weight; w: unused
   vec4 octave;       // Wrenninge 2013 x: contribution a; y: attenuation b; z: eccentricity c; w: unused
   vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; z: panorama scale; w: unused
+  vec4 ground_shadow;  // the clouds' shadow on the ground the sky shows below the horizon (cloud_shadow.h):
+                      // x: strength (0: off); y: samples per band crossing along the sun direction; zw: unused
   // The union of the layers' shells, overlapping layers merged: x, y: bottom
   // and top altitude km, by altitude; resolution.w of them. The view ray is
   // marched through each band it crosses, in order along the ray.
@@ -198,7 +200,7 @@ SKYBAKE_GPU_STRUCT(IblPush) {
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
-static_assert(sizeof(GpuClouds) == (6 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
+static_assert(sizeof(GpuClouds) == (7 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(IblPush) == 5 * 16, "IblPush must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");

@@ -12,6 +12,7 @@
 
 #include "skybake/model/aoas.h"
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/model/clouds.h"
 #include "skybake/model/view.h"
 #include "skybake/gpu/pass_timing.h"
@@ -126,6 +127,11 @@ class SkyRenderer {
   // count or a noise size differs (a new renderer is needed).
   bool UpdateClouds(const CloudInputs& clouds);
 
+  // The cloud shadow map (cloud_shadow.h): resolution^2 transmittances,
+  // row 0 north; zeros when the Sun's centre is at or below the horizon,
+  // ones without cloud layers. Defined in bake/gpu/cloud_shadow_render.cc.
+  std::vector<float> RenderCloudShadow(const glm::dvec3& sun_direction, const CloudShadowSettings& shadow);
+
   // The noise buffer of the cloud layers (shape, detail, weather per layer),
   // for tests; empty without clouds.
   std::vector<float> ReadCloudNoise() const;
@@ -178,6 +184,7 @@ class SkyRenderer {
   // tables (when the sun moved) before the views; the cloud pass after them.
   void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   void GenerateCloudNoise();
+  void CopyCloudWeatherImages();  // the weather images into the noise buffer, the volumes kept
 
   static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
 
@@ -222,6 +229,7 @@ class SkyRenderer {
   VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
+  VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

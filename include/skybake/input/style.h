@@ -9,6 +9,7 @@
 #include "skybake/input/output_settings.h"
 #include "skybake/model/aoas.h"
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/model/clouds.h"
 
 namespace skybake {
@@ -35,6 +36,7 @@ struct SkyStyle {
   PreviewSettings preview;
   AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
+  CloudShadowSettings cloud_shadow;  // [cloud_shadow]: the frame's cloud shadow map (cloud_shadow.h)
   GltfSettings gltf;
   IblSettings ibl;
   NightSettings night;        // stars, the Moon, moonlight (pipeline/night_sky.h)

@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_formation.h"
 #include "skybake/gpu_shared.h"
 
 namespace skybake {
@@ -62,6 +63,7 @@ struct CloudLayer {
   std::string weather_image;        // EXR or PNG; R = coverage (0..1); "" = procedural
   std::array<double, 2> weather_extent_m = {30000.0, 30000.0};  // [east, north] size of the image
   std::array<double, 2> weather_origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner
+  CloudFormation formation;  // [cloud_layer.formation]: coverage from the automaton (cloud_formation.h)
 };
 
 // Cloud sampling settings; quality.preset sets them, [quality] cloud_* keys

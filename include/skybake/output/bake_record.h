@@ -13,6 +13,7 @@
 #include "skybake/input/astronomy.h"
 #include "skybake/gpu/pass_timing.h"
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/model/sh.h"
 #include "skybake/model/solar_position.h"
 
@@ -47,6 +48,7 @@ struct FrameResult {
   double render_seconds = 0.0;
   double write_seconds = 0.0;
   std::vector<PassTiming> gpu_passes;
+  std::optional<CloudShadowInfo> cloud_shadow;  // placement of the frame's cloud shadow map, when written
 };
 
 struct BakeResult {

@@ -16,12 +16,17 @@
 //             frame (1 s of animation per hour of clock time, else per frame)
 //   moon      with the night sky's moonlight: a second directional light and
 //             node "moon", animated the same way
+//   ground    with [cloud_shadow]: node "cloud_shadow_ground", a horizontal
+//             square at the map's receiver altitude over the map's extent,
+//             its base colour the texture frame's cloud shadow map (NAME_ground.png,
+//             sRGB-encoded transmittance; a lit, rough, non-metallic material)
 //
 // Files: name.gltf + name.bin beside the PNG, and name.glb with everything
 // embedded. Provenance and units go in asset.extras and scene extras.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -79,7 +84,17 @@ struct SceneDescription {
   // +X -X +Y -Y +Z -Z; none: no image-based light.
   std::vector<std::string> ibl_images;
   ShRgb ibl_sh{};                  // E_lm of the sky without the Sun, the bake's units
+  // The ground plane textured with a frame's cloud shadow map (cloud_shadow.h):
+  // the PNG in out_dir and where the map lies. None: no ground plane.
+  std::string ground_texture_file;
+  std::optional<CloudShadowInfo> ground;
 };
+
+// The ground plane's texture: the transmittance of the cloud shadow map EXR
+// at `exr_path` (its R channel), sRGB-encoded to 8-bit grey RGB so that a
+// viewer's decoded base colour is the transmittance; written atomically to
+// `png_path`. Throws OutputError.
+void WriteCloudShadowGroundPng(const std::string& exr_path, const std::string& png_path);
 
 // A frame's Moon as a light key: its direction, illuminance at the observer
 // and colour (irradiance with the largest channel 1).

@@ -21,6 +21,7 @@
 #include <glm/vec3.hpp>
 
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/input/config.h"
 #include "skybake/input/frame_numbering.h"
 #include "skybake/base/errors.h"
@@ -53,6 +54,7 @@ struct ManifestFrame {
   ShRgb sh_irradiance_without_sun{};
   std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
   std::vector<ManifestFile> files;  // in the order they are written
+  std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
 };
 
 // What the glTF scene takes from the style, decided from the whole sequence

@@ -64,7 +64,10 @@ bool WritesLatlongPng(const SkyStyle& style);
 std::vector<ViewRequest> PlanViews(const SkyStyle& style);
 
 // `shaders`: the CLI's diagnostic switches, as the bake would get them.
-PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders = ShaderSwitches());
+// `hours_from_start`: each frame's clock time since the sequence's first
+// (Schedule frames; empty: 0 h), for the cloud formation's step count.
+PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& shaders = ShaderSwitches(),
+                    const std::vector<double>& hours_from_start = {});
 
 // The plan as `skybake plan` prints it.
 std::string FormatPlan(const PassPlan& plan, const std::string& source);

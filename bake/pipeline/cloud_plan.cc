@@ -1,0 +1,87 @@
+#include "cloud_plan.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include <fmt/format.h>
+
+#include "skybake/model/cloud_formation.h"
+#include "skybake/model/clouds.h"
+
+namespace skybake {
+namespace {
+
+// The shells of the layers merged where they overlap (ToCloudInputs' bands).
+int CloudBands(const std::vector<CloudLayer>& layers) {
+  std::vector<std::pair<double, double>> shells;
+  for (const CloudLayer& l : layers) shells.push_back({l.altitude_m, l.altitude_m + l.thickness_m});
+  std::sort(shells.begin(), shells.end());
+  int bands = 0;
+  double top = 0.0;
+  for (const auto& [lo, hi] : shells) {
+    if (bands == 0 || lo > top) {
+      ++bands;
+      top = hi;
+    } else {
+      top = std::max(top, hi);
+    }
+  }
+  return bands;
+}
+
+}  // namespace
+
+void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan) {
+  const CloudShadowSettings& s = first.cloud_shadow;
+  const std::vector<CloudLayer> layers = ActiveCloudLayers(first.clouds);
+  const bool runs = s.enabled && !layers.empty() && s.strength > 0.0;
+  const std::string why_off = !layers.empty() ? "cloud_shadow.strength = 0 (the map is all ones, no pass)"
+                                              : "no cloud layer after pruning (the map is all ones, no pass)";
+  plan.effects.push_back({"cloud shadow map", s.enabled, runs,
+                          runs ? fmt::format("[cloud_shadow] enabled, {} x {} texels over {} m, strength {}",
+                                             s.resolution, s.resolution, s.extent_m, s.strength)
+                               : (s.enabled ? why_off : "switched off in the style")});
+  const bool ground = s.enabled && s.ground;
+  const bool ground_on = ground && runs && PrunedStyle(first).effects.ground;
+  plan.effects.push_back(
+      {"ground cloud shadow", ground, ground_on,
+       ground_on ? fmt::format("cloud_shadow.ground = true: below-horizon texels march {} steps per band", s.steps)
+       : ground  ? (runs ? "the sky shows no ground (effects.ground off or ground_albedo 0)" : why_off)
+                 : "switched off in the style"});
+  if (!runs) return;
+  const int bands = CloudBands(layers);
+  plan.passes.push_back({"cloud shadow map", fmt::format("{} x {}", s.resolution, s.resolution),
+                         "once per frame with the Sun up", frames,
+                         double(s.resolution) * s.resolution * s.steps * bands});
+}
+
+void AddCloudFormationPlan(const SkyStyle& first, const std::vector<double>& hours_from_start, PassPlan& plan) {
+  bool requested = false;
+  for (const CloudLayer& l : first.clouds.layers) requested = requested || l.formation.enabled;
+  std::string why_on;
+  for (const CloudLayer& l : ActiveCloudLayers(first.clouds)) {
+    const CloudFormation& f = l.formation;
+    if (!f.enabled) continue;
+    // The steps a process simulates: from 0 to the last frame's step, and
+    // the one after it when the frame falls between two.
+    uint64_t steps = 0;
+    for (double h : hours_from_start.empty() ? std::vector<double>{0.0} : hours_from_start) {
+      const double step = f.warmup_steps + f.steps_per_hour * std::max(h, 0.0);
+      steps = std::max(steps, uint64_t(std::floor(step)) + (step > std::floor(step) ? 1 : 0));
+    }
+    const double cells = double(f.cells[0]) * f.cells[1] * f.cells[2];
+    why_on += fmt::format("{}{} x {} x {} cells at {} m, {} steps per hour", why_on.empty() ? "" : "; ", f.cells[0],
+                          f.cells[1], f.cells[2], l.altitude_m, f.steps_per_hour);
+    plan.passes.push_back({fmt::format("cloud formation (CPU) at {} m", l.altitude_m),
+                           fmt::format("{} x {} x {}", f.cells[0], f.cells[1], f.cells[2]),
+                           fmt::format("{} warm-up + {} per hour", f.warmup_steps, f.steps_per_hour), int(steps),
+                           cells});
+  }
+  plan.effects.push_back({"cloud formation", requested, !why_on.empty(),
+                          !why_on.empty() ? "[cloud_layer.formation] enabled: " + why_on
+                          : requested     ? "every layer with a formation is pruned (coverage 0 or density_per_m 0)"
+                                          : "switched off in the style"});
+}
+
+}  // namespace skybake

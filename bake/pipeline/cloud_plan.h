@@ -1,0 +1,25 @@
+// The cloud formation step and the cloud shadow passes in the pass plan
+// (pass_plan.h; cloud_formation.h, cloud_shadow.h). Private to the pipeline.
+#pragma once
+
+#include <vector>
+
+#include "skybake/pipeline/pass_plan.h"
+
+namespace skybake {
+
+// Effects "cloud shadow map" and "ground cloud shadow", and the shadow map's
+// GPU pass (medium samples: its resolution^2 x steps x bands density reads),
+// when it runs: [cloud_shadow] on, with a cloud layer left after pruning and
+// a strength above 0 (else the map is all ones, or all zeros with the Sun
+// down, written without a pass).
+void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan);
+
+// Effect "cloud formation" and its CPU step per active layer with a
+// formation: cells per step, and the steps simulated to reach the planned
+// frames' clock times (`hours_from_start`, one per frame; empty: every
+// frame at 0 h), from step 0 (a process, or a --shard / --frames part,
+// simulates from the start). Not medium samples: not in the plan's total.
+void AddCloudFormationPlan(const SkyStyle& first, const std::vector<double>& hours_from_start, PassPlan& plan);
+
+}  // namespace skybake
