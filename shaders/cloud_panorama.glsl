@@ -7,6 +7,18 @@
 #ifndef SKYBAKE_CLOUD_PANORAMA_GLSL
 #define SKYBAKE_CLOUD_PANORAMA_GLSL
 
+// The rows marched (SkyPush.offsets.w): [first, end); every other row holds
+// no cloud (cloud_panorama.h, CloudPanoramaRowsSeeingBands) and is read as such.
+int CloudPanoramaFirstRow() { return push.offsets.w & 0xffff; }
+int CloudPanoramaEndRow() { return push.offsets.w >> 16; }
+
+// Texel `index` (row y) of the panorama at `first`: radiance 0 and
+// transmittance 1 in the rows not marched.
+vec4 CloudPanoramaTexel(int first, int width, int index, int y) {
+  if (y < CloudPanoramaFirstRow() || y >= CloudPanoramaEndRow()) return vec4(0.0, 0.0, 0.0, 1.0);
+  return cloud_lut[first + index];
+}
+
 // The panorama's texels around `view` (Imf::LatLongMap's grid: row 0 the
 // zenith, columns 0 and width - 1 both the meridian behind -Z), bilinear,
 // but never across the horizon: a ray just below it meets the ground and no
@@ -30,9 +42,9 @@ vec4 CloudPanoramaRead(int first, int width, int height, vec3 view) {
   float mu1 = sin(kPi * (0.5 - float(y0 + 1) / float(height - 1)));
   if ((mu0 < mu_horizon) != below) fy = 1.0;
   if ((mu1 < mu_horizon) != below) fy = 0.0;
-  int row0 = first + y0 * width + x0, row1 = row0 + width;
-  vec4 a = mix(cloud_lut[row0], cloud_lut[row0 + 1], fx);
-  vec4 b = mix(cloud_lut[row1], cloud_lut[row1 + 1], fx);
+  int row0 = y0 * width + x0, row1 = row0 + width;
+  vec4 a = mix(CloudPanoramaTexel(first, width, row0, y0), CloudPanoramaTexel(first, width, row0 + 1, y0), fx);
+  vec4 b = mix(CloudPanoramaTexel(first, width, row1, y0 + 1), CloudPanoramaTexel(first, width, row1 + 1, y0 + 1), fx);
   return mix(a, b, fy);
 }
 

@@ -7,6 +7,7 @@
 // cloud_resample.comp then reads into every view.
 #include "common.glsl"
 #include "clouds.glsl"
+#include "cloud_panorama.glsl"
 #include "cloud_shadow.glsl"
 
 vec3 ViewDirection(ivec2 texel) {
@@ -21,6 +22,11 @@ vec3 ViewDirection(ivec2 texel) {
 
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
+  // The panorama's dispatch covers its marched rows only (cloud_panorama.glsl).
+  if (push.rect.w == CLOUD_MODE_PANORAMA) {
+    texel.y += CloudPanoramaFirstRow();
+    if (texel.y >= CloudPanoramaEndRow()) return;
+  }
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   AtmosphereParameters atm = AtmosphereFromUniform();
   vec3 view = ViewDirection(texel);

@@ -23,7 +23,7 @@ void main() {
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   // A latlong of the panorama's own size reads its own texel.
   vec4 c = push.view.x == MAPPING_LATLONG && push.view.y == push.rect.y && push.view.z == push.rect.z
-               ? cloud_lut[push.rect.x + texel.y * push.rect.y + texel.x]
+               ? CloudPanoramaTexel(push.rect.x, push.rect.y, texel.y * push.rect.y + texel.x, texel.y)
                : CloudPanoramaRead(push.rect.x, push.rect.y, push.rect.z, ViewDirection(texel));
   // The clouds' shadow on the ground below the horizon, per texel (cloud_shadow.glsl; off: 0).
   vec3 ground_loss = GroundCloudShadowLoss(AtmosphereFromUniform(), ViewDirection(texel), push.sun_direction.xyz);

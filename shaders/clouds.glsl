@@ -344,27 +344,64 @@ float CloudPhase(float cos_theta, float eccentricity) {
              HenyeyGreenstein(gpu_clouds.phase.x * eccentricity, cos_theta), gpu_clouds.phase.z);
 }
 
-// Optical depth (dimensionless) toward the Sun from a view sample, marched
-// with light_steps samples placed quadratically (dense near the sample)
-// over the distance to the top of the sample's band along the Sun, at most
-// kCloudLightDistanceKm.
+// Distance along the ray (r0, mu) to altitude H on the descending (sign
+// -1) or ascending (+1) branch; r_H^2 - r0^2 formed from altitudes.
+float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float mu, float H, float branch) {
+  float disc = r0 * r0 * mu * mu + (H - h0) * (2.0 * atm.bottom_radius + H + h0);
+  return -r0 * mu + branch * sqrt(max(disc, 0.0));
+}
+
+// Optical depth (dimensionless) toward the Sun from a view sample, in two
+// parts. Its own band: light_steps samples placed quadratically (dense near
+// the sample) over the distance to the top of the band along the Sun, at
+// most kCloudLightDistanceKm. The bands above (layers shadow each other: a
+// deck above darkens the sunlight of the clouds below it): each band the
+// Sun's ray crosses on its way up, min(light_steps, 4) uniform samples over
+// the crossing (a band above is crossed whole). Both without the detail
+// erosion. One loop over both parts with one density call: lavapipe inlines
+// every call, and each inlined density is a large part of the shader.
 const float kCloudLightDistanceKm = 8.0;
 float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top) {
   float reach = (band_top - h) / max(mu_s, 0.1);
   float distance = min(max(reach, 0.05), kCloudLightDistanceKm);
   int n = gpu_clouds.counts.z;
   float r = atm.bottom_radius + h;
-  float depth = 0.0;
-  float s0 = 0.0;
-  for (int i = 0; i < n; ++i) {
-    float u1 = float(i + 1) / float(n);
-    float s1 = distance * u1 * u1;
-    float s = 0.5 * (s0 + s1);
-    float hs = AltitudeAlongRay(atm, r, h, mu_s, s);
-    depth += CloudExtinction(xz + s * sun.xz, hs, false) * (s1 - s0);
-    s0 = s1;
+  float depth = 0.0, depth_above = 0.0;
+  // Part 0 is the own band, part 1 + b band b (when above band_top).
+  int bands = gpu_clouds.resolution.w > 1 ? gpu_clouds.resolution.w : 0;
+  int n_above = min(n, 4);
+  for (int part = 0; part <= CLOUD_MAX_LAYERS; ++part) {
+    int steps = n;
+    float s_lo = 0.0, ds = 0.0;
+    if (part > 0) {
+      int b = part - 1;
+      if (b >= bands) continue;
+      float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
+      if (lo < band_top) continue;
+      s_lo = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
+      float s_hi = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
+      ds = (s_hi - s_lo) / float(n_above);
+      steps = n_above;
+    }
+    float s0 = 0.0;
+    for (int i = 0; i < steps; ++i) {
+      float s, length_;
+      if (part == 0) {
+        float u1 = float(i + 1) / float(n);
+        float s1 = distance * u1 * u1;
+        s = 0.5 * (s0 + s1);
+        length_ = s1 - s0;
+        s0 = s1;
+      } else {
+        s = s_lo + (float(i) + 0.5) * ds;
+        length_ = ds;
+      }
+      float sigma = CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * length_;
+      if (part == 0) depth += sigma;
+      else depth_above += sigma;
+    }
   }
-  return depth;
+  return bands > 1 ? depth + depth_above : depth;
 }
 
 // The ambient table at altitude h: x sky above, y ground below.
@@ -428,39 +465,6 @@ struct CloudMarch {
   float transmittance;  // of the clouds along the whole ray (grey)
 };
 
-// Distance along the ray (r0, mu) to altitude H on the descending (sign
-// -1) or ascending (+1) branch; r_H^2 - r0^2 formed from altitudes.
-float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float mu, float H, float branch) {
-  float disc = r0 * r0 * mu * mu + (H - h0) * (2.0 * atm.bottom_radius + H + h0);
-  return -r0 * mu + branch * sqrt(max(disc, 0.0));
-}
-
-// Optical depth (dimensionless) toward the Sun through the bands above the
-// one whose top is `band_top` (Layers shadow each other: a deck above darkens
-// the sunlight of the clouds below it): each band the Sun's ray crosses on
-// its way up, marched with min(light_steps, 4) uniform samples (a band above
-// is crossed whole; its shape without detail, as in the light march).
-float CloudOpticalDepthOfBandsAbove(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun,
-                                    float band_top) {
-  float r = atm.bottom_radius + h;
-  int n = min(gpu_clouds.counts.z, 4);
-  int bands = gpu_clouds.resolution.w;
-  float depth = 0.0;
-  for (int b = 0; b < CLOUD_MAX_LAYERS; ++b) {
-    if (b >= bands) continue;
-    float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
-    if (lo < band_top) continue;
-    float s0 = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
-    float s1 = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
-    float ds = (s1 - s0) / float(n);
-    for (int i = 0; i < n; ++i) {
-      float s = s0 + (float(i) + 0.5) * ds;
-      depth += CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * ds;
-    }
-  }
-  return depth;
-}
-
 // Marches the view ray through the part [t0, t1] of a band of thickness
 // `band_thickness`: steps of a third of view_steps per thickness crossed,
 // at most view_steps (a vertical crossing takes a third of them, a
@@ -489,7 +493,6 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     vec3 scattered = vec3(0.0);
     if (max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
       float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
-      if (gpu_clouds.resolution.w > 1) tau += CloudOpticalDepthOfBandsAbove(atm, xz, h, mu_s, sun, band_top);
       // Wrenninge 2013: octave o scatters a^o of the light, sees b^o of the
       // optical depth and a phase of eccentricity c^o.
       float a = 1.0, b = 1.0, c = 1.0, sum = 0.0;
@@ -535,7 +538,9 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
 }
 
 // The clouds along `view`: every band the ray crosses, in order, before the
-// ground and within range.x of the viewer.
+// ground and within range.x of the viewer. The segments are listed first and
+// marched by one call site: lavapipe inlines every call, and one inlined march
+// per band and branch made the shader eight marches long.
 CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   CloudMarch m;
   m.radiance = vec3(0.0);
@@ -546,6 +551,9 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   float mu = ClampCosine(view.y);
   float t_far = gpu_clouds.range.x;
   int bands = gpu_clouds.resolution.w;
+  // Segments in order along the ray: x, y the distances; z the band's top, w its thickness.
+  vec4 segments[2 * CLOUD_MAX_LAYERS];
+  int count = 0;
   // The descending branch (mu < 0): altitude falls to the perigee, or to
   // the ground.
   float t_perigee = 0.0;
@@ -562,7 +570,7 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
       if (h0 <= lo || h_perigee >= hi) continue;
       float ta = h0 > hi ? CloudRayToAltitude(atm, r0, h0, mu, hi, -1.0) : 0.0;
       float tb = h_perigee < lo ? CloudRayToAltitude(atm, r0, h0, mu, lo, -1.0) : t_end;
-      MarchCloudSegment(atm, view, sun, ap, ta, min(min(tb, t_end), t_far), hi, hi - lo, m);
+      segments[count++] = vec4(ta, min(min(tb, t_end), t_far), hi, hi - lo);
     }
   }
   if (!ground) {
@@ -574,9 +582,11 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
       if (hi <= h_perigee) continue;
       float ta = h_perigee < lo ? CloudRayToAltitude(atm, r0, h0, mu, lo, 1.0) : t_start;
       float tb = CloudRayToAltitude(atm, r0, h0, mu, hi, 1.0);
-      MarchCloudSegment(atm, view, sun, ap, max(ta, t_start), min(tb, t_far), hi, hi - lo, m);
+      segments[count++] = vec4(max(ta, t_start), min(tb, t_far), hi, hi - lo);
     }
   }
+  for (int i = 0; i < count; ++i)
+    MarchCloudSegment(atm, view, sun, ap, segments[i].x, segments[i].y, segments[i].z, segments[i].w, m);
   return m;
 }
 

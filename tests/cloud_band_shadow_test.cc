@@ -1,4 +1,4 @@
-// Cloud bands shadow each other (clouds.glsl, CloudOpticalDepthOfBandsAbove):
+// Cloud bands shadow each other (clouds.glsl, CloudOpticalDepthToSun):
 // the sunlight of a sample is attenuated by the bands above its own, on
 // lavapipe under the validation layer.
 #include <memory>

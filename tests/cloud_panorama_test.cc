@@ -3,6 +3,7 @@
 // it stay close to the views marched texel by texel, on lavapipe under the
 // validation layer.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -78,6 +79,42 @@ double MeanRelativeDifference(const std::vector<float>& a, const std::vector<flo
     sum += std::abs(vb);
   }
   return diff / sum;
+}
+
+TEST(CloudPanoramaChoice, OnlyTheRowsThatCanSeeABandAreMarched) {
+  const CloudPanorama p{2048, 1024};
+  const double radius_km = 6360.0;
+  const std::vector<std::array<double, 2>> w3_band = {{1.5, 3.0}};
+  auto mu = [&](int y) { return std::sin(-3.14159265358979 * (double(y) / 1023.0 - 0.5)); };
+  // From the ground: the sky half and the rows within the margin below the
+  // horizontal (0.02 in cosine: 6-7 rows); every row left out sees the ground.
+  CloudPanoramaRows r = CloudPanoramaRowsSeeingBands(p, radius_km, 0.0, w3_band);
+  EXPECT_EQ(r.begin, 0);
+  EXPECT_GT(r.end, 512);
+  EXPECT_LT(r.end, 512 + 10);
+  EXPECT_LT(mu(r.end), -kCloudPanoramaRowMargin);
+  EXPECT_GE(mu(r.end - 1), -kCloudPanoramaRowMargin);
+  // 800 m up, below the band: the horizon dips (cosine -0.0159), so more rows.
+  CloudPanoramaRows up = CloudPanoramaRowsSeeingBands(p, radius_km, 0.8, w3_band);
+  EXPECT_GT(up.end, r.end);
+  const double dip = -std::sqrt(1.0 - std::pow(radius_km / (radius_km + 0.8), 2));
+  EXPECT_LT(mu(up.end), dip - kCloudPanoramaRowMargin);
+  // Inside the band: every row.
+  r = CloudPanoramaRowsSeeingBands(p, radius_km, 2.0, w3_band);
+  EXPECT_EQ(r.begin, 0);
+  EXPECT_EQ(r.end, 1024);
+  // Above every band (an aircraft at 5 km): the rows below the margin above
+  // the horizontal, down to the nadir.
+  r = CloudPanoramaRowsSeeingBands(p, radius_km, 5.0, {{1.5, 3.0}, {4.0, 4.5}});
+  EXPECT_GT(r.begin, 500);
+  EXPECT_LT(r.begin, 512);
+  EXPECT_LE(mu(r.begin), kCloudPanoramaRowMargin);
+  EXPECT_GT(mu(r.begin - 1), kCloudPanoramaRowMargin);
+  EXPECT_EQ(r.end, 1024);
+  // Between two bands: every row.
+  r = CloudPanoramaRowsSeeingBands(p, radius_km, 3.5, {{1.5, 3.0}, {4.0, 4.5}});
+  EXPECT_EQ(r.begin, 0);
+  EXPECT_EQ(r.end, 1024);
 }
 
 TEST(CloudPanoramaPass, LatlongIsTheMarchedOneAndTheCubeStaysClose) {

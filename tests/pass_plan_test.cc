@@ -270,6 +270,58 @@ struct Equivalence {
   std::string zero_strength_toml;
 };
 
+// The cloud panorama (gpu/cloud_panorama.h) is listed with its size, the
+// rows it marches and their medium samples, and the views read from it with
+// none; with quality.cloud_panorama_scale = 0 every view marches its own
+// texels; without a cloud layer (or with it pruned) there is no cloud pass.
+// Views: six 64^2 faces, the 64 x 384 strip, a 256 x 128 latlong, so the
+// panorama is 256 x 128 and, from the ground, marches rows 0 to 64 (row 65's
+// cosine, -0.037, is past the 0.02 margin below the horizon).
+TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
+  const std::string layer = "[render]\ncube_size = 64\nlatlong_height = 128\n"
+                            "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = COVERAGE\n";
+  auto style = [&](const std::string& coverage, const std::string& more = "") {
+    std::string t = layer;
+    t.replace(t.find("COVERAGE"), 8, coverage);
+    return Style(t + more);
+  };
+  auto pass = [](const PassPlan& p, const std::string& name) -> const PlannedPass* {
+    for (const PlannedPass& x : p.passes)
+      if (x.name == name) return &x;
+    return nullptr;
+  };
+  const SkyStyle on = style("0.45");
+  const CloudQuality& cq = on.clouds.quality;
+  const PassPlan plan = PlanPasses({on, on});
+  const PlannedPass* panorama = pass(plan, "clouds panorama");
+  ASSERT_NE(panorama, nullptr) << FormatPlan(plan, "on");
+  EXPECT_EQ(panorama->size, "256 x 128, rows 0 to 64 marched");
+  EXPECT_EQ(panorama->runs, 2);
+  EXPECT_EQ(panorama->samples, 256.0 * 65.0 * cq.view_steps * (1.0 + cq.light_steps));
+  const PlannedPass* latlong = pass(plan, "clouds latlong (resampled)");
+  ASSERT_NE(latlong, nullptr);
+  EXPECT_EQ(latlong->samples, 0.0);
+  EXPECT_NE(pass(plan, "clouds face 5 (resampled)"), nullptr);
+  EXPECT_EQ(pass(plan, "clouds latlong"), nullptr);
+  EXPECT_NE(FormatPlan(plan, "on").find("clouds panorama"), std::string::npos);
+  // 2 km up, inside the layer: every row.
+  EXPECT_EQ(pass(PlanPasses({style("0.45", "[atmosphere]\nobserver_altitude_m = 2000\n")}), "clouds panorama")->size,
+            "256 x 128, rows 0 to 127 marched");
+  // Off: each view marches its own texels.
+  const PassPlan marched = PlanPasses({style("0.45", "[quality]\ncloud_panorama_scale = 0.0\n")});
+  EXPECT_EQ(pass(marched, "clouds panorama"), nullptr);
+  ASSERT_NE(pass(marched, "clouds latlong"), nullptr);
+  EXPECT_EQ(pass(marched, "clouds latlong")->samples, 256.0 * 128.0 * cq.view_steps * (1.0 + cq.light_steps));
+  EXPECT_GT(marched.total_samples, PlanPasses({on}).total_samples);
+  // Pruned (coverage 0) or no layer: no cloud pass at all.
+  for (const SkyStyle& none : {style("0.0"), Style("[render]\ncube_size = 64\nlatlong_height = 128\n")}) {
+    const PassPlan p = PlanPasses({none});
+    EXPECT_EQ(pass(p, "clouds panorama"), nullptr);
+    EXPECT_EQ(pass(p, "clouds latlong"), nullptr);
+    EXPECT_EQ(pass(p, "clouds latlong (resampled)"), nullptr);
+  }
+}
+
 // The cloud formation's CPU step and the cloud shadow map's pass are listed
 // with their cost: the formation simulates from step 0 to the last planned
 // frame's step (warm-up 5 + 10 per hour x 1.25 h = 17.5: 18 steps) of

@@ -33,4 +33,27 @@ CloudPanorama ChooseCloudPanorama(const std::vector<ViewRequest>& views, double 
   return p;
 }
 
+CloudPanoramaRows CloudPanoramaRowsSeeingBands(const CloudPanorama& panorama, double bottom_radius_km,
+                                               double observer_altitude_km,
+                                               const std::vector<std::array<double, 2>>& bands) {
+  CloudPanoramaRows rows{0, panorama.height};
+  if (bands.empty() || panorama.height < 2) return rows;
+  double lowest = bands.front()[0], highest = bands.front()[1];
+  for (const auto& b : bands) {
+    lowest = std::min(lowest, b[0]);
+    highest = std::max(highest, b[1]);
+  }
+  constexpr double kPi = 3.14159265358979323846;
+  // Row y's cosine of the zenith angle (DirectionFromLatLongPixel).
+  auto mu = [&](int y) { return std::sin(-kPi * (double(y) / double(panorama.height - 1) - 0.5)); };
+  if (observer_altitude_km < lowest) {
+    const double ratio = bottom_radius_km / (bottom_radius_km + observer_altitude_km);
+    const double mu_horizon = -std::sqrt(std::max(1.0 - ratio * ratio, 0.0));
+    while (rows.end > 1 && mu(rows.end - 1) < mu_horizon - kCloudPanoramaRowMargin) --rows.end;
+  } else if (observer_altitude_km > highest) {
+    while (rows.begin < panorama.height - 1 && mu(rows.begin) > kCloudPanoramaRowMargin) ++rows.begin;
+  }
+  return rows;
+}
+
 }  // namespace skybake

@@ -703,6 +703,15 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   // buffer; growing it rewrites the descriptors, so before the output's.
   const CloudPanorama panorama = cloud_layers_ > 0 ? ChooseCloudPanorama(views, gpu_clouds_.range.z) : CloudPanorama{};
   if (panorama.width > 0) EnsureCloudLutCapacity(CloudLutTexels(gpu_clouds_) + panorama.texels());
+  // Its rows that can see a cloud (the others are not marched), packed for the
+  // shaders as begin + end x 65536 (SkyPush.offsets.w, cloud_panorama.glsl).
+  CloudPanoramaRows panorama_rows{0, panorama.height};
+  if (panorama.width > 0) {
+    std::vector<std::array<double, 2>> bands;
+    for (int b = 0; b < gpu_clouds_.resolution.w; ++b) bands.push_back({gpu_clouds_.bands[b].x, gpu_clouds_.bands[b].y});
+    panorama_rows = CloudPanoramaRowsSeeingBands(panorama, gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.z, bands);
+  }
+  const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
   BindOutput(target);
   const VkPipeline sky_pipeline = sky_pipeline_;
 
@@ -730,9 +739,10 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
     push.view = {MAPPING_LATLONG, panorama.width, panorama.height, 0};
     push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
+    push.offsets.w = panorama_row_range;
     // Read by the cloud passes after the views' barrier below.
     dispatches.push_back({"clouds panorama", cloud_pipeline_, push, GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
-                          GroupCount(panorama.height, SKYBAKE_LOCAL_SIZE_Y)});
+                          GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y)});
     barriers.push_back(false);
     ++counters_.cloud_dispatches;
   }
@@ -783,6 +793,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       if (panorama.width > 0) {
         d.pipeline = cloud_resample_pipeline_;
         d.push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_RESAMPLE};
+        d.push.offsets.w = panorama_row_range;
       }
       dispatches.push_back(d);
       barriers.push_back(false);  // views are disjoint

@@ -1,11 +1,14 @@
 #include "cloud_plan.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
+#include <string>
 
 #include <fmt/format.h>
 
+#include "skybake/gpu/cloud_panorama.h"
 #include "skybake/model/cloud_formation.h"
 #include "skybake/model/clouds.h"
 
@@ -31,6 +34,37 @@ int CloudBands(const std::vector<CloudLayer>& layers) {
 }
 
 }  // namespace
+
+void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<ViewRequest>& views, int frames,
+                       PassPlan& plan) {
+  const CloudQuality& cq = first.clouds.quality;
+  const double per_texel = double(cq.view_steps) * layers * (1.0 + cq.light_steps);
+  auto view_name = [](const ViewRequest& v) {
+    return v.mapping == MAPPING_LATLONG      ? std::string("clouds latlong")
+           : v.mapping == MAPPING_CUBE_STRIP ? std::string("clouds cube strip")
+                                             : fmt::format("clouds face {}", v.face);
+  };
+  const CloudPanorama panorama = ChooseCloudPanorama(views, cq.panorama_scale);
+  if (panorama.width == 0) {
+    for (const ViewRequest& v : views)
+      plan.passes.push_back({view_name(v), fmt::format("{} x {}", v.width, v.height), "once per frame (at most)",
+                             frames, double(v.width) * v.height * per_texel});
+    return;
+  }
+  std::vector<std::array<double, 2>> bands;
+  for (const CloudLayer& l : ActiveCloudLayers(first.clouds))
+    bands.push_back({l.altitude_m * 1e-3, (l.altitude_m + l.thickness_m) * 1e-3});
+  const CloudPanoramaRows rows = CloudPanoramaRowsSeeingBands(
+      panorama, first.atmosphere.bottom_radius_km, first.atmosphere.observer_altitude_m * 1e-3, bands);
+  plan.passes.push_back({"clouds panorama",
+                         fmt::format("{} x {}, rows {} to {} marched", panorama.width, panorama.height, rows.begin,
+                                     rows.end - 1),
+                         fmt::format("once per frame (quality.cloud_panorama_scale = {})", cq.panorama_scale), frames,
+                         double(panorama.width) * (rows.end - rows.begin) * per_texel});
+  for (const ViewRequest& v : views)
+    plan.passes.push_back({view_name(v) + " (resampled)", fmt::format("{} x {}", v.width, v.height),
+                           "once per frame", frames, 0.0});
+}
 
 void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan) {
   const CloudShadowSettings& s = first.cloud_shadow;

@@ -15,6 +15,16 @@ namespace skybake {
 // down, written without a pass).
 void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan);
 
+// The cloud march's passes over `views`: with a cloud panorama
+// (gpu/cloud_panorama.h: quality.cloud_panorama_scale > 0 and cheaper than
+// marching the views), "clouds panorama" (its size, the rows that can see a
+// band, and their medium samples) and one "clouds <view> (resampled)" per
+// view, no medium samples; else each view marches its own texels. Medium
+// samples: at most view_steps per layer crossing, each lit sample
+// light_steps more.
+void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<ViewRequest>& views, int frames,
+                       PassPlan& plan);
+
 // Effect "cloud formation" and its CPU step per active layer with a
 // formation: cells per step, and the steps simulated to reach the planned
 // frames' clock times (`hours_from_start`, one per frame; empty: every

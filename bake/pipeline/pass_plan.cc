@@ -215,14 +215,7 @@ void PlanCloudPasses(const SkyStyle& first, PassPlan& plan) {
     // ambient 16 altitudes x 64 directions x 16 steps.
     plan.passes.push_back({"cloud tables", "AP 32 x 64 x 32, ambient 16", "once per frame", plan.frames,
                            32.0 * 64 * 32 * 4 + 16.0 * 64 * 16});
-    for (const ViewRequest& v : PlanViews(first)) {
-      std::string name = v.mapping == MAPPING_LATLONG      ? "clouds latlong"
-                         : v.mapping == MAPPING_CUBE_STRIP ? "clouds cube strip"
-                                                           : fmt::format("clouds face {}", v.face);
-      // At most view_steps per layer crossing, each lit sample light_steps more.
-      plan.passes.push_back({name, Size(v.width, v.height), "once per frame (at most)", plan.frames,
-                             double(v.width) * v.height * cq.view_steps * layers * (1.0 + cq.light_steps)});
-    }
+    AddCloudMarchPlan(first, layers, PlanViews(first), plan.frames, plan);  // cloud_plan.h: panorama or views
   }
 }
 

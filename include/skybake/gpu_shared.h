@@ -136,7 +136,8 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
   vec4 sun_direction;  // xyz: unit vector towards the Sun; w: unused
   ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE)
   ivec4 offsets;       // x: first output texel of this view in the output buffer; y: 1 = no sun disc;
-                       // z: first direction of a MAPPING_DIRECTIONS view
+                       // z: first direction of a MAPPING_DIRECTIONS view; w: cloud panorama and
+                       // resample passes: the panorama's marched rows, begin + end x 65536
   ivec4 rect;          // sun-disc pass: texels [x, z) x [y, w) of the view
 };
 

@@ -11,6 +11,7 @@
 // that view gives; the other views read it bilinearly.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <vector>
 
@@ -36,6 +37,26 @@ int CloudPanoramaHeightFor(const ViewRequest& view);
 // than marching the views (its texels more than 2/3 of theirs: a bake of one
 // latlong view marches it), or when it would exceed kMaxCloudPanoramaHeight.
 CloudPanorama ChooseCloudPanorama(const std::vector<ViewRequest>& views, double scale);
+
+// The rows [begin, end) of a panorama whose rays can meet a cloud band; the
+// others hold no cloud (radiance 0, transmittance 1), are not marched, and
+// the resample reads them as such. From below every band (the ground's
+// observer), the rays that meet the ground first see no cloud: the rows more
+// than kCloudPanoramaRowMargin below the horizon's cosine. From above every
+// band, the rays that rise see none: the rows more than the margin above the
+// horizontal. From inside a band, every row. `bands`: the bands' bottom and
+// top altitudes, km (GpuClouds.bands); radii in km.
+struct CloudPanoramaRows {
+  int begin = 0;
+  int end = 0;
+};
+CloudPanoramaRows CloudPanoramaRowsSeeingBands(const CloudPanorama& panorama, double bottom_radius_km,
+                                               double observer_altitude_km,
+                                               const std::vector<std::array<double, 2>>& bands);
+// In cosine of the zenith angle: 0.02 keeps the marched rows' rays clear of
+// the ground's tangent by a kilometre or more (float rounding at 6360 km is
+// half a metre), so a row left out is one the march would leave empty too.
+constexpr double kCloudPanoramaRowMargin = 0.02;
 
 // 4096 x 2048 texels of RGBA float: 128 MiB.
 constexpr int kMaxCloudPanoramaHeight = 2048;
