@@ -33,7 +33,6 @@ constexpr double kPi = 3.14159265358979323846;
 // Columns of a signed permutation, as images of skybake's +X, +Y, +Z.
 glm::dmat3 Columns(glm::dvec3 x, glm::dvec3 y, glm::dvec3 z) { return glm::dmat3(x, y, z); }
 
-const glm::dmat3 kIdentity{1.0};
 const glm::dmat3 kMirrorX = Columns({-1, 0, 0}, {0, 1, 0}, {0, 0, 1});
 // Unreal: glTF (x, y, z) is UE (x, z, y) (UE's glTF exporter, FGLTFConverterUtility::ConvertVector, inverted).
 const glm::dmat3 kSwapYZ = Columns({1, 0, 0}, {0, 0, 1}, {0, 1, 0});
