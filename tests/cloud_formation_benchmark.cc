@@ -6,6 +6,7 @@
 //     a part of a sharded bake does for its first frame; and the next frame
 //     (30 minutes, 10 steps later) continued from the process's lattice, as
 //     every later frame does; both with the smoothing and coverage map;
+//   - with formation.density, the next frame's 64^3 density volume too;
 //   - the 256 x 256 shadow map of that style on lavapipe (GPU timestamps).
 //
 //   build/tests/cloud_formation_benchmark --benchmark_repetitions=3
@@ -82,6 +83,25 @@ void BM_FormationNextFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_FormationNextFrame)->Unit(benchmark::kMillisecond)->Iterations(12);
+
+// With formation.density: the next frame's density volume as well, the
+// smoothed lattice resampled to 64^3 (FormationDensityAt), 30 minutes on
+// from the last frame like BM_FormationNextFrame.
+void BM_FormationDensityNextFrame(benchmark::State& state) {
+  const SkyStyle& style = Afternoon();
+  const CloudFormation& f = style.clouds.layers[0].formation;
+  const CloudMask mask = ReadCloudMask(StyleDir() + "/" + f.mask_image, f);
+  const uint32_t seed = style.aoas.seed;
+  const int n = int(state.range(0));
+  double hours = 0.0;
+  benchmark::DoNotOptimize(FormationDensityAt(f, &mask, seed, hours * 3600.0, n).data());
+  for (auto _ : state) {
+    hours += 0.5;
+    benchmark::DoNotOptimize(FormationDensityAt(f, &mask, seed, hours * 3600.0, n).data());
+  }
+  state.counters["voxels"] = double(n) * n * n;
+}
+BENCHMARK(BM_FormationDensityNextFrame)->Arg(64)->Unit(benchmark::kMillisecond)->Iterations(12);
 
 void BM_ShadowMap(benchmark::State& state) {
   const SkyStyle& style = Afternoon();
