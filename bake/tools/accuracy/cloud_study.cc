@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -116,7 +117,9 @@ double CloudPassMs(const SkyRenderer& renderer) {
 
 double Median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
-  return v.empty() ? 0.0 : v[v.size() / 2];
+  if (v.empty()) return 0.0;
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
 // Texels that look above the horizon (the lower half sees the ground and,
@@ -211,20 +214,24 @@ std::vector<CloudQuality> MarchCases(bool quick) {
     cases.push_back(MakeQuality(48, 6, 32, 16, 64));
     return cases;
   }
-  // The steps at the production volumes (64/32/256).
-  for (int view : {16, 24, 32, 48, 64, 96, 128, 192})
-    for (int light : {3, 4, 6, 8, 12, 16}) cases.push_back(MakeQuality(view, light, 64, 32, 256));
+  // The steps at the production volumes (64/32/256): a low Sun's light
+  // crosses the layer over kilometres, so light steps matter as much as
+  // view steps.
+  for (int view : {16, 32, 48, 64, 96})
+    for (int light : {6, 12, 24}) cases.push_back(MakeQuality(view, light, 64, 32, 256));
+  for (int view : {16, 48}) cases.push_back(MakeQuality(view, 3, 64, 32, 256));
+  for (int view : {32, 48, 64}) cases.push_back(MakeQuality(view, 16, 64, 32, 256));
   // The draft volumes (48/24/128) with the cheaper steps, the reference
   // volumes (128/64/512) with the dearer ones.
-  for (int view : {16, 24, 32, 48, 64})
-    for (int light : {4, 6, 8}) cases.push_back(MakeQuality(view, light, 48, 24, 128));
-  for (int view : {64, 96, 128, 192})
-    for (int light : {8, 12, 16}) cases.push_back(MakeQuality(view, light, 128, 64, 512));
-  // One volume or the octaves changed from production.
-  for (int shape : {32, 48, 128}) cases.push_back(MakeQuality(48, 6, shape, 32, 256));
-  for (int detail : {16, 64}) cases.push_back(MakeQuality(48, 6, 64, detail, 256));
-  for (int weather : {128, 512}) cases.push_back(MakeQuality(48, 6, 64, 32, weather));
-  for (int octaves : {1, 2, 4}) cases.push_back(MakeQuality(48, 6, 64, 32, 256, octaves));
+  for (int view : {24, 32, 48})
+    for (int light : {6, 12}) cases.push_back(MakeQuality(view, light, 48, 24, 128));
+  for (auto [view, light] : {std::pair{64, 24}, {96, 24}, {128, 24}, {192, 24}, {128, 32}, {192, 32}})
+    cases.push_back(MakeQuality(view, light, 128, 64, 512));
+  // One volume or the octaves changed from 48/12 at the production volumes.
+  for (int shape : {32, 128}) cases.push_back(MakeQuality(48, 12, shape, 32, 256));
+  cases.push_back(MakeQuality(48, 12, 64, 16, 256));
+  cases.push_back(MakeQuality(48, 12, 64, 32, 128));
+  for (int octaves : {2, 4}) cases.push_back(MakeQuality(48, 12, 64, 32, 256, octaves));
   return cases;
 }
 
@@ -244,8 +251,8 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
   const Scene scene = StudyScene();
   Renderers renderers(vulkan, scene);
   CloudStudyResult result;
-  const int height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 192);
-  const int timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 3);
+  const int height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 128);
+  const int timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 2);
   result.latlong_height = height;
   // A high sun and a low one (long light paths through the layer, long view
   // paths through the air), the Sun's azimuth of the style.

@@ -22,8 +22,8 @@ namespace skybake {
 struct CloudStudyOptions {
   std::string out_dir = "docs";  // cloud_study.csv, cloud_study_results.md, cloud_study.png
   bool quick = false;            // a few cases on a small latlong (the ctest smoke run)
-  int latlong_height = 0;        // rows of the study's latlong; 0: 192 (quick: 24)
-  int timing_runs = 0;           // renders timed per case, the median kept; 0: 3 (quick: 1)
+  int latlong_height = 0;        // rows of the study's latlong; 0: 128 (quick: 24)
+  int timing_runs = 0;           // renders timed per case, the median kept; 0: 2 (quick: 1)
   std::string only;              // when set, only the cases whose name contains it
   std::function<void(const std::string&)> progress;
 };
