@@ -1,0 +1,435 @@
+#include "skybake/tools/cloud_study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <tuple>
+#include <utility>
+
+#include <fmt/format.h>
+#include <glm/glm.hpp>
+
+#include "skybake/gpu/sky_renderer.h"
+#include "skybake/input/config.h"
+#include "skybake/model/aoas.h"
+#include "skybake/model/view.h"
+#include "skybake/output/exr_io.h"
+
+namespace skybake {
+namespace {
+
+// W3's layer (configs/benchmark/w3.toml), the default atmosphere, production
+// sky quality: the sky behind the clouds is the same in every case, so every
+// difference is the clouds'.
+constexpr char kStudyStyle[] = R"([[cloud_layer]]
+altitude_m = 1500.0
+thickness_m = 1500.0
+type = "cumulus"
+coverage = 0.45
+density_per_m = 0.05
+wind_m_s = [8.0, 2.0]
+)";
+
+struct Scene {
+  SkyStyle style;
+  AtmosphereParams atmosphere;
+  EffectSettings effects;
+  Rgb scale{};
+};
+
+Scene StudyScene() {
+  ConfigResult loaded = ParseSkyStyle(kStudyStyle, "cloud study (the layer of configs/benchmark/w3.toml)");
+  if (!loaded.ok()) throw std::runtime_error("cloud study style: " + loaded.errors.front().Format());
+  Scene s;
+  s.style = loaded.style;
+  s.atmosphere = StyledAtmosphere(s.style.atmosphere, s.style.aoas);
+  s.effects = s.style.effects;
+  // No disc: its texels would dominate every mean and are not the clouds'.
+  s.effects.sun_disc = false;
+  s.scale = OutputScale(s.style.output.units);
+  return s;
+}
+
+CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather, int octaves = 8,
+                         double panorama_scale = 0.0) {
+  CloudQuality q;
+  q.view_steps = view;
+  q.light_steps = light;
+  q.shape_resolution = shape;
+  q.detail_resolution = detail;
+  q.weather_resolution = weather;
+  q.octaves = octaves;
+  q.panorama_scale = panorama_scale;
+  return q;
+}
+
+std::string CaseName(const CloudQuality& q) {
+  std::string name = fmt::format("{}/{} vol {}/{}/{}", q.view_steps, q.light_steps, q.shape_resolution,
+                                 q.detail_resolution, q.weather_resolution);
+  if (q.octaves != 8) name += fmt::format(" oct {}", q.octaves);
+  return name;
+}
+
+using Images = std::vector<std::vector<float>>;
+
+// One renderer per noise-volume size; the step counts, octaves and
+// panorama scale are uniforms (SkyRenderer::UpdateClouds).
+class Renderers {
+ public:
+  Renderers(VulkanContext& vulkan, const Scene& scene) : vulkan_(vulkan), scene_(scene) {}
+
+  SkyRenderer& For(const CloudQuality& q) {
+    CloudSettings clouds = scene_.style.clouds;
+    clouds.quality = q;
+    if (CloudLoopIterationsPerTexel(clouds) > kMaxCloudLoopIterations)
+      throw std::runtime_error(fmt::format("cloud study: {} exceeds lavapipe's loop limit", CaseName(q)));
+    CloudInputs inputs = ToCloudInputs(clouds, scene_.style.aoas.seed, "", 0.0);
+    auto key = std::make_tuple(q.shape_resolution, q.detail_resolution, q.weather_resolution);
+    auto it = renderers_.find(key);
+    if (it != renderers_.end() && it->second->UpdateClouds(inputs)) return *it->second;
+    auto renderer = std::make_unique<SkyRenderer>(vulkan_, scene_.atmosphere, scene_.style.quality, scene_.effects,
+                                                  scene_.scale, false, AoasInputs(), inputs);
+    SkyRenderer& r = *renderer;
+    renderers_[key] = std::move(renderer);
+    return r;
+  }
+
+ private:
+  VulkanContext& vulkan_;
+  const Scene& scene_;
+  std::map<std::tuple<int, int, int>, std::unique_ptr<SkyRenderer>> renderers_;
+};
+
+// The cloud march's GPU time of the last render: the "clouds ..." passes
+// (latlong, faces, panorama, resample); the noise volumes (once per bake)
+// and the per-sun tables are not the settings' per-texel cost.
+double CloudPassMs(const SkyRenderer& renderer) {
+  double ms = 0.0;
+  for (const PassTiming& t : renderer.last_timings())
+    if (t.name.rfind("clouds ", 0) == 0) ms += t.gpu_ms;
+  return ms;
+}
+
+double Median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  if (v.empty()) return 0.0;
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// Texels that look above the horizon (the lower half sees the ground and,
+// from the ground, no cloud): where every error is measured.
+std::vector<std::vector<char>> SkyMasks(const std::vector<ViewRequest>& views) {
+  std::vector<std::vector<char>> masks;
+  for (const ViewRequest& v : views) {
+    std::vector<char> m(size_t(v.width) * v.height);
+    for (int y = 0; y < v.height; ++y)
+      for (int x = 0; x < v.width; ++x) m[size_t(y) * v.width + x] = ViewTexelDirection(v, x, y).y > 0.0;
+    masks.push_back(std::move(m));
+  }
+  return masks;
+}
+
+struct StudyError {
+  double mean = 0.0;  // sum |a - r| / sum r over the sky texels' RGB
+  double rmse = 0.0;  // sqrt(mean (a - r)^2) / mean r
+};
+
+StudyError Compare(const Images& a, const Images& ref, const std::vector<std::vector<char>>& masks) {
+  double sum_abs = 0.0, sum_sq = 0.0, sum_ref = 0.0, count = 0.0;
+  for (size_t v = 0; v < ref.size(); ++v)
+    for (size_t i = 0; i < masks[v].size(); ++i) {
+      if (!masks[v][i]) continue;
+      for (int c = 0; c < 3; ++c) {
+        const double r = ref[v][4 * i + c], d = double(a[v][4 * i + c]) - r;
+        sum_abs += std::abs(d);
+        sum_sq += d * d;
+        sum_ref += r;
+        count += 1.0;
+      }
+    }
+  StudyError e;
+  if (sum_ref <= 0.0 || count == 0.0) return e;
+  e.mean = sum_abs / sum_ref;
+  e.rmse = std::sqrt(sum_sq / count) / (sum_ref / count);
+  return e;
+}
+
+bool AllFinite(const Images& images) {
+  for (const auto& image : images)
+    for (float f : image)
+      if (!std::isfinite(f)) return false;
+  return true;
+}
+
+struct Renders {
+  std::vector<Images> per_sun;  // one per sun elevation
+  double ms_per_mp = 0.0;
+};
+
+Renders RenderCase(Renderers& renderers, const CloudQuality& q, const std::vector<glm::dvec3>& suns,
+                   const std::vector<ViewRequest>& views, int timing_runs) {
+  SkyRenderer& renderer = renderers.For(q);
+  double texels = 0.0;
+  for (const ViewRequest& v : views) texels += double(v.width) * v.height;
+  Renders r;
+  std::vector<double> ms;
+  for (size_t s = 0; s < suns.size(); ++s) {
+    r.per_sun.push_back(renderer.Render(suns[s], views, false));
+    if (!AllFinite(r.per_sun.back()))
+      throw std::runtime_error(fmt::format("cloud study: {} rendered a value that is not finite", CaseName(q)));
+    if (s == 0) ms.push_back(CloudPassMs(renderer));
+  }
+  // More timed runs at the first sun (its tables are built: only the cloud
+  // passes run again).
+  for (int run = 1; run < timing_runs; ++run) {
+    renderer.Render(suns[0], views, false);
+    ms.push_back(CloudPassMs(renderer));
+  }
+  r.ms_per_mp = Median(ms) / (texels * 1e-6);
+  return r;
+}
+
+// The worst error over the sun elevations.
+StudyError WorstError(const std::vector<Images>& a, const std::vector<Images>& ref,
+                 const std::vector<std::vector<char>>& masks) {
+  StudyError worst;
+  for (size_t s = 0; s < ref.size(); ++s) {
+    StudyError e = Compare(a[s], ref[s], masks);
+    worst.mean = std::max(worst.mean, e.mean);
+    worst.rmse = std::max(worst.rmse, e.rmse);
+  }
+  return worst;
+}
+
+std::vector<CloudQuality> MarchCases(bool quick) {
+  std::vector<CloudQuality> cases;
+  if (quick) {
+    cases.push_back(MakeQuality(8, 2, 32, 16, 64));
+    cases.push_back(MakeQuality(48, 6, 32, 16, 64));
+    return cases;
+  }
+  // The steps at the production volumes (64/32/256): a low Sun's light
+  // crosses the layer over kilometres, so light steps matter as much as
+  // view steps.
+  for (int view : {16, 32, 48, 64, 96})
+    for (int light : {6, 12, 24}) cases.push_back(MakeQuality(view, light, 64, 32, 256));
+  for (int view : {16, 48}) cases.push_back(MakeQuality(view, 3, 64, 32, 256));
+  for (int view : {32, 48, 64}) cases.push_back(MakeQuality(view, 16, 64, 32, 256));
+  // The draft volumes (48/24/128) with the cheaper steps, the reference
+  // volumes (128/64/512) with the dearer ones.
+  for (int view : {24, 32, 48})
+    for (int light : {6, 12}) cases.push_back(MakeQuality(view, light, 48, 24, 128));
+  for (auto [view, light] : {std::pair{64, 24}, {96, 24}, {128, 24}, {192, 24}, {128, 32}, {192, 32}})
+    cases.push_back(MakeQuality(view, light, 128, 64, 512));
+  // One volume or the octaves changed from 48/12 at the production volumes.
+  for (int shape : {32, 128}) cases.push_back(MakeQuality(48, 12, shape, 32, 256));
+  cases.push_back(MakeQuality(48, 12, 64, 16, 256));
+  cases.push_back(MakeQuality(48, 12, 64, 32, 128));
+  for (int octaves : {2, 4}) cases.push_back(MakeQuality(48, 12, 64, 32, 256, octaves));
+  return cases;
+}
+
+std::string Fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
+
+}  // namespace
+
+std::vector<CloudPresetChoice> CloudPresetBounds() {
+  return {{"draft", 0.10, -1}, {"production", 0.05, -1}, {"reference", 0.01, -1}};
+}
+
+CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& options) {
+  auto say = [&](const std::string& text) {
+    if (options.progress) options.progress(text);
+  };
+  std::filesystem::create_directories(options.out_dir);
+  const Scene scene = StudyScene();
+  Renderers renderers(vulkan, scene);
+  CloudStudyResult result;
+  const int height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 128);
+  const int timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 2);
+  result.latlong_height = height;
+  // A high sun and a low one (long light paths through the layer, long view
+  // paths through the air), the Sun's azimuth of the style.
+  result.sun_elevations_deg = options.quick ? std::vector<double>{45.0} : std::vector<double>{45.0, 10.0};
+  std::vector<glm::dvec3> suns;
+  for (double e : result.sun_elevations_deg)
+    suns.push_back(SunDirectionFromElevationAzimuth(e, scene.style.sun.azimuth_deg));
+
+  // 1. The reference and its convergence: each setting halved in turn.
+  result.reference = options.quick ? MakeQuality(128, 24, 32, 16, 64) : MakeQuality(384, 64, 128, 64, 512);
+  const CloudQuality& ref = result.reference;
+  const std::vector<ViewRequest> latlong = {ViewRequest{MAPPING_LATLONG, 2 * height, height, 0}};
+  const auto latlong_masks = SkyMasks(latlong);
+  say(fmt::format("clouds: reference {} on a {} x {} latlong, {} sun elevation(s)", CaseName(ref), 2 * height,
+                  height, suns.size()));
+  const Renders reference = RenderCase(renderers, ref, suns, latlong, 1);
+  auto converge = [&](const std::string& change, const CloudQuality& q) {
+    Renders r = RenderCase(renderers, q, suns, latlong, 1);
+    StudyError e = WorstError(r.per_sun, reference.per_sun, latlong_masks);
+    result.convergence.push_back({change, e.mean, e.rmse});
+    say(fmt::format("clouds: reference with {}: {:.2e} from it", change, e.mean));
+  };
+  {
+    CloudQuality q = ref;
+    q.view_steps /= 2;
+    converge(fmt::format("view steps {} -> {}", ref.view_steps, q.view_steps), q);
+    q = ref;
+    q.light_steps /= 2;
+    converge(fmt::format("light steps {} -> {}", ref.light_steps, q.light_steps), q);
+    if (!options.quick) {
+      q = ref;
+      q.shape_resolution /= 2;
+      q.detail_resolution /= 2;
+      q.weather_resolution /= 2;
+      converge(fmt::format("volumes {}/{}/{} -> {}/{}/{}", ref.shape_resolution, ref.detail_resolution,
+                           ref.weather_resolution, q.shape_resolution, q.detail_resolution, q.weather_resolution),
+               q);
+      q = ref;
+      q.octaves = 16;
+      converge("octaves 8 -> 16", q);
+    }
+  }
+
+  // 2. The march settings on one latlong (marched texel by texel).
+  std::vector<CloudQuality> cases = MarchCases(options.quick);
+  for (const CloudQuality& q : cases) {
+    const std::string name = CaseName(q);
+    if (!options.only.empty() && name.find(options.only) == std::string::npos) continue;
+    Renders r = RenderCase(renderers, q, suns, latlong, timing_runs);
+    StudyError e = WorstError(r.per_sun, reference.per_sun, latlong_masks);
+    result.cases.push_back({name, q, e.mean, e.rmse, r.ms_per_mp, false});
+    say(fmt::format("clouds: {:<28} {:8.0f} ms/MP  mean error {:.2e}  RMSE {:.2e}", name, r.ms_per_mp, e.mean,
+                    e.rmse));
+  }
+  for (CloudStudyCase& c : result.cases) {
+    c.pareto = true;
+    for (const CloudStudyCase& o : result.cases)
+      if (&o != &c && o.ms_per_mp <= c.ms_per_mp && o.mean_error <= c.mean_error &&
+          (o.ms_per_mp < c.ms_per_mp || o.mean_error < c.mean_error))
+        c.pareto = false;
+  }
+  result.presets = CloudPresetBounds();
+  for (CloudPresetChoice& p : result.presets)
+    for (size_t i = 0; i < result.cases.size(); ++i) {
+      const CloudStudyCase& c = result.cases[i];
+      if (c.pareto && c.mean_error <= p.bound &&
+          (p.choice < 0 || c.ms_per_mp < result.cases[size_t(p.choice)].ms_per_mp))
+        p.choice = int(i);
+    }
+
+  // 3. The panorama: a bake's views (the latlong and six faces of half its
+  // height, as W3), the clouds marched once into a panorama of `scale` times
+  // the finest view's height and resampled, against every view marched at
+  // the reference's steps.
+  {
+    std::vector<ViewRequest> views = latlong;
+    for (int face = 0; face < 6; ++face) views.push_back(ViewRequest{MAPPING_VULKAN_FACE, height / 2, height / 2, face});
+    const auto masks = SkyMasks(views);
+    const Renders marched_ref = RenderCase(renderers, ref, suns, views, 1);
+    const CloudQuality production =
+        options.quick ? MakeQuality(48, 6, 32, 16, 64) : CloudQualityPreset("production");
+    for (double scale : options.quick ? std::vector<double>{0.0, 1.0} : std::vector<double>{0.0, 0.5, 0.75, 1.0}) {
+      CloudQuality q = production;
+      q.panorama_scale = scale;
+      Renders r = RenderCase(renderers, q, suns, views, timing_runs);
+      StudyError e = WorstError(r.per_sun, marched_ref.per_sun, masks);
+      std::string name = scale > 0.0 ? fmt::format("panorama {} x the finest view", scale) : "every view marched";
+      result.panorama.push_back({name, q, e.mean, e.rmse, r.ms_per_mp, false});
+      say(fmt::format("clouds: {:<28} {:8.0f} ms/MP  mean error {:.2e}", name, r.ms_per_mp, e.mean));
+    }
+  }
+
+  // 4. Files.
+  {
+    std::ostringstream csv;
+    csv << "case,view_steps,light_steps,octaves,shape_resolution,detail_resolution,weather_resolution,"
+           "panorama_scale,ms_per_megapixel,mean_relative_error,relative_rmse,pareto\n";
+    for (const auto* list : {&result.cases, &result.panorama})
+      for (const CloudStudyCase& c : *list)
+        csv << fmt::format("{},{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{}\n", c.name, c.quality.view_steps,
+                           c.quality.light_steps, c.quality.octaves, c.quality.shape_resolution,
+                           c.quality.detail_resolution, c.quality.weather_resolution, c.quality.panorama_scale,
+                           c.ms_per_mp, c.mean_error, c.rmse, c.pareto ? 1 : 0);
+    WriteFileAtomically(options.out_dir + "/cloud_study.csv", csv.str());
+  }
+  std::string plot_status = "not written (no case)";
+  if (!result.cases.empty()) {
+    std::ostringstream data, front;
+    for (const CloudStudyCase& c : result.cases)
+      data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", std::max(c.ms_per_mp, 1e-3), std::max(c.mean_error, 1e-7),
+                          c.pareto ? 1 : 0, c.name);
+    std::vector<const CloudStudyCase*> sorted;
+    for (const CloudStudyCase& c : result.cases)
+      if (c.pareto) sorted.push_back(&c);
+    std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->ms_per_mp < b->ms_per_mp; });
+    for (const CloudStudyCase* c : sorted)
+      front << fmt::format("{:.6g} {:.6g}\n", std::max(c->ms_per_mp, 1e-3), std::max(c->mean_error, 1e-7));
+    std::ostringstream plot;
+    plot << "set terminal pngcairo size 1100,750 noenhanced\n"
+         << "set output '" << options.out_dir << "/cloud_study.png'\n"
+         << "set logscale xy\nset grid\n"
+         << "set xlabel 'cloud passes, lavapipe time per megapixel (ms, 2 cores)'\n"
+         << "set ylabel 'mean relative error, sky half, worst sun elevation'\n"
+         << "set title 'skybake clouds: what accuracy costs (W3 layer vs converged reference)'\n"
+         << "set key top right\n"
+         << "plot '" << options.out_dir << "/cloud_study_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
+         << "     '" << options.out_dir << "/cloud_study_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
+         << "     '" << options.out_dir << "/cloud_study_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
+    WriteFileAtomically(options.out_dir + "/cloud_study_plot.dat", data.str());
+    WriteFileAtomically(options.out_dir + "/cloud_study_front.dat", front.str());
+    WriteFileAtomically(options.out_dir + "/cloud_study.gnuplot", plot.str());
+    plot_status = "written";
+    if (std::system(fmt::format("gnuplot '{}/cloud_study.gnuplot' 2>/dev/null", options.out_dir).c_str()) != 0)
+      plot_status = "not written (gnuplot missing: apt-get install gnuplot-nox)";
+  }
+
+  std::string elevations;
+  for (double e : result.sun_elevations_deg) elevations += (elevations.empty() ? "" : ", ") + fmt::format("{}", e);
+  std::string md;
+  md += fmt::format(
+      "## Clouds: W3's layer on a {} x {} latlong, sun elevations {} deg (worst of them), texels above the horizon\n\n",
+      2 * height, height, elevations);
+  md += fmt::format(
+      "Reference: {} view / {} light steps, volumes {}/{}/{} (shape/detail/weather), {} octaves. Its "
+      "convergence, each setting halved (the mean relative difference from the reference):\n\n",
+      ref.view_steps, ref.light_steps, ref.shape_resolution, ref.detail_resolution, ref.weather_resolution,
+      ref.octaves);
+  md += "| change | mean relative difference | relative RMSE |\n| --- | ---: | ---: |\n";
+  for (const CloudConvergence& c : result.convergence)
+    md += fmt::format("| {} | {:.2e} | {:.2e} |\n", c.change, c.mean_error, c.rmse);
+  md += "\n| case (view/light steps, volumes shape/detail/weather) | ms per megapixel | mean relative error | "
+        "relative RMSE | Pareto |\n| --- | ---: | ---: | ---: | :---: |\n";
+  for (const CloudStudyCase& c : result.cases)
+    md += fmt::format("| {} | {} | {:.2e} | {:.2e} | {} |\n", c.name, Fixed(c.ms_per_mp, 0), c.mean_error, c.rmse,
+                      c.pareto ? "yes" : "");
+  md += "\n### Cloud presets chosen from the front\n\n| preset | bound (mean relative error) | case | mean relative error | "
+        "ms per megapixel |\n| --- | --- | --- | ---: | ---: |\n";
+  for (const CloudPresetChoice& p : result.presets) {
+    if (p.choice >= 0) {
+      const CloudStudyCase& c = result.cases[size_t(p.choice)];
+      md += fmt::format("| `{}` | <= {:g}% | {} | {:.2e} | {} |\n", p.preset, p.bound * 100, c.name, c.mean_error,
+                        Fixed(c.ms_per_mp, 0));
+    } else {
+      md += fmt::format("| `{}` | <= {:g}% | none of the cases meets it | | |\n", p.preset, p.bound * 100);
+    }
+  }
+  md += fmt::format(
+      "\n### The panorama (production steps; the latlong and six {}^2 faces; against every view marched at the "
+      "reference's steps; time per megapixel of all the views)\n\n| case | ms per megapixel | mean relative error | "
+      "relative RMSE |\n| --- | ---: | ---: | ---: |\n",
+      height / 2);
+  for (const CloudStudyCase& c : result.panorama)
+    md += fmt::format("| {} | {} | {:.2e} | {:.2e} |\n", c.name, Fixed(c.ms_per_mp, 0), c.mean_error, c.rmse);
+  md += fmt::format("\nPlot {}: {}/cloud_study.png\n", plot_status, options.out_dir);
+  WriteFileAtomically(options.out_dir + "/cloud_study_results.md", md);
+  result.markdown = md;
+  return result;
+}
+
+}  // namespace skybake
