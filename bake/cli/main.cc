@@ -116,112 +116,123 @@ struct BakeArgs {
 
 enum class Mode { kBake, kCheck, kPlan };
 
-int RunBake(const BakeArgs& args, Mode mode) {
-  const bool check_only = mode == Mode::kCheck;
-  // Parse and validate: every error at once, before any GPU work.
-  std::optional<FrameRange> frames;
-  std::optional<ShardSpec> shard;
-  if (!args.frames.empty()) frames = ParseFrameRange(args.frames);
-  if (!args.shard.empty()) shard = ParseShard(args.shard);
+// The style and overrides of --size, --engine and --set, in the order given.
+std::vector<std::string> StyleOverrides(const BakeArgs& args) {
   std::vector<std::string> overrides = args.overrides;
   if (args.size > 0) {
     overrides.push_back(fmt::format("render.cube_size={}", args.size));
     overrides.push_back(fmt::format("render.latlong_height={}", args.size));
   }
   if (!args.engine.empty()) overrides.push_back("output.engine=" + args.engine);
-  ConfigResult config = LoadSkyStyle(args.style_path, overrides);
-  if (!config.ok()) {
-    PrintErrors(config.errors);
-    return kExitConfig;
-  }
-  for (const ConfigError& w : config.warnings) std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
-  // A schedule (its own file, or inline in the style) makes a sequence: every
-  // frame's style is resolved and checked before any GPU work.
-  std::string schedule_path = args.schedule_path;
-  if (schedule_path.empty() && FileHasSchedule(args.style_path)) schedule_path = args.style_path;
+  return overrides;
+}
+
+// What a bake reads: the style and, with a schedule (its own file, or
+// inline in the style), every frame's resolved style.
+struct LoadedBake {
+  ConfigResult config;
+  std::string schedule_path;
   std::optional<Schedule> schedule;
   std::vector<SkyStyle> frame_styles;
-  if (!schedule_path.empty()) {
-    ScheduleResult loaded = LoadSchedule(schedule_path);
-    if (!loaded.ok()) {
-      PrintErrors(loaded.errors);
-      return kExitConfig;
-    }
-    FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
-    for (const ConfigError& w : styles.warnings)
-      std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
-    if (!styles.ok()) {
-      PrintErrors(styles.errors);
-      return kExitConfig;
-    }
-    schedule = std::move(loaded.schedule);
-    frame_styles = std::move(styles.styles);
+
+  // The styles baked: every frame's, or the one style.
+  std::vector<SkyStyle> Styles() const { return schedule ? frame_styles : std::vector<SkyStyle>{config.style}; }
+};
+
+// Reads and checks the style, the schedule and every frame's style, printing
+// every error at once; false when there were errors (nothing may be baked).
+bool LoadBake(const BakeArgs& args, LoadedBake& bake) {
+  const std::vector<std::string> overrides = StyleOverrides(args);
+  bake.config = LoadSkyStyle(args.style_path, overrides);
+  if (!bake.config.ok()) {
+    PrintErrors(bake.config.errors);
+    return false;
   }
-  // The night sky: its catalogue readable, its frames clock times at a place (night_sky.h).
-  {
-    std::vector<const SkyStyle*> styles;
-    if (schedule)
-      for (const SkyStyle& style : frame_styles) styles.push_back(&style);
-    else
-      styles.push_back(&config.style);
-    const std::vector<ConfigError> night_errors = CheckNightSky(styles, schedule ? &*schedule : nullptr, args.star_catalogue);
-    if (!night_errors.empty()) {
-      PrintErrors(night_errors);
-      return kExitConfig;
-    }
+  for (const ConfigError& w : bake.config.warnings)
+    std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
+  // A schedule makes a sequence: every frame's style is resolved and checked
+  // before any GPU work.
+  bake.schedule_path = args.schedule_path;
+  if (bake.schedule_path.empty() && FileHasSchedule(args.style_path)) bake.schedule_path = args.style_path;
+  if (bake.schedule_path.empty()) return true;
+  ScheduleResult loaded = LoadSchedule(bake.schedule_path);
+  if (!loaded.ok()) {
+    PrintErrors(loaded.errors);
+    return false;
   }
-  // Budget: every frame's memory and time estimate, before any GPU work.
-  BakeOptions options;
-  options.max_memory_mib = args.max_memory_mib;
-  options.max_frame_seconds = args.max_frame_seconds;
+  FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
+  for (const ConfigError& w : styles.warnings)
+    std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
+  if (!styles.ok()) {
+    PrintErrors(styles.errors);
+    return false;
+  }
+  bake.schedule = std::move(loaded.schedule);
+  bake.frame_styles = std::move(styles.styles);
+  return true;
+}
+
+// The night sky: its catalogue readable, its frames clock times at a place
+// (night_sky.h); false when not (the errors printed).
+bool CheckNight(const BakeArgs& args, const LoadedBake& bake) {
+  std::vector<const SkyStyle*> styles;
+  if (bake.schedule)
+    for (const SkyStyle& style : bake.frame_styles) styles.push_back(&style);
+  else
+    styles.push_back(&bake.config.style);
+  const std::vector<ConfigError> night_errors =
+      CheckNightSky(styles, bake.schedule ? &*bake.schedule : nullptr, args.star_catalogue);
+  if (night_errors.empty()) return true;
+  PrintErrors(night_errors);
+  return false;
+}
+
+// Every frame's memory and time estimate against the budget (a BudgetError
+// when over), before any GPU work; returns the largest of each.
+ResourceEstimate CheckFrameBudgets(const LoadedBake& bake, const BakeOptions& options) {
   ResourceEstimate largest;
-  for (const SkyStyle& style : schedule ? frame_styles : std::vector<SkyStyle>{config.style}) {
+  for (const SkyStyle& style : bake.Styles()) {
     CheckBudget(style, options);
     ResourceEstimate e = EstimateResources(style);
     if (e.memory_mib > largest.memory_mib) largest.memory_mib = e.memory_mib;
     if (e.seconds > largest.seconds) largest.seconds = e.seconds;
   }
-  // Shard: the part of the sequence this run bakes (README "Scale-out").
-  std::optional<FrameRange> part;
-  if (frames || shard) {
-    if (!schedule)
-      throw UsageError("--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
-                       "[schedule])");
-    part = SelectFrames(*schedule, frames, shard);
-  }
-  if (args.resume && !schedule) {
-    std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
-                         "an inline [schedule]), or use --force to bake a single style again\n");
-    return kExitUsage;
-  }
-  if (mode == Mode::kPlan || args.dry_run) {
-    // The passes, LUTs and shader variant the bake would run, and why.
-    // The part that --frames / --shard select, when given.
-    const RenderPlan bake_plan =
-        schedule ? PlanSequenceBake(frame_styles, *schedule, part) : PlanSingleBake(config.style);
-    std::vector<double> planned_hours;  // the cloud formation's steps follow the clock
-    for (const FramePlan& f : bake_plan.frames)
-      if (bake_plan.Bakes(f)) planned_hours.push_back(f.hours_from_start);
-    PassPlan plan = PlanPasses(bake_plan.BakedStyles(), args.shaders, planned_hours);
-    std::string what = args.style_path + (schedule ? " with " + schedule_path : "");
-    if (part)
-      what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
-                          schedule->frames.back().number);
-    std::printf("%s", FormatPlan(plan, what).c_str());
-    return kExitOk;
-  }
-  if (check_only) {
-    std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
-                largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
-    if (schedule)
-      std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), schedule_path.c_str(),
-                  schedule->frames.size());
-    else
-      std::printf("%s: ok\n", args.style_path.c_str());
-    return kExitOk;
-  }
+  return largest;
+}
 
-  // Bake: device, pipelines, LUTs, render, files, preview.
+// `skybake plan` (or --dry-run): the passes, LUTs and shader variant the
+// bake would run, and why; of the part that --frames / --shard select, when
+// given.
+int PrintPlan(const BakeArgs& args, const LoadedBake& bake, const std::optional<FrameRange>& part) {
+  const std::optional<Schedule>& schedule = bake.schedule;
+  const RenderPlan bake_plan =
+      schedule ? PlanSequenceBake(bake.frame_styles, *schedule, part) : PlanSingleBake(bake.config.style);
+  std::vector<double> planned_hours;  // the cloud formation's steps follow the clock
+  for (const FramePlan& f : bake_plan.frames)
+    if (bake_plan.Bakes(f)) planned_hours.push_back(f.hours_from_start);
+  PassPlan plan = PlanPasses(bake_plan.BakedStyles(), args.shaders, planned_hours);
+  std::string what = args.style_path + (schedule ? " with " + bake.schedule_path : "");
+  if (part)
+    what += fmt::format(" (frames {} to {} of {} to {})", part->first, part->last, schedule->frames.front().number,
+                        schedule->frames.back().number);
+  std::printf("%s", FormatPlan(plan, what).c_str());
+  return kExitOk;
+}
+
+// `skybake check`: the largest estimate per frame, and that the style is ok.
+int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstimate& largest) {
+  std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
+              largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
+  if (bake.schedule)
+    std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), bake.schedule_path.c_str(),
+                bake.schedule->frames.size());
+  else
+    std::printf("%s: ok\n", args.style_path.c_str());
+  return kExitOk;
+}
+
+// The bake's options from the command line (and the environment main read).
+void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, BakeOptions& options) {
   options.out_dir = args.out_dir;
   options.force = args.force;
   options.resume = args.resume;
@@ -236,9 +247,10 @@ int RunBake(const BakeArgs& args, Mode mode) {
       std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
     };
   }
-  BakeResult result = schedule ? BakeSequence(frame_styles, *schedule, options) : BakeStyle(config.style, options);
+}
 
-  // Report: the files, then anything the validation layer said.
+// The files, then anything the validation layer said.
+int ReportBake(const BakeResult& result) {
   for (const BakedFile& f : result.files)
     std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
   if (result.half_scale != 1.0)
@@ -252,6 +264,42 @@ int RunBake(const BakeArgs& args, Mode mode) {
     return kExitVulkan;
   }
   return kExitOk;
+}
+
+int RunBake(const BakeArgs& args, Mode mode) {
+  // Parse and validate: every error at once, before any GPU work.
+  std::optional<FrameRange> frames;
+  std::optional<ShardSpec> shard;
+  if (!args.frames.empty()) frames = ParseFrameRange(args.frames);
+  if (!args.shard.empty()) shard = ParseShard(args.shard);
+  LoadedBake bake;
+  if (!LoadBake(args, bake) || !CheckNight(args, bake)) return kExitConfig;
+  // Budget: every frame's memory and time estimate, before any GPU work.
+  BakeOptions options;
+  options.max_memory_mib = args.max_memory_mib;
+  options.max_frame_seconds = args.max_frame_seconds;
+  const ResourceEstimate largest = CheckFrameBudgets(bake, options);
+  // Shard: the part of the sequence this run bakes (README "Scale-out").
+  std::optional<FrameRange> part;
+  if (frames || shard) {
+    if (!bake.schedule)
+      throw UsageError("--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
+                       "[schedule])");
+    part = SelectFrames(*bake.schedule, frames, shard);
+  }
+  if (args.resume && !bake.schedule) {
+    std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
+                         "an inline [schedule]), or use --force to bake a single style again\n");
+    return kExitUsage;
+  }
+  if (mode == Mode::kPlan || args.dry_run) return PrintPlan(args, bake, part);
+  if (mode == Mode::kCheck) return PrintCheck(args, bake, largest);
+
+  // Bake: device, pipelines, LUTs, render, files, preview; then report.
+  SetBakeOptions(args, part, options);
+  const BakeResult result = bake.schedule ? BakeSequence(bake.frame_styles, *bake.schedule, options)
+                                          : BakeStyle(bake.config.style, options);
+  return ReportBake(result);
 }
 
 int RunMergeManifest(const MergeOptions& options) {

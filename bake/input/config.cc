@@ -76,9 +76,9 @@ bool IsSafeFileName(const std::string& name) { return IsPlainFileName(name); }
 
 // --------------------------------------------------------------- the schema
 
-// Calls the visitor once per key of a style, in file order.
+// The atmosphere (atmosphere.h): the planet, Rayleigh, Mie and ozone.
 template <class Visitor>
-void VisitStyle(SkyStyle& s, Visitor& v) {
+void VisitAtmosphere(SkyStyle& s, Visitor& v) {
   AtmosphereParams& a = s.atmosphere;
   v.Real("atmosphere.bottom_radius_km", a.bottom_radius_km, kPositive);
   v.Real("atmosphere.top_radius_km", a.top_radius_km, kPositive);
@@ -93,13 +93,22 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Triple("atmosphere.ozone.absorption_per_km", a.ozone_absorption_per_km, kNonNegative);
   v.Real("atmosphere.ozone.peak_altitude_km", a.ozone_peak_altitude_km, kNonNegative);
   v.Real("atmosphere.ozone.half_width_km", a.ozone_half_width_km, kPositive);
+}
 
+// The Sun: where it is, its disc and irradiance.
+template <class Visitor>
+void VisitSun(SkyStyle& s, Visitor& v) {
+  AtmosphereParams& a = s.atmosphere;
   v.Real("sun.elevation_deg", s.sun.elevation_deg, kElevation);
   v.Real("sun.azimuth_deg", s.sun.azimuth_deg, kAnyFinite);
   v.Real("sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadius);
   v.Triple("sun.irradiance", a.solar_irradiance, kNonNegative);
   v.Real("sun.limb_darkening_u", a.limb_darkening_u, kUnit);
+}
 
+// Which effects the sky has.
+template <class Visitor>
+void VisitEffects(SkyStyle& s, Visitor& v) {
   v.Bool("effects.multiple_scattering", s.effects.multiple_scattering);
   v.Bool("effects.sun_disc", s.effects.sun_disc);
   v.Bool("effects.ground", s.effects.ground);
@@ -110,7 +119,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("effects.night_dimming", s.effects.night_dimming);
   v.Real("effects.night_dimming_strength", s.effects.night_dimming_strength, kUnit);
   v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
+}
 
+// The sampling: the preset, then the keys that refine it (sky and clouds).
+template <class Visitor>
+void VisitQuality(SkyStyle& s, Visitor& v) {
   QualitySettings& q = s.quality;
   v.Preset("quality.preset", s.quality_preset, q, s.clouds.quality);  // first: the keys below refine it
   v.Choice("quality.integrator", q.integrator,
@@ -143,7 +156,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
     v.Real("quality.cloud_max_distance_km", cq.max_distance_km, kCloudDistance);
     v.Real("quality.cloud_panorama_scale", cq.panorama_scale, kCloudPanoramaScale);
   }
+}
 
+// The sizes, the files written and the preview's exposure.
+template <class Visitor>
+void VisitOutputs(SkyStyle& s, Visitor& v) {
   v.Int("render.cube_size", s.render.cube_size, 1, kMaxCubeSize);
   v.Int("render.latlong_height", s.render.latlong_height, 1, kMaxLatlongHeight);
 
@@ -171,8 +188,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
 
   v.Bool("preview.auto_exposure", s.preview.auto_exposure);
   v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
+}
 
-  // AOAS (Shen, Mallett, Shkurko 2019): the aesthetic principles.
+// AOAS (Shen, Mallett, Shkurko 2019): the aesthetic principles.
+template <class Visitor>
+void VisitAoas(SkyStyle& s, Visitor& v) {
   AoasSettings& x = s.aoas;
   v.Uint("aoas.seed", x.seed);
   v.Bool("skydome.enabled", x.skydome.enabled);
@@ -194,8 +214,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Bool("shapes.enabled", x.shapes.enabled);
   v.Real("shapes.strength", x.shapes.strength, kUnit);
   v.Shapes("shapes.shape", x.shapes.shapes);
+}
 
-  // Volumetric cloud layers (clouds.h, docs/clouds.md).
+// Volumetric cloud layers (clouds.h, docs/clouds.md) and their shadow map.
+template <class Visitor>
+void VisitClouds(SkyStyle& s, Visitor& v) {
   v.CloudLayers("cloud_layer", s.clouds.layers);
   // The cloud shadow map (cloud_shadow.h): written into the resolved style
   // only when on, so a style without it resolves as before it existed.
@@ -215,7 +238,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
     v.Int("cloud_shadow.steps", cs.steps, 1, 256);
     v.Bool("cloud_shadow.ground", cs.ground);
   }
+}
 
+// The glTF scene (gltf_scene.h).
+template <class Visitor>
+void VisitGltf(SkyStyle& s, Visitor& v) {
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
   v.Choice("gltf.dome", g.dome, {{"sphere", DomeShape::kSphere}, {"hemisphere", DomeShape::kHemisphere}});
@@ -223,7 +250,11 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Real("gltf.flattening", g.flattening, kFlattening);
   v.Int("gltf.segments", g.segments, 8, 1024);
   v.Bool("gltf.image_based_light", g.image_based_light);
+}
 
+// The prefiltered image-based light (ibl.h).
+template <class Visitor>
+void VisitIbl(SkyStyle& s, Visitor& v) {
   IblSettings& i = s.ibl;
   v.Bool("ibl.specular", i.specular);
   v.Bool("ibl.irradiance", i.irradiance);
@@ -243,10 +274,13 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   v.Choice("ibl.ktx2_format", i.ktx2_format,
            {{"rgba16f", KtxFormat::kRgba16f}, {"b10g11r11", KtxFormat::kB10g11r11}, {"e5b9g9r9", KtxFormat::kE5b9g9r9}});
   v.Int("ibl.ktx2_zstd_level", i.ktx2_zstd_level, 0, 19);
+}
 
-  // The night sky (night_sky.h): read always; written into the resolved
-  // style only when a part of it is on, so a style without it resolves
-  // (and its EXR headers record it) as before the night sky existed.
+// The night sky (night_sky.h): read always; written into the resolved
+// style only when a part of it is on, so a style without it resolves (and
+// its EXR headers record it) as before the night sky existed.
+template <class Visitor>
+void VisitNight(SkyStyle& s, Visitor& v) {
   NightSettings& n = s.night;
   if (v.kReads || n.Any()) {
     v.Bool("night.stars", n.stars);
@@ -258,6 +292,22 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
     v.Bool("night.airglow", n.airglow);
     v.Real("night.airglow_height_km", n.airglow_height_km, Range{0.0, 500.0, true, false});
   }
+}
+
+// Calls the visitor once per key of a style, in file order: one section
+// after another.
+template <class Visitor>
+void VisitStyle(SkyStyle& s, Visitor& v) {
+  VisitAtmosphere(s, v);
+  VisitSun(s, v);
+  VisitEffects(s, v);
+  VisitQuality(s, v);
+  VisitOutputs(s, v);
+  VisitAoas(s, v);
+  VisitClouds(s, v);
+  VisitGltf(s, v);
+  VisitIbl(s, v);
+  VisitNight(s, v);
 }
 
 // --------------------------------------------------------------- reading
