@@ -117,6 +117,155 @@ CubeTexel VulkanCubeTexelFromDirection(const glm::dvec3& d, int face_size) {
 
 // --------------------------------------------------------------- the device pass
 
+namespace {
+
+// One dispatch of the filter: a specular level, the irradiance cube or the
+// DFG table, written from output texel `first_texel` on.
+struct Pass {
+  int mode, size, level;
+  VkDeviceSize first_texel;
+  VkDeviceSize table_first = 0;  // IBL_MODE_SPECULAR: the first entry of the level's sample table
+};
+
+// The passes a request asks for, in the order they are recorded, and the
+// output buffer's size in texels (vec4).
+struct IblPassList {
+  std::vector<Pass> passes;
+  VkDeviceSize texels = 0;
+};
+
+// Output texels: specular levels 1.. (level 0 is the source itself), the
+// irradiance cube, the DFG table; then each specular level's GGX sample
+// table (GgxSampleEntry, one vec4 a sample), in the same buffer.
+IblPassList PlanPasses(const IblSettings& s, bool dfg, int levels, const std::vector<double>& roughness) {
+  IblPassList list;
+  VkDeviceSize& texels = list.texels;
+  if (s.specular)
+    for (int level = 1; level < levels; ++level) {
+      const int size = std::max(1, s.size >> level);
+      list.passes.push_back({IBL_MODE_SPECULAR, size, level, texels});
+      texels += VkDeviceSize(size) * size * 6;
+    }
+  if (s.irradiance) {
+    list.passes.push_back({IBL_MODE_IRRADIANCE, s.irradiance_size, 0, texels});
+    texels += VkDeviceSize(s.irradiance_size) * s.irradiance_size * 6;
+  }
+  if (dfg) {
+    list.passes.push_back({IBL_MODE_DFG, s.dfg_size, 0, texels});
+    texels += VkDeviceSize(s.dfg_size) * s.dfg_size;
+  }
+  for (Pass& p : list.passes)
+    if (p.mode == IBL_MODE_SPECULAR) {
+      p.table_first = texels;
+      texels += VkDeviceSize(IblLevelSamples(s, roughness[p.level]));
+    }
+  return list;
+}
+
+// Source mip chain down to 1 x 1, box-filtered: what the filtered lookups read.
+std::vector<CubeLevel> SourceMipChain(const CubeLevel& source) {
+  std::vector<CubeLevel> chain{source};
+  while (chain.back().size > 1) chain.push_back(DownsampleCube(chain.back()));
+  return chain;
+}
+
+void CreateHostBuffer(VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage, VkBuffer& buffer,
+                      VkDeviceMemory& memory, void*& mapped) {
+  VkDevice device = context.device();
+  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  info.size = size;
+  info.usage = usage;
+  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device, buffer, &req);
+  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  alloc.allocationSize = req.size;
+  alloc.memoryTypeIndex = context.FindMemoryType(
+      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+      VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
+  VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
+  VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
+  VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped));
+}
+
+// A barrier on the whole of `buffer`: `src` writes made visible to `dst` reads.
+void BufferBarrier(VkCommandBuffer cmd, VkBuffer buffer, VkAccessFlags src_access, VkPipelineStageFlags src_stage,
+                   VkAccessFlags dst_access, VkPipelineStageFlags dst_stage) {
+  VkBufferMemoryBarrier barrier{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
+  barrier.srcAccessMask = src_access;
+  barrier.dstAccessMask = dst_access;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.buffer = buffer;
+  barrier.size = VK_WHOLE_SIZE;
+  vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, 1, &barrier, 0, nullptr);
+}
+
+// A layout transition of every mip and face of `image`, ordering `src` before `dst`.
+void ImageBarrier(VkCommandBuffer cmd, VkImage image, uint32_t mip_levels, VkImageLayout old_layout,
+                  VkImageLayout new_layout, VkAccessFlags src_access, VkPipelineStageFlags src_stage,
+                  VkAccessFlags dst_access, VkPipelineStageFlags dst_stage) {
+  VkImageMemoryBarrier barrier{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+  barrier.srcAccessMask = src_access;
+  barrier.dstAccessMask = dst_access;
+  barrier.oldLayout = old_layout;
+  barrier.newLayout = new_layout;
+  barrier.srcQueueFamilyIndex = barrier.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+  barrier.image = image;
+  barrier.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, mip_levels, 0, 6};
+  vkCmdPipelineBarrier(cmd, src_stage, dst_stage, 0, 0, nullptr, 0, nullptr, 1, &barrier);
+}
+
+// One push-constant block and one dispatch of groups_x x groups_y x groups_z workgroups.
+void PushAndDispatch(VkCommandBuffer cmd, VkPipelineLayout layout, const gpu::IblPush& push, uint32_t groups_x,
+                     uint32_t groups_y, uint32_t groups_z) {
+  vkCmdPushConstants(cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+  vkCmdDispatch(cmd, groups_x, groups_y, groups_z);
+}
+
+uint32_t Groups(int invocations, int local_size) { return uint32_t((invocations + local_size - 1) / local_size); }
+
+gpu::vec4 Vec4(const glm::dvec3& v, float w) { return {float(v.x), float(v.y), float(v.z), w}; }
+gpu::vec4 Vec4(const Rgb& v, float w) { return {float(v[0]), float(v[1]), float(v[2]), w}; }
+
+// Roughness 0 with ibl.include_sun: a point source's energy into the texel
+// that holds its centre (a disc a fraction of a texel wide), E / the
+// texel's solid angle.
+void AddPointSource(CubeLevel& level, const glm::dvec3& direction, const Rgb& irradiance) {
+  const CubeTexel t = VulkanCubeTexelFromDirection(direction, level.size);
+  const double solid_angle = CubeTexelSolidAngle(t.x, t.y, level.size);
+  float* texel = &level.faces[t.face][(size_t(t.y) * level.size + t.x) * 4];
+  for (int c = 0; c < 3; ++c) texel[c] += float(irradiance[c] / solid_angle);
+}
+
+// The push constants of pass `p` of a bake of `request` from a source cube
+// of `source_size` texels and `source_levels` mips.
+gpu::IblPush PushFor(const IblRequest& request, const Pass& p, double roughness, int source_size,
+                     uint32_t source_levels) {
+  const IblSettings& s = request.settings;
+  const double alpha = roughness * roughness;
+  const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
+                      : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
+                                                      : s.dfg_samples;
+  gpu::IblPush push{};
+  push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
+  push.source = {source_size, int32_t(source_levels), int32_t(p.table_first), 0};
+  push.lobe = {float(alpha), float(s.lod_bias),
+               p.mode == IBL_MODE_SPECULAR ? float(IblSunKernelNormalization(alpha)) : 0.0f,
+               s.include_sun ? 1.0f : 0.0f};
+  push.sun_direction = Vec4(request.sun_direction, 0.0f);
+  push.sun_irradiance = Vec4(request.sun_irradiance, 0.0f);
+  push.moon_direction = Vec4(request.moon_direction, 0.0f);
+  push.moon_irradiance = Vec4(request.moon_irradiance, request.moon ? 1.0f : 0.0f);
+  return push;
+}
+
+const char* TimingName(int mode) {
+  return mode == IBL_MODE_SPECULAR ? "IBL specular" : mode == IBL_MODE_IRRADIANCE ? "IBL irradiance" : "IBL DFG";
+}
+
+}  // namespace
+
 IblBaker::IblBaker(VulkanContext& context) : context_(context) {
   VkDevice device = context_.device();
   try {
@@ -137,21 +286,7 @@ IblBaker::IblBaker(VulkanContext& context) : context_(context) {
     const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, 2, sizeof(gpu::IblPush));
     set_layout_ = layouts.set;
     pipeline_layout_ = layouts.pipeline;
-
-    VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    module_info.codeSize = sizeof(kIblPrefilterSpv);
-    module_info.pCode = kIblPrefilterSpv;
-    VkShaderModule module;
-    VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
-    VkComputePipelineCreateInfo pipeline_info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    pipeline_info.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    pipeline_info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipeline_info.stage.module = module;
-    pipeline_info.stage.pName = "main";
-    pipeline_info.layout = pipeline_layout_;
-    VkResult created = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipeline_info, nullptr, &pipeline_);
-    vkDestroyShaderModule(device, module, nullptr);
-    VK_CHECK(created);
+    pipeline_ = CreateComputePipeline(device, kIblPrefilterSpv, sizeof(kIblPrefilterSpv), pipeline_layout_);
 
     // Trilinear, clamped at the face edges (Vulkan filters across cube faces).
     VkSamplerCreateInfo sampler_info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};
@@ -172,7 +307,7 @@ IblBaker::IblBaker(VulkanContext& context) : context_(context) {
     if (timestamps_) {
       VkQueryPoolCreateInfo query_info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
       query_info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-      query_info.queryCount = 6;
+      query_info.queryCount = kTimestampQueries;
       VK_CHECK(vkCreateQueryPool(device, &query_info, nullptr, &query_pool_));
     }
   } catch (...) {
@@ -204,17 +339,23 @@ void IblBaker::Release() {
 // the destructor whatever happens.
 struct IblBaker::Resources {
   VkDevice device;
+  VkCommandPool command_pool;
   VkImage image = VK_NULL_HANDLE;
   VkDeviceMemory image_memory = VK_NULL_HANDLE;
   VkImageView view = VK_NULL_HANDLE;
+  uint32_t image_levels = 0;
+  std::vector<VkBufferImageCopy> copies;  // staging -> image, one a source mip
   VkBuffer staging = VK_NULL_HANDLE, output = VK_NULL_HANDLE;
   VkDeviceMemory staging_memory = VK_NULL_HANDLE, output_memory = VK_NULL_HANDLE;
   void* staging_mapped = nullptr;
   void* output_mapped = nullptr;
   VkDescriptorPool pool = VK_NULL_HANDLE;
+  VkDescriptorSet set = VK_NULL_HANDLE;
+  VkCommandBuffer cmd = VK_NULL_HANDLE;
   VkFence fence = VK_NULL_HANDLE;
-  explicit Resources(VkDevice d) : device(d) {}
+  Resources(VkDevice d, VkCommandPool p) : device(d), command_pool(p) {}
   ~Resources() {
+    if (cmd) vkFreeCommandBuffers(device, command_pool, 1, &cmd);
     if (fence) vkDestroyFence(device, fence, nullptr);
     if (pool) vkDestroyDescriptorPool(device, pool, nullptr);
     if (view) vkDestroyImageView(device, view, nullptr);
@@ -227,102 +368,27 @@ struct IblBaker::Resources {
   }
 };
 
-namespace {
-
-void CreateHostBuffer(VulkanContext& context, VkDeviceSize size, VkBufferUsageFlags usage, VkBuffer& buffer,
-                      VkDeviceMemory& memory, void*& mapped) {
-  VkDevice device = context.device();
-  VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
-  info.size = size;
-  info.usage = usage;
-  info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
-  VK_CHECK(vkCreateBuffer(device, &info, nullptr, &buffer));
-  VkMemoryRequirements req;
-  vkGetBufferMemoryRequirements(device, buffer, &req);
-  VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
-  alloc.allocationSize = req.size;
-  alloc.memoryTypeIndex = context.FindMemoryType(
-      req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-      VK_MEMORY_PROPERTY_HOST_CACHED_BIT);
-  VK_CHECK(vkAllocateMemory(device, &alloc, nullptr, &memory));
-  VK_CHECK(vkBindBufferMemory(device, buffer, memory, 0));
-  VK_CHECK(vkMapMemory(device, memory, 0, VK_WHOLE_SIZE, 0, &mapped));
-}
-
-}  // namespace
-
-IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
-  const IblSettings& s = request.settings;
+// The source mip chain into a staging buffer, and the cube image (all its
+// mips, six faces) the copies will fill.
+void IblBaker::CreateSourceImage(Resources& r, const std::vector<CubeLevel>& chain) {
   VkDevice device = context_.device();
-  Resources r(device);
-  timings_.clear();
-
-  // Source mip chain down to 1 x 1, box-filtered: what the filtered lookups read.
-  std::vector<CubeLevel> chain{source};
-  while (chain.back().size > 1) chain.push_back(DownsampleCube(chain.back()));
-  const uint32_t source_levels = uint32_t(chain.size());
   VkDeviceSize staging_bytes = 0;
   for (const CubeLevel& level : chain) staging_bytes += VkDeviceSize(level.size) * level.size * 16 * 6;
-
-  // Output texels: specular levels 1.. (level 0 is the source itself), the
-  // irradiance cube, the DFG table.
-  const int levels = request.roughness.empty() ? IblLevelCount(s) : int(request.roughness.size());
-  auto roughness_of = [&](int level) {
-    return request.roughness.empty() ? IblRoughness(level, levels) : request.roughness[level];
-  };
-  struct Pass {
-    int mode, size, level;
-    VkDeviceSize first_texel;
-  };
-  std::vector<Pass> passes;
-  VkDeviceSize texels = 0;
-  if (s.specular)
-    for (int level = 1; level < levels; ++level) {
-      int size = std::max(1, s.size >> level);
-      passes.push_back({IBL_MODE_SPECULAR, size, level, texels});
-      texels += VkDeviceSize(size) * size * 6;
-    }
-  if (s.irradiance) {
-    passes.push_back({IBL_MODE_IRRADIANCE, s.irradiance_size, 0, texels});
-    texels += VkDeviceSize(s.irradiance_size) * s.irradiance_size * 6;
-  }
-  if (request.dfg) {
-    passes.push_back({IBL_MODE_DFG, s.dfg_size, 0, texels});
-    texels += VkDeviceSize(s.dfg_size) * s.dfg_size;
-  }
-  // Each specular level's GGX sample table (GgxSampleEntry, one vec4 a
-  // sample) after the maps, in the same buffer.
-  std::vector<VkDeviceSize> table_first(passes.size(), 0);
-  for (size_t i = 0; i < passes.size(); ++i)
-    if (passes[i].mode == IBL_MODE_SPECULAR) {
-      table_first[i] = texels;
-      texels += VkDeviceSize(IblLevelSamples(s, roughness_of(passes[i].level)));
-    }
-  const uint64_t max_range = context_.properties().limits.maxStorageBufferRange;
-  if (texels * 16 > max_range)
-    throw VulkanError(fmt::format("the IBL maps need {} MiB in one storage buffer; {} allows {} MiB: lower ibl.size",
-                                  (texels * 16) >> 20, context_.device_info().name, max_range >> 20),
-                      VK_ERROR_OUT_OF_DEVICE_MEMORY);
-
   CreateHostBuffer(context_, staging_bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, r.staging, r.staging_memory,
                    r.staging_mapped);
-  CreateHostBuffer(context_, std::max<VkDeviceSize>(texels, 1) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, r.output,
-                   r.output_memory, r.output_mapped);
-  std::vector<VkBufferImageCopy> copies;
-  {
-    char* dst = static_cast<char*>(r.staging_mapped);
-    VkDeviceSize offset = 0;
-    for (uint32_t level = 0; level < source_levels; ++level) {
-      const CubeLevel& l = chain[level];
-      VkBufferImageCopy copy{};
-      copy.bufferOffset = offset;
-      copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 6};
-      copy.imageExtent = {uint32_t(l.size), uint32_t(l.size), 1};
-      copies.push_back(copy);
-      for (const std::vector<float>& face : l.faces) {
-        std::memcpy(dst + offset, face.data(), face.size() * sizeof(float));
-        offset += face.size() * sizeof(float);
-      }
+  char* dst = static_cast<char*>(r.staging_mapped);
+  VkDeviceSize offset = 0;
+  r.image_levels = uint32_t(chain.size());
+  for (uint32_t level = 0; level < r.image_levels; ++level) {
+    const CubeLevel& l = chain[level];
+    VkBufferImageCopy copy{};
+    copy.bufferOffset = offset;
+    copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, level, 0, 6};
+    copy.imageExtent = {uint32_t(l.size), uint32_t(l.size), 1};
+    r.copies.push_back(copy);
+    for (const std::vector<float>& face : l.faces) {
+      std::memcpy(dst + offset, face.data(), face.size() * sizeof(float));
+      offset += face.size() * sizeof(float);
     }
   }
 
@@ -330,8 +396,8 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
   image_info.flags = VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT;
   image_info.imageType = VK_IMAGE_TYPE_2D;
   image_info.format = VK_FORMAT_R32G32B32A32_SFLOAT;
-  image_info.extent = {uint32_t(source.size), uint32_t(source.size), 1};
-  image_info.mipLevels = source_levels;
+  image_info.extent = {uint32_t(chain[0].size), uint32_t(chain[0].size), 1};
+  image_info.mipLevels = r.image_levels;
   image_info.arrayLayers = 6;
   image_info.samples = VK_SAMPLE_COUNT_1_BIT;
   image_info.tiling = VK_IMAGE_TILING_OPTIMAL;
@@ -351,8 +417,21 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
   view_info.image = r.image;
   view_info.viewType = VK_IMAGE_VIEW_TYPE_CUBE;
   view_info.format = VK_FORMAT_R32G32B32A32_SFLOAT;
-  view_info.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, source_levels, 0, 6};
+  view_info.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, r.image_levels, 0, 6};
   VK_CHECK(vkCreateImageView(device, &view_info, nullptr, &r.view));
+}
+
+// The host-visible output buffer of `texels` vec4, the descriptor set that
+// binds it and the source cube, the command buffer and its fence.
+void IblBaker::CreateOutputAndSet(Resources& r, VkDeviceSize texels) {
+  VkDevice device = context_.device();
+  const uint64_t max_range = context_.properties().limits.maxStorageBufferRange;
+  if (texels * 16 > max_range)
+    throw VulkanError(fmt::format("the IBL maps need {} MiB in one storage buffer; {} allows {} MiB: lower ibl.size",
+                                  (texels * 16) >> 20, context_.device_info().name, max_range >> 20),
+                      VK_ERROR_OUT_OF_DEVICE_MEMORY);
+  CreateHostBuffer(context_, std::max<VkDeviceSize>(texels, 1) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, r.output,
+                   r.output_memory, r.output_mapped);
 
   VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1},
                                         {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1}};
@@ -365,19 +444,18 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
   set_alloc.descriptorPool = r.pool;
   set_alloc.descriptorSetCount = 1;
   set_alloc.pSetLayouts = &set_layout_;
-  VkDescriptorSet set;
-  VK_CHECK(vkAllocateDescriptorSets(device, &set_alloc, &set));
+  VK_CHECK(vkAllocateDescriptorSets(device, &set_alloc, &r.set));
   VkDescriptorImageInfo image_descriptor{sampler_, r.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL};
   VkDescriptorBufferInfo buffer_descriptor{r.output, 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet writes[2] = {};
   writes[0] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  writes[0].dstSet = set;
+  writes[0].dstSet = r.set;
   writes[0].dstBinding = IBL_BINDING_SOURCE;
   writes[0].descriptorCount = 1;
   writes[0].descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
   writes[0].pImageInfo = &image_descriptor;
   writes[1] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  writes[1].dstSet = set;
+  writes[1].dstSet = r.set;
   writes[1].dstBinding = IBL_BINDING_OUTPUT;
   writes[1].descriptorCount = 1;
   writes[1].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
@@ -388,140 +466,94 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
   cmd_alloc.commandPool = command_pool_;
   cmd_alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
   cmd_alloc.commandBufferCount = 1;
-  VkCommandBuffer cmd;
-  VK_CHECK(vkAllocateCommandBuffers(device, &cmd_alloc, &cmd));
-  struct CommandBufferFree {
-    VkDevice device;
-    VkCommandPool pool;
-    VkCommandBuffer cmd;
-    ~CommandBufferFree() { vkFreeCommandBuffers(device, pool, 1, &cmd); }
-  } free_cmd{device, command_pool_, cmd};
+  VK_CHECK(vkAllocateCommandBuffers(device, &cmd_alloc, &r.cmd));
   VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &r.fence));
+}
 
+// Records the whole bake into r.cmd: the source upload, the sample tables,
+// every filter pass (one push-constant block each, PushFor), timestamps
+// around each run of passes of one mode.
+// Returns the mode of each timestamp pair.
+std::vector<int> IblBaker::RecordPasses(const Resources& r, const std::vector<gpu::IblPush>& passes) {
+  VkCommandBuffer cmd = r.cmd;
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(cmd, &begin));
-  if (timestamps_) vkCmdResetQueryPool(cmd, query_pool_, 0, 6);
-  // The whole image to transfer-destination layout before the copy.
-  VkImageMemoryBarrier to_transfer{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-  to_transfer.srcAccessMask = 0;
-  to_transfer.dstAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  to_transfer.oldLayout = VK_IMAGE_LAYOUT_UNDEFINED;
-  to_transfer.newLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  to_transfer.srcQueueFamilyIndex = to_transfer.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_transfer.image = r.image;
-  to_transfer.subresourceRange = view_info.subresourceRange;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &to_transfer);
-  vkCmdCopyBufferToImage(cmd, r.staging, r.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(copies.size()),
-                         copies.data());
-  // The copy's writes made visible to the compute shader's sampling.
-  VkImageMemoryBarrier to_read = to_transfer;
-  to_read.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT;
-  to_read.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-  to_read.oldLayout = VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL;
-  to_read.newLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0,
-                       nullptr, 1, &to_read);
+  if (timestamps_) vkCmdResetQueryPool(cmd, query_pool_, 0, kTimestampQueries);
+  // The whole image to transfer-destination layout before the copy; the
+  // copy's writes made visible to the compute shader's sampling.
+  ImageBarrier(cmd, r.image, r.image_levels, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+               VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+  vkCmdCopyBufferToImage(cmd, r.staging, r.image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, uint32_t(r.copies.size()),
+                         r.copies.data());
+  ImageBarrier(cmd, r.image, r.image_levels, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+               VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+               VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
   vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_);
-  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set, 0, nullptr);
-  auto push_for = [&](const Pass& p, size_t index) {
-    gpu::IblPush push{};
-    const double roughness = roughness_of(p.level);
-    const double alpha = roughness * roughness;
-    const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
-                        : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
-                                                        : s.dfg_samples;
-    push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
-    push.source = {source.size, int32_t(source_levels), int32_t(table_first[index]), 0};
-    push.lobe = {float(alpha), float(s.lod_bias),
-                 p.mode == IBL_MODE_SPECULAR ? float(IblSunKernelNormalization(alpha)) : 0.0f,
-                 s.include_sun ? 1.0f : 0.0f};
-    push.sun_direction = {float(request.sun_direction.x), float(request.sun_direction.y),
-                          float(request.sun_direction.z), 0.0f};
-    push.sun_irradiance = {float(request.sun_irradiance[0]), float(request.sun_irradiance[1]),
-                           float(request.sun_irradiance[2]), 0.0f};
-    push.moon_direction = {float(request.moon_direction.x), float(request.moon_direction.y),
-                           float(request.moon_direction.z), 0.0f};
-    push.moon_irradiance = {float(request.moon_irradiance[0]), float(request.moon_irradiance[1]),
-                            float(request.moon_irradiance[2]), request.moon ? 1.0f : 0.0f};
-    return push;
-  };
+  vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &r.set, 0, nullptr);
+
   // The sample tables first (rows of 64 samples), then a barrier: the
   // specular passes read them.
   bool tables = false;
-  for (size_t i = 0; i < passes.size(); ++i) {
-    if (passes[i].mode != IBL_MODE_SPECULAR) continue;
-    gpu::IblPush push = push_for(passes[i], i);
+  for (gpu::IblPush push : passes) {
+    if (push.target.x != IBL_MODE_SPECULAR) continue;
     const int width = 64, rows = (push.target.w + width - 1) / width;
     push.target.x = IBL_MODE_GGX_SAMPLES;
     push.target.y = width;
-    push.target.z = int32_t(table_first[i]);
-    vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(cmd, uint32_t((width + SKYBAKE_LOCAL_SIZE_X - 1) / SKYBAKE_LOCAL_SIZE_X),
-                  uint32_t((rows + SKYBAKE_LOCAL_SIZE_Y - 1) / SKYBAKE_LOCAL_SIZE_Y), 1);
+    push.target.z = push.source.z;
+    PushAndDispatch(cmd, pipeline_layout_, push, Groups(width, SKYBAKE_LOCAL_SIZE_X), Groups(rows, SKYBAKE_LOCAL_SIZE_Y),
+                    1);
     tables = true;
   }
-  if (tables) {
-    VkBufferMemoryBarrier written{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-    written.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-    written.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-    written.srcQueueFamilyIndex = written.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-    written.buffer = r.output;
-    written.size = VK_WHOLE_SIZE;
-    vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0,
-                         nullptr, 1, &written, 0, nullptr);
-  }
+  if (tables)
+    BufferBarrier(cmd, r.output, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+
   // Passes write disjoint texels and read only the image and the tables: no
   // barrier between them.
   int open_mode = -1;
   std::vector<int> modes;  // the mode of each timestamp pair
-  for (const Pass& p : passes) {
-    if (timestamps_ && p.mode != open_mode) {
-      if (open_mode >= 0) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 1));
-      modes.push_back(p.mode);
+  for (const gpu::IblPush& push : passes) {
+    const int mode = push.target.x, size = push.target.y;
+    if (timestamps_ && mode != open_mode) {
+      if (open_mode >= 0)
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 1));
+      modes.push_back(mode);
       vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 2));
-      open_mode = p.mode;
+      open_mode = mode;
     }
-    const gpu::IblPush push = push_for(p, size_t(&p - passes.data()));
-    vkCmdPushConstants(cmd, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    const uint32_t groups = uint32_t((p.size + SKYBAKE_LOCAL_SIZE_X - 1) / SKYBAKE_LOCAL_SIZE_X);
-    vkCmdDispatch(cmd, groups, groups, p.mode == IBL_MODE_DFG ? 1 : 6);
+    const uint32_t groups = Groups(size, SKYBAKE_LOCAL_SIZE_X);
+    PushAndDispatch(cmd, pipeline_layout_, push, groups, groups, mode == IBL_MODE_DFG ? 1 : 6);
   }
   if (timestamps_ && open_mode >= 0)
     vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 1));
   // The shader's writes made visible to the host's read-back.
-  VkBufferMemoryBarrier to_host{VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER};
-  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  to_host.srcQueueFamilyIndex = to_host.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-  to_host.buffer = r.output;
-  to_host.size = VK_WHOLE_SIZE;
-  vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0, nullptr, 1,
-                       &to_host, 0, nullptr);
+  BufferBarrier(cmd, r.output, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_HOST_READ_BIT, VK_PIPELINE_STAGE_HOST_BIT);
   VK_CHECK(vkEndCommandBuffer(cmd));
-  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-  submit.commandBufferCount = 1;
-  submit.pCommandBuffers = &cmd;
-  VK_CHECK(vkQueueSubmit(context_.queue(), 1, &submit, r.fence));
-  VK_CHECK(vkWaitForFences(device, 1, &r.fence, VK_TRUE, UINT64_MAX));
+  return modes;
+}
 
-  if (timestamps_ && !modes.empty()) {
-    std::vector<uint64_t> stamps(2 * modes.size());
-    VK_CHECK(vkGetQueryPoolResults(device, query_pool_, 0, uint32_t(stamps.size()), stamps.size() * 8, stamps.data(),
-                                   8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-    const double period_ms = context_.properties().limits.timestampPeriod * 1e-6;
-    for (size_t i = 0; i < modes.size(); ++i)
-      timings_.push_back({modes[i] == IBL_MODE_SPECULAR     ? "IBL specular"
-                          : modes[i] == IBL_MODE_IRRADIANCE ? "IBL irradiance"
-                                                            : "IBL DFG",
-                          double(stamps[2 * i + 1] - stamps[2 * i]) * period_ms});
-  }
+// The GPU time of each run of passes of one mode, from the timestamps.
+void IblBaker::ReadTimings(const std::vector<int>& modes) {
+  if (!timestamps_ || modes.empty()) return;
+  std::vector<uint64_t> stamps(2 * modes.size());
+  VK_CHECK(vkGetQueryPoolResults(context_.device(), query_pool_, 0, uint32_t(stamps.size()), stamps.size() * 8,
+                                 stamps.data(), 8, VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+  const double period_ms = context_.properties().limits.timestampPeriod * 1e-6;
+  for (size_t i = 0; i < modes.size(); ++i)
+    timings_.push_back({TimingName(modes[i]), double(stamps[2 * i + 1] - stamps[2 * i]) * period_ms});
+}
 
-  // Read back.
+namespace {
+
+// The maps from the output buffer `out`: level 0 is the source (with the
+// point sources when they go into the maps), the other levels, the
+// irradiance cube and the DFG table as the passes wrote them.
+IblMaps ReadMaps(const IblRequest& request, const CubeLevel& source, const std::vector<Pass>& passes,
+                 const float* out) {
   IblMaps maps;
-  const float* out = static_cast<const float*>(r.output_mapped);
   auto read_cube = [&](const Pass& p) {
     CubeLevel level;
     level.size = p.size;
@@ -532,21 +564,11 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
     }
     return level;
   };
-  if (s.specular) {
+  if (request.settings.specular) {
     maps.specular.push_back(source);
-    if (s.include_sun) {
-      // Roughness 0: the Sun's energy into the texel that holds its centre
-      // (a disc a fraction of a texel wide), E / solid angle of the texel.
-      const CubeTexel t = VulkanCubeTexelFromDirection(request.sun_direction, source.size);
-      const double solid_angle = CubeTexelSolidAngle(t.x, t.y, source.size);
-      float* texel = &maps.specular[0].faces[t.face][(size_t(t.y) * source.size + t.x) * 4];
-      for (int c = 0; c < 3; ++c) texel[c] += float(request.sun_irradiance[c] / solid_angle);
-      if (request.moon) {
-        const CubeTexel m = VulkanCubeTexelFromDirection(request.moon_direction, source.size);
-        const double moon_solid_angle = CubeTexelSolidAngle(m.x, m.y, source.size);
-        float* moon_texel = &maps.specular[0].faces[m.face][(size_t(m.y) * source.size + m.x) * 4];
-        for (int c = 0; c < 3; ++c) moon_texel[c] += float(request.moon_irradiance[c] / moon_solid_angle);
-      }
+    if (request.settings.include_sun) {
+      AddPointSource(maps.specular[0], request.sun_direction, request.sun_irradiance);
+      if (request.moon) AddPointSource(maps.specular[0], request.moon_direction, request.moon_irradiance);
     }
   }
   for (const Pass& p : passes) {
@@ -559,6 +581,31 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
     }
   }
   return maps;
+}
+
+}  // namespace
+
+IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
+  timings_.clear();
+  const int levels = request.roughness.empty() ? IblLevelCount(request.settings) : int(request.roughness.size());
+  std::vector<double> roughness = request.roughness;
+  if (roughness.empty())
+    for (int level = 0; level < levels; ++level) roughness.push_back(IblRoughness(level, levels));
+  const IblPassList list = PlanPasses(request.settings, request.dfg, levels, roughness);
+
+  Resources r(context_.device(), command_pool_);
+  CreateSourceImage(r, SourceMipChain(source));
+  CreateOutputAndSet(r, list.texels);
+  std::vector<gpu::IblPush> pushes;
+  for (const Pass& p : list.passes) pushes.push_back(PushFor(request, p, roughness[p.level], source.size, r.image_levels));
+  const std::vector<int> modes = RecordPasses(r, pushes);
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &r.cmd;
+  VK_CHECK(vkQueueSubmit(context_.queue(), 1, &submit, r.fence));
+  VK_CHECK(vkWaitForFences(context_.device(), 1, &r.fence, VK_TRUE, UINT64_MAX));
+  ReadTimings(modes);
+  return ReadMaps(request, source, list.passes, static_cast<const float*>(r.output_mapped));
 }
 
 }  // namespace skybake

@@ -403,13 +403,6 @@ void SkyRenderer::BindOutput(const Buffer& target) {
 }
 
 VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass) {
-  VkDevice device = context_.device();
-  VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-  module_info.codeSize = bytes;
-  module_info.pCode = code;
-  VkShaderModule module;
-  VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
-
   // Specialization constants (SPEC_* of gpu_shared.h). Every pipeline gets
   // them all; a shader that does not use one ignores it.
   struct {
@@ -430,19 +423,7 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4}};
   VkSpecializationInfo specialization{15, entries, sizeof(values), &values};
-
-  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-  info.stage.module = module;
-  info.stage.pName = "main";
-  info.stage.pSpecializationInfo = &specialization;
-  info.layout = pipeline_layout_;
-  VkPipeline pipeline;
-  VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
-  vkDestroyShaderModule(device, module, nullptr);
-  VK_CHECK(result);
-  return pipeline;
+  return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
 void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,

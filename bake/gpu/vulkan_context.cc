@@ -376,4 +376,25 @@ ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayout
   return layouts;
 }
 
+VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t bytes, VkPipelineLayout layout,
+                                 const VkSpecializationInfo* specialization) {
+  VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+  module_info.codeSize = bytes;
+  module_info.pCode = code;
+  VkShaderModule module;
+  VK_CHECK(vkCreateShaderModule(device, &module_info, nullptr, &module));
+  VkComputePipelineCreateInfo info{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+  info.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+  info.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+  info.stage.module = module;
+  info.stage.pName = "main";
+  info.stage.pSpecializationInfo = specialization;
+  info.layout = layout;
+  VkPipeline pipeline;
+  VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  vkDestroyShaderModule(device, module, nullptr);
+  VK_CHECK(result);
+  return pipeline;
+}
+
 }  // namespace skybake

@@ -34,6 +34,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/gpu_shared.h"
 #include "skybake/gpu/pass_timing.h"
 #include "skybake/gpu/vulkan_context.h"
 #include "skybake/input/output_settings.h"
@@ -116,7 +117,12 @@ class IblBaker {
 
  private:
   struct Resources;
+  static constexpr uint32_t kTimestampQueries = 6;  // a begin and an end for each of the three modes
   void Release();
+  void CreateSourceImage(Resources& r, const std::vector<CubeLevel>& chain);
+  void CreateOutputAndSet(Resources& r, VkDeviceSize texels);
+  std::vector<int> RecordPasses(const Resources& r, const std::vector<gpu::IblPush>& passes);
+  void ReadTimings(const std::vector<int>& modes);
   VulkanContext& context_;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;

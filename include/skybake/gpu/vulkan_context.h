@@ -94,6 +94,11 @@ struct ComputeLayouts {
 ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayoutBinding* bindings,
                                     uint32_t binding_count, uint32_t push_bytes);
 
+// A compute pipeline of SPIR-V `code` (`bytes` long, entry point "main")
+// with `layout` and optional specialization constants; the caller destroys it.
+VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t bytes, VkPipelineLayout layout,
+                                 const VkSpecializationInfo* specialization = nullptr);
+
 struct VulkanOptions {
   int device_index = -1;      // -1: choose the best usable device
   bool validation = false;    // load VK_LAYER_KHRONOS_validation
