@@ -15,6 +15,7 @@
 #include "skybake/model/spectrum.h"
 #include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
+#include "study.h"
 
 namespace skybake {
 namespace {
@@ -222,5 +223,7 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
   WriteFileAtomically(options.out_dir + "/spectral_results.md", md);
   return md;
 }
+
+std::string RunSpectralStudy(StudyContext& context) { return RunSpectralStudy(context.vulkan, context.options); }
 
 }  // namespace skybake
