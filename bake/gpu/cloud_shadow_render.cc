@@ -7,6 +7,7 @@
 #include "shaders/kCloudShadowSpv.spv.h"
 #include "skybake/model/cloud_shadow.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "skybake/gpu/spectral_sky.h"
 
 namespace skybake {
 namespace {
@@ -21,6 +22,8 @@ int32_t FloatBits(double v) {
 }  // namespace
 
 std::vector<float> SkyRenderer::RenderCloudShadow(const glm::dvec3& sun, const CloudShadowSettings& s) {
+  // The clouds are grey: one group's map is every wavelength's.
+  if (spectral_) return spectral_->group(0).RenderCloudShadow(sun, s);
   const size_t texels = size_t(s.resolution) * s.resolution;
   // The Sun's centre at or below the horizon: no direct sunlight, zeros;
   // without cloud layers nothing shadows it: ones.

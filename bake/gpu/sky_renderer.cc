@@ -26,6 +26,7 @@
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
 #include "skybake/gpu/cloud_panorama.h"
+#include "skybake/gpu/spectral_sky.h"
 
 namespace skybake {
 namespace {
@@ -56,6 +57,11 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
       effects_(effects),
       aoas_switches_(aoas.switches),
       output_directions_(output_directions) {
+  if (quality.wavelengths > kRgbWavelengths && !output_directions) {
+    spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
+    SyncSpectral();
+    return;
+  }
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
   disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches, shaders);
   // Clouds (clouds.h): a style without layers gets no cloud pipeline, no
@@ -496,7 +502,16 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
   }
 }
 
+void SkyRenderer::SyncSpectral() {
+  timings_ = spectral_->last_timings();
+  counters_ = spectral_->counters();
+}
+
 void SkyRenderer::PrecomputeLuts() {
+  if (spectral_) {
+    spectral_->PrecomputeLuts();
+    return SyncSpectral();
+  }
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
   gpu::SkyPush push{};
@@ -596,6 +611,11 @@ void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& d
 
 std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
                                                     const std::vector<ViewRequest>& views, bool sun_disc) {
+  if (spectral_) {
+    std::vector<std::vector<float>> images = spectral_->Render(sun, views, sun_disc);
+    SyncSpectral();
+    return images;
+  }
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
   size_t total = 0;
   const std::vector<size_t> offsets = TexelOffsets(views, total);
@@ -634,6 +654,13 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
 
 RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                                          bool sun_disc) {
+  if (spectral_) {  // combined on the host, held in memory of its own
+    auto images = std::make_shared<std::vector<std::vector<float>>>(Render(sun, views, sun_disc));
+    RenderedViews result;
+    for (const std::vector<float>& image : *images) result.views.push_back(image.data());
+    result.hold = images;
+    return result;
+  }
   if (!luts_ready_ && !output_directions_) PrecomputeLuts();
   size_t total = 0;
   const std::vector<size_t> offsets = TexelOffsets(views, total);
@@ -787,6 +814,11 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
 
 std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
                                                  const std::vector<glm::dvec3>& directions, bool sun_disc) {
+  if (spectral_) {
+    std::vector<float> radiance = spectral_->RenderDirections(sun, directions, sun_disc);
+    SyncSpectral();
+    return radiance;
+  }
   if (!luts_ready_) PrecomputeLuts();
   // The directions after the view's texels, where the sun-disc pass still
   // finds them once the sky pass has written radiance.
@@ -807,6 +839,8 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
 
 bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                                    const EffectSettings& effects, const Rgb& output_scale) {
+  if (spectral_) return spectral_->UpdateAtmosphere(atmosphere, quality, effects);
+  if (quality.wavelengths != quality_.wavelengths) return false;
   const gpu::GpuAtmosphere g = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
   // The shader variant (specialization constants) and the buffer sizes must
   // stay; every other value is uniform data.
@@ -828,6 +862,7 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
 }
 
 bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
+  if (spectral_) return spectral_->UpdateClouds(clouds);
   const gpu::GpuClouds& c = clouds.uniform;
   auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
@@ -858,12 +893,14 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
 }
 
 std::vector<float> SkyRenderer::ReadCloudNoise() const {
+  if (spectral_) return spectral_->group(0).ReadCloudNoise();
   if (cloud_layers_ == 0) return {};
   const float* data = static_cast<const float*>(cloud_noise_buffer_.mapped);
   return std::vector<float>(data, data + CloudNoiseFloats(gpu_clouds_));
 }
 
 bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {
+  if (spectral_) return spectral_->UpdateAoas(aoas);
   const AoasSwitches& s = aoas.switches;
   if (s.skydome != aoas_switches_.skydome || s.ambiguity != aoas_switches_.ambiguity ||
       s.cloud_noise != aoas_switches_.cloud_noise || s.cloud_shapes != aoas_switches_.cloud_shapes)
@@ -874,11 +911,13 @@ bool SkyRenderer::UpdateAoas(const AoasInputs& aoas) {
 }
 
 std::vector<float> SkyRenderer::ReadTransmittanceLut() const {
+  if (spectral_) return spectral_->group(0).ReadTransmittanceLut();
   const float* data = static_cast<const float*>(transmittance_buffer_.mapped);
   return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.x) * gpu_atmosphere_.lut_sizes.y * 4);
 }
 
 std::vector<float> SkyRenderer::ReadMultipleScatteringLut() const {
+  if (spectral_) return spectral_->group(0).ReadMultipleScatteringLut();
   const float* data = static_cast<const float*>(multiscattering_buffer_.mapped);
   return std::vector<float>(data, data + size_t(gpu_atmosphere_.lut_sizes.z) * gpu_atmosphere_.lut_sizes.w * 4);
 }

@@ -142,6 +142,7 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   v.Int("quality.transmittance_lut_width", q.transmittance_width, 2, kMaxLutSize);
   v.Int("quality.transmittance_lut_height", q.transmittance_height, 2, kMaxLutSize);
   v.Int("quality.multiscattering_lut_size", q.multiscattering_size, 2, kMaxLutSize);
+  v.Int("quality.wavelengths", q.wavelengths, kRgbWavelengths, kMaxWavelengthBins);  // spectrum.h
   // The cloud sampling keys: read always; written into the resolved style
   // only when it has cloud layers, so a style without them resolves (and
   // its EXR headers record it) as before clouds existed.
@@ -175,6 +176,7 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
            {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
   v.Choice("output.units", o.units,
            {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
+  v.Choice("output.color_space", o.color_space, {{"rec709", ColorSpace::kRec709}, {"acescg", ColorSpace::kAcesCg}});
   v.Bool("output.faces", o.faces);
   v.Bool("output.cube_strip", o.cube_strip);
   v.Bool("output.latlong", o.latlong);
@@ -1219,6 +1221,41 @@ void CheckIbl(const SkyStyle& style, StyleChecks& c) {
   }
 }
 
+// The spectral mode (quality.wavelengths > 3) integrates radiance to colour:
+// radiance output keeps the three named wavelengths, and the per-texel
+// effects that act on RGB colour (saturation, the night floor's neutral
+// grey) have no spectral form yet.
+void CheckSpectral(SkyStyle& style, StyleChecks& c) {
+  const bool radiance = style.output.units == OutputUnits::kSpectral;
+  if (radiance && style.output.color_space != ColorSpace::kRec709) {
+    ConfigError e = c.Locate("output.color_space");
+    e.message = "radiance at 680/550/440 nm (output.units = \"spectral\") has no primaries: set "
+                "output.units = \"luminance\" or output.color_space = \"rec709\"";
+    c.errors.push_back(e);
+  }
+  if (style.quality.wavelengths <= kRgbWavelengths) return;
+  if (radiance) {
+    ConfigError w = c.Locate("quality.wavelengths");
+    w.message = fmt::format("output.units = \"spectral\" writes radiance at 680/550/440 nm, so the {} bins are "
+                            "not rendered (the three-wavelength path is): set output.units = \"luminance\" for "
+                            "the spectral mode's colour",
+                            style.quality.wavelengths);
+    c.warnings.push_back(w);
+    style.quality.wavelengths = kRgbWavelengths;
+    return;
+  }
+  auto refuse = [&](const char* key, const char* what) {
+    ConfigError e = c.Locate("quality.wavelengths");
+    e.message = fmt::format("the spectral mode ({} bins) cannot render {} ({} is set), which acts on RGB colour: "
+                            "set quality.wavelengths = 3 or turn {} off",
+                            style.quality.wavelengths, what, key, key);
+    c.errors.push_back(e);
+  };
+  if (style.aoas.clouds.enabled) refuse("clouds.enabled", "the AOAS saturation clouds");
+  if (style.aoas.shapes.enabled) refuse("shapes.enabled", "the AOAS cloud shapes");
+  if (style.effects.night_dimming) refuse("effects.night_dimming", "the night-sky floor");
+}
+
 // A preset that every explicit key overrides changes nothing: say so.
 void WarnPresetChangesNothing(const SkyStyle& style, const StyleReader& reader, StyleChecks& c) {
   if (reader.Given("quality.preset")) {
@@ -1248,6 +1285,8 @@ std::string ResolvedToml(SkyStyle& style) {
   else if (style.ibl.full_samples_roughness == 0.0) recorded["ibl"].as_table()->erase("full_samples_roughness");
   if (style.output.engine == "none") recorded["output"].as_table()->erase("engine");
   if (!style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
+  if (style.quality.wavelengths == kRgbWavelengths) recorded["quality"].as_table()->erase("wavelengths");
+  if (style.output.color_space == ColorSpace::kRec709) recorded["output"].as_table()->erase("color_space");
   std::ostringstream resolved;
   resolved << recorded;
   return resolved.str();
@@ -1278,6 +1317,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   CheckFaceNames(result.style, checks);
   CheckSceneAndEngine(result.style, checks);
   CheckIbl(result.style, checks);
+  CheckSpectral(result.style, checks);
   WarnPresetChangesNothing(result.style, reader, checks);
   if (!result.ok()) return result;
 

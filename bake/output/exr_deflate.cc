@@ -265,9 +265,10 @@ std::string AssembleExr(const ExrFile& file, const std::vector<Chunk>& chunks) {
   for (const char* channel : {"B", "G", "R"})
     check(exr_result_t(exr_add_channel(context, part, channel, type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1)),
           "a channel");
-  // Rec.709 primaries and D65 white, as Imf::Chromaticities() defines them.
-  const exr_attr_chromaticities_t rec709{0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
-  check(exr_attr_set_chromaticities(context, part, "chromaticities", &rec709), "chromaticities");
+  // The primaries and white of the options (Rec.709 and D65 unless told).
+  const std::array<float, 8>& xy = options.chromaticities;
+  const exr_attr_chromaticities_t primaries{xy[0], xy[1], xy[2], xy[3], xy[4], xy[5], xy[6], xy[7]};
+  check(exr_attr_set_chromaticities(context, part, "chromaticities", &primaries), "chromaticities");
   if (options.envmap >= 0)
     check(exr_attr_set_envmap(context, part, "envmap", exr_envmap_t(options.envmap)), "envmap");
   if (options.white_luminance > 0.0)

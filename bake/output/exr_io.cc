@@ -237,7 +237,8 @@ std::string EncodeWithOpenExr(const std::string& path, const RgbaImage& image, c
   header.channels().insert("R", Imf::Channel(type));
   header.channels().insert("G", Imf::Channel(type));
   header.channels().insert("B", Imf::Channel(type));
-  Imf::addChromaticities(header, Imf::Chromaticities());  // Rec.709 primaries, D65
+  const std::array<float, 8>& xy = options.chromaticities;
+  Imf::addChromaticities(header, Imf::Chromaticities({xy[0], xy[1]}, {xy[2], xy[3]}, {xy[4], xy[5]}, {xy[6], xy[7]}));
   if (options.envmap >= 0) Imf::addEnvmap(header, Imf::Envmap(options.envmap));
   if (options.white_luminance > 0.0) Imf::addWhiteLuminance(header, float(options.white_luminance));
   for (const auto& [key, value] : options.attributes)

@@ -72,12 +72,38 @@ const RgbaImage* LatlongOf(const FrameJob& job) {
   return index < job.images.size() ? &job.images[index] : nullptr;
 }
 
+// The views in the maps' colour space (output.color_space): Rec.709 as
+// rendered, or converted copies (ACEScg) with the EXR options saying so.
+std::vector<RgbaImage> InOutputColorSpace(const FrameJob& job, ExrWriteOptions& exr) {
+  if (job.plan->style->output.color_space != ColorSpace::kAcesCg) return {};
+  const std::array<std::array<double, 2>, 4> xy = Chromaticities(ColorSpace::kAcesCg);
+  for (int i = 0; i < 8; ++i) exr.chromaticities[i] = float(xy[i / 2][i % 2]);
+  exr.attributes["skybake:units"] = "linear ACEScg (AP1 primaries, ACES white) luminance, cd/m^2 per 1.0 divided "
+                                    "by skybake:scale";
+  const Matrix3 m = Rec709ToAcesCg();
+  std::vector<RgbaImage> converted;
+  for (const RgbaImage& image : job.images) {
+    RgbaImage c{image.width, image.height, std::vector<float>(image.texels() * 4), nullptr};
+    const float* in = image.data();
+    for (size_t t = 0; t < image.texels(); ++t) {
+      for (int i = 0; i < 3; ++i)
+        c.rgba[4 * t + i] = float(m[i][0] * in[4 * t] + m[i][1] * in[4 * t + 1] + m[i][2] * in[4 * t + 2]);
+      c.rgba[4 * t + 3] = in[4 * t + 3];
+    }
+    converted.push_back(std::move(c));
+  }
+  return converted;
+}
+
 // The faces, strip and latlong EXRs encoded together in memory (their
 // chunks shared among the threads), then each written atomically and
 // checksummed from the same bytes.
-std::vector<BakedFile> WriteViewExrs(const FrameJob& job, const ExrWriteOptions& exr, const BakeOptions& options) {
+std::vector<BakedFile> WriteViewExrs(const FrameJob& job, const ExrWriteOptions& frame_exr, const BakeOptions& options) {
   const OutputSettings& o = job.plan->style->output;
   const FrameNames& names = job.plan->names;
+  ExrWriteOptions exr = frame_exr;
+  const std::vector<RgbaImage> converted = InOutputColorSpace(job, exr);
+  const std::vector<RgbaImage>& images = converted.empty() ? job.images : converted;
   std::vector<ExrFile> exrs;
   std::vector<std::string> kinds;
   size_t view_index = 0;
@@ -86,20 +112,20 @@ std::vector<BakedFile> WriteViewExrs(const FrameJob& job, const ExrWriteOptions&
       ExrWriteOptions face_exr = exr;
       face_exr.attributes["skybake:cube_face"] = CubeFaceLabel(face);
       face_exr.attributes["skybake:face_orientation"] = "Vulkan cube map face (sc, tc) table";
-      exrs.push_back({OutputPath(options, names.faces[face]), &job.images[view_index], face_exr});
+      exrs.push_back({OutputPath(options, names.faces[face]), &images[view_index], face_exr});
       kinds.push_back("face");
     }
   }
   if (o.cube_strip) {
     ExrWriteOptions cube_exr = exr;
     cube_exr.envmap = 1;  // ENVMAP_CUBE
-    exrs.push_back({OutputPath(options, names.cube), &job.images[view_index], cube_exr});
+    exrs.push_back({OutputPath(options, names.cube), &images[view_index], cube_exr});
     kinds.push_back("cube");
   }
   if (o.latlong) {
     ExrWriteOptions latlong_exr = exr;
     latlong_exr.envmap = 0;  // ENVMAP_LATLONG
-    exrs.push_back({OutputPath(options, names.latlong), LatlongOf(job), latlong_exr});
+    exrs.push_back({OutputPath(options, names.latlong), &images[LatlongOf(job) - job.images.data()], latlong_exr});
     kinds.push_back("latlong");
   }
   const std::vector<std::string> encoded = EncodeExrs(exrs);

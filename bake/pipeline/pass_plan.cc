@@ -341,6 +341,15 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   PlanSkyPasses(first, pruned, plan);
   const bool disc_pass = PlansSunDiscPass(first, pruned, shaders);
   if (disc_pass) plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
+  // The spectral mode (spectral_sky.h): the passes so far run once per group of three bins.
+  if (const int n = first.quality.wavelengths; n > kRgbWavelengths) {
+    const int groups = (n + 2) / 3;
+    for (PlannedPass& pass : plan.passes) pass.runs *= groups;
+    plan.effects.push_back({"spectral mode", true, true,
+                            fmt::format("quality.wavelengths = {}: {} groups of 3 wavelengths, each with its own "
+                                        "LUTs and views (the sky passes' runs count them)",
+                                        n, groups)});
+  }
   PlanCloudPasses(first, plan);
   PlanMoonlitPasses(first, pruned, plan);
   AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h

@@ -42,6 +42,9 @@ std::string RunIntegratorStudy(StudyContext& context);
 // The model against the measured skies of Kider et al. 2014: kider2014.csv
 // and its table.
 std::string RunKiderStudy(StudyContext& context);
+// The spectral mode: colour error of 3, 4, 8, 16 wavelengths against 48 bins
+// and their cost, twilight pictures (skybake/tools/spectral_study.h).
+std::string RunSpectralStudy(StudyContext& context);
 
 // One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
 struct StudyCase {

@@ -20,7 +20,7 @@
 
 namespace skybake {
 
-
+class SpectralSky;  // spectral_sky.h
 
 // Texels [x0, x1) x [y0, y1) of a view.
 struct TexelRect {
@@ -74,6 +74,8 @@ class SkyRenderer {
   // (xyz) instead of radiance: the shader-side mapping, for tests. `aoas`
   // holds the per-texel aesthetic principles (none by default); the hue
   // principle is already in `atmosphere` (StyledAtmosphere).
+  // With quality.wavelengths above 3 it is the spectral mode (spectral_sky.h):
+  // views are linear Rec.709 in cd/m^2 and `output_scale` is not used.
   SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
               const QualitySettings& quality, const EffectSettings& effects,
               const Rgb& output_scale, bool output_directions = false,
@@ -185,6 +187,11 @@ class SkyRenderer {
   void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   void GenerateCloudNoise();
   void CopyCloudWeatherImages();  // the weather images into the noise buffer, the volumes kept
+
+  // The spectral mode's groups (quality.wavelengths > 3), else null; its
+  // timings and counters are copied here after each call.
+  std::unique_ptr<SpectralSky> spectral_;
+  void SyncSpectral();
 
   static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "skybake/model/spectrum.h"
+
 namespace skybake {
 
 enum class PixelType { kHalf, kFloat };
@@ -28,6 +30,9 @@ struct OutputSettings {
   int zip_level = kDefaultZipLevel;  // deflate level of zip and zips, 1..9
   OverflowPolicy overflow = OverflowPolicy::kScale;
   OutputUnits units = OutputUnits::kLuminance;
+  // Primaries of luminance output's EXR maps (their `chromaticities`
+  // attribute when not Rec.709); previews, glTF and SH stay Rec.709.
+  ColorSpace color_space = ColorSpace::kRec709;
   bool faces = true;       // six face files
   bool cube_strip = true;  // one N x 6N cube strip
   bool latlong = true;     // one 2N x N latlong

@@ -68,6 +68,10 @@ struct QualitySettings {
   bool sky_view_lut = true;
   int sky_view_width = 256;
   int sky_view_height = 144;
+  // Wavelengths rendered: 3 is the 680/550/440 nm path (RGB channels); 4..48
+  // is the spectral mode (spectrum.h): that many bins over 355..835 nm,
+  // rendered three at a time and integrated to CIE XYZ, then Rec.709.
+  int wavelengths = 3;
 };
 
 // The named presets, chosen from the accuracy study (docs/accuracy.md):

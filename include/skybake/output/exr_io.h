@@ -3,6 +3,7 @@
 // place only once complete, so a crash never leaves a truncated file.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <stdexcept>
@@ -35,6 +36,9 @@ struct ExrWriteOptions {
   double scale = 1.0;            // multiplies every value before writing
   double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
   std::map<std::string, std::string> attributes;  // provenance string attributes
+  // The `chromaticities` attribute: CIE xy of red, green, blue and white
+  // (Rec.709 and D65 unless the values are in another space, ACEScg say).
+  std::array<float, 8> chromaticities = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
   // none, zip and zips are encoded by skybake's libdeflate encoder; true
   // uses OpenEXR's own (zlib) encoder instead, for comparison.
   bool openexr_encoder = false;

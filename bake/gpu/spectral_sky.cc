@@ -1,0 +1,128 @@
+#include "skybake/gpu/spectral_sky.h"
+
+#include <algorithm>
+#include <utility>
+
+namespace skybake {
+namespace {
+
+QualitySettings GroupQuality(QualitySettings q) {
+  q.wavelengths = kRgbWavelengths;
+  return q;
+}
+
+// Adds a group's three channels, times its matrix, to the RGB of `sum`
+// (RGBA texels); the first group also sets alpha.
+void Accumulate(const float* group, size_t texels, const Matrix3& to_rgb, bool first, float* sum) {
+  float m[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m[i][j] = float(to_rgb[i][j]);
+  for (size_t t = 0; t < texels; ++t) {
+    const float* in = group + 4 * t;
+    float* out = sum + 4 * t;
+    for (int i = 0; i < 3; ++i) out[i] += m[i][0] * in[0] + m[i][1] * in[1] + m[i][2] * in[2];
+    if (first) out[3] = in[3];
+  }
+}
+
+}  // namespace
+
+SpectralSky::SpectralSky(VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                         const EffectSettings& effects, const AoasInputs& aoas, const CloudInputs& clouds,
+                         const ShaderSwitches& shaders)
+    : SpectralSky(context, WavelengthBins(quality.wavelengths),
+                  SpectralGroups(atmosphere, WavelengthBins(quality.wavelengths)), quality, effects, aoas, clouds,
+                  shaders) {}
+
+SpectralSky::SpectralSky(VulkanContext& context, SpectralBins bins, std::vector<SpectralGroup> groups,
+                         const QualitySettings& quality, const EffectSettings& effects, const AoasInputs& aoas,
+                         const CloudInputs& clouds, const ShaderSwitches& shaders)
+    : bins_(std::move(bins)), groups_(std::move(groups)) {
+  // Each group renders radiance (unit output scale); the CIE weights make it cd/m^2.
+  for (const SpectralGroup& g : groups_)
+    renderers_.push_back(std::make_unique<SkyRenderer>(context, g.atmosphere, GroupQuality(quality), effects,
+                                                       Rgb{1.0, 1.0, 1.0}, false, aoas, clouds, shaders));
+}
+
+SpectralSky::~SpectralSky() = default;
+
+void SpectralSky::PrecomputeLuts() {
+  timings_.clear();
+  for (auto& r : renderers_) {
+    r->PrecomputeLuts();
+    timings_.insert(timings_.end(), r->last_timings().begin(), r->last_timings().end());
+  }
+}
+
+std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                                    bool sun_disc) {
+  std::vector<std::vector<float>> sum;
+  for (const ViewRequest& v : views) sum.emplace_back(size_t(v.width) * v.height * 4, 0.0f);
+  timings_.clear();
+  for (size_t g = 0; g < renderers_.size(); ++g) {
+    // Read where the device wrote it; the hold is released before the next group.
+    const RenderedViews rendered = renderers_[g]->RenderInPlace(sun, views, sun_disc);
+    timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
+    for (size_t i = 0; i < views.size(); ++i)
+      Accumulate(rendered.views[i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0,
+                 sum[i].data());
+  }
+  return sum;
+}
+
+std::vector<float> SpectralSky::RenderDirections(const glm::dvec3& sun, const std::vector<glm::dvec3>& directions,
+                                                 bool sun_disc) {
+  std::vector<float> sum(directions.size() * 4, 0.0f);
+  timings_.clear();
+  for (size_t g = 0; g < renderers_.size(); ++g) {
+    const std::vector<float> group = renderers_[g]->RenderDirections(sun, directions, sun_disc);
+    timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
+    Accumulate(group.data(), directions.size(), groups_[g].to_rgb, g == 0, sum.data());
+  }
+  return sum;
+}
+
+bool SpectralSky::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                                   const EffectSettings& effects) {
+  if (quality.wavelengths != bins_.count()) return false;  // also refuses groups of one's own
+  std::vector<SpectralGroup> groups = SpectralGroups(atmosphere, bins_);
+  for (size_t g = 0; g < renderers_.size(); ++g)
+    if (!renderers_[g]->UpdateAtmosphere(groups[g].atmosphere, GroupQuality(quality), effects, Rgb{1.0, 1.0, 1.0}))
+      return false;
+  groups_ = groups;
+  return true;
+}
+
+bool SpectralSky::UpdateAoas(const AoasInputs& aoas) {
+  bool ok = true;
+  for (auto& r : renderers_) ok = r->UpdateAoas(aoas) && ok;
+  return ok;
+}
+
+bool SpectralSky::UpdateClouds(const CloudInputs& clouds) {
+  bool ok = true;
+  for (auto& r : renderers_) ok = r->UpdateClouds(clouds) && ok;
+  return ok;
+}
+
+RenderCounters SpectralSky::counters() const {
+  RenderCounters sum;
+  for (const auto& r : renderers_) {
+    const RenderCounters& c = r->counters();
+    sum.transmittance_lut_builds += c.transmittance_lut_builds;
+    sum.multiscattering_lut_builds += c.multiscattering_lut_builds;
+    sum.skyview_lut_builds += c.skyview_lut_builds;
+    sum.pipelines += c.pipelines;
+    sum.variant_pipelines += c.variant_pipelines;
+    sum.sun_disc_dispatches += c.sun_disc_dispatches;
+    sum.cloud_noise_builds += c.cloud_noise_builds;
+    sum.cloud_table_builds += c.cloud_table_builds;
+    sum.cloud_dispatches += c.cloud_dispatches;
+    sum.sun_disc_texels += c.sun_disc_texels;
+  }
+  // A frame is every group's render of it.
+  sum.frames = renderers_.empty() ? 0 : renderers_.front()->counters().frames;
+  return sum;
+}
+
+}  // namespace skybake

@@ -1,0 +1,55 @@
+// The spectral mode's renderer (spectrum.h): one three-channel SkyRenderer
+// per group of three wavelength bins, each with its group's atmosphere and
+// LUTs, and their views combined into linear Rec.709 (cd/m^2) with the
+// groups' CIE weights. Cost grows with the number of groups, ceil(N / 3).
+// A SkyRenderer whose quality asks for more than three wavelengths holds one
+// and forwards to it, so every user of the renderer gets the spectral sky.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "skybake/gpu/sky_renderer.h"
+#include "skybake/model/spectrum.h"
+
+namespace skybake {
+
+class SpectralSky {
+ public:
+  SpectralSky(VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+              const EffectSettings& effects, const AoasInputs& aoas, const CloudInputs& clouds,
+              const ShaderSwitches& shaders);
+  // Groups of one's own (SpectralGroups of other bins, a flat sun, ...).
+  SpectralSky(VulkanContext& context, SpectralBins bins, std::vector<SpectralGroup> groups,
+              const QualitySettings& quality, const EffectSettings& effects, const AoasInputs& aoas = AoasInputs(),
+              const CloudInputs& clouds = CloudInputs(), const ShaderSwitches& shaders = ShaderSwitches());
+  ~SpectralSky();
+
+  const SpectralBins& bins() const { return bins_; }
+  const std::vector<SpectralGroup>& groups() const { return groups_; }
+  // The group's renderer: radiance (W m^-2 sr^-1 nm^-1) at its three wavelengths.
+  SkyRenderer& group(size_t g) { return *renderers_[g]; }
+
+  void PrecomputeLuts();
+  // Every group's views, combined: linear Rec.709 in cd/m^2, alpha of the first group.
+  std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                                         bool sun_disc);
+  std::vector<float> RenderDirections(const glm::dvec3& sun_direction, const std::vector<glm::dvec3>& directions,
+                                      bool sun_disc);
+  bool UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                        const EffectSettings& effects);
+  bool UpdateAoas(const AoasInputs& aoas);
+  bool UpdateClouds(const CloudInputs& clouds);
+
+  // Every group's passes of the last call, in order, and their counters summed.
+  const std::vector<PassTiming>& last_timings() const { return timings_; }
+  RenderCounters counters() const;
+
+ private:
+  SpectralBins bins_;
+  std::vector<SpectralGroup> groups_;
+  std::vector<std::unique_ptr<SkyRenderer>> renderers_;
+  std::vector<PassTiming> timings_;
+};
+
+}  // namespace skybake
