@@ -801,6 +801,25 @@ void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night
   }
 }
 
+void AddNightSkyPlan(const std::vector<SkyStyle>& frames, PassPlan& plan) {
+  if (frames.empty() || !frames.front().night.Any()) return;
+  const NightSettings& night = frames.front().night;
+  const int day = int(std::count_if(frames.begin(), frames.end(),
+                                    [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
+  const std::string pruned =
+      day == 0 ? std::string("no frame has the Sun up: every view splatted")
+               : fmt::format("in the {} of {} frames with the Sun up each view first goes through the tile bound, "
+                             "skipped where no addition can reach 2^-13 of a texel (the daylit sky outshines it)",
+                             day, int(frames.size()));
+  if (night.stars || night.moon)
+    plan.passes.push_back({"star and Moon splat (host)",
+                           fmt::format("{}{}4 texels a source", night.stars ? "stars to V " : "",
+                                       night.stars ? fmt::format("{}, ", night.star_magnitude_limit) : ""),
+                           "per frame; " + pruned, plan.frames, 0.0});
+  if (night.airglow)
+    plan.passes.push_back({"airglow (host)", "every texel above the horizon", "per frame; " + pruned, plan.frames, 0.0});
+}
+
 const StarCatalogue& StarCatalogues::Get(const std::string& path) {
   auto it = loaded_.find(path);
   if (it != loaded_.end()) return it->second;

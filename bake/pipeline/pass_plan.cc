@@ -11,6 +11,7 @@
 #include "skybake/model/aoas.h"
 #include "skybake/gpu/sky_renderer.h"
 #include "skybake/pipeline/engine_files.h"
+#include "skybake/pipeline/night_sky.h"
 
 namespace skybake {
 namespace {
@@ -352,6 +353,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   }
   PlanCloudPasses(first, plan);
   PlanMoonlitPasses(first, pruned, plan);
+  AddNightSkyPlan(frames, plan);  // night_sky.h: the host's splat and glow, and what prunes them
   AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
   AddCloudFormationPlan(first, hours_from_start, plan);  // CPU cell updates, not medium samples

@@ -16,8 +16,9 @@
 //   are added to every frame: by day they fall below the sky's radiance by
 //   the physics alone; an addition under 2^-13 of a texel's own value (a
 //   quarter of half float's resolution) is left out, so a day frame's maps
-//   are not copied at all; while the Sun is up a bound (SplatBound) finds
-//   the texels where that is certain and splats only what reaches the others.
+//   are not copied at all; while the Sun is up two bounds find where that
+//   is certain: by tiles first (BoundByTiles, which skips whole views), then
+//   by texels (SplatBound), and only what reaches the others is splatted.
 // - The Moon (night.moon): its disc, of the angular radius from its
 //   topocentric distance, lit by the Sun with the Lommel-Seeliger law
 //   L ~ mu0 / (mu0 + mu) (mu0, mu: cosines of incidence and emission; the
@@ -287,6 +288,13 @@ class NightSkyRenderer {
   int moonlight_renders_ = 0;
   double last_moonlight_seconds_ = 0.0;
 };
+
+// The night sky's host passes in the pass plan (`skybake plan`): the star
+// and Moon splat and the airglow, per frame, with what prunes them: the
+// tile bound (BoundByTiles) in the frames with the Sun up, which skips
+// every view where no addition can reach 2^-13 of a texel.
+struct PassPlan;
+void AddNightSkyPlan(const std::vector<SkyStyle>& frames, PassPlan& plan);
 
 // Catalogues by path, loaded once per bake; throws ConfigFailure when one
 // cannot be read.
