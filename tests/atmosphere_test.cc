@@ -29,6 +29,7 @@ vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #include "atmosphere.glsl"
 }  // namespace f64
 #undef SKYBAKE_ATMOSPHERE_GLSL
+#undef SKYBAKE_ATMOSPHERE_PARAMETERS_GLSL
 namespace f32 {
 #define SKYBAKE_REAL float
 #include "skybake/model/glsl_compat.h"

@@ -17,6 +17,7 @@
 #include "skybake/model/cloud_formation.h"
 #include "skybake/model/clouds.h"
 #include "skybake/input/config.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -207,19 +208,6 @@ TEST(CloudFormationRules, ClockTimeStepsAndDrift) {
   for (size_t i = 0; i < a.map.size(); ++i) EXPECT_NEAR(b.map[i], 0.5f * (a.map[i] + c.map[i]), 1e-6f) << i;
 }
 
-void WriteImage(const std::string& path, int w, int h, int channels,
-                const std::function<float(int, int, int)>& value) {
-  std::vector<float> pixels(size_t(w) * h * channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) pixels[(size_t(y) * w + x) * channels + c] = value(x, y, c);
-  auto out = OIIO::ImageOutput::create(path);
-  ASSERT_TRUE(out) << path;
-  OIIO::ImageSpec spec(w, h, channels, path.ends_with(".png") ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
-  ASSERT_TRUE(out->open(path, spec));
-  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-  out->close();
-}
 
 // The mask's channels: where blue (extinction) is 1 and Pext is 1 no cloud
 // stays; where red (humidity) and green (readiness) are 0 none forms; where
@@ -260,7 +248,7 @@ TEST(CloudFormationRules, DensityVolumeIsTheSmoothedLattice) {
 TEST(CloudFormationMask, ChannelsSetTheProbabilitiesPerColumn) {
   const std::string dir = testing::FreshTempDir("cloud_mask");
   // Layer 0: west half humid and ready, east half dry; layer 1 the reverse.
-  WriteImage(dir + "/mask.png", 32, 64, 3, [](int x, int y, int c) {
+  testing::WriteTestImage(dir + "/mask.png", 32, 64, 3, [](int x, int y, int c) {
     const bool west = x < 16, first = y < 32;
     if (c == 2) return 0.0f;
     return (west == first) ? 1.0f : 0.0f;
@@ -293,7 +281,7 @@ TEST(CloudFormationMask, ChannelsSetTheProbabilitiesPerColumn) {
   const CloudLattice l2 = SimulateFormation(moving, &mask, 3, 80);
   EXPECT_GT(clouds_in(l2, false), 100u);
   // Blue 1 with Pext 1: no cloud anywhere.
-  WriteImage(dir + "/clear.png", 32, 32, 4, [](int, int, int) { return 1.0f; });
+  testing::WriteTestImage(dir + "/clear.png", 32, 32, 4, [](int, int, int) { return 1.0f; });
   CloudFormation clear = Formation();
   clear.extinction_probability = 1.0;
   const CloudMask clear_mask = ReadCloudMask(dir + "/clear.png", clear);
@@ -305,10 +293,10 @@ TEST(CloudFormationMask, ChannelsSetTheProbabilitiesPerColumn) {
 // the bake before any GPU work: exit code 3, the message names the path.
 TEST(CloudFormationMask, BadMasksExitThreeWithThePath) {
   const std::string dir = testing::FreshTempDir("cloud_mask_bad");
-  WriteImage(dir + "/small.png", 16, 16, 3, [](int, int, int) { return 0.5f; });
-  WriteImage(dir + "/gray.exr", 32, 32, 1, [](int, int, int) { return 0.5f; });
-  WriteImage(dir + "/two.exr", 32, 32, 2, [](int, int, int) { return 0.5f; });
-  WriteImage(dir + "/good.png", 32, 32, 3, [](int, int, int) { return 0.5f; });
+  testing::WriteTestImage(dir + "/small.png", 16, 16, 3, [](int, int, int) { return 0.5f; });
+  testing::WriteTestImage(dir + "/gray.exr", 32, 32, 1, [](int, int, int) { return 0.5f; });
+  testing::WriteTestImage(dir + "/two.exr", 32, 32, 2, [](int, int, int) { return 0.5f; });
+  testing::WriteTestImage(dir + "/good.png", 32, 32, 3, [](int, int, int) { return 0.5f; });
   const std::pair<const char*, const char*> cases[] = {
       {"missing.png", "no such file"},
       {"small.png", "16 x 16 texels"},
@@ -393,32 +381,22 @@ warmup_steps = 20
 phase_probability = 0.005
 velocity_cells_per_hour = [4.0, 0.0, 0.0]
 )";
-  std::ofstream(schedule) << R"([schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 12:00:00, end = 13:30:00, step_minutes = 30 }
-)";
-  auto bake = [&](const std::string& out, const std::string& extra) {
-    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --schedule '" + schedule +
-                                                  "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
-    EXPECT_EQ(run.exit_code, 0) << run.output;
-  };
-  bake(root + "/whole", "");
-  bake(root + "/shards", "--shard 2/2");
-  bake(root + "/frame3", "--frames 3:3");
+  std::ofstream(schedule) << testing::IthacaSchedule("12:00:00", "13:30:00", 30);
+  testing::BakeSequence16(style, schedule, root + "/whole");
+  testing::BakeSequence16(style, schedule, root + "/shards", "--shard 2/2");
+  testing::BakeSequence16(style, schedule, root + "/frame3", "--frames 3:3");
   const std::set<std::string> whole = testing::FileNames(root + "/whole");
   ASSERT_TRUE(whole.count("sky_latlong.0003.exr"));
-  int compared = 0;
-  for (const std::string& dir : {root + "/shards", root + "/frame3"})
-    for (const std::string& name : testing::FileNames(dir)) {
-      if (name.find(".exr") == std::string::npos && name.find(".png") == std::string::npos) continue;
-      EXPECT_TRUE(testing::ReadFileBytes(dir + "/" + name) == testing::ReadFileBytes(root + "/whole/" + name))
-          << dir << "/" << name;
-      ++compared;
-    }
-  EXPECT_GT(compared, 8);
+  size_t compared = 0;
+  for (const std::string& dir : {root + "/shards", root + "/frame3"}) {
+    std::set<std::string> images = testing::FileNames(dir);
+    std::erase_if(images, [](const std::string& name) {
+      return name.find(".exr") == std::string::npos && name.find(".png") == std::string::npos;
+    });
+    testing::ExpectSameBytes(dir, root + "/whole", images);
+    compared += images.size();
+  }
+  EXPECT_GT(compared, 8u);
   EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
             testing::ReadFileBytes(root + "/whole/sky_latlong.0003.exr"));
   fs::remove_all(root);

@@ -25,6 +25,7 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -49,9 +50,11 @@ glm::dvec3 Sun(double elevation_deg, double azimuth_deg = 135.0) {
   return {std::cos(e) * std::sin(a), std::sin(e), -std::cos(e) * std::cos(a)};
 }
 
-// A slab of uniform extinction: coverage 1, no shape or detail noise, a
-// profile that is 1 across the whole thickness.
-const char* kSlab = R"(
+// A draft style with a 500 m layer at 1 km whose profile is 1 across the
+// whole thickness, no detail noise: its coverage, extinction (1/m) and shape
+// noise as TOML values.
+std::string SlabLayer(const std::string& coverage, const std::string& density_per_m, const std::string& shape_amount) {
+  return R"(
 [quality]
 preset = "draft"
 [[cloud_layer]]
@@ -59,11 +62,12 @@ altitude_m = 1000
 thickness_m = 500
 type = "custom"
 profile = [0.0, 0.0, 1.0, 1.0]
-coverage = 1.0
-density_per_m = 0.002
-shape_amount = 0.0
-detail_amount = 0.0
-)";
+coverage = )" + coverage + "\ndensity_per_m = " + density_per_m + "\nshape_amount = " + shape_amount +
+         "\ndetail_amount = 0.0\n";
+}
+
+// A slab of uniform extinction: coverage 1, no shape or detail noise.
+const std::string kSlab = SlabLayer("1.0", "0.002", "0.0");
 
 // tau = 0.002 /m x 500 m = 1 vertically; the map is exp(-tau / cos(zenith))
 // at every texel, for several sun elevations, and exp(-strength tau / cos).
@@ -206,19 +210,7 @@ TEST(CloudShadow, TilingMapWrapsWithoutASeam) {
 // moved one texel (one cell's extent) east. With only the coverage map
 // carrying the clouds (no shape or detail noise), to float rounding.
 TEST(CloudShadow, OneCellOfDriftMovesTheMapOneCell) {
-  const SkyStyle style = Style(R"(
-[quality]
-preset = "draft"
-[[cloud_layer]]
-altitude_m = 1000
-thickness_m = 500
-type = "custom"
-profile = [0.0, 0.0, 1.0, 1.0]
-coverage = 0.6
-density_per_m = 0.004
-shape_amount = 0.0
-detail_amount = 0.0
-[cloud_layer.formation]
+  const SkyStyle style = Style(SlabLayer("0.6", "0.004", "0.0") + R"([cloud_layer.formation]
 enabled = true
 cells = [32, 32, 4]
 size_m = [8000.0, 8000.0]
@@ -344,19 +336,7 @@ TEST(CloudShadow, GroundShadowAndMapBesideTheCloudPanorama) {
 // noise, so the map is exp(-tau / cos) at every texel; the same lattice
 // supplying the coverage only leaves the shape noise carving the layer.
 TEST(CloudShadow, FormationSuppliesTheWholeDensity) {
-  const std::string toml = R"(
-[quality]
-preset = "draft"
-[[cloud_layer]]
-altitude_m = 1000
-thickness_m = 500
-type = "custom"
-profile = [0.0, 0.0, 1.0, 1.0]
-coverage = 1.0
-density_per_m = 0.002
-shape_amount = 1.0
-detail_amount = 0.0
-[cloud_layer.formation]
+  const std::string toml = SlabLayer("1.0", "0.002", "1.0") + R"([cloud_layer.formation]
 enabled = true
 cells = [8, 8, 4]
 warmup_steps = 4
@@ -565,22 +545,8 @@ enabled = true
 resolution = 32
 extent_m = 8000.0
 )";
-  std::ofstream(schedule) << R"([schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 12:00:00, end = 12:30:00, step_minutes = 15 }
-)";
-  auto bake = [&](const std::string& out, const std::string& extra) {
-    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --schedule '" + schedule +
-                                                  "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
-    EXPECT_EQ(run.exit_code, 0) << run.output;
-  };
-  bake(root + "/whole", "");
-  bake(root + "/parts", "--shard 1/2");
-  bake(root + "/parts", "--shard 2/2");
-  ASSERT_EQ(testing::RunSkybake("merge-manifest '" + root + "/parts'").exit_code, 0);
+  std::ofstream(schedule) << testing::IthacaSchedule("12:00:00", "12:30:00", 15);
+  ASSERT_EQ(testing::BakeWholeAndTwoShards(style, schedule, root, "parts"), 0);
   for (int n = 1; n <= 3; ++n) {
     const std::string name = fmt::format("sky_cloudshadow.{:04d}.exr", n);
     ASSERT_TRUE(std::filesystem::exists(root + "/whole/" + name)) << name;

@@ -22,6 +22,7 @@
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -427,35 +428,17 @@ TEST(CloudSequence, ShardsAndResumeAreByteIdentical) {
   const std::string root = testing::FreshTempDir("cloud_sequence");
   const std::string style = root + "/style.toml", schedule = root + "/schedule.toml";
   std::ofstream(style) << std::string(kFast) + Layer(1500, 1500, "coverage = 0.5\nwind_m_s = [15.0, 5.0]");
-  std::ofstream(schedule) << R"([schedule]
-date = 2013-05-27
-latitude_deg = 42.44337
-longitude_deg = -76.48163
-utc_offset_hours = -4.0
-times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
-)";
-  auto bake = [&](const std::string& out, const std::string& extra) {
-    testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --schedule '" + schedule +
-                                                  "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
-    EXPECT_EQ(run.exit_code, 0) << run.output;
-  };
-  bake(root + "/whole", "");
-  bake(root + "/shards", "--shard 1/2");
-  bake(root + "/shards", "--shard 2/2");
-  EXPECT_EQ(testing::RunSkybake("merge-manifest '" + root + "/shards'").exit_code, 0);
+  std::ofstream(schedule) << testing::IthacaSchedule("09:00:00", "09:45:00", 15);
+  EXPECT_EQ(testing::BakeWholeAndTwoShards(style, schedule, root, "shards"), 0);
   // Resume: one frame's files lost, the rest verified by checksum.
   fs::copy(root + "/whole", root + "/resumed");
   for (const std::string& name : testing::FileNames(root + "/resumed"))
     if (name.find(".0003.") != std::string::npos) fs::remove(root + "/resumed/" + name);
-  bake(root + "/resumed", "--resume");
-  const std::set<std::string> whole = testing::FileNames(root + "/whole");
+  testing::BakeSequence16(style, schedule, root + "/resumed", "--resume");
+  std::set<std::string> whole = testing::FileNames(root + "/whole");
   EXPECT_GT(whole.size(), 30u);
-  for (const std::string& dir : {root + "/shards", root + "/resumed"})
-    for (const std::string& name : whole) {
-      if (name == "timings.json") continue;
-      EXPECT_TRUE(testing::ReadFileBytes(dir + "/" + name) == testing::ReadFileBytes(root + "/whole/" + name))
-          << dir << "/" << name;
-    }
+  whole.erase("timings.json");
+  for (const std::string& dir : {root + "/shards", root + "/resumed"}) testing::ExpectSameBytes(dir, root + "/whole", whole);
   // The wind moved the clouds between frames: the frames differ.
   EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
             testing::ReadFileBytes(root + "/whole/sky_latlong.0002.exr"));
@@ -464,17 +447,9 @@ times = { start = 09:00:00, end = 09:45:00, step_minutes = 15 }
 
 // ---------------------------------------------------------------- weather images
 
+// The same value in every channel.
 void WriteImage(const std::string& path, int w, int h, int channels, const std::function<float(int, int)>& value) {
-  std::vector<float> pixels(size_t(w) * h * channels);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < channels; ++c) pixels[(size_t(y) * w + x) * channels + c] = value(x, y);
-  auto out = OIIO::ImageOutput::create(path);
-  ASSERT_TRUE(out) << path;
-  OIIO::ImageSpec spec(w, h, channels, path.ends_with(".png") ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
-  ASSERT_TRUE(out->open(path, spec));
-  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
-  out->close();
+  testing::WriteTestImage(path, w, h, channels, [&](int x, int y, int) { return value(x, y); });
 }
 
 // A weather image puts the clouds where its first channel says: the west

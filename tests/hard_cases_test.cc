@@ -145,6 +145,16 @@ TEST_P(HardCaseTest, FiniteNonNegativeAndGpuMatchesDouble) {
   testing::ExpectNoValidationMessages();
 }
 
+// Every scattering and absorption coefficient 1000 times larger.
+void ThousandTimesDenser(AtmosphereParams& a) {
+  for (int c = 0; c < 3; ++c) {
+    a.rayleigh_scattering_per_km[c] *= 1000.0;
+    a.mie_scattering_per_km[c] *= 1000.0;
+    a.mie_extinction_per_km[c] *= 1000.0;
+    a.ozone_absorption_per_km[c] *= 1000.0;
+  }
+}
+
 EffectSettings NoDisc() {
   EffectSettings e;
   e.sun_disc = false;
@@ -175,24 +185,12 @@ INSTANTIATE_TEST_SUITE_P(
                  },
                  EffectSettings{}},
         HardCase{"atmosphere 1000x denser",
-                 [](AtmosphereParams& a) {
-                   for (int c = 0; c < 3; ++c) {
-                     a.rayleigh_scattering_per_km[c] *= 1000.0;
-                     a.mie_scattering_per_km[c] *= 1000.0;
-                     a.mie_extinction_per_km[c] *= 1000.0;
-                     a.ozone_absorption_per_km[c] *= 1000.0;
-                   }
-                 },
+                 ThousandTimesDenser,
                  NoDisc()},
         HardCase{"atmosphere 1000x denser, observer at 60 km",
                  [](AtmosphereParams& a) {
                    a.observer_altitude_m = 60e3;
-                   for (int c = 0; c < 3; ++c) {
-                     a.rayleigh_scattering_per_km[c] *= 1000.0;
-                     a.mie_scattering_per_km[c] *= 1000.0;
-                     a.mie_extinction_per_km[c] *= 1000.0;
-                     a.ozone_absorption_per_km[c] *= 1000.0;
-                   }
+                   ThousandTimesDenser(a);
                  },
                  NoDisc()},
         HardCase{"zero scattering",

@@ -62,6 +62,17 @@ IblSettings Settings(int size) {
   return s;
 }
 
+// A 128 cube's maps with ibl.include_sun, the Sun towards (0.3, 0.8, -0.5)
+// with an irradiance of (1000, 2000, 3000).
+IblRequest SunRequest128() {
+  IblRequest request;
+  request.settings = Settings(128);
+  request.settings.include_sun = true;
+  request.sun_direction = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
+  request.sun_irradiance = {1000.0, 2000.0, 3000.0};
+  return request;
+}
+
 TEST(IblTest, RoughnessOfEachLevelIsLevelOverLevelsMinusOne) {
   IblSettings s = Settings(256);
   EXPECT_EQ(IblLevelCount(s), 6);  // 256 .. 8
@@ -137,11 +148,7 @@ TEST(IblTest, WhiteFurnace) {
 TEST(IblTest, SunEnergyIsKeptInEveryLevel) {
   VulkanContext& vk = testing::Vulkan();
   IblBaker baker(vk);
-  IblRequest request;
-  request.settings = Settings(128);
-  request.settings.include_sun = true;
-  request.sun_direction = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
-  request.sun_irradiance = {1000.0, 2000.0, 3000.0};
+  IblRequest request = SunRequest128();
   IblMaps maps = baker.Bake(request, CubeOf(128, [](const glm::dvec3&) { return glm::dvec3(0.0); }));
   ASSERT_EQ(maps.specular.size(), 5u);
   for (size_t level = 0; level < maps.specular.size(); ++level) {
@@ -175,11 +182,7 @@ TEST(IblTest, SunEnergyIsKeptInEveryLevel) {
 TEST(IblTest, MoonEnergyIsKeptBesideTheSuns) {
   VulkanContext& vk = testing::Vulkan();
   IblBaker baker(vk);
-  IblRequest sun_only;
-  sun_only.settings = Settings(128);
-  sun_only.settings.include_sun = true;
-  sun_only.sun_direction = glm::normalize(glm::dvec3(0.3, 0.8, -0.5));
-  sun_only.sun_irradiance = {1000.0, 2000.0, 3000.0};
+  IblRequest sun_only = SunRequest128();
   const CubeLevel black = CubeOf(128, [](const glm::dvec3&) { return glm::dvec3(0.0); });
   IblRequest with_moon = sun_only;
   with_moon.moon = true;

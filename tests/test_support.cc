@@ -12,6 +12,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <OpenImageIO/imageio.h>
+
 namespace skybake::testing {
 namespace {
 std::unique_ptr<VulkanContext> g_context;
@@ -100,6 +102,40 @@ std::set<std::string> FileNames(const std::string& dir) {
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) names.insert(e.path().filename().string());
   return names;
+}
+
+void BakeSequence16(const std::string& style, const std::string& schedule, const std::string& out,
+                    const std::string& extra) {
+  CommandRun run = RunSkybake("bake '" + style + "' --schedule '" + schedule +
+                              "' --size 16 -q --vulkan-validation --out '" + out + "' " + extra);
+  EXPECT_EQ(run.exit_code, 0) << run.output;
+}
+
+int BakeWholeAndTwoShards(const std::string& style, const std::string& schedule, const std::string& root,
+                          const std::string& shards) {
+  BakeSequence16(style, schedule, root + "/whole");
+  BakeSequence16(style, schedule, root + "/" + shards, "--shard 1/2");
+  BakeSequence16(style, schedule, root + "/" + shards, "--shard 2/2");
+  return RunSkybake("merge-manifest '" + root + "/" + shards + "'").exit_code;
+}
+
+void ExpectSameBytes(const std::string& dir, const std::string& reference_dir, const std::set<std::string>& names) {
+  for (const std::string& name : names)
+    EXPECT_TRUE(ReadFileBytes(dir + "/" + name) == ReadFileBytes(reference_dir + "/" + name)) << dir << "/" << name;
+}
+
+void WriteTestImage(const std::string& path, int w, int h, int channels,
+                    const std::function<float(int, int, int)>& value) {
+  std::vector<float> pixels(size_t(w) * h * channels);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < channels; ++c) pixels[(size_t(y) * w + x) * channels + c] = value(x, y, c);
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << path;
+  OIIO::ImageSpec spec(w, h, channels, path.ends_with(".png") ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT);
+  ASSERT_TRUE(out->open(path, spec));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
+  out->close();
 }
 
 CubeFaceHit SpecCubeFace(const glm::dvec3& r) {

@@ -3,6 +3,7 @@
 // installable, so a missing device fails with the command that fixes it.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <set>
 #include <string>
@@ -50,6 +51,27 @@ std::string FreshTempDir(const std::string& name);
 // (none when it does not exist).
 std::string ReadFileBytes(const std::string& path);
 std::set<std::string> FileNames(const std::string& dir);
+
+// A sequence bake from the command line: `skybake bake STYLE --schedule
+// SCHEDULE --size 16 -q --vulkan-validation --out OUT EXTRA`, expected to
+// exit 0 (a test failure with its output when not).
+void BakeSequence16(const std::string& style, const std::string& schedule, const std::string& out,
+                    const std::string& extra = "");
+
+// The sequence baked whole into ROOT/whole and in two shards into
+// ROOT/SHARDS (BakeSequence16), then `merge-manifest ROOT/SHARDS`; returns
+// merge-manifest's exit code.
+int BakeWholeAndTwoShards(const std::string& style, const std::string& schedule, const std::string& root,
+                          const std::string& shards);
+
+// Expects `dir/NAME` to hold the bytes of `reference_dir/NAME` for each of
+// `names` (a test failure naming the file when not).
+void ExpectSameBytes(const std::string& dir, const std::string& reference_dir, const std::set<std::string>& names);
+
+// An image file (PNG: 8 bits, else float; by its extension) of w x h pixels
+// and `channels` channels, value(x, y, channel) each, through OpenImageIO.
+void WriteTestImage(const std::string& path, int w, int h, int channels,
+                    const std::function<float(int, int, int)>& value);
 
 // The OpenGL 4.6 / Vulkan specifications' "Cube Map Face Selection": the
 // major axis of `r` picks the face (0..5: +X -X +Y -Y +Z -Z), then (sc, tc)

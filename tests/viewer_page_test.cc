@@ -9,11 +9,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -104,17 +106,25 @@ TEST(ViewerPageTest, LooksAroundTheTestPattern) {
   EXPECT_NEAR(darker.At(160, 120).x, Srgb8(red.x / 16.0), 4.0);
 }
 
-TEST(ViewerPageTest, ScrubsTheFramesOfASequence) {
-  const std::string dir = testing::FreshTempDir("view_sequence");
+// The default style baked at 32 into DIR/out over a schedule whose sun
+// goes from 30 deg to -10 deg elevation in steps of `step_deg` (azimuth
+// 135 deg), and its page (`skybake view DIR/out`).
+void BakeAndViewSunSequence(const std::string& dir, int step_deg) {
   const std::string schedule = dir + "/schedule.toml";
   FILE* f = std::fopen(schedule.c_str(), "w");
   ASSERT_TRUE(f);
-  std::fputs("[schedule]\nsun = { elevation_deg = { start = 30, end = -10, step = -40 }, azimuth_deg = 135 }\n", f);
+  std::fputs(fmt::format("[schedule]\nsun = {{ elevation_deg = {{ start = 30, end = -10, step = {} }}, azimuth_deg = 135 }}\n",
+                         step_deg).c_str(), f);
   std::fclose(f);
   testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --schedule " +
                                                  schedule + " --size 32 -q --out " + dir + "/out");
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   ASSERT_EQ(testing::RunSkybake("view " + dir + "/out").exit_code, 0);
+}
+
+TEST(ViewerPageTest, ScrubsTheFramesOfASequence) {
+  const std::string dir = testing::FreshTempDir("view_sequence");
+  ASSERT_NO_FATAL_FAILURE(BakeAndViewSunSequence(dir, -40));
   Shot day = Open(dir + "/out", "drag:0,40");
   Shot night = Open(dir + "/out", "drag:0,40;frame:1");
   ASSERT_EQ(day.report["frames"], 2);
@@ -130,15 +140,7 @@ TEST(ViewerPageTest, ScrubsTheFramesOfASequence) {
 // reaches them (the harness serves the folder over HTTP).
 TEST(ViewerPageTest, LaterFramesBeyondTheCapAreReferencedNotEmbedded) {
   const std::string dir = testing::FreshTempDir("view_capped");
-  const std::string schedule = dir + "/schedule.toml";
-  FILE* f = std::fopen(schedule.c_str(), "w");
-  ASSERT_TRUE(f);
-  std::fputs("[schedule]\nsun = { elevation_deg = { start = 30, end = -10, step = -20 }, azimuth_deg = 135 }\n", f);
-  std::fclose(f);
-  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --schedule " +
-                                                 schedule + " --size 32 -q --out " + dir + "/out");
-  ASSERT_EQ(bake.exit_code, 0) << bake.output;
-  ASSERT_EQ(testing::RunSkybake("view " + dir + "/out").exit_code, 0);
+  ASSERT_NO_FATAL_FAILURE(BakeAndViewSunSequence(dir, -20));
   const auto full = std::filesystem::file_size(dir + "/out/view.html");
   ASSERT_EQ(testing::RunSkybake("view --force --embed-mib 0 " + dir + "/out").exit_code, 0);
   const auto capped = std::filesystem::file_size(dir + "/out/view.html");

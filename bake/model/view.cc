@@ -1,24 +1,17 @@
 #include "skybake/model/view.h"
 
+#include "skybake/model/shared_glsl.h"
+
 #include <type_traits>
 
 #include <glm/glm.hpp>
 
 namespace skybake {
-namespace view {
-
-// The texel mappings of shaders/envmap.glsl in double precision.
-#define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
-#include "envmap.glsl"
-#undef SKYBAKE_REAL
-
-}  // namespace view
 
 glm::dvec3 ViewTexelDirection(const ViewRequest& v, int x, int y) {
-  if (v.mapping == MAPPING_LATLONG) return view::DirectionFromLatLongPixel(x, y, v.width, v.height);
-  if (v.mapping == MAPPING_CUBE_STRIP) return view::DirectionFromCubeStripPixel(x, y, v.width);
-  if (v.mapping == MAPPING_VULKAN_FACE) return view::DirectionFromVulkanCubeTexel(v.face, x, y, v.width);
+  if (v.mapping == MAPPING_LATLONG) return glsl::DirectionFromLatLongPixel(x, y, v.width, v.height);
+  if (v.mapping == MAPPING_CUBE_STRIP) return glsl::DirectionFromCubeStripPixel(x, y, v.width);
+  if (v.mapping == MAPPING_VULKAN_FACE) return glsl::DirectionFromVulkanCubeTexel(v.face, x, y, v.width);
   return glm::dvec3(0.0, 1.0, 0.0);
 }
 

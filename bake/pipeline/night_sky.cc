@@ -16,7 +16,7 @@
 #include "skybake/input/config.h"
 #include "skybake/pipeline/gallery.h"
 #include "skybake/pipeline/pass_plan.h"
-#include "skybake/tools/reference_model.h"
+#include "skybake/model/shared_glsl.h"
 #include "skybake/input/schedule.h"
 
 namespace skybake {
@@ -502,7 +502,8 @@ size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, f
 
 TransmittanceTable::TransmittanceTable(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                                        const EffectSettings& effects) {
-  const ReferenceModel model(atmosphere, quality, effects, {1.0, 1.0, 1.0});
+  // The shared GLSL's direct optical depth (shared_glsl.h), 256 points.
+  const glsl::AtmosphereParameters atm = glsl::SharedAtmosphere(atmosphere, quality, effects);
   const double altitude_km = atmosphere.observer_altitude_m * 1e-3;
   const double r = atmosphere.bottom_radius_km + altitude_km;
   mu_horizon_ = -std::sqrt(std::max(0.0, 1.0 - (atmosphere.bottom_radius_km / r) * (atmosphere.bottom_radius_km / r)));
@@ -510,7 +511,8 @@ TransmittanceTable::TransmittanceTable(const AtmosphereParams& atmosphere, const
   table_.resize(kEntries);
   for (int i = 0; i < kEntries; ++i) {
     const double mu = mu_horizon_ + (1.0 - mu_horizon_) * i / (kEntries - 1);
-    const glm::dvec3 t = model.TransmittanceDirect(altitude_km, mu, 256);
+    const glm::dvec3 t =
+        glm::exp(-glsl::ComputeOpticalDepthToTopBoundary(atm, atm.bottom_radius + altitude_km, altitude_km, mu, 256));
     table_[i] = {t.x, t.y, t.z};
   }
 }

@@ -11,22 +11,17 @@
 
 #include <glm/glm.hpp>
 
+#include "skybake/model/shared_glsl.h"
 #include "skybake/model/shared_params.h"
 
 namespace skybake {
 namespace converged {
 
-// The shared geometry and medium functions, in double. The LUT hooks are
-// never reached: this reference integrates every ray directly.
-#define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
-vec3 TransmittanceLutTexel(int, int) { return vec3(0.0); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
-#include "atmosphere.glsl"
-
-AtmosphereParameters FromParams(const AtmosphereParams& a) {
-  AtmosphereParameters atm{};
+// The shared geometry and medium functions (shared_glsl.h) with Mie and ozone
+// on; their LUT hooks are never reached: this reference integrates every ray
+// directly.
+glsl::AtmosphereParameters FromParams(const AtmosphereParams& a) {
+  glsl::AtmosphereParameters atm{};
   FillPhysicalParameters(a, atm);
   atm.mie = true;
   atm.ozone = true;
@@ -62,7 +57,7 @@ void GaussLegendre(int n, std::vector<double>& nodes, std::vector<double>& weigh
 
 namespace {
 
-using converged::AtmosphereParameters;
+using glsl::AtmosphereParameters;
 
 constexpr int kGaussOrder = 8;
 
@@ -120,12 +115,12 @@ glm::dvec3 Integrate(double a, double b, double segment, F f) {
 
 glm::dvec3 OpticalDepth(const AtmosphereParameters& atm, double r, double altitude, double mu,
                         double segment) {
-  double t_max = converged::DistanceToTopBoundary(atm, r, altitude, mu);
+  double t_max = glsl::DistanceToTopBoundary(atm, r, altitude, mu);
   std::vector<double> points = RayBreakpoints(atm, r, altitude, mu, t_max);
   glm::dvec3 depth(0.0);
   for (size_t i = 0; i + 1 < points.size(); ++i) {
     depth += Integrate(points[i], points[i + 1], segment, [&](double t) {
-      return converged::SampleMedium(atm, converged::AltitudeAlongRay(atm, r, altitude, mu, t)).extinction;
+      return glsl::SampleMedium(atm, glsl::AltitudeAlongRay(atm, r, altitude, mu, t)).extinction;
     });
   }
   return depth;
@@ -164,21 +159,21 @@ glm::dvec3 ConvergedReference::Radiance(const glm::dvec3& view, const glm::dvec3
   double mu_s = glm::clamp(sun.y, -1.0, 1.0);
   double nu = glm::clamp(glm::dot(view, sun), -1.0, 1.0);
   if (altitude > atm.top_radius - atm.bottom_radius) {
-    double t_entry = converged::DistanceToAtmosphereEntry(atm, r, altitude, mu);
+    double t_entry = glsl::DistanceToAtmosphereEntry(atm, r, altitude, mu);
     if (t_entry < 0.0) return glm::dvec3(0.0);
     mu = glm::clamp((r * mu + t_entry) / atm.top_radius, -1.0, 1.0);
     mu_s = glm::clamp((r * mu_s + t_entry * nu) / atm.top_radius, -1.0, 1.0);
     r = atm.top_radius;
     altitude = atm.top_radius - atm.bottom_radius;
   }
-  bool ground = converged::RayIntersectsGround(atm, r, altitude, mu);
-  double t_max = ground ? converged::DistanceToBottomBoundary(atm, r, altitude, mu)
-                        : converged::DistanceToTopBoundary(atm, r, altitude, mu);
+  bool ground = glsl::RayIntersectsGround(atm, r, altitude, mu);
+  double t_max = ground ? glsl::DistanceToBottomBoundary(atm, r, altitude, mu)
+                        : glsl::DistanceToTopBoundary(atm, r, altitude, mu);
   std::vector<double> points = RayBreakpoints(atm, r, altitude, mu, t_max);
 
   // The planet's shadow: where the sun visibility ramps, g(t) = +/-eps.
   auto shadow_offset = [&](double t, double sign) {
-    double h = converged::AltitudeAlongRay(atm, r, altitude, mu, t);
+    double h = glsl::AltitudeAlongRay(atm, r, altitude, mu, t);
     double r_t = atm.bottom_radius + h;
     double mu_s_t = (r * mu_s + t * nu) / r_t;
     double cos_theta_h = -std::sqrt(std::max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
@@ -204,16 +199,16 @@ glm::dvec3 ConvergedReference::Radiance(const glm::dvec3& view, const glm::dvec3
   }
   std::sort(points.begin(), points.end());
 
-  const double rayleigh_phase = converged::RayleighPhase(nu);
-  const double mie_phase = converged::MiePhase(atm.mie_g, view, sun);
+  const double rayleigh_phase = glsl::RayleighPhase(nu);
+  const double mie_phase = glsl::MiePhase(atm.mie_g, view, sun);
   auto extinction = [&](double t) {
-    return converged::SampleMedium(atm, converged::AltitudeAlongRay(atm, r, altitude, mu, t)).extinction;
+    return glsl::SampleMedium(atm, glsl::AltitudeAlongRay(atm, r, altitude, mu, t)).extinction;
   };
   auto source = [&](double t) {
-    double alt = converged::AltitudeAlongRay(atm, r, altitude, mu, t);
+    double alt = glsl::AltitudeAlongRay(atm, r, altitude, mu, t);
     double r_t = atm.bottom_radius + alt;
     double mu_s_t = glm::clamp((r * mu_s + t * nu) / r_t, -1.0, 1.0);
-    converged::MediumSample m = converged::SampleMedium(atm, alt);
+    glsl::MediumSample m = glsl::SampleMedium(atm, alt);
     return glm::dvec3((m.rayleigh_scattering * rayleigh_phase + m.mie_scattering * mie_phase) *
                       SunTransmittance(atm, r_t, alt, mu_s_t, seg));
   };

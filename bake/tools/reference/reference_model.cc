@@ -1,6 +1,6 @@
 #include "skybake/tools/reference_model.h"
 
-#include "skybake/model/shared_params.h"
+#include "skybake/model/shared_glsl.h"
 
 #include <algorithm>
 #include <thread>
@@ -10,57 +10,10 @@
 #include <glm/glm.hpp>
 
 namespace skybake {
-namespace reference {
-
-#define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
-
-// The LUTs the shared code reads through its hooks. Set by the model before
-// each call; thread_local so that worker threads can evaluate in parallel.
-struct LutView {
-  const std::vector<glm::dvec3>* transmittance = nullptr;
-  const std::vector<glm::dvec3>* multiscattering = nullptr;
-  const std::vector<glm::dvec3>* skyview = nullptr;
-  int transmittance_width = 0;
-  int multiscattering_width = 0;
-  int skyview_width = 0;
-};
-thread_local LutView g_luts;
-
-vec3 TransmittanceLutTexel(int x, int y) {
-  return (*g_luts.transmittance)[size_t(y) * g_luts.transmittance_width + x];
-}
-vec3 MultipleScatteringLutTexel(int x, int y) {
-  return (*g_luts.multiscattering)[size_t(y) * g_luts.multiscattering_width + x];
-}
-vec3 SkyViewLutTexel(int x, int y) {
-  return (*g_luts.skyview)[size_t(y) * g_luts.skyview_width + x];
-}
-
-// The shape arcs the shared code reads through its hooks (as the GPU reads
-// them from the AOAS uniform block).
-thread_local const gpu::GpuAoas* g_aoas = nullptr;
-vec4 ShapeSegmentStart(int i) {
-  const gpu::vec4& v = g_aoas->shape_segments[2 * i];
-  return vec4(v.x, v.y, v.z, v.w);
-}
-vec4 ShapeSegmentEnd(int i) {
-  const gpu::vec4& v = g_aoas->shape_segments[2 * i + 1];
-  return vec4(v.x, v.y, v.z, v.w);
-}
-
-constexpr int kPerlinPermutation[256] = {SKYBAKE_PERLIN_PERMUTATION};
-int PerlinPermutation(int i) { return kPerlinPermutation[i]; }
-
-#include "atmosphere.glsl"
-#include "aoas.glsl"
-#include "envmap.glsl"
-
-}  // namespace reference
 
 struct ReferenceModel::Impl {
-  reference::AtmosphereParameters atm;
-  reference::AoasParameters aoas;
+  glsl::AtmosphereParameters atm;
+  glsl::AoasParameters aoas;
   gpu::GpuAoas gpu_aoas;
   glm::dvec3 output_scale;
   std::vector<glm::dvec3> transmittance;
@@ -70,14 +23,17 @@ struct ReferenceModel::Impl {
   bool skyview_ready = false;
   glm::dvec3 skyview_sun{0.0};
 
+  // The LUTs and the AOAS block, for the shared code's hooks on this thread.
   void Bind() const {
-    reference::g_luts.transmittance = &transmittance;
-    reference::g_luts.multiscattering = &multiscattering;
-    reference::g_luts.skyview = &skyview;
-    reference::g_luts.skyview_width = atm.sky_view_width;
-    reference::g_luts.transmittance_width = atm.transmittance_width;
-    reference::g_luts.multiscattering_width = atm.multiscattering_width;
-    reference::g_aoas = &gpu_aoas;
+    glsl::Tables tables;
+    tables.transmittance = &transmittance;
+    tables.multiscattering = &multiscattering;
+    tables.skyview = &skyview;
+    tables.skyview_width = atm.sky_view_width;
+    tables.transmittance_width = atm.transmittance_width;
+    tables.multiscattering_width = atm.multiscattering_width;
+    tables.aoas = &gpu_aoas;
+    glsl::BindTables(tables);
   }
 };
 
@@ -101,8 +57,8 @@ glm::dvec3 ToVec(const Rgb& rgb) { return {rgb[0], rgb[1], rgb[2]}; }
 glm::dvec3 ToVec(const gpu::vec4& v) { return {v.x, v.y, v.z}; }
 
 // The same unpacking as AoasFromUniform() in shaders/common.glsl.
-reference::AoasParameters AoasFromUniform(const gpu::GpuAoas& g, const AoasSwitches& switches) {
-  reference::AoasParameters aoas;
+glsl::AoasParameters AoasFromUniform(const gpu::GpuAoas& g, const AoasSwitches& switches) {
+  glsl::AoasParameters aoas;
   aoas.dome_radius = g.dome.x;
   aoas.viewer_position = ToVec(g.viewer);
   aoas.l_pt = g.dome.y;
@@ -131,33 +87,8 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
     : impl_(new Impl) {
   impl_->gpu_aoas = aoas_inputs.uniform;
   impl_->aoas = AoasFromUniform(aoas_inputs.uniform, aoas_inputs.switches);
-  reference::AtmosphereParameters& atm = impl_->atm;
-  FillPhysicalParameters(a, atm);
-  atm.transmittance_width = q.transmittance_width;
-  atm.transmittance_height = q.transmittance_height;
-  atm.multiscattering_width = q.multiscattering_size;
-  atm.multiscattering_height = q.multiscattering_size;
-  atm.view_steps = q.view_steps;
-  atm.transmittance_steps = q.transmittance_steps;
-  atm.multiscattering_steps = q.multiscattering_steps;
-  atm.multiscattering_sqrt_dirs = q.multiscattering_sqrt_dirs;
-  atm.integrator = q.integrator;
-  atm.light_steps = q.light_steps;
-  atm.step_distribution = q.step_distribution;
-  atm.sky_view_width = q.sky_view_width;
-  atm.sky_view_height = q.sky_view_height;
+  impl_->atm = glsl::SharedAtmosphere(a, q, effects);
   impl_->use_skyview = q.sky_view_lut;
-  atm.multiple_scattering = effects.multiple_scattering;
-  atm.sun_disc = effects.sun_disc;
-  atm.ground = effects.ground;
-  atm.mie = effects.mie;
-  atm.ozone = effects.ozone;
-  atm.multiple_scattering_strength = effects.multiple_scattering_strength;
-  atm.sun_disc_strength = effects.sun_disc_strength;
-  atm.night = effects.night_dimming;
-  Rgb night = NightSkyRadiance(effects);
-  atm.night_radiance = ToVec(night);
-  atm.night_strength = effects.night_dimming_strength;
   impl_->output_scale = ToVec(output_scale);
   impl_->transmittance.assign(size_t(q.transmittance_width) * q.transmittance_height, glm::dvec3(1.0));
   impl_->multiscattering.assign(size_t(q.multiscattering_size) * q.multiscattering_size, glm::dvec3(0.0));
@@ -169,16 +100,16 @@ ReferenceModel::ReferenceModel(ReferenceModel&& other) noexcept : impl_(other.im
 }
 
 void ReferenceModel::PrecomputeLuts() {
-  const reference::AtmosphereParameters& atm = impl_->atm;
+  const glsl::AtmosphereParameters& atm = impl_->atm;
   int tw = atm.transmittance_width;
   ParallelFor(impl_->transmittance.size(), impl_, [&](size_t i) {
-    impl_->transmittance[i] = reference::ComputeTransmittanceLutTexel(atm, int(i % tw), int(i / tw));
+    impl_->transmittance[i] = glsl::ComputeTransmittanceLutTexel(atm, int(i % tw), int(i / tw));
   });
   if (atm.multiple_scattering) {
     int mw = atm.multiscattering_width;
     ParallelFor(impl_->multiscattering.size(), impl_, [&](size_t i) {
       impl_->multiscattering[i] =
-          reference::ComputeMultipleScatteringLutTexel(atm, int(i % mw), int(i / mw));
+          glsl::ComputeMultipleScatteringLutTexel(atm, int(i % mw), int(i / mw));
     });
   }
 }
@@ -188,11 +119,11 @@ void ReferenceModel::PrepareSun(const glm::dvec3& sun) const {
   if (impl_->skyview_ready && impl_->skyview_sun == sun) return;
   impl_->skyview_ready = true;
   impl_->skyview_sun = sun;
-  const reference::AtmosphereParameters& atm = impl_->atm;
+  const glsl::AtmosphereParameters& atm = impl_->atm;
   impl_->skyview.assign(size_t(atm.sky_view_width) * atm.sky_view_height, glm::dvec3(0.0));
   int w = atm.sky_view_width;
   ParallelFor(impl_->skyview.size(), impl_, [&](size_t i) {
-    impl_->skyview[i] = reference::ComputeSkyViewLutTexel(atm, int(i % w), int(i / w), sun.y);
+    impl_->skyview[i] = glsl::ComputeSkyViewLutTexel(atm, int(i % w), int(i / w), sun.y);
   });
 }
 
@@ -200,14 +131,14 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
   PrepareSun(sun);  // the sky-view LUT, as the GPU builds it
   impl_->Bind();
   if (impl_->use_skyview)
-    return reference::ComputeSkyRadianceFromSkyView(impl_->atm, view, sun) * impl_->output_scale;
-  return reference::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
+    return glsl::ComputeSkyRadianceFromSkyView(impl_->atm, view, sun) * impl_->output_scale;
+  return glsl::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
 }
 
 glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
   PrepareSun(sun);
   impl_->Bind();
-  return reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
+  return glsl::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
          impl_->output_scale;
 }
 
@@ -216,7 +147,7 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
   std::vector<glm::dvec3> dirs = ViewDirections(view);
   std::vector<double> image(dirs.size() * 4);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {
-    glm::dvec3 l = reference::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun,
+    glm::dvec3 l = glsl::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun,
                                                        impl_->use_skyview) *
                    impl_->output_scale;
     image[4 * i + 0] = l.x;
@@ -230,12 +161,12 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
 glm::dvec3 ReferenceModel::TransmittanceFromLut(double altitude_km, double mu) const {
   impl_->Bind();
   double r = impl_->atm.bottom_radius + altitude_km;
-  return reference::GetTransmittanceToTopBoundary(impl_->atm, r, altitude_km, mu);
+  return glsl::GetTransmittanceToTopBoundary(impl_->atm, r, altitude_km, mu);
 }
 
 glm::dvec3 ReferenceModel::TransmittanceDirect(double altitude_km, double mu, int steps) const {
   double r = impl_->atm.bottom_radius + altitude_km;
-  return glm::exp(-reference::ComputeOpticalDepthToTopBoundary(impl_->atm, r, altitude_km, mu, steps));
+  return glm::exp(-glsl::ComputeOpticalDepthToTopBoundary(impl_->atm, r, altitude_km, mu, steps));
 }
 
 const std::vector<glm::dvec3>& ReferenceModel::transmittance_lut() const { return impl_->transmittance; }
