@@ -77,6 +77,22 @@ vec4 GgxSampleEntry(uint i, uint samples, float alpha, int face_size, int levels
   return vec4(l, FilteredLod(1.0 / (float(samples) * pdf), face_size, levels, bias));
 }
 
+// Coarse grids (IBL_MODE_SPECULAR_GRID): a sample whose filtered lookup
+// reads source mip m returns, as a function of the texel's direction, a
+// signal that is bilinear between that mip's texels, 2^m source texels
+// apart, so at level l (texels 2^l source texels apart) its lookups need
+// not be taken at every texel: grid k, 2^k texels of the level apart, holds
+// the sum over the samples with floor(m - l) = k (k = 0: the texels
+// themselves; k at most `grids`), and each texel adds those sums bilinearly
+// interpolated. A sample is thus never read on a grid coarser than its own
+// mip's texels. With N = V the mip depends on the sample alone, so every
+// texel of a level splits the table the same way.
+int IblGridOf(float lod, int level, int grids) { return clamp(int(floor(lod - float(level))), 0, grids); }
+
+// The number of coarse grids of a level of face_size texels: down to 2 x 2,
+// at most IBL_MAX_GRIDS.
+int IblGridCount(int face_size) { return clamp(findMSB(face_size) - 1, 0, IBL_MAX_GRIDS); }
+
 // The Sun as a point source of irradiance E (at normal incidence) in
 // direction s, through the same kernel as the GGX sample table: E (n.s) D(h) / 4 / W,
 // W the kernel's normalization (the integral of (n.l) D(h) / 4 over n.l > 0,

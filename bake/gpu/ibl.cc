@@ -119,12 +119,15 @@ CubeTexel VulkanCubeTexelFromDirection(const glm::dvec3& d, int face_size) {
 
 namespace {
 
-// One dispatch of the filter: a specular level, the irradiance cube or the
-// DFG table, written from output texel `first_texel` on.
+// One dispatch of the filter: a specular level or one of its coarse grids,
+// the irradiance cube or the DFG table, written from output texel
+// `first_texel` on.
 struct Pass {
   int mode, size, level;
   VkDeviceSize first_texel;
-  VkDeviceSize table_first = 0;  // IBL_MODE_SPECULAR: the first entry of the level's sample table
+  VkDeviceSize table_first = 0;  // IBL_MODE_SPECULAR(_GRID): the first entry of the level's sample table
+  VkDeviceSize grids_first = 0;  // IBL_MODE_SPECULAR: the first texel of its coarse grids
+  int grid = 0;                  // IBL_MODE_SPECULAR_GRID: k, the grid 2^k texels of the level apart
 };
 
 // The passes a request asks for, in the order they are recorded, and the
@@ -134,9 +137,15 @@ struct IblPassList {
   VkDeviceSize texels = 0;
 };
 
+// The number of coarse grids of a specular level of `size` texels (IblGridCount in ibl.glsl).
+int GridCount(int size) { return std::clamp(Log2(size) - 1, 0, IBL_MAX_GRIDS); }
+
 // Output texels: specular levels 1.. (level 0 is the source itself), the
 // irradiance cube, the DFG table; then each specular level's GGX sample
-// table (GgxSampleEntry, one vec4 a sample), in the same buffer.
+// table (GgxSampleEntry, one vec4 a sample) and its coarse grids (IblGridOf
+// in ibl.glsl; (size / 2^k + 2)^2 texels a face, a border included), in
+// the same buffer. The grids are recorded first: the level's own pass adds
+// them.
 IblPassList PlanPasses(const IblSettings& s, bool dfg, int levels, const std::vector<double>& roughness) {
   IblPassList list;
   VkDeviceSize& texels = list.texels;
@@ -154,11 +163,22 @@ IblPassList PlanPasses(const IblSettings& s, bool dfg, int levels, const std::ve
     list.passes.push_back({IBL_MODE_DFG, s.dfg_size, 0, texels});
     texels += VkDeviceSize(s.dfg_size) * s.dfg_size;
   }
-  for (Pass& p : list.passes)
-    if (p.mode == IBL_MODE_SPECULAR) {
-      p.table_first = texels;
-      texels += VkDeviceSize(IblLevelSamples(s, roughness[p.level]));
+  std::vector<Pass> grids;
+  for (Pass& p : list.passes) {
+    if (p.mode != IBL_MODE_SPECULAR) continue;
+    p.table_first = texels;  // the table, then its runs (IBL_MODE_GRID_RANGES)
+    texels += VkDeviceSize(IblLevelSamples(s, roughness[p.level])) + IBL_MAX_GRIDS + 1;
+    if (roughness[p.level] <= 0.0) continue;  // a copy of the source: no samples
+    p.grids_first = texels;
+    for (int k = 1; k <= GridCount(p.size); ++k) {
+      const int m = p.size >> k;
+      Pass grid{IBL_MODE_SPECULAR_GRID, m, p.level, texels, p.table_first};
+      grid.grid = k;
+      grids.push_back(grid);
+      texels += VkDeviceSize(m + 2) * (m + 2) * 6;
     }
+  }
+  list.passes.insert(list.passes.begin(), grids.begin(), grids.end());
   return list;
 }
 
@@ -244,12 +264,14 @@ gpu::IblPush PushFor(const IblRequest& request, const Pass& p, double roughness,
                      uint32_t source_levels) {
   const IblSettings& s = request.settings;
   const double alpha = roughness * roughness;
-  const int samples = p.mode == IBL_MODE_SPECULAR     ? IblLevelSamples(s, roughness)
+  const bool specular = p.mode == IBL_MODE_SPECULAR || p.mode == IBL_MODE_SPECULAR_GRID;
+  const int samples = specular                        ? IblLevelSamples(s, roughness)
                       : p.mode == IBL_MODE_IRRADIANCE ? s.irradiance_samples
                                                       : s.dfg_samples;
   gpu::IblPush push{};
   push.target = {p.mode, p.size, int32_t(p.first_texel), samples};
-  push.source = {source_size, int32_t(source_levels), int32_t(p.table_first), 0};
+  push.source = {source_size, int32_t(source_levels), int32_t(p.table_first),
+                 p.mode == IBL_MODE_SPECULAR_GRID ? p.grid : int32_t(p.grids_first)};
   push.lobe = {float(alpha), float(s.lod_bias),
                p.mode == IBL_MODE_SPECULAR ? float(IblSunKernelNormalization(alpha)) : 0.0f,
                s.include_sun ? 1.0f : 0.0f};
@@ -261,7 +283,7 @@ gpu::IblPush PushFor(const IblRequest& request, const Pass& p, double roughness,
 }
 
 const char* TimingName(int mode) {
-  return mode == IBL_MODE_SPECULAR ? "IBL specular" : mode == IBL_MODE_IRRADIANCE ? "IBL irradiance" : "IBL DFG";
+  return mode == IBL_MODE_SPECULAR || mode == IBL_MODE_SPECULAR_GRID ? "IBL specular" : mode == IBL_MODE_IRRADIANCE ? "IBL irradiance" : "IBL DFG";
 }
 
 }  // namespace
@@ -506,24 +528,39 @@ std::vector<int> IblBaker::RecordPasses(const Resources& r, const std::vector<gp
                     1);
     tables = true;
   }
-  if (tables)
+  if (tables) {
+    BufferBarrier(cmd, r.output, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                  VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    // Each table's runs, one per grid, then a barrier: every filter pass reads them.
+    for (gpu::IblPush push : passes) {
+      if (push.target.x != IBL_MODE_SPECULAR) continue;
+      push.target.x = IBL_MODE_GRID_RANGES;
+      PushAndDispatch(cmd, pipeline_layout_, push, 1, 1, 1);
+    }
     BufferBarrier(cmd, r.output, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                   VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+  }
 
-  // Passes write disjoint texels and read only the image and the tables: no
-  // barrier between them.
+  // Passes write disjoint texels and read only the image and the tables,
+  // but a specular level's own pass reads its coarse grids: one barrier
+  // after the grids.
   int open_mode = -1;
   std::vector<int> modes;  // the mode of each timestamp pair
   for (const gpu::IblPush& push : passes) {
     const int mode = push.target.x, size = push.target.y;
-    if (timestamps_ && mode != open_mode) {
-      if (open_mode >= 0)
+    if (mode != open_mode) {
+      if (timestamps_ && open_mode >= 0)
         vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 1));
-      modes.push_back(mode);
-      vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 2));
+      if (open_mode == IBL_MODE_SPECULAR_GRID)
+        BufferBarrier(cmd, r.output, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                      VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+      if (timestamps_) {
+        modes.push_back(mode);
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * modes.size() - 2));
+      }
       open_mode = mode;
     }
-    const uint32_t groups = Groups(size, SKYBAKE_LOCAL_SIZE_X);
+    const uint32_t groups = Groups(mode == IBL_MODE_SPECULAR_GRID ? size + 2 : size, SKYBAKE_LOCAL_SIZE_X);
     PushAndDispatch(cmd, pipeline_layout_, push, groups, groups, mode == IBL_MODE_DFG ? 1 : 6);
   }
   if (timestamps_ && open_mode >= 0)

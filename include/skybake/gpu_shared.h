@@ -191,11 +191,15 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
 #define IBL_MODE_IRRADIANCE 1  // cosine-filtered radiance E / pi (a white Lambertian surface's radiance)
 #define IBL_MODE_DFG 2         // split-sum DFG table: x = N.V, y = perceptual roughness
 #define IBL_MODE_GGX_SAMPLES 3 // a specular level's GGX sample table (GgxSampleEntry), shared by its texels
+#define IBL_MODE_SPECULAR_GRID 4 // a specular level's wide-footprint samples on a grid 2^k coarser (IblGridOf)
+#define IBL_MODE_GRID_RANGES 5 // the run of a level's sorted sample table each grid holds, and the table's weight
+#define IBL_MAX_GRIDS 4        // coarse grids a specular level has at most (k = 1..4)
 
 SKYBAKE_GPU_STRUCT(IblPush) {
   ivec4 target;         // x: IBL_MODE_*; y: face size of this level, texels; z: first output texel; w: samples
   ivec4 source;         // x: face size of the source's level 0, texels; y: source mip count;
-                        // z: IBL_MODE_SPECULAR: first entry of the level's sample table in the output; w: unused
+                        // z: IBL_MODE_SPECULAR(_GRID): first entry of the level's sample table in the output;
+                        // w: IBL_MODE_SPECULAR: first texel of the level's coarse grids; _GRID: the grid's k
   vec4 lobe;            // x: GGX alpha = roughness^2; y: mip bias of the filtered lookups (log2 texels);
                         // z: normalization W of the sun's kernel (IblSunKernelNormalization); w: 1 = add the sun
   vec4 sun_direction;   // xyz: unit vector towards the Sun; w: unused

@@ -117,7 +117,7 @@ class IblBaker {
 
  private:
   struct Resources;
-  static constexpr uint32_t kTimestampQueries = 6;  // a begin and an end for each of the three modes
+  static constexpr uint32_t kTimestampQueries = 8;  // a begin and an end for each of the four modes
   void Release();
   void CreateSourceImage(Resources& r, const std::vector<CubeLevel>& chain);
   void CreateOutputAndSet(Resources& r, VkDeviceSize texels);

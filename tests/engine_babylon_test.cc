@@ -1,0 +1,107 @@
+// The babylon preset checked in Babylon.js itself (headless Chromium,
+// babylonjs 9 from tests/viewer/node_modules, tests/viewer/
+// engine_babylon_cube.html): `skybake testpattern --engine babylon` writes
+// the preset's faces, and the page loads them as a Babylon user loads a
+// skybox, CubeTexture("sky_babylon", scene, ["_px", "_py", "_pz", "_nx",
+// "_ny", "_nz"]) on a StandardMaterial box in SKYBOX_MODE, in Babylon's
+// default left-handed scene. A 3-degree camera looks along known directions:
+// a direction d of skybake's world is g = (-d.x, d.y, d.z) in Babylon's
+// (its glTF loader's root node mirrors x, docs/engines.md), and there it must
+// see the face, the horizon and North's letter that the pattern puts at d.
+// Babylon's CubeTexture loads images, not EXRs (its EXR loader does no cube
+// of six files), so the test writes each face EXR as an 8-bit PNG of the
+// same name first (the pattern's colours are in [0, 1]). skybake's own
+// Vulkan faces loaded the same way show the trap the preset removes.
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <OpenImageIO/imageio.h>
+#include <glm/glm.hpp>
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "skybake/pipeline/test_pattern.h"
+#include "test_support.h"
+
+namespace skybake {
+namespace {
+
+// `stem`.exr as an 8-bit RGB PNG `stem`.png (values clamped to [0, 1], no transfer curve).
+void WritePng(const std::string& stem) {
+  auto in = OIIO::ImageInput::open(stem + ".exr");
+  ASSERT_TRUE(in) << stem;
+  const OIIO::ImageSpec& spec = in->spec();
+  std::vector<float> rgb(size_t(spec.width) * spec.height * 3);
+  ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, rgb.data()));
+  std::vector<unsigned char> bytes(rgb.size());
+  for (size_t i = 0; i < rgb.size(); ++i) bytes[i] = (unsigned char)std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f);
+  auto out = OIIO::ImageOutput::create(stem + ".png");
+  ASSERT_TRUE(out);
+  ASSERT_TRUE(out->open(stem + ".png", OIIO::ImageSpec(spec.width, spec.height, 3, OIIO::TypeDesc::UINT8)));
+  ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, bytes.data()));
+  out->close();
+}
+
+TEST(EngineBabylonTest, TestPatternFacesAreWhereTheySayInBabylon) {
+  const std::string dir = testing::FreshTempDir("engine_babylon_pattern");
+  testing::CommandRun r = testing::RunSkybake("testpattern --engine babylon --size 128 --out " + dir);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"}) {
+    WritePng(dir + "/sky_babylon_" + face);
+    WritePng(dir + "/sky_" + face);
+  }
+  // The directions of engine_threejs_test, in skybake's world: face axes 10
+  // degrees below the horizon (the horizon line and the letters are above
+  // or on it), the +X face's horizon and beside it, North's letter.
+  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0}, {0, -1, 0}, {0, -0.18, 1},
+                                        {0, -0.18, -1},
+                                        {1, 0, 0.5},
+                                        {1, 0.2, 0.5},
+                                        {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
+  std::string query = "bases=sky_babylon,sky&dirs=";
+  for (size_t i = 0; i < dirs.size(); ++i)
+    query += (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
+             std::to_string(dirs[i].z);
+  const std::string command = "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs "
+                              "engine_babylon_cube.html '" + dir + "' '" + dir + "/babylon.png' '" + query + "'";
+  auto [code, output] = testing::RunCommand(command);
+  ASSERT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("{\"chromium_exit\"");
+  ASSERT_NE(at, std::string::npos) << output;
+  const nlohmann::json report = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at))["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("Babylon.js pattern: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["handedness"], "left") << "Babylon's default scene";
+  // 8-bit faces: each colour within 2 steps of 255 of the tint.
+  const double tolerance = 2.0 / 255.0;
+  const auto seen = report["sky_babylon"].get<std::vector<std::vector<double>>>();
+  ASSERT_EQ(seen.size(), dirs.size());
+  for (int face = 0; face < 6; ++face) {
+    const glm::dvec3 expected = TestPatternFaceColor(face);
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(seen[size_t(face)][size_t(c)], expected[c], tolerance) << "along face " << face << " channel " << c;
+  }
+  // The white horizon line lifts green on the red +X face; the view above it is plain.
+  EXPECT_GT(seen[6][1], TestPatternFaceColor(0)[1] + 0.1) << "horizon";
+  EXPECT_NEAR(seen[7][1], TestPatternFaceColor(0)[1], tolerance) << "above the horizon";
+  // North's white letter lifts blue on the yellow -Z face.
+  EXPECT_GT(seen[8][2], TestPatternFaceColor(5)[2] + 0.1) << "N above the horizon at -Z";
+  // skybake's own faces (Vulkan order and orientation) loaded the same way:
+  // at least one face axis shows another face's tint.
+  const auto plain = report["sky"].get<std::vector<std::vector<double>>>();
+  ASSERT_EQ(plain.size(), dirs.size());
+  int wrong = 0;
+  for (int face = 0; face < 6; ++face) {
+    const glm::dvec3 expected = TestPatternFaceColor(face);
+    double d = 0.0;
+    for (int c = 0; c < 3; ++c) d = std::max(d, std::abs(plain[size_t(face)][size_t(c)] - expected[c]));
+    wrong += d > 0.1;
+  }
+  EXPECT_GT(wrong, 0) << "the Vulkan faces load right in Babylon without the preset";
+  std::printf("Babylon.js: %d of 6 face axes show another face with skybake's Vulkan faces\n", wrong);
+}
+
+}  // namespace
+}  // namespace skybake
