@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <random>
 
 #include <fmt/format.h>
@@ -527,15 +528,17 @@ TEST(NightSkyGpu, MoonlightIsBelowHalfFloatResolutionWhileTheSunIsUp) {
   testing::ExpectNoValidationMessages();
 }
 
-// The splat bound (SplatBound) skips only what cannot change a byte: the
-// maps of one frame's stars and Moon, with the bound and with every splat
-// run whole, are the same bytes, under a high sun (every view skipped), a
-// low sun with the first-quarter Moon up (its disc shows in daylight: the
-// bound opens only the texels around it), and at night (stars everywhere).
+// The bounds (BoundByTiles, then SplatBound) skip only what cannot change a
+// byte: the maps of one frame's stars, Moon and airglow, with the bounds and
+// with every splat run whole and the glow checked texel by texel, are the
+// same bytes at every sun elevation from high noon through the dusk where
+// stars begin to show to the night, with the first-quarter Moon up (its disc
+// shows in daylight: the bounds open only the texels around it) and down.
 TEST(NightSkyGpu, SplatBoundChangesNoByte) {
   SkyStyle style;
   style.night.stars = true;
   style.night.moon = true;
+  style.night.airglow = true;
   style.effects.night_dimming = true;
   std::string error;
   const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
@@ -543,7 +546,8 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
   const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
   const Rgb scale = OutputScale(style.output.units);
   SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, scale);
-  NightSkyRenderer bounded(testing::Vulkan()), whole(testing::Vulkan());
+  NightSkyRenderer bounded(testing::Vulkan()), exact(testing::Vulkan()), whole(testing::Vulkan());
+  exact.set_tile_bound(false);
   whole.set_splat_bound(false);
   std::vector<ViewRequest> views = ViewsOfSize(64);
   for (const ViewRequest& v : ViewsOfSize(256)) views.push_back(v);
@@ -551,58 +555,111 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
   // in the East; 2024-04-16 08:20 UT: the Moon down.
   const GeoLocation paranal{-24.6272, -70.4042};
   const double moon_up = 2460415.5 + 22.0 / 24.0 + 20.0 / 1440.0, moon_down = moon_up + 10.0 / 24.0;
-  struct Case {
-    double sun_elevation_deg;
-    double julian_day_ut;
-    const char* what;
-  };
-  for (const Case& c : {Case{50.0, moon_down, "high sun"}, Case{4.0, moon_up, "low sun, Moon up"},
-                        Case{-40.0, moon_up, "night"}}) {
-    const glm::dvec3 sun = SunDirectionFromElevationAzimuth(c.sun_elevation_deg, 290.0);
-    const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
-    const NightFrame night = ComputeNightFrame(style, &*catalogue, table, c.julian_day_ut, paranal, sun);
-    ASSERT_GT(night.stars, 1000u);
-    ASSERT_TRUE(night.moon);
-    if (c.julian_day_ut == moon_up) ASSERT_GT(night.moon->sky.elevation_deg, 30.0);
-    else ASSERT_LT(night.moon->sky.elevation_deg, -5.0);
-    std::vector<RgbaImage> a, b;
-    for (size_t i = 0; i < views.size(); ++i) {
-      a.push_back({views[i].width, views[i].height, sky[i], nullptr});
-      b.push_back({views[i].width, views[i].height, sky[i], nullptr});
+  const std::vector<Rgb> airglow =
+      AirglowTable(style.atmosphere, table, 90.0, style.effects.night_sky_luminance_cd_m2, style.output.units);
+  size_t dusk_views_skipped = 0, dusk_views_changed = 0;
+  for (const double elevation : {50.0, 20.0, 8.0, 4.0, 1.0, -1.0, -3.0, -5.0, -7.0, -9.0, -12.0, -40.0})
+    for (const double julian_day_ut : {moon_down, moon_up}) {
+      const bool up = julian_day_ut == moon_up;
+      const std::string what = fmt::format("sun {} deg, Moon {}", elevation, up ? "up" : "down");
+      const glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 290.0);
+      const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
+      NightFrame night = ComputeNightFrame(style, &*catalogue, table, julian_day_ut, paranal, sun);
+      night.airglow = airglow;
+      ASSERT_GT(night.stars, 1000u);
+      ASSERT_TRUE(night.moon);
+      if (up) ASSERT_GT(night.moon->sky.elevation_deg, 30.0);
+      else ASSERT_LT(night.moon->sky.elevation_deg, -5.0);
+      std::vector<RgbaImage> a, b, c;
+      for (size_t i = 0; i < views.size(); ++i) {
+        a.push_back({views[i].width, views[i].height, sky[i], nullptr});
+        b.push_back({views[i].width, views[i].height, sky[i], nullptr});
+        c.push_back({views[i].width, views[i].height, sky[i], nullptr});
+      }
+      const size_t skipped_before = bounded.splats_skipped(), tiles_before = bounded.splats_skipped_by_tiles();
+      const auto t0 = std::chrono::steady_clock::now();
+      bounded.AddToViews(style, night, views, a);
+      const auto t1 = std::chrono::steady_clock::now();
+      exact.AddToViews(style, night, views, c);
+      const auto t2 = std::chrono::steady_clock::now();
+      whole.AddToViews(style, night, views, b);
+      const auto t3 = std::chrono::steady_clock::now();
+      const size_t skipped = bounded.splats_skipped() - skipped_before;
+      const size_t by_tiles = bounded.splats_skipped_by_tiles() - tiles_before;
+      size_t changed = 0;
+      for (size_t i = 0; i < views.size(); ++i) {
+        ASSERT_EQ(a[i].rgba.size(), b[i].rgba.size());
+        ASSERT_EQ(c[i].rgba.size(), b[i].rgba.size());
+        EXPECT_EQ(std::memcmp(a[i].rgba.data(), b[i].rgba.data(), a[i].rgba.size() * sizeof(float)), 0)
+            << what << ", view " << i;
+        EXPECT_EQ(std::memcmp(c[i].rgba.data(), b[i].rgba.data(), c[i].rgba.size() * sizeof(float)), 0)
+            << what << ", view " << i;
+        changed += a[i].rgba != sky[i];
+      }
+      // For the record (docs/performance.md), not a target.
+      std::printf("%s: the night's additions with both bounds %.1f ms, SplatBound alone %.1f ms, whole %.1f ms; "
+                  "%zu of %zu views skipped (%zu by the tiles), %zu changed\n",
+                  what.c_str(), std::chrono::duration<double, std::milli>(t1 - t0).count(),
+                  std::chrono::duration<double, std::milli>(t2 - t1).count(),
+                  std::chrono::duration<double, std::milli>(t3 - t2).count(), skipped, views.size(), by_tiles,
+                  changed);
+      if (elevation >= 20.0 && !up) {
+        // Nothing to splat anywhere, and the tiles alone show it but for a
+        // few of the larger views, where a tile's stars together outweigh
+        // its smallest texel (the latlong's polar rows): SplatBound then
+        // finds nothing either.
+        EXPECT_EQ(skipped, views.size()) << what;
+        EXPECT_GE(by_tiles, views.size() - 4) << what;
+        EXPECT_EQ(changed, 0u) << what;
+      } else if (elevation >= 20.0) {
+        EXPECT_GT(changed, 0u) << what;  // the Moon in daylight
+        EXPECT_GT(by_tiles, 0u) << what;  // the faces without it
+      } else if (elevation < -15.0) {
+        // Stars (and the glow) on every view but the faces below the
+        // horizon (-Y); by night neither bound is used, the splats run whole.
+        EXPECT_EQ(skipped, 0u) << what;
+        EXPECT_EQ(changed, views.size() - 2) << what;
+        EXPECT_EQ(a[3].rgba, sky[3]);
+      } else {
+        // Sunrise and dusk: the brightest stars begin to show in the data
+        // before the Sun is down (a 256 face's texel is small enough).
+        dusk_views_skipped += by_tiles;
+        dusk_views_changed += changed;
+      }
     }
-    const size_t skipped_before = bounded.splats_skipped();
-    const auto t0 = std::chrono::steady_clock::now();
-    bounded.AddToViews(style, night, views, a);
-    const auto t1 = std::chrono::steady_clock::now();
-    whole.AddToViews(style, night, views, b);
-    const auto t2 = std::chrono::steady_clock::now();
-    // For the record (docs/performance.md), not a target.
-    std::printf("%s: the night's splat with the bound %.1f ms, whole %.1f ms\n", c.what,
-                std::chrono::duration<double, std::milli>(t1 - t0).count(),
-                std::chrono::duration<double, std::milli>(t2 - t1).count());
-    const size_t skipped = bounded.splats_skipped() - skipped_before;
-    size_t changed = 0;
-    for (size_t i = 0; i < views.size(); ++i) {
-      ASSERT_EQ(a[i].rgba.size(), b[i].rgba.size());
-      EXPECT_EQ(std::memcmp(a[i].rgba.data(), b[i].rgba.data(), a[i].rgba.size() * sizeof(float)), 0)
-          << c.what << ", view " << i;
-      changed += a[i].rgba != sky[i];
-    }
-    if (c.sun_elevation_deg > 40.0) {
-      EXPECT_EQ(skipped, views.size()) << c.what;  // nothing to splat anywhere
-      EXPECT_EQ(changed, 0u) << c.what;
-    } else if (c.sun_elevation_deg > 0.0) {
-      EXPECT_GT(changed, 0u) << c.what;  // the Moon in daylight
-      EXPECT_GT(skipped, 0u) << c.what;  // the faces without it
-    } else {
-      // Stars on every view but the faces below the horizon (-Y); by night
-      // the splats run whole.
-      EXPECT_EQ(skipped, 0u) << c.what;
-      EXPECT_EQ(changed, views.size() - 2) << c.what;
-      EXPECT_EQ(a[3].rgba, sky[3]);
-    }
-  }
+  // At dusk the bounds both skip views and let the first stars through.
+  EXPECT_GT(dusk_views_skipped, 0u);
+  EXPECT_GT(dusk_views_changed, 0u);
   testing::ExpectNoValidationMessages();
+}
+
+// The tile bound's smallest solid angle per tile, from its corner texels,
+// is the smallest of its texels' (faces, strips and latlongs, tiles cut by
+// the view's edge or, in a strip, by a face's).
+TEST(NightSky, SplatTilesHoldTheirSmallestSolidAngle) {
+  for (const int n : {16, 37, 64, 100})
+    for (const ViewRequest& view : ViewsOfSize(n)) {
+      const SplatTiles tiles(view, {});
+      std::vector<double> smallest(size_t(tiles.count()), std::numeric_limits<double>::infinity());
+      std::vector<int> texels(size_t(tiles.count()), 0);
+      for (int y = 0; y < view.height; ++y)
+        for (int x = 0; x < view.width; ++x) {
+          const int t = tiles.TileOf(x, y);
+          ASSERT_GE(t, 0);
+          ASSERT_LT(t, tiles.count());
+          int x0, x1, y0, y1;
+          tiles.Rect(t, x0, x1, y0, y1);
+          ASSERT_TRUE(x >= x0 && x < x1 && y >= y0 && y < y1) << n << " " << view.mapping;
+          ++texels[size_t(t)];
+          const double omega = ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG ? 0 : x, y);
+          smallest[size_t(t)] = std::min(smallest[size_t(t)], omega);
+        }
+      for (int t = 0; t < tiles.count(); ++t) {
+        EXPECT_GT(texels[size_t(t)], 0);
+        EXPECT_LE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 + 1e-12)) << n << " " << view.mapping << " " << t;
+        EXPECT_GE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 - 1e-12)) << n << " " << view.mapping << " " << t;
+      }
+    }
 }
 
 // The bound is conservative for any sky: random skies and random sources,
@@ -611,6 +668,7 @@ TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(-1.0, 1.0), log10(-9.0, -3.0), sky(-1.0, 4.0);
   int nothing_applied = 0, some_applied = 0, skipped_sources = 0;
+  int tile_skipped = 0, tile_narrowed = 0, glow_shown = 0, glow_skipped = 0;
   for (int trial = 0; trial < 12; ++trial) {
     // Every other trial a bright sky (10^3 to 10^5) and faint sources.
     sky = std::uniform_real_distribution<double>(trial % 2 ? 3.0 : -1.0, trial % 2 ? 5.0 : 4.0);
@@ -627,11 +685,48 @@ TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
         if (i % 4 != 3) rgba[i] = float(std::pow(10.0, sky(rng)));
       SplatBound bound;
       const std::vector<TexelAdd> bounded = BoundedSplat(view, sources, rgba.data(), kNightSplatMinRelative, &bound);
-      std::vector<float> whole = rgba, kept = rgba;
+      std::vector<float> whole = rgba, kept = rgba, tiled = rgba;
       const size_t applied = ApplyTexelAdds(SplatPointSources(view, sources), rgba.data(), whole.data(),
                                             kNightSplatMinRelative);
       ApplyTexelAdds(bounded, rgba.data(), kept.data(), kNightSplatMinRelative);
       EXPECT_EQ(std::memcmp(whole.data(), kept.data(), whole.size() * sizeof(float)), 0) << trial << " " << view.mapping;
+      // The tile bound in front: its sources alone through SplatBound give
+      // the same bytes, and it skips only views where nothing is applied.
+      std::vector<float> mu(size_t(view.width) * view.height);
+      for (int y = 0; y < view.height; ++y)
+        for (int x = 0; x < view.width; ++x) mu[size_t(y) * view.width + x] = float(ViewTexelDirection(view, x, y).y);
+      const SplatTiles tiles(view, mu);
+      const TileBound tb = BoundByTiles(view, tiles, sources, {}, rgba.data(), kNightSplatMinRelative);
+      EXPECT_FALSE(tb.airglow);
+      if (!tb.splat) {
+        EXPECT_EQ(applied, 0u) << trial << " " << view.mapping;
+        ++tile_skipped;
+      } else {
+        std::vector<PointSource> some;
+        for (size_t k : tb.sources) some.push_back(sources[k]);
+        tile_narrowed += some.size() < sources.size();
+        ApplyTexelAdds(BoundedSplat(view, some, rgba.data(), kNightSplatMinRelative), rgba.data(), tiled.data(),
+                       kNightSplatMinRelative);
+        EXPECT_EQ(std::memcmp(whole.data(), tiled.data(), whole.size() * sizeof(float)), 0)
+            << trial << " " << view.mapping;
+      }
+      // A glow: the tile bound lets it through wherever a texel takes it.
+      std::vector<Rgb> glow(kAirglowEntries);
+      const double g = std::pow(10.0, log10(rng) + 3.0);
+      for (int i = kAirglowEntries / 2; i < kAirglowEntries; ++i) glow[size_t(i)] = {g, g * (1.0 + 1e-3 * i), g};
+      const TileBound gb = BoundByTiles(view, tiles, {}, glow, rgba.data(), kNightSplatMinRelative);
+      bool shows = false;
+      for (size_t i = 0; i < mu.size() && !shows; ++i) {
+        const Rgb a = AirglowAt(glow, mu[i]);
+        const double add = std::max({a[0], a[1], a[2]});
+        const float* t = rgba.data() + 4 * i;
+        shows = add > 0.0 && !(add < kNightSplatMinRelative * std::max({double(t[0]), double(t[1]), double(t[2])}));
+      }
+      if (shows) {
+        EXPECT_TRUE(gb.airglow) << trial << " " << view.mapping;
+      }
+      glow_shown += shows;
+      glow_skipped += !gb.airglow;
       if (applied == 0) {
         ++nothing_applied;
         continue;
@@ -645,6 +740,12 @@ TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
   EXPECT_GT(nothing_applied, 0);
   EXPECT_GT(some_applied, 0);
   EXPECT_GT(skipped_sources, 0);
+  // The tile bound skipped views, narrowed the sources of others, let the
+  // glow through on some and kept it out of others.
+  EXPECT_GT(tile_skipped, 0);
+  EXPECT_GT(tile_narrowed, 0);
+  EXPECT_GT(glow_shown, 0);
+  EXPECT_GT(glow_skipped, 0);
 }
 
 }  // namespace

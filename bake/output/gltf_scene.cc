@@ -82,6 +82,81 @@ tinygltf::Value ToValue(const json& j) {
   return tinygltf::Value();
 }
 
+// Vertex positions (with the bounds glTF requires of them), normals, texture
+// coordinates and triangle indices, each in a bufferView of its own.
+int AddPositions(tinygltf::Model& model, const std::vector<glm::vec3>& positions) {
+  glm::vec3 lo(1e30f), hi(-1e30f);
+  for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
+  return AddAccessor(model,
+                     AddBufferView(model, positions.data(), positions.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, positions.size(), TINYGLTF_TYPE_VEC3, {lo.x, lo.y, lo.z},
+                     {hi.x, hi.y, hi.z});
+}
+
+int AddNormals(tinygltf::Model& model, const std::vector<glm::vec3>& normals) {
+  return AddAccessor(model, AddBufferView(model, normals.data(), normals.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, normals.size(), TINYGLTF_TYPE_VEC3);
+}
+
+int AddTexcoords(tinygltf::Model& model, const std::vector<glm::vec2>& uvs) {
+  return AddAccessor(model, AddBufferView(model, uvs.data(), uvs.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_FLOAT, uvs.size(), TINYGLTF_TYPE_VEC2);
+}
+
+int AddIndices(tinygltf::Model& model, const std::vector<uint32_t>& indices) {
+  return AddAccessor(model,
+                     AddBufferView(model, indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, indices.size(), TINYGLTF_TYPE_SCALAR);
+}
+
+// A PNG by file name, its sampler (linear, `wrap` on both axes) and the
+// texture joining them; returns the texture.
+int AddTexture(tinygltf::Model& model, const std::string& name, const std::string& uri, int wrap) {
+  tinygltf::Image image;
+  image.name = name;
+  image.uri = uri;
+  image.mimeType = "image/png";
+  model.images.push_back(image);
+  tinygltf::Sampler sampler;
+  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.wrapS = sampler.wrapT = wrap;
+  model.samplers.push_back(sampler);
+  tinygltf::Texture texture;
+  texture.source = int(model.images.size()) - 1;
+  texture.sampler = int(model.samplers.size()) - 1;
+  model.textures.push_back(texture);
+  return int(model.textures.size()) - 1;
+}
+
+// A rough, non-metallic material whose base colour is `texture`; `unlit`:
+// KHR_materials_unlit (the sky dome shows its texture as it is). Returns it.
+int AddMaterial(tinygltf::Model& model, const std::string& name, int texture, bool unlit) {
+  tinygltf::Material material;
+  material.name = name;
+  material.pbrMetallicRoughness.baseColorTexture.index = texture;
+  material.pbrMetallicRoughness.metallicFactor = 0.0;
+  material.pbrMetallicRoughness.roughnessFactor = 1.0;
+  if (unlit) material.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
+  model.materials.push_back(material);
+  return int(model.materials.size()) - 1;
+}
+
+// A mesh of one triangle primitive and the node that places it, both named
+// `name`; returns the node.
+int AddMeshNode(tinygltf::Model& model, const std::string& name, tinygltf::Primitive primitive) {
+  primitive.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Mesh mesh;
+  mesh.name = name;
+  mesh.primitives.push_back(primitive);
+  model.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.name = name;
+  node.mesh = int(model.meshes.size()) - 1;
+  model.nodes.push_back(node);
+  return int(model.nodes.size()) - 1;
+}
+
 // The texture PNG: a regular file, never read through a link.
 std::string ReadFile(const std::string& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
@@ -121,57 +196,16 @@ void AddCloudShadowGround(const SceneDescription& scene, tinygltf::Model& model,
   const std::vector<glm::vec3> normals(4, glm::vec3(0.0f, 1.0f, 0.0f));
   const std::vector<glm::vec2> uvs = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}, {1.0f, 1.0f}};
   const std::vector<uint32_t> indices = {0, 2, 3, 0, 3, 1};
-  glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
   tinygltf::Primitive primitive;
-  primitive.attributes["POSITION"] =
-      AddAccessor(model, AddBufferView(model, positions.data(), positions.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
-                  TINYGLTF_COMPONENT_TYPE_FLOAT, positions.size(), TINYGLTF_TYPE_VEC3, {lo.x, lo.y, lo.z},
-                  {hi.x, hi.y, hi.z});
-  primitive.attributes["NORMAL"] =
-      AddAccessor(model, AddBufferView(model, normals.data(), normals.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
-                  TINYGLTF_COMPONENT_TYPE_FLOAT, normals.size(), TINYGLTF_TYPE_VEC3);
-  primitive.attributes["TEXCOORD_0"] =
-      AddAccessor(model, AddBufferView(model, uvs.data(), uvs.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
-                  TINYGLTF_COMPONENT_TYPE_FLOAT, uvs.size(), TINYGLTF_TYPE_VEC2);
-  primitive.indices =
-      AddAccessor(model,
-                  AddBufferView(model, indices.data(), indices.size() * 4, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, indices.size(), TINYGLTF_TYPE_SCALAR);
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-
-  tinygltf::Image image;
-  image.name = "cloud_shadow";
-  image.uri = scene.ground_texture_file;
-  image.mimeType = "image/png";
-  model.images.push_back(image);
+  primitive.attributes["POSITION"] = AddPositions(model, positions);
+  primitive.attributes["NORMAL"] = AddNormals(model, normals);
+  primitive.attributes["TEXCOORD_0"] = AddTexcoords(model, uvs);
+  primitive.indices = AddIndices(model, indices);
   // A map that tiles repeats beyond its edges; one that does not is clamped.
-  tinygltf::Sampler sampler;
-  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-  sampler.wrapS = sampler.wrapT = g.tiles ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-  model.samplers.push_back(sampler);
-  tinygltf::Texture texture;
-  texture.source = int(model.images.size()) - 1;
-  texture.sampler = int(model.samplers.size()) - 1;
-  model.textures.push_back(texture);
-  tinygltf::Material material;
-  material.name = "cloud_shadow_ground";
-  material.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size()) - 1;
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 1.0;
-  model.materials.push_back(material);
-  primitive.material = int(model.materials.size()) - 1;
-
-  tinygltf::Mesh mesh;
-  mesh.name = "cloud_shadow_ground";
-  mesh.primitives.push_back(primitive);
-  model.meshes.push_back(mesh);
-  tinygltf::Node node;
-  node.name = "cloud_shadow_ground";
-  node.mesh = int(model.meshes.size()) - 1;
-  model.nodes.push_back(node);
-  gltf_scene.nodes.push_back(int(model.nodes.size()) - 1);
+  const int texture = AddTexture(model, "cloud_shadow", scene.ground_texture_file,
+                                 g.tiles ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+  primitive.material = AddMaterial(model, "cloud_shadow_ground", texture, false);
+  gltf_scene.nodes.push_back(AddMeshNode(model, "cloud_shadow_ground", primitive));
 }
 
 // EXT_lights_image_based: the RGBD faces as images (by file name; the .glb
@@ -271,65 +305,175 @@ glm::dquat SunNodeRotation(const glm::dvec3& sun_direction) {
 
 namespace {
 
-// The Moon: light 1, node 2, its rotation keys in the animation (a second
-// one when the Sun has none).
-void AddMoonLight(tinygltf::Model& model, const std::vector<SceneSun>& moons, tinygltf::Scene& gltf_scene) {
-  size_t brightest = 0;
-  for (size_t i = 1; i < moons.size(); ++i)
-    if (moons[i].illuminance_lux > moons[brightest].illuminance_lux) brightest = i;
-  const SceneSun& key = moons[brightest];
+// A KHR_lights_punctual directional light of `sun`'s illuminance (lux) and
+// colour, and the node that turns it (its -Z along the sun's direction);
+// returns the node.
+int AddDirectionalLight(tinygltf::Model& model, const std::string& name, const SceneSun& sun) {
   tinygltf::Light light;
-  light.name = "moon";
+  light.name = name;
   light.type = "directional";
-  light.intensity = key.illuminance_lux;
-  light.color = {key.color[0], key.color[1], key.color[2]};
+  light.intensity = sun.illuminance_lux;
+  light.color = {sun.color[0], sun.color[1], sun.color[2]};
   model.lights.push_back(light);
   tinygltf::Node node;
-  node.name = "moon";
-  const glm::dquat q = SunNodeRotation(key.direction);
+  node.name = name;
+  const glm::dquat q = SunNodeRotation(sun.direction);
   node.rotation = {q.x, q.y, q.z, q.w};
   tinygltf::Value::Object light_ref;
   light_ref["light"] = tinygltf::Value(int(model.lights.size()) - 1);
   node.extensions["KHR_lights_punctual"] = tinygltf::Value(light_ref);
   model.nodes.push_back(node);
-  const int node_index = int(model.nodes.size()) - 1;
-  gltf_scene.nodes.push_back(node_index);
-  if (moons.size() < 2) return;
+  return int(model.nodes.size()) - 1;
+}
+
+// The accessors of a rotation track: one key per light direction, at its
+// time (s); the input holds the times, the output the quaternions.
+struct RotationKeys {
+  int input = -1, output = -1;
+};
+
+RotationKeys AddRotationKeys(tinygltf::Model& model, const std::vector<SceneSun>& keys) {
   std::vector<float> times, rotations;
-  for (const SceneSun& m : moons) {
-    times.push_back(float(m.time_s));
-    const glm::dquat r = SunNodeRotation(m.direction);
-    rotations.insert(rotations.end(), {float(r.x), float(r.y), float(r.z), float(r.w)});
+  for (const SceneSun& k : keys) {
+    times.push_back(float(k.time_s));
+    const glm::dquat q = SunNodeRotation(k.direction);
+    rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
   }
+  // Keep consecutive quaternions in one hemisphere so interpolation takes the short way.
   for (size_t k = 4; k < rotations.size(); k += 4) {
     float dot = 0;
     for (int c = 0; c < 4; ++c) dot += rotations[k + c] * rotations[k - 4 + c];
     if (dot < 0)
       for (int c = 0; c < 4; ++c) rotations[k + c] = -rotations[k + c];
   }
-  const int input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
-                                TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR, {times.front()},
-                                {times.back()});
-  const int output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
-                                 TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
-  model.bufferViews[model.accessors[input].bufferView].target = 0;
-  model.bufferViews[model.accessors[output].bufferView].target = 0;
+  RotationKeys track;
+  track.input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
+                            TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR, {times.front()},
+                            {times.back()});
+  track.output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
+                             TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
+  // Animation data is not vertex data: no target.
+  model.bufferViews[model.accessors[track.input].bufferView].target = 0;
+  model.bufferViews[model.accessors[track.output].bufferView].target = 0;
+  return track;
+}
+
+// Animates `node`'s rotation by `track`: a sampler and a channel in the
+// scene's one animation, made (and named `name`) if there is none yet.
+void AnimateRotation(tinygltf::Model& model, const std::string& name, const RotationKeys& track, int node) {
   if (model.animations.empty()) {
     tinygltf::Animation animation;
-    animation.name = "moon_path";
+    animation.name = name;
     model.animations.push_back(animation);
   }
   tinygltf::Animation& animation = model.animations.front();
   tinygltf::AnimationSampler sampler;
-  sampler.input = input;
-  sampler.output = output;
+  sampler.input = track.input;
+  sampler.output = track.output;
   sampler.interpolation = "LINEAR";
   animation.samplers.push_back(sampler);
   tinygltf::AnimationChannel channel;
   channel.sampler = int(animation.samplers.size()) - 1;
-  channel.target_node = node_index;
+  channel.target_node = node;
   channel.target_path = "rotation";
   animation.channels.push_back(channel);
+}
+
+// The Moon: light 1, node 2, its rotation keys in the animation (a second
+// one when the Sun has none).
+void AddMoonLight(tinygltf::Model& model, const std::vector<SceneSun>& moons, tinygltf::Scene& gltf_scene) {
+  size_t brightest = 0;
+  for (size_t i = 1; i < moons.size(); ++i)
+    if (moons[i].illuminance_lux > moons[brightest].illuminance_lux) brightest = i;
+  const int node = AddDirectionalLight(model, "moon", moons[brightest]);
+  gltf_scene.nodes.push_back(node);
+  if (moons.size() < 2) return;
+  AnimateRotation(model, "moon_path", AddRotationKeys(model, moons), node);
+}
+
+// The sky dome, mesh 0 and node 0: its geometry and the tone-mapped sRGB
+// latlong as its unlit texture (texture 0), clamped, so the seam columns at
+// u = 0.5 / width and 1 - 0.5 / width never blend with each other.
+void AddSkyDome(const SceneDescription& scene, tinygltf::Model& model) {
+  const DomeMesh dome = BuildDome(scene.dome, scene.texture_width, scene.texture_height);
+  tinygltf::Primitive primitive;
+  primitive.attributes["POSITION"] = AddPositions(model, dome.positions);
+  primitive.attributes["TEXCOORD_0"] = AddTexcoords(model, dome.uvs);
+  primitive.indices = AddIndices(model, dome.indices);
+  const int texture = AddTexture(model, "sky", scene.texture_file, TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+  primitive.material = AddMaterial(model, "sky_unlit", texture, true);
+  AddMeshNode(model, "skydome", primitive);
+}
+
+// The sun, light 0 and node 1, at the scene's light frame; with more than
+// one frame its path as the animation "sun_path", one rotation key a frame.
+void AddSun(const SceneDescription& scene, tinygltf::Model& model) {
+  const int node = AddDirectionalLight(model, "sun", scene.suns.at(size_t(scene.light_frame)));
+  if (scene.suns.size() > 1) AnimateRotation(model, "sun_path", AddRotationKeys(model, scene.suns), node);
+}
+
+// The whole scene: dome, sun, and what the bake adds (image-based light,
+// Moon, cloud shadow ground), with the units and frame in the asset's extras.
+tinygltf::Model BuildSceneModel(const SceneDescription& scene) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "skybake " SKYBAKE_VERSION;
+  model.extensionsUsed = {"KHR_materials_unlit", "KHR_lights_punctual"};
+  model.extensionsRequired = {};
+  model.buffers.resize(1);
+  AddSkyDome(scene, model);
+  AddSun(scene, model);
+
+  tinygltf::Scene gltf_scene;
+  gltf_scene.name = scene.name;
+  gltf_scene.nodes = {0, 1};
+  if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
+  if (!scene.moons.empty()) AddMoonLight(model, scene.moons, gltf_scene);
+  if (scene.ground) AddCloudShadowGround(scene, model, gltf_scene);
+  json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
+  gltf_scene.extras = ToValue(json{{"skybake", extras}});
+  model.scenes.push_back(gltf_scene);
+  model.defaultScene = 0;
+  json asset_extras = {
+      {"skybake",
+       {{"units", {{"length", "metre"},
+                   {"sun_intensity", "lux (KHR_lights_punctual directional)"},
+                   {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
+        {"frame", "+Y up, right-handed, North -Z, East +X; sun light shines along its node's -Z"},
+        {"texture_layout", "OpenEXR latlong (Imf::LatLongMap): u = 0 at longitude +pi, v = 0 at latitude +pi/2"}}}};
+  model.asset.extras = ToValue(asset_extras);
+  return model;
+}
+
+// name.gltf + name.bin: the JSON references the .bin and the PNG by name.
+void WriteGltfAndBin(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const std::string& name,
+                     const WrittenScene& written) {
+  std::string bin(model.buffers[0].data.begin(), model.buffers[0].data.end());
+  std::ostringstream out;
+  if (!writer.WriteGltfSceneToStream(&model, out, true, false))
+    throw OutputError(fmt::format("cannot serialise {}", written.gltf_path));
+  json document = json::parse(out.str());
+  document["buffers"][0]["uri"] = name + ".bin";
+  WriteFileAtomically(written.bin_path, bin);
+  WriteFileAtomically(written.gltf_path, document.dump(2) + "\n");
+}
+
+// name.glb: the PNGs move into the binary chunk.
+void WriteGlb(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const std::filesystem::path& dir,
+              const std::string& texture_file, const std::string& glb_path) {
+  std::string png = ReadFile((dir / texture_file).string());
+  tinygltf::Model glb = model;
+  glb.images[0].uri.clear();
+  glb.images[0].bufferView = AddBufferView(glb, png.data(), png.size(), 0);
+  for (size_t i = 1; i < glb.images.size(); ++i) {
+    const std::string face = ReadFile((dir / glb.images[i].uri).string());
+    glb.images[i].uri.clear();
+    glb.images[i].bufferView = AddBufferView(glb, face.data(), face.size(), 0);
+  }
+  std::ostringstream out;
+  if (!writer.WriteGltfSceneToStream(&glb, out, false, true))
+    throw OutputError(fmt::format("cannot serialise {}", glb_path));
+  WriteFileAtomically(glb_path, out.str());
 }
 
 }  // namespace
@@ -350,181 +494,11 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
   written.gltf_path = (dir / (scene.name + ".gltf")).string();
   written.bin_path = (dir / (scene.name + ".bin")).string();
   written.glb_path = (dir / (scene.name + ".glb")).string();
-
-  DomeMesh dome = BuildDome(scene.dome, scene.texture_width, scene.texture_height);
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "skybake " SKYBAKE_VERSION;
-  model.extensionsUsed = {"KHR_materials_unlit", "KHR_lights_punctual"};
-  model.extensionsRequired = {};
-  model.buffers.resize(1);
-
-  // Geometry.
-  glm::vec3 lo(1e30f), hi(-1e30f);
-  for (const glm::vec3& p : dome.positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  int positions = AddAccessor(model,
-                              AddBufferView(model, dome.positions.data(), dome.positions.size() * 12,
-                                            TINYGLTF_TARGET_ARRAY_BUFFER),
-                              TINYGLTF_COMPONENT_TYPE_FLOAT, dome.positions.size(), TINYGLTF_TYPE_VEC3,
-                              {lo.x, lo.y, lo.z}, {hi.x, hi.y, hi.z});
-  int uvs = AddAccessor(model,
-                        AddBufferView(model, dome.uvs.data(), dome.uvs.size() * 8, TINYGLTF_TARGET_ARRAY_BUFFER),
-                        TINYGLTF_COMPONENT_TYPE_FLOAT, dome.uvs.size(), TINYGLTF_TYPE_VEC2);
-  int indices = AddAccessor(model,
-                            AddBufferView(model, dome.indices.data(), dome.indices.size() * 4,
-                                          TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER),
-                            TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, dome.indices.size(), TINYGLTF_TYPE_SCALAR);
-
-  // Sun animation: one rotation key per frame.
-  int animation_input = -1, animation_output = -1;
-  if (scene.suns.size() > 1) {
-    std::vector<float> times;
-    std::vector<float> rotations;
-    for (const SceneSun& s : scene.suns) {
-      times.push_back(float(s.time_s));
-      glm::dquat q = SunNodeRotation(s.direction);
-      rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
-    }
-    // Keep consecutive quaternions in one hemisphere so interpolation takes the short way.
-    for (size_t k = 4; k < rotations.size(); k += 4) {
-      float dot = 0;
-      for (int c = 0; c < 4; ++c) dot += rotations[k + c] * rotations[k - 4 + c];
-      if (dot < 0) for (int c = 0; c < 4; ++c) rotations[k + c] = -rotations[k + c];
-    }
-    animation_input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
-                                  TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR,
-                                  {times.front()}, {times.back()});
-    animation_output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
-                                   TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
-    // Animation data is not vertex data: no target.
-    model.bufferViews[model.accessors[animation_input].bufferView].target = 0;
-    model.bufferViews[model.accessors[animation_output].bufferView].target = 0;
-  }
-
-  // Texture: the tone-mapped sRGB latlong. Clamped, so the seam columns at
-  // u = 0.5 / width and 1 - 0.5 / width never blend with each other.
-  tinygltf::Image image;
-  image.name = "sky";
-  image.uri = scene.texture_file;
-  image.mimeType = "image/png";
-  model.images.push_back(image);
-  tinygltf::Sampler sampler;
-  sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-  sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-  sampler.wrapS = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-  sampler.wrapT = TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-  model.samplers.push_back(sampler);
-  tinygltf::Texture texture;
-  texture.source = 0;
-  texture.sampler = 0;
-  model.textures.push_back(texture);
-
-  tinygltf::Material material;
-  material.name = "sky_unlit";
-  material.pbrMetallicRoughness.baseColorTexture.index = 0;
-  material.pbrMetallicRoughness.metallicFactor = 0.0;
-  material.pbrMetallicRoughness.roughnessFactor = 1.0;
-  material.extensions["KHR_materials_unlit"] = tinygltf::Value(tinygltf::Value::Object());
-  model.materials.push_back(material);
-
-  tinygltf::Mesh mesh;
-  mesh.name = "skydome";
-  tinygltf::Primitive primitive;
-  primitive.attributes["POSITION"] = positions;
-  primitive.attributes["TEXCOORD_0"] = uvs;
-  primitive.indices = indices;
-  primitive.material = 0;
-  primitive.mode = TINYGLTF_MODE_TRIANGLES;
-  mesh.primitives.push_back(primitive);
-  model.meshes.push_back(mesh);
-
-  // The sun: KHR_lights_punctual directional light, lux.
-  const SceneSun& light_sun = scene.suns.at(size_t(scene.light_frame));
-  tinygltf::Light light;
-  light.name = "sun";
-  light.type = "directional";
-  light.intensity = light_sun.illuminance_lux;
-  light.color = {light_sun.color[0], light_sun.color[1], light_sun.color[2]};
-  model.lights.push_back(light);
-
-  tinygltf::Node dome_node;
-  dome_node.name = "skydome";
-  dome_node.mesh = 0;
-  model.nodes.push_back(dome_node);
-  tinygltf::Node sun_node;
-  sun_node.name = "sun";
-  glm::dquat q = SunNodeRotation(light_sun.direction);
-  sun_node.rotation = {q.x, q.y, q.z, q.w};
-  tinygltf::Value::Object light_ref;
-  light_ref["light"] = tinygltf::Value(0);
-  sun_node.extensions["KHR_lights_punctual"] = tinygltf::Value(light_ref);
-  model.nodes.push_back(sun_node);
-
-  if (animation_input >= 0) {
-    tinygltf::Animation animation;
-    animation.name = "sun_path";
-    tinygltf::AnimationSampler s;
-    s.input = animation_input;
-    s.output = animation_output;
-    s.interpolation = "LINEAR";
-    animation.samplers.push_back(s);
-    tinygltf::AnimationChannel channel;
-    channel.sampler = 0;
-    channel.target_node = 1;
-    channel.target_path = "rotation";
-    animation.channels.push_back(channel);
-    model.animations.push_back(animation);
-  }
-
-  tinygltf::Scene gltf_scene;
-  gltf_scene.name = scene.name;
-  gltf_scene.nodes = {0, 1};
-  if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
-  if (!scene.moons.empty()) AddMoonLight(model, scene.moons, gltf_scene);
-  if (scene.ground) AddCloudShadowGround(scene, model, gltf_scene);
-  json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
-  gltf_scene.extras = ToValue(json{{"skybake", extras}});
-  model.scenes.push_back(gltf_scene);
-  model.defaultScene = 0;
-  json asset_extras = {
-      {"skybake",
-       {{"units", {{"length", "metre"},
-                   {"sun_intensity", "lux (KHR_lights_punctual directional)"},
-                   {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
-        {"frame", "+Y up, right-handed, North -Z, East +X; sun light shines along its node's -Z"},
-        {"texture_layout", "OpenEXR latlong (Imf::LatLongMap): u = 0 at longitude +pi, v = 0 at latitude +pi/2"}}}};
-  model.asset.extras = ToValue(asset_extras);
-
+  const tinygltf::Model model = BuildSceneModel(scene);
   tinygltf::TinyGLTF writer;
   writer.SetImageWriter(nullptr, nullptr);
-
-  // name.gltf + name.bin: the JSON references the .bin and the PNG by name.
-  std::string bin(model.buffers[0].data.begin(), model.buffers[0].data.end());
-  {
-    std::ostringstream out;
-    if (!writer.WriteGltfSceneToStream(&model, out, true, false))
-      throw OutputError(fmt::format("cannot serialise {}", written.gltf_path));
-    json document = json::parse(out.str());
-    document["buffers"][0]["uri"] = scene.name + ".bin";
-    WriteFileAtomically(written.bin_path, bin);
-    WriteFileAtomically(written.gltf_path, document.dump(2) + "\n");
-  }
-  // name.glb: the PNG moves into the binary chunk.
-  {
-    std::string png = ReadFile((dir / scene.texture_file).string());
-    tinygltf::Model glb = model;
-    glb.images[0].uri.clear();
-    glb.images[0].bufferView = AddBufferView(glb, png.data(), png.size(), 0);
-    for (size_t i = 1; i < glb.images.size(); ++i) {
-      const std::string face = ReadFile((dir / glb.images[i].uri).string());
-      glb.images[i].uri.clear();
-      glb.images[i].bufferView = AddBufferView(glb, face.data(), face.size(), 0);
-    }
-    std::ostringstream out;
-    if (!writer.WriteGltfSceneToStream(&glb, out, false, true))
-      throw OutputError(fmt::format("cannot serialise {}", written.glb_path));
-    WriteFileAtomically(written.glb_path, out.str());
-  }
+  WriteGltfAndBin(writer, model, scene.name, written);
+  WriteGlb(writer, model, dir, scene.texture_file, written.glb_path);
   return written;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/format.h>
 #include <glm/glm.hpp>
@@ -368,6 +369,120 @@ std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<Po
   return adds;
 }
 
+SplatTiles::SplatTiles(const ViewRequest& view, const std::vector<float>& mu) : view_(view) {
+  const int w = view.width, h = view.height;
+  const bool strip = view.mapping == MAPPING_CUBE_STRIP;
+  face_rows_ = strip ? w : h;  // a strip's tiles stay within one face
+  tiles_x_ = (w + kSplatTileSize - 1) / kSplatTileSize;
+  tiles_per_face_ = (face_rows_ + kSplatTileSize - 1) / kSplatTileSize;
+  const int tiles = tiles_x_ * tiles_per_face_ * (strip ? 6 : 1);
+  min_solid_angle_.resize(size_t(tiles));
+  if (!mu.empty()) mu_range_.assign(2 * size_t(tiles), 0.0f);
+  for (int t = 0; t < tiles; ++t) {
+    int x0, x1, y0, y1;
+    Rect(t, x0, x1, y0, y1);
+    // The smallest solid angle is at a corner texel: a face's texel (and a
+    // strip's, whose edge texels are halved) shrinks away from the face's
+    // centre in each coordinate, a latlong's row towards either pole, and
+    // the farthest column and row of a rectangle are at its ends. The
+    // latlong's repeated meridian takes column 0's (it receives its
+    // additions), which is every column's.
+    double omega = std::numeric_limits<double>::infinity();
+    for (int y : {y0, y1 - 1})
+      for (int x : {x0, x1 - 1})
+        omega = std::min(omega, ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG ? 0 : x, y));
+    min_solid_angle_[size_t(t)] = omega;
+    if (mu.empty()) continue;
+    float lo = 2.0f, hi = -2.0f;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        lo = std::min(lo, mu[size_t(y) * w + x]);
+        hi = std::max(hi, mu[size_t(y) * w + x]);
+      }
+    mu_range_[2 * size_t(t)] = lo;
+    mu_range_[2 * size_t(t) + 1] = hi;
+  }
+}
+
+int SplatTiles::TileOf(int x, int y) const {
+  const int face = y / face_rows_, row = y - face * face_rows_;
+  return (face * tiles_per_face_ + row / kSplatTileSize) * tiles_x_ + x / kSplatTileSize;
+}
+
+void SplatTiles::Rect(int tile, int& x0, int& x1, int& y0, int& y1) const {
+  const int tx = tile % tiles_x_, ty = tile / tiles_x_;
+  const int face = ty / tiles_per_face_, row = (ty - face * tiles_per_face_) * kSplatTileSize;
+  x0 = tx * kSplatTileSize;
+  x1 = std::min(x0 + kSplatTileSize, view_.width);
+  y0 = face * face_rows_ + row;
+  y1 = face * face_rows_ + std::min(row + kSplatTileSize, face_rows_);
+}
+
+TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const std::vector<PointSource>& sources,
+                       const std::vector<Rgb>& airglow, const float* rgba, double min_relative) {
+  TileBound b;
+  const int w = view.width;
+  // Each source's load into every tile it has a target in (once per tile).
+  std::vector<double> load(size_t(tiles.count()), 0.0);
+  std::vector<int> first_tile(sources.size() + 1, 0);
+  std::vector<int> reached;  // source k's tiles: reached[first_tile[k], first_tile[k + 1])
+  std::vector<SplatTarget> targets;
+  for (size_t k = 0; k < sources.size(); ++k) {
+    first_tile[k] = int(reached.size());
+    const PointSource& s = sources[k];
+    if (s.irradiance[0] <= 0.0 && s.irradiance[1] <= 0.0 && s.irradiance[2] <= 0.0) continue;
+    SplatTargets(view, glm::normalize(s.direction), targets);
+    const size_t begin = reached.size();
+    auto add = [&](int x, int y) {
+      const int t = tiles.TileOf(x, y);
+      if (std::find(reached.begin() + long(begin), reached.end(), t) == reached.end()) reached.push_back(t);
+    };
+    for (const SplatTarget& t : targets) {
+      add(t.x, t.y);
+      if (view.mapping == MAPPING_LATLONG && t.x == 0) add(w - 1, t.y);  // the repeated meridian
+    }
+    const double e = LargestChannel(s.irradiance);
+    for (size_t i = begin; i < reached.size(); ++i) load[size_t(reached[i])] += e;
+  }
+  first_tile[sources.size()] = int(reached.size());
+  // The glow: its table's first and last entries for a range of mu (as AirglowAt).
+  auto glow_max = [&](float lo, float hi) {
+    if (airglow.empty()) return 0.0;
+    auto index = [&](double mu) { return (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * double(airglow.size() - 1); };
+    const size_t i0 = std::min(size_t(index(lo)), airglow.size() - 2);
+    const size_t i1 = std::min(size_t(index(hi)), airglow.size() - 2) + 1;
+    double m = 0.0;
+    for (size_t i = i0; i <= i1; ++i) m = std::max(m, LargestChannel(airglow[i]));
+    return m;
+  };
+  // Each tile that may matter: its floor against the load and the glow.
+  std::vector<char> open(size_t(tiles.count()), 0);
+  for (int t = 0; t < tiles.count(); ++t) {
+    const double glow = glow_max(tiles.min_mu(t), tiles.max_mu(t));
+    if (load[size_t(t)] <= 0.0 && glow <= 0.0) continue;
+    int x0, x1, y0, y1;
+    tiles.Rect(t, x0, x1, y0, y1);
+    float floor = std::numeric_limits<float>::infinity();
+    for (int y = y0; y < y1; ++y) {
+      const float* row = rgba + 4 * (size_t(y) * w);
+      for (int x = x0; x < x1; ++x) floor = std::min(floor, std::max({row[4 * x], row[4 * x + 1], row[4 * x + 2]}));
+    }
+    ++b.tiles_read;
+    // The margins: SplatBound's, and a millionth for the glow's blend.
+    const double capacity = min_relative * double(floor) * tiles.min_solid_angle(t) * (1.0 - 1e-4);
+    if (load[size_t(t)] > 0.0 && !(load[size_t(t)] < capacity)) open[size_t(t)] = 1;
+    if (glow > 0.0 && !(glow < min_relative * double(floor) * (1.0 - 1e-6))) b.airglow = true;
+  }
+  for (size_t k = 0; k < sources.size(); ++k)
+    for (int i = first_tile[k]; i < first_tile[k + 1]; ++i)
+      if (open[size_t(reached[size_t(i)])]) {
+        b.sources.push_back(k);
+        break;
+      }
+  b.splat = !b.sources.empty();
+  return b;
+}
+
 size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, float* rgba_out, double min_relative) {
   size_t applied = 0;
   for (const TexelAdd& a : adds) {
@@ -573,6 +688,32 @@ std::vector<TexelAdd> NightSkyRenderer::BoundedSplat(const ViewRequest& view, co
   return adds;
 }
 
+TileBound NightSkyRenderer::Bound(const ViewRequest& view, const NightFrame& night,
+                                  const std::vector<PointSource>& sources, const float* rgba) {
+  // By night the stars and the glow show nearly everywhere: the bound
+  // would open every tile and only add its own cost.
+  if (!splat_bound_ || !tile_bound_ || !night.daylight) {
+    TileBound all;
+    all.airglow = !night.airglow.empty();
+    all.splat = !sources.empty();
+    for (size_t k = 0; k < sources.size(); ++k) all.sources.push_back(k);
+    return all;
+  }
+  const bool with_mu = !night.airglow.empty();
+  const std::array<int, 5> key = {view.mapping, view.width, view.height, view.face, int(with_mu)};
+  auto it = tiles_.find(key);
+  if (it == tiles_.end()) {
+    static const std::vector<float> none;
+    it = tiles_.emplace(key, std::make_unique<SplatTiles>(view, with_mu ? TexelMu(view) : none)).first;
+  }
+  TileBound b = BoundByTiles(view, *it->second, sources, night.airglow, rgba, kNightSplatMinRelative);
+  if (!b.splat) {
+    ++splats_skipped_;
+    ++tiles_skipped_;
+  }
+  return b;
+}
+
 namespace {
 
 // Adds the airglow where it is at least kNightSplatMinRelative of the
@@ -590,6 +731,15 @@ bool AddAirglow(const std::vector<Rgb>& table, const std::vector<float>& mu, con
     for (int c = 0; c < 3; ++c) rgba_out[4 * i + c] += float(a[c]);
   }
   return any;
+}
+
+// The sources `which` of `sources`, in their order (all when they are all).
+std::vector<PointSource> SourcesOf(const std::vector<PointSource>& sources, const std::vector<size_t>& which) {
+  if (which.size() == sources.size()) return sources;
+  std::vector<PointSource> some;
+  some.reserve(which.size());
+  for (size_t k : which) some.push_back(sources[k]);
+  return some;
 }
 
 }  // namespace
@@ -610,14 +760,23 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
       for (size_t k = 0; k < image.rgba.size(); ++k)
         if (k % 4 != 3) image.rgba[k] += moonlit[i][k];
     }
-    if (!night.airglow.empty()) {
+    // The tile bound first (BoundByTiles): the glow and the splat only
+    // where they may change a byte. Its floors, read before the glow, are
+    // still floors after it (the glow only adds).
+    const TileBound bound = Bound(views[i], night, night.sources, image.data());
+    if (bound.airglow) {
       const std::vector<float>& mu = TexelMu(views[i]);
       if (AddAirglow(night.airglow, mu, image.data(), nullptr)) {
         own();
         AddAirglow(night.airglow, mu, image.rgba.data(), image.rgba.data());
       }
     }
-    const std::vector<TexelAdd> adds = BoundedSplat(views[i], night.sources, image.data(), night.daylight);
+    if (!bound.splat) continue;
+    // The sources that reach no open tile add nothing that is kept: every
+    // texel they reach is in a closed tile, and every source reaching an
+    // open tile is here, in its order (the same sums).
+    const std::vector<TexelAdd> adds =
+        BoundedSplat(views[i], SourcesOf(night.sources, bound.sources), image.data(), night.daylight);
     if (ApplyTexelAdds(adds, image.data(), nullptr, kNightSplatMinRelative) == 0) continue;
     own();
     ApplyTexelAdds(adds, image.rgba.data(), image.rgba.data(), kNightSplatMinRelative);
@@ -634,9 +793,11 @@ void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night
     if (!moonlit.empty())
       for (size_t k = 0; k < faces[i].size(); ++k)
         if (k % 4 != 3) faces[i][k] += moonlit[i][k];
-    if (!night.airglow.empty()) AddAirglow(night.airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
-    ApplyTexelAdds(BoundedSplat(views[i], stars, faces[i].data(), night.daylight), faces[i].data(), faces[i].data(),
-                   kNightSplatMinRelative);
+    const TileBound bound = Bound(views[i], night, stars, faces[i].data());
+    if (bound.airglow) AddAirglow(night.airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
+    if (!bound.splat) continue;
+    ApplyTexelAdds(BoundedSplat(views[i], SourcesOf(stars, bound.sources), faces[i].data(), night.daylight),
+                   faces[i].data(), faces[i].data(), kNightSplatMinRelative);
   }
 }
 

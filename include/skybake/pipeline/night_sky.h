@@ -135,6 +135,49 @@ struct SplatBound {
 std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources, const float* rgba,
                                    double min_relative, SplatBound* bound = nullptr);
 
+// The first, coarse look, before any splat (a day frame then pays neither
+// the splat nor SplatBound's per-texel work): the view's texels in tiles of
+// kSplatTileSize^2 (a cube strip's within one face), each with its smallest
+// solid angle (from its corner texels: a texel's solid angle falls away from
+// the face's centre, and a latlong row's towards the poles) and the range of
+// mu = cos(zenith angle) of its texels. A tile's load is the sum of the
+// largest channel of the irradiance of every source with a splat target in
+// it, its floor the smallest largest channel of its texels; where the load
+// is under min_relative x floor x smallest solid angle (less the margin of
+// SplatBound), no texel of the tile can take an addition (a texel's load is
+// at most its tile's). The airglow, at most the largest entry of its table
+// over the tile's range of mu, is under min_relative x floor there, or it
+// may show. Costs one target lookup per source and one read of the texels
+// of the tiles a source or the glow reaches.
+inline constexpr int kSplatTileSize = 16;
+class SplatTiles {
+ public:
+  // `mu`: the view's texel mu (row-major), for the airglow's ranges; may be empty.
+  SplatTiles(const ViewRequest& view, const std::vector<float>& mu);
+  int count() const { return int(min_solid_angle_.size()); }
+  int TileOf(int x, int y) const;
+  // The tile's texels: columns [x0, x1), rows [y0, y1).
+  void Rect(int tile, int& x0, int& x1, int& y0, int& y1) const;
+  double min_solid_angle(int tile) const { return min_solid_angle_[size_t(tile)]; }
+  float min_mu(int tile) const { return mu_range_.empty() ? -1.0f : mu_range_[2 * size_t(tile)]; }
+  float max_mu(int tile) const { return mu_range_.empty() ? 1.0f : mu_range_[2 * size_t(tile) + 1]; }
+
+ private:
+  ViewRequest view_;
+  int tiles_x_ = 0, tiles_per_face_ = 0, face_rows_ = 0;
+  std::vector<double> min_solid_angle_;
+  std::vector<float> mu_range_;
+};
+struct TileBound {
+  bool splat = false;            // some tile a source reaches may take an addition
+  bool airglow = false;          // some tile may take the glow
+  std::vector<size_t> sources;   // the sources with a target in such a tile, increasing
+  size_t tiles_read = 0;         // tiles whose texels were read
+};
+// `airglow`: the glow's table (AirglowTable), or empty.
+TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const std::vector<PointSource>& sources,
+                       const std::vector<Rgb>& airglow, const float* rgba, double min_relative);
+
 // The atmosphere's transmittance from the observer to space along a
 // direction, as a table over mu = cos(zenith angle): the shared integral
 // (ReferenceModel::TransmittanceDirect, 256 steps) at 4096 values of mu,
@@ -206,12 +249,18 @@ class NightSkyRenderer {
                   std::vector<std::vector<float>>& faces);
 
   int moonlight_renders() const { return moonlight_renders_; }
-  // With false, every splat runs whole (SplatBound off; by night it always
-  // does): for the test that the bound changes no byte.
+  // With false, every splat runs whole (neither BoundByTiles nor
+  // SplatBound; by night SplatBound is not used anyway) and the glow is
+  // checked texel by texel: for the test that the bounds change no byte.
   void set_splat_bound(bool on) { splat_bound_ = on; }
-  // Views (and faces) whose splat the bound skipped altogether, and those
-  // splatted (in part or whole), since construction.
+  // With false, only the tile bound is off (SplatBound still runs by day):
+  // what a day frame paid before it, for the measurement.
+  void set_tile_bound(bool on) { tile_bound_ = on; }
+  // Views (and faces) whose splat the bounds skipped altogether (of which
+  // the tile bound alone, BoundByTiles), and those splatted (in part or
+  // whole), since construction.
   size_t splats_skipped() const { return splats_skipped_; }
+  size_t splats_skipped_by_tiles() const { return tiles_skipped_; }
   size_t splats_run() const { return splats_run_; }
   double last_moonlight_seconds() const { return last_moonlight_seconds_; }
 
@@ -224,8 +273,13 @@ class NightSkyRenderer {
   // the Sun is up (SplatBound).
   std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<PointSource>& sources,
                                      const float* rgba, bool daylight);
-  bool splat_bound_ = true;
-  size_t splats_skipped_ = 0, splats_run_ = 0;
+  // What may change `rgba` (the view's texels): BoundByTiles, or with the
+  // bounds off everything.
+  TileBound Bound(const ViewRequest& view, const NightFrame& night, const std::vector<PointSource>& sources,
+                  const float* rgba);
+  bool splat_bound_ = true, tile_bound_ = true;
+  size_t splats_skipped_ = 0, splats_run_ = 0, tiles_skipped_ = 0;
+  std::map<std::array<int, 5>, std::unique_ptr<SplatTiles>> tiles_;
   VulkanContext& context_;
   std::map<std::array<int, 4>, std::vector<float>> texel_mu_;
   std::unique_ptr<SkyRenderer> moonlight_;

@@ -1,0 +1,86 @@
+// The parts of the accuracy study (`skybake accuracy`, tools/accuracy.h) and
+// what they share. `RunAccuracyStudy` (accuracy.cc) opens the Vulkan context
+// once and runs each study in turn; each study is a file of its own with one
+// function `std::string RunXStudy(StudyContext&)` that computes, writes its
+// own files into the output folder and returns its markdown sections. A new
+// study (clouds, spectral) is one more such file, declared here, and one call
+// in RunAccuracyStudy. Private to the accuracy library.
+#pragma once
+
+#include <algorithm>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "skybake/gpu/vulkan_context.h"
+#include "skybake/model/atmosphere.h"
+#include "skybake/tools/accuracy.h"
+
+namespace skybake {
+
+// What every study is given: the options, the one Vulkan context, and the
+// lines for the report's end (where each plot went), in the order added.
+struct StudyContext {
+  const AccuracyStudyOptions& options;
+  VulkanContext& vulkan;
+  std::vector<std::string> notes;
+
+  void Say(const std::string& text) const {
+    if (options.progress) options.progress(text);
+  }
+  // `name` in the output folder.
+  std::string OutPath(const std::string& name) const { return options.out_dir + "/" + name; }
+};
+
+// The studies, in the order of the report.
+// Every integrator and sample count against the converged reference, timed:
+// accuracy.csv, accuracy.png (and its gnuplot inputs); the tables of cases,
+// presets and the reference's convergence.
+std::string RunIntegratorStudy(StudyContext& context);
+// The model against the measured skies of Kider et al. 2014: kider2014.csv
+// and its table.
+std::string RunKiderStudy(StudyContext& context);
+
+// One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
+struct StudyCase {
+  std::string name;
+  QualitySettings quality;
+};
+
+std::string IntegratorName(int integrator);
+// A case with `view` steps on the view ray and `light` on each sun ray (0:
+// the transmittance LUT), the sky-view LUT at sw x sh when `sky_view`.
+StudyCase MakeCase(int integrator, int view, int light, bool sky_view = false, int sw = 0, int sh = 0,
+                   int steps = STEPS_UNIFORM);
+
+// fn(i) for i in [0, n) on every hardware thread.
+template <class Fn>
+void ParallelIndices(size_t n, Fn fn) {
+  unsigned threads = std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> pool;
+  for (unsigned t = 0; t < threads; ++t)
+    pool.emplace_back([&, t] {
+      for (size_t i = t; i < n; i += threads) fn(i);
+    });
+  for (auto& th : pool) th.join();
+}
+
+// CIE L*a*b* (D65) of a display sRGB colour after exposure and ACES.
+glm::dvec3 DisplayLab(const glm::dvec3& radiance, const Rgb& to_luminance, double exposure);
+
+double Median(std::vector<double> v);
+
+// GPU time of one render per megapixel (lavapipe, GPU timestamps, median of
+// 3 renders), with a latlong sized to the cost.
+double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere,
+                        const QualitySettings& quality, const EffectSettings& effects);
+
+std::vector<std::string> SplitCsv(const std::string& line);
+
+// Runs gnuplot on `script` (in the output folder), which draws `png` there,
+// and adds the note "Plot written: <out>/<png>" (or why not) to the report.
+void RunGnuplot(StudyContext& context, const std::string& script, const std::string& png);
+
+}  // namespace skybake
