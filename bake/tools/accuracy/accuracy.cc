@@ -17,8 +17,11 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   StudyContext context{options, vulkan, {}};
 
   std::string md;
-  md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
-  md += RunKiderStudy(context);       // kider2014.csv
+  if (options.study != "clouds") {
+    md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
+    md += RunKiderStudy(context);       // kider2014.csv
+  }
+  if (options.study != "sky") md += RunCloudQualityStudy(context);  // cloud_study.csv, cloud_study.png
   for (const std::string& note : context.notes) md += "\n" + note + "\n";
   WriteFileAtomically(options.out_dir + "/accuracy_results.md", md);
   return md;

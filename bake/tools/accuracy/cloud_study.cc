@@ -21,6 +21,7 @@
 #include "skybake/model/aoas.h"
 #include "skybake/model/view.h"
 #include "skybake/output/exr_io.h"
+#include "study.h"
 
 namespace skybake {
 namespace {
@@ -464,6 +465,15 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
   WriteFileAtomically(options.out_dir + "/cloud_study_results.md", md);
   result.markdown = md;
   return result;
+}
+
+std::string RunCloudQualityStudy(StudyContext& context) {
+  CloudStudyOptions options;
+  options.out_dir = context.options.out_dir;
+  options.quick = context.options.quick;
+  options.only = context.options.only;
+  options.progress = context.options.progress;
+  return RunCloudStudy(context.vulkan, options).markdown;
 }
 
 }  // namespace skybake

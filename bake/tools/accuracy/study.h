@@ -42,6 +42,10 @@ std::string RunIntegratorStudy(StudyContext& context);
 // The model against the measured skies of Kider et al. 2014: kider2014.csv
 // and its table.
 std::string RunKiderStudy(StudyContext& context);
+// The cloud settings against a converged cloud march (tools/cloud_study.h):
+// cloud_study.csv, cloud_study.png; the tables of cases, the reference's
+// convergence, the cloud presets and the panorama sizes.
+std::string RunCloudQualityStudy(StudyContext& context);
 
 // One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
 struct StudyCase {
