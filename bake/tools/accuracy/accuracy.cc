@@ -17,11 +17,15 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   StudyContext context{options, vulkan, {}};
 
   std::string md;
-  // --only spectral: the spectral study alone (its own spectral_results.md).
-  if (options.only == "spectral") return RunSpectralStudy(context);
-  md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
-  md += RunKiderStudy(context);       // kider2014.csv
-  if (options.only.empty()) md += RunSpectralStudy(context);  // spectral.csv, spectral_twilight_*.png
+  // --study spectral (or --only spectral): the spectral study alone, with its
+  // own spectral_results.md.
+  if (options.study == "spectral" || options.only == "spectral") return RunSpectralStudy(context);
+  if (options.study != "clouds") {
+    md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
+    md += RunKiderStudy(context);       // kider2014.csv
+  }
+  if (options.study == "all" && options.only.empty()) md += RunSpectralStudy(context);  // spectral.csv, spectral_twilight_*.png
+  if (options.study != "sky") md += RunCloudQualityStudy(context);  // cloud_study.csv, cloud_study.png
   for (const std::string& note : context.notes) md += "\n" + note + "\n";
   WriteFileAtomically(options.out_dir + "/accuracy_results.md", md);
   return md;

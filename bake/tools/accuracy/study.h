@@ -45,6 +45,10 @@ std::string RunKiderStudy(StudyContext& context);
 // The spectral mode: colour error of 3, 4, 8, 16 wavelengths against 48 bins
 // and their cost, twilight pictures (skybake/tools/spectral_study.h).
 std::string RunSpectralStudy(StudyContext& context);
+// The cloud settings against a converged cloud march (tools/cloud_study.h):
+// cloud_study.csv, cloud_study.png; the tables of cases, the reference's
+// convergence, the cloud presets and the panorama sizes.
+std::string RunCloudQualityStudy(StudyContext& context);
 
 // One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
 struct StudyCase {

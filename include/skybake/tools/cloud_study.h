@@ -23,7 +23,7 @@ struct CloudStudyOptions {
   std::string out_dir = "docs";  // cloud_study.csv, cloud_study_results.md, cloud_study.png
   bool quick = false;            // a few cases on a small latlong (the ctest smoke run)
   int latlong_height = 0;        // rows of the study's latlong; 0: 128 (quick: 24)
-  int timing_runs = 0;           // renders timed per case, the median kept; 0: 2 (quick: 1)
+  int timing_runs = 0;           // renders timed per case (after its error renders), the median kept; 0: 2 (quick: 1)
   std::string only;              // when set, only the cases whose name contains it
   std::function<void(const std::string&)> progress;
 };
@@ -33,8 +33,9 @@ struct CloudStudyCase {
   CloudQuality quality;
   double mean_error = 0.0;  // worst over the sun elevations of mean |L - L_ref| / mean L_ref
   double rmse = 0.0;        // the same elevations' worst RMSE / mean L_ref
-  double ms_per_mp = 0.0;   // the cloud passes' GPU time per megapixel of output, median
-  bool pareto = false;      // on the front of (ms_per_mp, mean_error) among the march cases
+  double ms_per_mp = 0.0;   // the cloud passes' GPU time per megapixel of output, median (wall time on lavapipe)
+  double cpu_ms_per_mp = 0.0;  // the process's CPU time of a render per megapixel, median: the front's cost
+  bool pareto = false;      // on the front of (cpu_ms_per_mp, mean_error) among the march cases
 };
 
 // How far the reference is from converged: its error measure between the
