@@ -477,7 +477,7 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
   cli.accuracy->add_option("--shared", cli.study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
   cli.accuracy->add_flag("--quick", cli.study.quick, "Fewer cases and directions (a smoke run)");
   cli.accuracy->add_option("--only", cli.study.only,
-                           "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\": the spectral study alone");
+                           "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\" or \"kider-spectral\": that study alone");
   cli.accuracy->add_option("--observer-altitude-m", cli.study.observer_altitude_m, "Observer altitude of the study (m)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));

@@ -19,8 +19,10 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   std::string md;
   // --only spectral: the spectral study alone (its own spectral_results.md).
   if (options.only == "spectral") return RunSpectralStudy(context);
+  if (options.only == "kider-spectral") return RunKiderSpectralStudy(context);  // kider2014_spectral.csv
   md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
   md += RunKiderStudy(context);       // kider2014.csv
+  md += RunKiderSpectralStudy(context);  // kider2014_spectral.csv
   if (options.only.empty()) md += RunSpectralStudy(context);  // spectral.csv, spectral_twilight_*.png
   for (const std::string& note : context.notes) md += "\n" + note + "\n";
   WriteFileAtomically(options.out_dir + "/accuracy_results.md", md);

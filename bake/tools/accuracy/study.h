@@ -45,6 +45,9 @@ std::string RunKiderStudy(StudyContext& context);
 // The spectral mode: colour error of 3, 4, 8, 16 wavelengths against 48 bins
 // and their cost, twilight pictures (skybake/tools/spectral_study.h).
 std::string RunSpectralStudy(StudyContext& context);
+// Kider 2014 with Bruneton's protocol as published: 31 wavelengths
+// 360..712.5 nm (kider2014_spectral.csv) beside Galaj & Wojciechowski's table.
+std::string RunKiderSpectralStudy(StudyContext& context);
 
 // One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
 struct StudyCase {
