@@ -524,7 +524,8 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
       ->capture_default_str();
   cli.accuracy->add_option("--shared", cli.study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
   cli.accuracy->add_flag("--quick", cli.study.quick, "Fewer cases and directions (a smoke run)");
-  cli.accuracy->add_option("--only", cli.study.only, "Only the cases whose name contains this text, e.g. \"sky-view\"");
+  cli.accuracy->add_option("--only", cli.study.only,
+                           "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\" or \"kider-spectral\": that study alone");
   cli.accuracy->add_option("--study", cli.study.study,
                            "Which studies: sky (integrators, Kider 2014), clouds (cloud settings: cloud_study.csv), "
                            "spectral (wavelength counts: spectral.csv), all")

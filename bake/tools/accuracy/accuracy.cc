@@ -17,12 +17,14 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   StudyContext context{options, vulkan, {}};
 
   std::string md;
-  // --study spectral (or --only spectral): the spectral study alone, with its
-  // own spectral_results.md.
+  // --study spectral or --only spectral: the spectral study alone (its own
+  // spectral_results.md); --only kider-spectral: Kider 2014 by wavelength alone.
   if (options.study == "spectral" || options.only == "spectral") return RunSpectralStudy(context);
+  if (options.only == "kider-spectral") return RunKiderSpectralStudy(context);  // kider2014_spectral.csv
   if (options.study != "clouds") {
-    md += RunIntegratorStudy(context);  // accuracy.csv, accuracy.png
-    md += RunKiderStudy(context);       // kider2014.csv
+    md += RunIntegratorStudy(context);     // accuracy.csv, accuracy.png
+    md += RunKiderStudy(context);          // kider2014.csv
+    md += RunKiderSpectralStudy(context);  // kider2014_spectral.csv
   }
   if (options.study == "all" && options.only.empty()) md += RunSpectralStudy(context);  // spectral.csv, spectral_twilight_*.png
   if (options.study != "sky") md += RunCloudQualityStudy(context);  // cloud_study.csv, cloud_study.png

@@ -49,6 +49,9 @@ std::string RunSpectralStudy(StudyContext& context);
 // cloud_study.csv, cloud_study.png; the tables of cases, the reference's
 // convergence, the cloud presets and the panorama sizes.
 std::string RunCloudQualityStudy(StudyContext& context);
+// Kider 2014 with Bruneton's protocol as published: 31 wavelengths
+// 360..712.5 nm (kider2014_spectral.csv) beside Galaj & Wojciechowski's table.
+std::string RunKiderSpectralStudy(StudyContext& context);
 
 // One GPU configuration of a study, by name ("simpson 64/LUT quadratic").
 struct StudyCase {
