@@ -4,7 +4,10 @@
 // Each tile is the upper half of the style's latlong preview (the sky above
 // the ground plane, all 360 degrees of azimuth; South in the middle, North at
 // both ends), under a label with the style's name and the AOAS principles it
-// uses. Labels are drawn with OpenImageIO's text renderer (FreeType and the
+// uses. A style with its own [schedule] (a date, a time and a place, as the
+// night styles configs/styles/night_*.toml) is baked at its schedule's first
+// frame, so its stars and Moon are placed; its label adds the night sky's
+// parts and the clock time. Labels are drawn with OpenImageIO's text renderer (FreeType and the
 // DejaVu fonts, Debian package fonts-dejavu-core).
 #pragma once
 
@@ -44,8 +47,9 @@ std::vector<std::string> StyleFilesIn(const std::string& dir);
 std::string DescribePrinciples(const SkyStyle& style);
 
 // Bakes every style into out_dir/<style>/ (its latlong preview and its
-// manifest) and writes out_dir/gallery.png. Throws ConfigFailure for an invalid style, and
-// what BakeStyle throws.
+// manifest) and writes out_dir/gallery.png. Throws ConfigFailure for an
+// invalid style or schedule (and a night sky without its catalogue), and
+// what BakeStyle and BakeSequence throw.
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options);
 
 }  // namespace skybake
