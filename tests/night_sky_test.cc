@@ -845,6 +845,23 @@ glm::dvec3 SkyMean(const Rgb8& image) {
   return sum / double(std::max(n, 1));
 }
 
+// A night style of a gallery whose catalogue is missing is refused with the
+// fix before any style is baked (exit 3).
+TEST(NightGallery, RefusesAMissingCatalogueBeforeAnyBake) {
+  const std::string dir = testing::FreshTempDir("night_gallery_bad");
+  fs::create_directories(dir + "/styles");
+  fs::copy_file(SourceDir() + "/configs/styles/natural.toml", dir + "/styles/a_natural.toml");
+  std::string night = testing::ReadFileBytes(SourceDir() + "/configs/styles/night_moonless.toml");
+  night.replace(night.find("star_magnitude_limit"), 0, "star_catalogue = \"missing.json\"\n");
+  std::ofstream(dir + "/styles/b_night.toml") << night;
+  testing::CommandRun run = RunSkybake(fmt::format("gallery '{0}/styles' --size 16 -q --out '{0}/out'", dir));
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("b_night.toml:"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("night.star_catalogue"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir + "/out/a_natural")) << run.output;
+  fs::remove_all(dir);
+}
+
 // The gallery's night styles (configs/styles/night_*.toml) carry their own
 // date, time and place: their tiles show the stars and the moonlit sky, which
 // go when the night sky is switched off.

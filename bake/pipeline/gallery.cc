@@ -56,6 +56,30 @@ std::string DescribePrinciples(const SkyStyle& style) {
   return out;
 }
 
+std::optional<GalleryFrame> GalleryFrameOf(const std::string& path, const std::vector<std::string>& overrides,
+                                           const std::string& star_catalogue, std::vector<ConfigError>& errors) {
+  if (!FileHasSchedule(path)) return std::nullopt;
+  ScheduleResult loaded = LoadSchedule(path);
+  if (!loaded.ok()) {
+    errors.insert(errors.end(), loaded.errors.begin(), loaded.errors.end());
+    return std::nullopt;
+  }
+  GalleryFrame frame{{}, loaded.schedule};
+  frame.schedule.frames.resize(1);
+  FrameStyles styles = ResolveFrameStyles(path, overrides, frame.schedule);
+  if (!styles.ok()) {
+    errors.insert(errors.end(), styles.errors.begin(), styles.errors.end());
+    return std::nullopt;
+  }
+  frame.style = styles.styles.front();
+  const std::vector<ConfigError> night = CheckNightSky({&frame.style}, &frame.schedule, star_catalogue);
+  if (!night.empty()) {
+    errors.insert(errors.end(), night.begin(), night.end());
+    return std::nullopt;
+  }
+  return frame;
+}
+
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
   GalleryResult result;
   std::filesystem::create_directories(options.out_dir);
@@ -89,20 +113,14 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
     // that one frame.
     BakeResult baked;
     std::string principles;
-    if (FileHasSchedule(path)) {
-      ScheduleResult loaded = LoadSchedule(path);
-      if (!loaded.ok()) throw ConfigFailure(path + " has an invalid [schedule]", loaded.errors);
-      Schedule first = loaded.schedule;
-      first.frames.resize(1);
-      FrameStyles frames = ResolveFrameStyles(path, overrides, first);
-      if (!frames.ok()) throw ConfigFailure(path + " has an invalid [schedule]", frames.errors);
-      std::vector<const SkyStyle*> styles = {&frames.styles.front()};
-      const std::vector<ConfigError> night = CheckNightSky(styles, &first, bake.star_catalogue);
-      if (!night.empty()) throw ConfigFailure(night.front().message, night);
-      baked = BakeSequence(frames.styles, first, bake);
-      principles = DescribePrinciples(frames.styles.front());
-      if (const std::optional<CivilTime>& t = first.frames.front().time)
+    std::vector<ConfigError> errors;
+    if (std::optional<GalleryFrame> frame = GalleryFrameOf(path, overrides, bake.star_catalogue, errors)) {
+      baked = BakeSequence({frame->style}, frame->schedule, bake);
+      principles = DescribePrinciples(frame->style);
+      if (const std::optional<CivilTime>& t = frame->schedule.frames.front().time)
         principles += fmt::format(", {:04}-{:02}-{:02} {:02}:{:02}", t->year, t->month, t->day, t->hour, t->minute);
+    } else if (!errors.empty()) {
+      throw ConfigFailure(path + " has an invalid [schedule] or night sky", errors);
     } else {
       baked = BakeStyle(config.style, bake);
       principles = DescribePrinciples(config.style);

@@ -11,10 +11,12 @@
 // DejaVu fonts, Debian package fonts-dejavu-core).
 #pragma once
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "skybake/input/schedule.h"
 #include "skybake/pipeline/pipeline.h"
 
 namespace skybake {
@@ -45,6 +47,17 @@ std::vector<std::string> StyleFilesIn(const std::string& dir);
 
 // The AOAS principles a style turns on, as a short list ("physical" if none).
 std::string DescribePrinciples(const SkyStyle& style);
+
+// A style with its own [schedule]: the schedule cut to its first frame and
+// that frame's style; nothing for a style without one, or when `errors`
+// gets the schedule's, the frame's or the night sky's errors (CheckNightSky
+// with `star_catalogue`).
+struct GalleryFrame {
+  SkyStyle style;
+  Schedule schedule;
+};
+std::optional<GalleryFrame> GalleryFrameOf(const std::string& path, const std::vector<std::string>& overrides,
+                                           const std::string& star_catalogue, std::vector<ConfigError>& errors);
 
 // Bakes every style into out_dir/<style>/ (its latlong preview and its
 // manifest) and writes out_dir/gallery.png. Throws ConfigFailure for an
