@@ -788,3 +788,132 @@ TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
 
 }  // namespace
 }  // namespace skybake
+
+namespace skybake {
+namespace {
+
+// An 8-bit RGB image (PNG) as read by OpenImageIO.
+struct Rgb8 {
+  int w = 0, h = 0;
+  std::vector<unsigned char> rgb;
+  double Y(int x, int y) const {
+    const unsigned char* p = &rgb[3 * (size_t(y) * w + x)];
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+  }
+};
+Rgb8 ReadPng(const std::string& path) {
+  Rgb8 image;
+  auto in = OIIO::ImageInput::open(path);
+  EXPECT_TRUE(in) << path;
+  if (!in) return image;
+  image.w = in->spec().width;
+  image.h = in->spec().height;
+  image.rgb.resize(size_t(image.w) * image.h * 3);
+  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.rgb.data());
+  return image;
+}
+
+// Points of light in the sky half of a latlong preview: texels that are the
+// brightest of their 3 x 3 neighbours and at least 24 (8-bit luminance) over
+// the median of their 7 x 7.
+int PointsOfLight(const Rgb8& image) {
+  int count = 0;
+  for (int y = 3; y < image.h / 2 - 3; ++y)
+    for (int x = 3; x < image.w - 3; ++x) {
+      const double c = image.Y(x, y);
+      bool peak = true;
+      std::vector<double> around;
+      for (int dy = -3; dy <= 3; ++dy)
+        for (int dx = -3; dx <= 3; ++dx) {
+          const double v = image.Y(x + dx, y + dy);
+          around.push_back(v);
+          if (std::abs(dx) <= 1 && std::abs(dy) <= 1 && (dx || dy) && v > c) peak = false;
+        }
+      std::nth_element(around.begin(), around.begin() + 24, around.end());
+      if (peak && c >= around[24] + 24.0) ++count;
+    }
+  return count;
+}
+
+// Mean 8-bit channel of the sky rows between 10 and 60 deg elevation.
+glm::dvec3 SkyMean(const Rgb8& image) {
+  glm::dvec3 sum(0.0);
+  int n = 0;
+  for (int y = image.h / 6; y < image.h * 4 / 9; ++y)
+    for (int x = 0; x < image.w; ++x, ++n)
+      for (int c = 0; c < 3; ++c) sum[c] += image.rgb[3 * (size_t(y) * image.w + x) + c];
+  return sum / double(std::max(n, 1));
+}
+
+// A night style of a gallery whose catalogue is missing is refused with the
+// fix before any style is baked (exit 3).
+TEST(NightGallery, RefusesAMissingCatalogueBeforeAnyBake) {
+  const std::string dir = testing::FreshTempDir("night_gallery_bad");
+  fs::create_directories(dir + "/styles");
+  fs::copy_file(SourceDir() + "/configs/styles/natural.toml", dir + "/styles/a_natural.toml");
+  std::string night = testing::ReadFileBytes(SourceDir() + "/configs/styles/night_moonless.toml");
+  night.replace(night.find("star_magnitude_limit"), 0, "star_catalogue = \"missing.json\"\n");
+  std::ofstream(dir + "/styles/b_night.toml") << night;
+  testing::CommandRun run = RunSkybake(fmt::format("gallery '{0}/styles' --size 16 -q --out '{0}/out'", dir));
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("b_night.toml:"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("night.star_catalogue"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir + "/out/a_natural")) << run.output;
+  fs::remove_all(dir);
+}
+
+// The gallery's night styles (configs/styles/night_*.toml) carry their own
+// date, time and place: their tiles show the stars and the moonlit sky, which
+// go when the night sky is switched off.
+TEST(NightGallery, NightTilesShowStarsAndMoonlight) {
+  const std::string dir = testing::FreshTempDir("night_gallery");
+  fs::create_directories(dir + "/styles");
+  for (const char* name : {"night_moonlit", "night_moonless", "night_twilight"})
+    fs::copy_file(SourceDir() + "/configs/styles/" + name + ".toml", dir + "/styles/" + name + ".toml");
+  const std::string common = fmt::format("gallery '{0}/styles' --size 128 --columns 3 --vulkan-validation -q", dir);
+  testing::CommandRun on = RunSkybake(common + fmt::format(" --out '{}/on'", dir));
+  ASSERT_EQ(on.exit_code, 0) << on.output;
+  testing::CommandRun off = RunSkybake(
+      common + fmt::format(" --out '{}/off' --set night.stars=false --set night.moonlight=false", dir));
+  ASSERT_EQ(off.exit_code, 0) << off.output;
+  // The labels name the night sky's parts and the clock time.
+  EXPECT_NE(on.output.find("stars, moonlight, airglow, sun -37.0 deg, 2024-04-23 21:00"), std::string::npos)
+      << on.output;
+  EXPECT_NE(on.output.find("2024-04-08 23:30"), std::string::npos) << on.output;
+  auto preview = [&](const std::string& which, const std::string& name) {
+    for (const auto& e : fs::directory_iterator(dir + "/" + which + "/" + name))
+      if (e.path().extension() == ".png") return ReadPng(e.path().string());
+    ADD_FAILURE() << "no preview for " << name;
+    return Rgb8();
+  };
+  const Rgb8 moonless = preview("on", "night_moonless"), moonless_off = preview("off", "night_moonless");
+  const Rgb8 twilight = preview("on", "night_twilight"), twilight_off = preview("off", "night_twilight");
+  const Rgb8 moonlit = preview("on", "night_moonlit"), moonlit_off = preview("off", "night_moonlit");
+  ASSERT_EQ(moonless.w, 256);
+  // Moonless: the stars, and none without them.
+  const int stars = PointsOfLight(moonless), no_stars = PointsOfLight(moonless_off);
+  std::printf("points of light: moonless %d (off %d), twilight %d (off %d), moonlit %d (off %d)\n", stars, no_stars,
+              PointsOfLight(twilight), PointsOfLight(twilight_off), PointsOfLight(moonlit), PointsOfLight(moonlit_off));
+  EXPECT_GE(stars, 30);
+  EXPECT_LE(no_stars, 1);
+  // Twilight: the brightest stars come through (the rising Moon's disc is
+  // in both).
+  EXPECT_GT(PointsOfLight(twilight), PointsOfLight(twilight_off));
+  // Moonlit: a blue sky, several times the sky without moonlight, and
+  // stars through it.
+  const glm::dvec3 lit = SkyMean(moonlit), unlit = SkyMean(moonlit_off);
+  std::printf("moonlit sky mean RGB %.1f %.1f %.1f, without moonlight %.1f %.1f %.1f\n", lit.x, lit.y, lit.z, unlit.x,
+              unlit.y, unlit.z);
+  EXPECT_GT(lit.z, lit.x + 10.0);
+  EXPECT_GT(lit.z, 3.0 * unlit.z);
+  EXPECT_GT(PointsOfLight(moonlit), PointsOfLight(moonlit_off));
+  // The sheet: three tiles of 256 x 64 under their labels.
+  auto in = OIIO::ImageInput::open(dir + "/on/gallery.png");
+  ASSERT_TRUE(in);
+  EXPECT_EQ(in->spec().width, 3 * (256 + 8) + 8);
+  EXPECT_EQ(in->spec().height, 64 + 40 + 8 + 8);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace skybake

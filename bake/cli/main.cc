@@ -331,6 +331,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   for (const std::string& path : styles) {
     ConfigResult config = LoadSkyStyle(path, args.overrides);
     errors.insert(errors.end(), config.errors.begin(), config.errors.end());
+    if (config.ok()) GalleryFrameOf(path, args.overrides, args.star_catalogue, errors);  // its own [schedule], night sky
   }
   if (!errors.empty()) {
     PrintErrors(errors);

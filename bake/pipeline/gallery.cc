@@ -8,6 +8,8 @@
 #include "skybake/output/exr_io.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/base/oiio_module.h"
+#include "skybake/input/schedule.h"
+#include "skybake/pipeline/night_sky.h"
 
 namespace skybake {
 namespace {
@@ -41,10 +43,41 @@ std::string DescribePrinciples(const SkyStyle& style) {
     parts.push_back(fmt::format("{} shape{}", a.shapes.shapes.size(), a.shapes.shapes.size() == 1 ? "" : "s"));
   for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
     parts.push_back(fmt::format("{} {:g} km", CloudTypeName(l.type), l.altitude_m * 1e-3));
-  parts.push_back(fmt::format("sun {:g} deg", style.sun.elevation_deg));
+  const NightSettings& n = style.night;
+  if (n.stars) parts.push_back("stars");
+  if (n.moonlight) parts.push_back("moonlight");
+  else if (n.moon) parts.push_back("Moon");
+  if (n.airglow) parts.push_back("airglow");
+  // A night style's sun comes from its clock time: to a tenth of a degree.
+  parts.push_back(n.Any() ? fmt::format("sun {:.1f} deg", style.sun.elevation_deg)
+                          : fmt::format("sun {:g} deg", style.sun.elevation_deg));
   std::string out;
   for (size_t i = 0; i < parts.size(); ++i) out += (i ? ", " : "") + parts[i];
   return out;
+}
+
+std::optional<GalleryFrame> GalleryFrameOf(const std::string& path, const std::vector<std::string>& overrides,
+                                           const std::string& star_catalogue, std::vector<ConfigError>& errors) {
+  if (!FileHasSchedule(path)) return std::nullopt;
+  ScheduleResult loaded = LoadSchedule(path);
+  if (!loaded.ok()) {
+    errors.insert(errors.end(), loaded.errors.begin(), loaded.errors.end());
+    return std::nullopt;
+  }
+  GalleryFrame frame{{}, loaded.schedule};
+  frame.schedule.frames.resize(1);
+  FrameStyles styles = ResolveFrameStyles(path, overrides, frame.schedule);
+  if (!styles.ok()) {
+    errors.insert(errors.end(), styles.errors.begin(), styles.errors.end());
+    return std::nullopt;
+  }
+  frame.style = styles.styles.front();
+  const std::vector<ConfigError> night = CheckNightSky({&frame.style}, &frame.schedule, star_catalogue);
+  if (!night.empty()) {
+    errors.insert(errors.end(), night.begin(), night.end());
+    return std::nullopt;
+  }
+  return frame;
 }
 
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
@@ -75,9 +108,25 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
     if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
     BakeOptions bake = options.bake;
     bake.out_dir = (std::filesystem::path(options.out_dir) / name).string();  // preview + manifest
-    BakeResult baked = BakeStyle(config.style, bake);
+    // A style with its own [schedule] (a date, a time and a place: the
+    // night styles) is baked at its schedule's first frame, as a sequence of
+    // that one frame.
+    BakeResult baked;
+    std::string principles;
+    std::vector<ConfigError> errors;
+    if (std::optional<GalleryFrame> frame = GalleryFrameOf(path, overrides, bake.star_catalogue, errors)) {
+      baked = BakeSequence({frame->style}, frame->schedule, bake);
+      principles = DescribePrinciples(frame->style);
+      if (const std::optional<CivilTime>& t = frame->schedule.frames.front().time)
+        principles += fmt::format(", {:04}-{:02}-{:02} {:02}:{:02}", t->year, t->month, t->day, t->hour, t->minute);
+    } else if (!errors.empty()) {
+      throw ConfigFailure(path + " has an invalid [schedule] or night sky", errors);
+    } else {
+      baked = BakeStyle(config.style, bake);
+      principles = DescribePrinciples(config.style);
+    }
     result.validation_messages += baked.validation_messages;
-    GalleryEntry entry{name, path, DescribePrinciples(config.style), ""};
+    GalleryEntry entry{name, path, principles, ""};
     for (const BakedFile& f : baked.files)
       if (f.kind == "preview") entry.preview = f.path;
     result.entries.push_back(entry);
