@@ -536,6 +536,31 @@ TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
   EXPECT_EQ(small_budget.output.find("skybake: device"), std::string::npos) << "no GPU work";
 }
 
+// A sequence counts what it keeps of each frame (its record and manifest
+// entry, about 52 KiB at 9 files a frame, and every frame's style): 1,000
+// frames at --size 1 need about 54 MiB beyond their tiny frames, above a
+// 20 MiB budget, before any GPU work; ten of them (--frames) fit.
+TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
+  const std::string root = FreshTempDir("seqbudget");
+  const std::string schedule = root + "/long.toml";
+  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = { start = 0, end = 89, step = "
+                          << fmt::format("{:.17g}", 89.0 / 999) << " }, azimuth_deg = 135 }\n";
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 -q --max-memory-mib 20 ";
+  CommandRun run = RunSkybake(bake + "--out '" + out + "'");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_NE(run.output.find("the sequence needs an estimated "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their records and manifest entries), above the "
+                            "budget of 20 MiB: bake it in parts"),
+            std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
+  EXPECT_TRUE(FileNames(out).empty());
+  CommandRun part = RunSkybake(bake + "--frames 1:10 --out '" + out + "'");
+  EXPECT_EQ(part.exit_code, 0) << part.output;
+  fs::remove_all(root);
+}
+
 // Cube 2048 and latlong 4096x2048 (58.7 Mtexels) ray-marched with 4096
 // steps = 2.41e11 samples, at lavapipe's measured 1.2e7 samples/s. (The
 // default sky-view LUT reads each texel once: 1.1 s for the default style.)
