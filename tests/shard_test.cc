@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/input/frame_numbering.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -338,6 +339,55 @@ TEST_F(Shard, BadFramesAndShardsAreUsageErrorsBeforeAnyGpuWork) {
   CommandRun bake_help = RunSkybake("bake --help");
   EXPECT_NE(bake_help.output.find("--shard I/N"), std::string::npos) << bake_help.output;
   EXPECT_NE(bake_help.output.find("--frames FIRST:LAST"), std::string::npos) << bake_help.output;
+}
+
+// Every frame of a sequence has the same number width, the one its last
+// frame needs (at least four digits): frames 9,998 to 10,001 of a schedule
+// numbered 9,990 to 10,001 are named .09998 to .10001 (not .9998 beside
+// .10000), and a --resume of them finds them; a schedule ending at 9,999
+// keeps today's four digits.
+TEST(FrameNumbering, EveryFrameOfASequenceHasTheWidthOfItsLastFrame) {
+  EXPECT_EQ(FrameNumberWidth(0), 4);
+  EXPECT_EQ(FrameNumberWidth(9999), 4);
+  EXPECT_EQ(FrameNumberWidth(10000), 5);
+  EXPECT_EQ(FrameNumberWidth(100000), 6);
+  EXPECT_EQ(FrameNumberSuffix(12), ".0012");
+  EXPECT_EQ(FrameNumberSuffix(12, 5), ".00012");
+  EXPECT_EQ(FrameNumberSuffix(0, 5), "");
+  const std::string root = FreshTempDir("padding");
+  for (int last : {10001, 9999}) {
+    SCOPED_TRACE(last);
+    const std::string schedule = fmt::format("{}/sun{}.toml", root, last);
+    std::ofstream(schedule) << fmt::format(
+        "[schedule]\nfirst_frame = {}\nsun = {{ elevation_deg = {{ start = 0, end = 11, step = 1 }}, "
+        "azimuth_deg = 135 }}\n",
+        last - 11);
+    const std::string out = fmt::format("{}/out{}", root, last);
+    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 --vulkan-validation "
+                             "--frames 9998:" + std::to_string(last) + " --out '" + out + "'";
+    CommandRun run = RunSkybake(bake + " -q");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::set<std::string> faces;
+    for (const std::string& name : FileNames(out))
+      if (name.rfind("sky_px.", 0) == 0) faces.insert(name);
+    if (last == 10001) {
+      EXPECT_EQ(faces, (std::set<std::string>{"sky_px.09998.exr", "sky_px.09999.exr", "sky_px.10000.exr",
+                                              "sky_px.10001.exr"}));
+      EXPECT_TRUE(fs::exists(out + "/sky_latlong.09998.png"));
+      EXPECT_TRUE(fs::exists(out + "/manifest.shard-9998-10001.json"));
+    } else {
+      EXPECT_EQ(faces, (std::set<std::string>{"sky_px.9998.exr", "sky_px.9999.exr"}));
+    }
+    // The part's manifest names are the ones the bake gives: --resume
+    // verifies every frame and renders none again.
+    CommandRun resume = RunSkybake(bake + " --resume");
+    EXPECT_EQ(resume.exit_code, 0) << resume.output;
+    size_t verified = 0;
+    for (size_t at = 0; (at = resume.output.find("files verified by checksum", at)) != std::string::npos; ++at)
+      ++verified;
+    EXPECT_EQ(verified, last == 10001 ? 4u : 2u) << resume.output;
+  }
+  fs::remove_all(root);
 }
 
 }  // namespace
