@@ -260,6 +260,10 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
       {"edited sun", "0002-0002",
        [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][1] = 0.5; },
        "do not give their sequence_sha256"},
+      {"face label edited", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][0]["face"] = "-X"; },
+       "frame 1: '-X' is not the face of the frame's face file 1 (+X: +X, -X, +Y, -Y, +Z, -Z in that order)"},
+      {"face label missing", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][2].erase("face"); },
+       "no 'face'"},
       {"texture of another frame", "0001-0001",
        [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "sky_latlong.0001.png"; },
        "gltf.texture.file 'sky_latlong.0001.png' of the shard manifests in "},
@@ -299,6 +303,34 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
                               "/manifest.shard-0002-0002.json, is not a regular file (links are not followed)"),
               std::string::npos)
         << run.output;
+  }
+  // Two face files of part 1 swapped on disk and in its manifest, sizes and
+  // checksums with them: every name is a face name and each part is
+  // consistent on its own, but the two parts name the +X face differently.
+  {
+    const std::string dir = root + "/case";
+    fs::remove_all(dir);
+    fs::copy(parts, dir);
+    fs::rename(dir + "/sky_px.0001.exr", dir + "/swap.exr");
+    fs::rename(dir + "/sky_nx.0001.exr", dir + "/sky_px.0001.exr");
+    fs::rename(dir + "/swap.exr", dir + "/sky_nx.0001.exr");
+    const std::string path = dir + "/manifest.shard-0001-0001.json";
+    nlohmann::json m = nlohmann::json::parse(std::ifstream(path));
+    nlohmann::json& files = m["frames"][0]["files"];
+    ASSERT_EQ(files[0]["face"], "+X");
+    ASSERT_EQ(files[1]["face"], "-X");
+    std::swap(files[0]["file"], files[1]["file"]);
+    std::swap(files[0]["bytes"], files[1]["bytes"]);
+    std::swap(files[0]["sha256"], files[1]["sha256"]);
+    std::ofstream(path) << m.dump(2);
+    const std::set<std::string> before = FileNames(dir);
+    CommandRun run = RunSkybake("merge-manifest --force '" + dir + "'");
+    EXPECT_EQ(run.exit_code, 8) << run.output;
+    EXPECT_NE(run.output.find("frame 2: 'sky_px.0002.exr' is not the +X face file of frame 2: the other frames name "
+                              "that face 'nx' (sky_nx.0002.exr)"),
+              std::string::npos)
+        << run.output;
+    EXPECT_EQ(FileNames(dir), before) << "nothing written";
   }
   // The untouched parts merge.
   CommandRun merged = RunSkybake("merge-manifest '" + parts + "'");

@@ -18,6 +18,7 @@
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/input/engine_preset.h"
+#include "skybake/model/envmap.h"
 
 namespace skybake {
 namespace {
@@ -44,7 +45,9 @@ json ShJson(const ShRgb& c) {
 }
 
 json FileJson(const ManifestFile& f) {
-  return {{"file", f.file}, {"kind", f.kind}, {"bytes", f.bytes}, {"sha256", f.sha256}};
+  json file = {{"file", f.file}, {"kind", f.kind}, {"bytes", f.bytes}, {"sha256", f.sha256}};
+  if (!f.face.empty()) file["face"] = f.face;
+  return file;
 }
 
 json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}}; }
@@ -191,9 +194,11 @@ constexpr int64_t kMaxFileBytes = int64_t(1) << 53;
 std::vector<ManifestFile> FilesOf(const Reader& r, const json& array) {
   if (!array.is_array()) r.Fail("a file list is not an array");
   std::vector<ManifestFile> files;
-  for (const json& f : array)
+  for (const json& f : array) {
     files.push_back({r.Get<std::string>(f, "file"), r.Get<std::string>(f, "kind"),
                      uint64_t(r.Integer(f, "bytes", 0, kMaxFileBytes)), r.Get<std::string>(f, "sha256")});
+    if (files.back().kind == "face") files.back().face = r.Get<std::string>(f, "face");
+  }
   return files;
 }
 
@@ -292,6 +297,7 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 // BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png,
 // in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
+  std::map<std::string, std::string> face_names;  // "+X" -> "px": the same in every frame
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
   if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
     FailName(path, "gltf.texture.file", m.gltf.texture_file, "a plain file name of a PNG in the folder");
@@ -325,6 +331,10 @@ void CheckNames(const std::string& path, const Manifest& m) {
       if (file.kind == "face") {
         if (stage > 0 || faces.size() == 6)
           FailName(path, where, file.file, "one of six face files listed before the frame's other files");
+        if (file.face != CubeFaceLabel(int(faces.size())))
+          FailName(path, where, file.face,
+                   fmt::format("the face of the frame's face file {} ({}: +X, -X, +Y, -Y, +Z, -Z in that order)",
+                               faces.size() + 1, CubeFaceLabel(int(faces.size()))));
         faces.push_back(stem_of(file, ".exr", "face"));
       } else if (file.kind == "cube") {
         with_suffix(file, stem_of(file, ".exr", "cube strip"), "_cube", "cube strip", 1);
@@ -380,6 +390,15 @@ void CheckNames(const std::string& path, const Manifest& m) {
           FailName(path, where, f.files[i].file,
                    fmt::format("a face file skybake names for frame {} (BASE_FACE{}.exr, six different faces)",
                                f.number, number));
+        // A face keeps its name in every frame: a face file renamed to
+        // another face's name (and listed so) differs from the other frames.
+        const std::string label = CubeFaceLabel(int(i));
+        const std::string face_name = face.substr(base.size() + 1);
+        auto [known, inserted] = face_names.emplace(label, face_name);
+        if (!inserted && known->second != face_name)
+          FailName(path, where, f.files[i].file,
+                   fmt::format("the {} face file of frame {}: the other frames name that face '{}' ({}_{}{}.exr)",
+                               label, f.number, known->second, base, known->second, number));
       }
     }
   }
@@ -419,8 +438,11 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sh_irradiance_with_sun = frame.sh_irradiance_with_sun;
   f.moon = frame.moon;
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
-  for (const BakedFile& file : frame.files)
+  int faces = 0;  // a frame lists its faces first, +X to -Z (WriteViewExrs)
+  for (const BakedFile& file : frame.files) {
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+    if (file.kind == "face") f.files.back().face = CubeFaceLabel(faces++);
+  }
   f.cloud_shadow = frame.cloud_shadow;
   return f;
 }
@@ -764,18 +786,19 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
   const Manifest& shared = parts[parts.order.front()];
   CheckEveryFrameOnce(parts, *shared.sequence, options.dir);
 
-  // Every listed file in place, as the part recorded it.
+  // The names of all parts together (one name per face in every frame),
+  // then every listed file in place, as the part recorded it.
   Manifest merged = shared;
   merged.part.reset();
   merged.frames.clear();
   merged.scene.clear();
-  for (size_t i : parts.order) {
-    for (const ManifestFrame& f : parts[i].frames) {
+  for (size_t i : parts.order)
+    for (const ManifestFrame& f : parts[i].frames) merged.frames.push_back(f);
+  CheckNames(fmt::format("the shard manifests in {}", options.dir), merged);
+  for (size_t i : parts.order)
+    for (const ManifestFrame& f : parts[i].frames)
       for (const ManifestFile& file : f.files)
         CheckListedFile(dir, file, f, parts[i], parts.paths[i], options.verify_checksums);
-      merged.frames.push_back(f);
-    }
-  }
   CheckMergedIdentity(merged, options.dir);
 
   // What the merge writes, locked against any other live bake or merge
