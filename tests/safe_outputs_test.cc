@@ -424,6 +424,17 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   EXPECT_EQ(sized.output.find("files verified by checksum"), std::string::npos) << sized.output;
   EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
 
+  // A face listed as another face (its name kept) is refused too.
+  m = nlohmann::json::parse(good);
+  m["frames"][0]["files"][1]["face"] = "+X";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun face = RunSkybake(bake + " --resume");
+  EXPECT_EQ(face.exit_code, 8) << face.output;
+  EXPECT_NE(face.output.find("lists 'sky_nx.0001.exr' as face '+X' for frame 1, where this bake of the same style "
+                             "writes face -X under that name"),
+            std::string::npos)
+      << face.output;
+
   m = nlohmann::json::parse(good);
   m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
   std::ofstream(manifest_path) << m.dump(2);
@@ -537,9 +548,9 @@ TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
 }
 
 // A sequence counts what it keeps of each frame (its record and manifest
-// entry, about 52 KiB at 9 files a frame, and every frame's style): 1,000
-// frames at --size 1 need about 54 MiB beyond their tiny frames, above a
-// 20 MiB budget, before any GPU work; ten of them (--frames) fit.
+// entry, 118 KiB at 9 files a frame, and every frame's style): 1,000 frames
+// at --size 1 need about 118 MiB beyond their tiny frames, above a 20 MiB
+// budget, before any GPU work; ten of them (--frames) fit.
 TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
   const std::string root = FreshTempDir("seqbudget");
   const std::string schedule = root + "/long.toml";

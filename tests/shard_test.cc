@@ -375,7 +375,7 @@ TEST_F(Shard, BadFramesAndShardsAreUsageErrorsBeforeAnyGpuWork) {
 
 // Every frame of a sequence has the same number width, the one its last
 // frame needs (at least four digits): frames 9,998 to 10,001 of a schedule
-// numbered 9,990 to 10,001 are named .09998 to .10001 (not .9998 beside
+// numbered 9,996 to 10,001 are named .09998 to .10001 (not .9998 beside
 // .10000), and a --resume of them finds them; a schedule ending at 9,999
 // keeps today's four digits.
 TEST(FrameNumbering, EveryFrameOfASequenceHasTheWidthOfItsLastFrame) {
@@ -391,12 +391,13 @@ TEST(FrameNumbering, EveryFrameOfASequenceHasTheWidthOfItsLastFrame) {
     SCOPED_TRACE(last);
     const std::string schedule = fmt::format("{}/sun{}.toml", root, last);
     std::ofstream(schedule) << fmt::format(
-        "[schedule]\nfirst_frame = {}\nsun = {{ elevation_deg = {{ start = 0, end = 11, step = 1 }}, "
+        "[schedule]\nfirst_frame = {}\nsun = {{ elevation_deg = {{ start = 0, end = 5, step = 1 }}, "
         "azimuth_deg = 135 }}\n",
-        last - 11);
+        last - 5);
     const std::string out = fmt::format("{}/out{}", root, last);
-    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 --vulkan-validation "
-                             "--frames 9998:" + std::to_string(last) + " --out '" + out + "'";
+    // Names only: no validation layer, which makes lavapipe several times slower.
+    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 --frames 9998:" +
+                             std::to_string(last) + " --out '" + out + "'";
     CommandRun run = RunSkybake(bake + " -q");
     ASSERT_EQ(run.exit_code, 0) << run.output;
     std::set<std::string> faces;
