@@ -10,7 +10,7 @@
 
 layout(local_size_x = SKYBAKE_LOCAL_SIZE_X, local_size_y = SKYBAKE_LOCAL_SIZE_Y) in;
 
-layout(std140, set = 0, binding = BINDING_ATMOSPHERE) uniform AtmosphereBlock {
+layout(std430, set = 0, binding = BINDING_ATMOSPHERE) readonly buffer AtmosphereBlock {
   GpuAtmosphere gpu_atmosphere;
 };
 layout(std430, set = 0, binding = BINDING_TRANSMITTANCE) buffer TransmittanceBuffer {
@@ -32,9 +32,20 @@ layout(std430, set = 0, binding = BINDING_SKYVIEW) buffer SkyViewBuffer {
 layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
   GpuAoas gpu_aoas;
 };
-layout(push_constant) uniform PushBlock {
-  SkyPush push;
+// The dispatch's constants (SkyPush) come from a storage buffer, at the
+// index the push constant gives, and not from push constants: lavapipe
+// compiles a new variant of a shader for each new set of push-constant or
+// uniform values that decide a branch ("inlined uniforms") and keeps every
+// variant while the pipeline lives, so a sequence's new Sun every frame cost
+// an LLVM compile and about 1 MiB that was never given back. Storage-buffer
+// values are never inlined. (docs/performance.md, "Long sequences".)
+layout(std430, set = 0, binding = BINDING_DISPATCH) readonly buffer DispatchBuffer {
+  SkyPush dispatch_constants[];
 };
+layout(push_constant) uniform PushBlock {
+  uint dispatch_index;
+};
+#define push dispatch_constants[dispatch_index]
 
 // Optional effects (EffectSettings); off effects are compiled out.
 layout(constant_id = SPEC_MULTIPLE_SCATTERING) const bool kMultipleScattering = true;

@@ -424,6 +424,17 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   EXPECT_EQ(sized.output.find("files verified by checksum"), std::string::npos) << sized.output;
   EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
 
+  // A face listed as another face (its name kept) is refused too.
+  m = nlohmann::json::parse(good);
+  m["frames"][0]["files"][1]["face"] = "+X";
+  std::ofstream(manifest_path) << m.dump(2);
+  CommandRun face = RunSkybake(bake + " --resume");
+  EXPECT_EQ(face.exit_code, 8) << face.output;
+  EXPECT_NE(face.output.find("lists 'sky_nx.0001.exr' as face '+X' for frame 1, where this bake of the same style "
+                             "writes face -X under that name"),
+            std::string::npos)
+      << face.output;
+
   m = nlohmann::json::parse(good);
   m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
   std::ofstream(manifest_path) << m.dump(2);
@@ -534,6 +545,31 @@ TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
   EXPECT_EQ(small_budget.exit_code, 7) << small_budget.output;
   EXPECT_NE(small_budget.output.find("estimated 3 MiB of memory per frame"), std::string::npos) << small_budget.output;
   EXPECT_EQ(small_budget.output.find("skybake: device"), std::string::npos) << "no GPU work";
+}
+
+// A sequence counts what it keeps of each frame (its record and manifest
+// entry, 118 KiB at 9 files a frame, and every frame's style): 1,000 frames
+// at --size 1 need about 118 MiB beyond their tiny frames, above a 20 MiB
+// budget, before any GPU work; ten of them (--frames) fit.
+TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
+  const std::string root = FreshTempDir("seqbudget");
+  const std::string schedule = root + "/long.toml";
+  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = { start = 0, end = 89, step = "
+                          << fmt::format("{:.17g}", 89.0 / 999) << " }, azimuth_deg = 135 }\n";
+  const std::string out = root + "/out";
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 -q --max-memory-mib 20 ";
+  CommandRun run = RunSkybake(bake + "--out '" + out + "'");
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_NE(run.output.find("the sequence needs an estimated "), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their records and manifest entries), above the "
+                            "budget of 20 MiB: bake it in parts"),
+            std::string::npos)
+      << run.output;
+  EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
+  EXPECT_TRUE(FileNames(out).empty());
+  CommandRun part = RunSkybake(bake + "--frames 1:10 --out '" + out + "'");
+  EXPECT_EQ(part.exit_code, 0) << part.output;
+  fs::remove_all(root);
 }
 
 // Cube 2048 and latlong 4096x2048 (58.7 Mtexels) ray-marched with 4096

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/input/frame_numbering.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -259,6 +260,10 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
       {"edited sun", "0002-0002",
        [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][1] = 0.5; },
        "do not give their sequence_sha256"},
+      {"face label edited", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][0]["face"] = "-X"; },
+       "frame 1: '-X' is not the face of the frame's face file 1 (+X: +X, -X, +Y, -Y, +Z, -Z in that order)"},
+      {"face label missing", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][2].erase("face"); },
+       "no 'face'"},
       {"texture of another frame", "0001-0001",
        [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "sky_latlong.0001.png"; },
        "gltf.texture.file 'sky_latlong.0001.png' of the shard manifests in "},
@@ -299,6 +304,34 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
               std::string::npos)
         << run.output;
   }
+  // Two face files of part 1 swapped on disk and in its manifest, sizes and
+  // checksums with them: every name is a face name and each part is
+  // consistent on its own, but the two parts name the +X face differently.
+  {
+    const std::string dir = root + "/case";
+    fs::remove_all(dir);
+    fs::copy(parts, dir);
+    fs::rename(dir + "/sky_px.0001.exr", dir + "/swap.exr");
+    fs::rename(dir + "/sky_nx.0001.exr", dir + "/sky_px.0001.exr");
+    fs::rename(dir + "/swap.exr", dir + "/sky_nx.0001.exr");
+    const std::string path = dir + "/manifest.shard-0001-0001.json";
+    nlohmann::json m = nlohmann::json::parse(std::ifstream(path));
+    nlohmann::json& files = m["frames"][0]["files"];
+    ASSERT_EQ(files[0]["face"], "+X");
+    ASSERT_EQ(files[1]["face"], "-X");
+    std::swap(files[0]["file"], files[1]["file"]);
+    std::swap(files[0]["bytes"], files[1]["bytes"]);
+    std::swap(files[0]["sha256"], files[1]["sha256"]);
+    std::ofstream(path) << m.dump(2);
+    const std::set<std::string> before = FileNames(dir);
+    CommandRun run = RunSkybake("merge-manifest --force '" + dir + "'");
+    EXPECT_EQ(run.exit_code, 8) << run.output;
+    EXPECT_NE(run.output.find("frame 2: 'sky_px.0002.exr' is not the +X face file of frame 2: the other frames name "
+                              "that face 'nx' (sky_nx.0002.exr)"),
+              std::string::npos)
+        << run.output;
+    EXPECT_EQ(FileNames(dir), before) << "nothing written";
+  }
   // The untouched parts merge.
   CommandRun merged = RunSkybake("merge-manifest '" + parts + "'");
   EXPECT_EQ(merged.exit_code, 0) << merged.output;
@@ -338,6 +371,56 @@ TEST_F(Shard, BadFramesAndShardsAreUsageErrorsBeforeAnyGpuWork) {
   CommandRun bake_help = RunSkybake("bake --help");
   EXPECT_NE(bake_help.output.find("--shard I/N"), std::string::npos) << bake_help.output;
   EXPECT_NE(bake_help.output.find("--frames FIRST:LAST"), std::string::npos) << bake_help.output;
+}
+
+// Every frame of a sequence has the same number width, the one its last
+// frame needs (at least four digits): frames 9,998 to 10,001 of a schedule
+// numbered 9,996 to 10,001 are named .09998 to .10001 (not .9998 beside
+// .10000), and a --resume of them finds them; a schedule ending at 9,999
+// keeps today's four digits.
+TEST(FrameNumbering, EveryFrameOfASequenceHasTheWidthOfItsLastFrame) {
+  EXPECT_EQ(FrameNumberWidth(0), 4);
+  EXPECT_EQ(FrameNumberWidth(9999), 4);
+  EXPECT_EQ(FrameNumberWidth(10000), 5);
+  EXPECT_EQ(FrameNumberWidth(100000), 6);
+  EXPECT_EQ(FrameNumberSuffix(12), ".0012");
+  EXPECT_EQ(FrameNumberSuffix(12, 5), ".00012");
+  EXPECT_EQ(FrameNumberSuffix(0, 5), "");
+  const std::string root = FreshTempDir("padding");
+  for (int last : {10001, 9999}) {
+    SCOPED_TRACE(last);
+    const std::string schedule = fmt::format("{}/sun{}.toml", root, last);
+    std::ofstream(schedule) << fmt::format(
+        "[schedule]\nfirst_frame = {}\nsun = {{ elevation_deg = {{ start = 0, end = 5, step = 1 }}, "
+        "azimuth_deg = 135 }}\n",
+        last - 5);
+    const std::string out = fmt::format("{}/out{}", root, last);
+    // Names only: no validation layer, which makes lavapipe several times slower.
+    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 --frames 9998:" +
+                             std::to_string(last) + " --out '" + out + "'";
+    CommandRun run = RunSkybake(bake + " -q");
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    std::set<std::string> faces;
+    for (const std::string& name : FileNames(out))
+      if (name.rfind("sky_px.", 0) == 0) faces.insert(name);
+    if (last == 10001) {
+      EXPECT_EQ(faces, (std::set<std::string>{"sky_px.09998.exr", "sky_px.09999.exr", "sky_px.10000.exr",
+                                              "sky_px.10001.exr"}));
+      EXPECT_TRUE(fs::exists(out + "/sky_latlong.09998.png"));
+      EXPECT_TRUE(fs::exists(out + "/manifest.shard-9998-10001.json"));
+    } else {
+      EXPECT_EQ(faces, (std::set<std::string>{"sky_px.9998.exr", "sky_px.9999.exr"}));
+    }
+    // The part's manifest names are the ones the bake gives: --resume
+    // verifies every frame and renders none again.
+    CommandRun resume = RunSkybake(bake + " --resume");
+    EXPECT_EQ(resume.exit_code, 0) << resume.output;
+    size_t verified = 0;
+    for (size_t at = 0; (at = resume.output.find("files verified by checksum", at)) != std::string::npos; ++at)
+      ++verified;
+    EXPECT_EQ(verified, last == 10001 ? 4u : 2u) << resume.output;
+  }
+  fs::remove_all(root);
 }
 
 }  // namespace

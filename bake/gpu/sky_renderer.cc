@@ -33,7 +33,7 @@ namespace {
 
 // Of the bindings of gpu_shared.h, the atmosphere, AOAS and cloud blocks are uniform.
 bool IsUniformBinding(uint32_t binding) {
-  return binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS || binding == BINDING_CLOUDS;
+  return binding == BINDING_AOAS || binding == BINDING_CLOUDS;
 }
 
 // Texels of the cloud tables: the aerial-perspective LUT's in-scattering and
@@ -72,7 +72,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VkDevice device = context_.device();
 
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), storage);
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
   aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
@@ -87,6 +87,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
   cloud_noise_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_)) * 4 : 16, storage);
   cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
+  dispatch_buffer_ = CreateBuffer(64 * sizeof(gpu::SkyPush), storage);  // grown by Submit when a submission needs more
 
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -96,12 +97,12 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
-  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(gpu::SkyPush));
+  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(uint32_t));
   set_layout_ = layouts.set;
   pipeline_layout_ = layouts.pipeline;
 
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 3}};
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = 2;
@@ -271,6 +272,7 @@ void SkyRenderer::DestroyAll() {
   set_layout_ = VK_NULL_HANDLE;
   DestroyBuffer(skyview_buffer_);
   DestroyBuffer(cloud_lut_buffer_);
+  DestroyBuffer(dispatch_buffer_);
   DestroyBuffer(cloud_noise_buffer_);
   DestroyBuffer(clouds_buffer_);
   DestroyBuffer(output_buffer_);
@@ -369,6 +371,22 @@ void SkyRenderer::EnsureOutputCapacity(VkDeviceSize bytes) {
   UpdateDescriptors();
 }
 
+void SkyRenderer::EnsureDispatchCapacity(size_t dispatches) {
+  const VkDeviceSize bytes = VkDeviceSize(dispatches) * sizeof(gpu::SkyPush);
+  if (bytes <= dispatch_buffer_.size) return;
+  DestroyBuffer(dispatch_buffer_);
+  dispatch_buffer_ = CreateBuffer(2 * bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  // Only this binding: the output binding may point at a frame slot.
+  const VkDescriptorBufferInfo info{dispatch_buffer_.buffer, 0, VK_WHOLE_SIZE};
+  VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+  write.dstSet = descriptor_set_;
+  write.dstBinding = BINDING_DISPATCH;
+  write.descriptorCount = 1;
+  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+  write.pBufferInfo = &info;
+  vkUpdateDescriptorSets(context_.device(), 1, &write, 0, nullptr);
+}
+
 void SkyRenderer::UpdateDescriptors() {
   VkDescriptorBufferInfo infos[kBindingCount] = {
       {atmosphere_buffer_.buffer, 0, VK_WHOLE_SIZE},
@@ -380,6 +398,7 @@ void SkyRenderer::UpdateDescriptors() {
       {clouds_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {cloud_noise_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {cloud_lut_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {dispatch_buffer_.buffer, 0, VK_WHOLE_SIZE},
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -445,6 +464,13 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
     query_capacity_ = qinfo.queryCount;
   }
 
+  // Each dispatch's constants into the dispatch buffer (host-coherent: the
+  // submission makes the writes visible); the previous submission was
+  // waited for, so nothing reads the buffer now.
+  EnsureDispatchCapacity(dispatches.size());
+  for (size_t i = 0; i < dispatches.size(); ++i)
+    std::memcpy(static_cast<gpu::SkyPush*>(dispatch_buffer_.mapped) + i, &dispatches[i].push, sizeof(gpu::SkyPush));
+
   VK_CHECK(vkResetCommandBuffer(command_buffer_, 0));
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
@@ -457,8 +483,9 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
     if (timestamps_supported_)
       vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, query_pool_, uint32_t(2 * i));
     vkCmdBindPipeline(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, d.pipeline);
-    vkCmdPushConstants(command_buffer_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0,
-                       sizeof(gpu::SkyPush), &d.push);
+    const uint32_t dispatch_index = uint32_t(i);
+    vkCmdPushConstants(command_buffer_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(dispatch_index),
+                       &dispatch_index);
     vkCmdDispatch(command_buffer_, d.groups_x, d.groups_y, 1);
     if (timestamps_supported_)
       vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, query_pool_,

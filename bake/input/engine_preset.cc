@@ -186,11 +186,11 @@ std::vector<EngineImage> EngineImages(const EnginePreset& preset, int n, int h) 
   return images;
 }
 
-std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name) {
+std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name, int number_width) {
   std::vector<std::string> names;
   const EnginePreset* preset = FindEnginePreset(style.output.engine);
   if (!preset) return names;
-  const std::string number = FrameNumberSuffix(number_in_name);
+  const std::string number = FrameNumberSuffix(number_in_name, number_width);
   const std::string stem = style.output.basename + "_" + preset->name + "_";
   for (const std::string& face : preset->faces) names.push_back(stem + face + number + ".exr");
   if (preset->latlong) names.push_back(stem + "latlong" + number + ".exr");
@@ -214,8 +214,8 @@ std::optional<std::string> EngineStyleError(const SkyStyle& style) {
   return std::nullopt;
 }
 
-std::optional<std::string> EngineFileBase(const std::string& file, int number_in_name) {
-  const std::string tail = FrameNumberSuffix(number_in_name) + ".exr";
+std::optional<std::string> EngineFileBase(const std::string& file, int number_in_name, int number_width) {
+  const std::string tail = FrameNumberSuffix(number_in_name, number_width) + ".exr";
   if (file.size() <= tail.size() || file.compare(file.size() - tail.size(), tail.size(), tail) != 0)
     return std::nullopt;
   const std::string stem = file.substr(0, file.size() - tail.size());

@@ -6,8 +6,8 @@
 
 namespace skybake {
 
-std::string CloudShadowFileName(const std::string& basename, int frame_number) {
-  return basename + "_cloudshadow" + FrameNumberSuffix(frame_number) + ".exr";
+std::string CloudShadowFileName(const std::string& basename, int frame_number, int number_width) {
+  return basename + "_cloudshadow" + FrameNumberSuffix(frame_number, number_width) + ".exr";
 }
 
 BakedFile WriteCloudShadowFile(const std::string& path, const std::vector<float>& transmittance,

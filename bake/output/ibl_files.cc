@@ -11,12 +11,12 @@
 
 namespace skybake {
 
-std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name, bool with_dfg) {
+std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name, bool with_dfg, int number_width) {
   const IblSettings& s = style.ibl;
   std::vector<IblFileName> names;
   if (!s.Requested()) return names;
   const std::string base = style.output.basename;
-  const std::string number = FrameNumberSuffix(number_in_name);
+  const std::string number = FrameNumberSuffix(number_in_name, number_width);
   if (s.exr) {
     if (s.specular)
       for (int level = 0; level < IblLevelCount(s); ++level)

@@ -18,6 +18,7 @@
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/input/engine_preset.h"
+#include "skybake/model/envmap.h"
 
 namespace skybake {
 namespace {
@@ -44,7 +45,9 @@ json ShJson(const ShRgb& c) {
 }
 
 json FileJson(const ManifestFile& f) {
-  return {{"file", f.file}, {"kind", f.kind}, {"bytes", f.bytes}, {"sha256", f.sha256}};
+  json file = {{"file", f.file}, {"kind", f.kind}, {"bytes", f.bytes}, {"sha256", f.sha256}};
+  if (!f.face.empty()) file["face"] = f.face;
+  return file;
 }
 
 json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}}; }
@@ -191,9 +194,11 @@ constexpr int64_t kMaxFileBytes = int64_t(1) << 53;
 std::vector<ManifestFile> FilesOf(const Reader& r, const json& array) {
   if (!array.is_array()) r.Fail("a file list is not an array");
   std::vector<ManifestFile> files;
-  for (const json& f : array)
+  for (const json& f : array) {
     files.push_back({r.Get<std::string>(f, "file"), r.Get<std::string>(f, "kind"),
                      uint64_t(r.Integer(f, "bytes", 0, kMaxFileBytes)), r.Get<std::string>(f, "sha256")});
+    if (files.back().kind == "face") files.back().face = r.Get<std::string>(f, "face");
+  }
   return files;
 }
 
@@ -237,11 +242,11 @@ bool EndsWith(const std::string& s, const std::string& tail) {
 // after the latlong and before the PNG: BASE_specular_mL.NNNN.exr per level
 // or BASE_specular.NNNN.ktx2, BASE_irradiance.NNNN.exr/.ktx2, and the
 // frame-independent BASE_dfg.exr/.ktx2. `stage` as in CheckNames (3: IBL).
-void CheckIblName(const std::string& path, const std::string& where, int number_in_name, const ManifestFile& file,
-                  std::string& base, int& stage) {
+void CheckIblName(const std::string& path, const std::string& where, int number_in_name, int number_width,
+                  const ManifestFile& file, std::string& base, int& stage) {
   if (file.kind == "ibl_gltf") {
     // BASE_specular_mLEVEL_FACE.NNNN.png: the scene's EXT_lights_image_based faces (gltf_ibl.h).
-    const std::string tail = FrameNumberSuffix(number_in_name) + ".png";
+    const std::string tail = FrameNumberSuffix(number_in_name, number_width) + ".png";
     std::string stem = EndsWith(file.file, tail) ? file.file.substr(0, file.file.size() - tail.size()) : "";
     const size_t face = stem.size() > 3 ? stem.size() - 3 : std::string::npos;
     const std::string face_name = face == std::string::npos ? "" : stem.substr(face);
@@ -261,7 +266,7 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
     stage = 3;
     return;
   }
-  const std::string number = file.kind == "ibl_dfg" ? std::string() : FrameNumberSuffix(number_in_name);
+  const std::string number = file.kind == "ibl_dfg" ? std::string() : FrameNumberSuffix(number_in_name, number_width);
   const char* suffix = file.kind == "ibl_specular" ? "_specular" : file.kind == "ibl_irradiance" ? "_irradiance" : "_dfg";
   const std::string shape = fmt::format("BASE{}{}.exr or .ktx2{}", suffix, number,
                                         file.kind == "ibl_specular" ? " (BASE_specular_mLEVEL... for EXR levels)" : "");
@@ -292,12 +297,15 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 // BASE_latlong.NNNN.exr, the IBL files (CheckIblName), BASE_cloudshadow.NNNN.exr, BASE_latlong.NNNN.png,
 // in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
+  std::map<std::string, std::string> face_names;  // "+X" -> "px": the same in every frame
   if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
   if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
     FailName(path, "gltf.texture.file", m.gltf.texture_file, "a plain file name of a PNG in the folder");
+  // Every frame number of a sequence has its width (FrameNumberWidth).
+  const int number_width = FrameNumberWidth(m.sequence ? m.sequence->last : 0);
   for (const ManifestFrame& f : m.frames) {
     const std::string where = fmt::format("frame {}", f.number);
-    const std::string number = FrameNumberSuffix(f.number);
+    const std::string number = FrameNumberSuffix(f.number, number_width);
     std::string base;
     std::vector<std::string> faces;
     int stage = 0;  // 0 faces, 1 cube, 2 latlong, 3 IBL, 4 png, 5 done: the order files are written in
@@ -323,6 +331,10 @@ void CheckNames(const std::string& path, const Manifest& m) {
       if (file.kind == "face") {
         if (stage > 0 || faces.size() == 6)
           FailName(path, where, file.file, "one of six face files listed before the frame's other files");
+        if (file.face != CubeFaceLabel(int(faces.size())))
+          FailName(path, where, file.face,
+                   fmt::format("the face of the frame's face file {} ({}: +X, -X, +Y, -Y, +Z, -Z in that order)",
+                               faces.size() + 1, CubeFaceLabel(int(faces.size()))));
         faces.push_back(stem_of(file, ".exr", "face"));
       } else if (file.kind == "cube") {
         with_suffix(file, stem_of(file, ".exr", "cube strip"), "_cube", "cube strip", 1);
@@ -330,10 +342,10 @@ void CheckNames(const std::string& path, const Manifest& m) {
         with_suffix(file, stem_of(file, ".exr", "latlong"), "_latlong", "latlong", 2);
       } else if (file.kind == "ibl_specular" || file.kind == "ibl_irradiance" || file.kind == "ibl_dfg" ||
                  file.kind == "ibl_gltf") {
-        CheckIblName(path, where, f.number, file, base, stage);
+        CheckIblName(path, where, f.number, number_width, file, base, stage);
       } else if (file.kind == "engine") {
         // BASE_ENGINE_SUFFIX.NNNN.exr (engine_preset.h), after the IBL files.
-        const std::optional<std::string> b = EngineFileBase(file.file, f.number);
+        const std::optional<std::string> b = EngineFileBase(file.file, f.number, number_width);
         if (stage > 4 || !IsPlainFileName(file.file) || !b || b->empty())
           FailName(path, where, file.file, fmt::format("an engine preset's file skybake names for frame {} "
                                                        "(BASE_ENGINE_SUFFIX{}.exr)", f.number, number));
@@ -378,6 +390,15 @@ void CheckNames(const std::string& path, const Manifest& m) {
           FailName(path, where, f.files[i].file,
                    fmt::format("a face file skybake names for frame {} (BASE_FACE{}.exr, six different faces)",
                                f.number, number));
+        // A face keeps its name in every frame: a face file renamed to
+        // another face's name (and listed so) differs from the other frames.
+        const std::string label = CubeFaceLabel(int(i));
+        const std::string face_name = face.substr(base.size() + 1);
+        auto [known, inserted] = face_names.emplace(label, face_name);
+        if (!inserted && known->second != face_name)
+          FailName(path, where, f.files[i].file,
+                   fmt::format("the {} face file of frame {}: the other frames name that face '{}' ({}_{}{}.exr)",
+                               label, f.number, known->second, base, known->second, number));
       }
     }
   }
@@ -417,8 +438,11 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   f.sh_irradiance_with_sun = frame.sh_irradiance_with_sun;
   f.moon = frame.moon;
   f.sh_irradiance_without_sun = frame.sh_irradiance_without_sun;
-  for (const BakedFile& file : frame.files)
+  int faces = 0;  // a frame lists its faces first, +X to -Z (WriteViewExrs)
+  for (const BakedFile& file : frame.files) {
     f.files.push_back({fs::path(file.path).filename().string(), file.kind, file.bytes, file.sha256});
+    if (file.kind == "face") f.files.back().face = CubeFaceLabel(faces++);
+  }
   f.cloud_shadow = frame.cloud_shadow;
   return f;
 }
@@ -606,42 +630,53 @@ void WriteTimings(const BakeResult& result, const std::string& out_dir, double t
   WriteFileAtomically(path, timings.dump(2) + "\n");
 }
 
-MergeResult MergeShardManifests(const MergeOptions& options) {
+namespace {
+
+// The parts of a merge: every manifest.shard-FIRST-LAST.json of the folder,
+// read and checked (ReadManifest), each with the JSON all parts share, in
+// the order of their first frames.
+struct MergeParts {
+  std::vector<std::string> paths;
+  std::vector<std::pair<Manifest, json>> parts;
+  std::vector<size_t> order;  // indices into paths and parts, by first frame
+  const Manifest& operator[](size_t i) const { return parts[i].first; }
+};
+
+MergeParts ReadMergeParts(const MergeOptions& options) {
   const fs::path dir(options.dir);
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
     throw ManifestError(fmt::format("{} is not a folder: give the folder the shards baked into", options.dir));
-
-  // The parts: every manifest.shard-FIRST-LAST.json, by first frame.
   static const std::regex kPartName(R"(manifest\.shard-\d+-\d+\.json)");
-  std::vector<std::string> paths;
+  MergeParts p;
   for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
     const std::string name = e.path().filename().string();
-    if (e.is_regular_file() && std::regex_match(name, kPartName)) paths.push_back(e.path().string());
+    if (e.is_regular_file() && std::regex_match(name, kPartName)) p.paths.push_back(e.path().string());
   }
-  if (paths.empty())
+  if (p.paths.empty())
     throw ManifestError(fmt::format("no shard manifests (manifest.shard-FIRST-LAST.json) in {}: bake with --shard "
                                     "I/N or --frames A:B into it first",
                                     options.dir));
-  std::vector<std::pair<Manifest, json>> parts;
-  for (const std::string& path : paths) {
+  for (const std::string& path : p.paths) {
     Manifest m = ReadManifest(path);
     std::ifstream in(path, std::ios::binary);
-    parts.emplace_back(std::move(m), SharedPart(json::parse(in)));
+    p.parts.emplace_back(std::move(m), SharedPart(json::parse(in)));
   }
-  std::vector<size_t> order(parts.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  for (size_t i = 0; i < parts.size(); ++i)
-    if (!parts[i].first.part || !parts[i].first.sequence)
-      throw ManifestError(fmt::format("{} is not the manifest of a part of a sequence", paths[i]));
-  std::sort(order.begin(), order.end(),
-            [&](size_t a, size_t b) { return parts[a].first.part->first < parts[b].first.part->first; });
+  p.order.resize(p.parts.size());
+  for (size_t i = 0; i < p.order.size(); ++i) p.order[i] = i;
+  for (size_t i = 0; i < p.parts.size(); ++i)
+    if (!p[i].part || !p[i].sequence)
+      throw ManifestError(fmt::format("{} is not the manifest of a part of a sequence", p.paths[i]));
+  std::sort(p.order.begin(), p.order.end(), [&](size_t a, size_t b) { return p[a].part->first < p[b].part->first; });
+  return p;
+}
 
-  // One bake: the parts agree on everything but their frames.
-  const size_t first = order.front();
-  for (size_t i : order) {
-    const json& a = parts[first].second;
-    const json& b = parts[i].second;
+// One bake: the parts agree on everything but their frames.
+void CheckOneBake(const MergeParts& p) {
+  const size_t first = p.order.front();
+  for (size_t i : p.order) {
+    const json& a = p.parts[first].second;
+    const json& b = p.parts[i].second;
     if (a == b) continue;
     std::string key;
     for (const json* side : {&a, &b})
@@ -650,81 +685,76 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
     throw ManifestError(fmt::format(
         "{} and {} come from different bakes: their '{}' differs ({} vs {}): bake every shard with the same "
         "skybake version, style, schedule, --set and --size into one folder",
-        paths[first], paths[i], key, a.contains(key) ? a[key].dump() : "none", b.contains(key) ? b[key].dump() : "none"));
+        p.paths[first], p.paths[i], key, a.contains(key) ? a[key].dump() : "none",
+        b.contains(key) ? b[key].dump() : "none"));
   }
+}
 
-  // Every frame once: complete parts, no overlap, no gap.
-  const Manifest& shared = parts[first].first;
-  const FrameRange sequence = *shared.sequence;
+// Every frame of the sequence once: complete parts, no overlap, no gap.
+void CheckEveryFrameOnce(const MergeParts& p, const FrameRange& sequence, const std::string& dir) {
   std::map<int, size_t> owner;  // frame number -> part
-  for (size_t i : order) {
-    const Manifest& m = parts[i].first;
+  for (size_t i : p.order) {
+    const Manifest& m = p[i];
     if (!m.complete || int(m.frames.size()) != m.part->count())
       throw ManifestError(fmt::format("{} is incomplete ({} of frames {} baked): finish it by running its bake "
                                       "again with --resume",
-                                      paths[i], m.frames.size(), FrameRangeText(*m.part)));
+                                      p.paths[i], m.frames.size(), FrameRangeText(*m.part)));
     for (const ManifestFrame& f : m.frames) {
       if (!m.part->Contains(f.number) || !sequence.Contains(f.number))
-        throw ManifestError(fmt::format("{} lists frame {}, outside its part {}", paths[i], f.number,
+        throw ManifestError(fmt::format("{} lists frame {}, outside its part {}", p.paths[i], f.number,
                                         FrameRangeText(*m.part)));
       auto [it, inserted] = owner.emplace(f.number, i);
       if (!inserted)
         throw ManifestError(fmt::format("frame {} is in both {} and {}: the shards overlap; remove one of the two "
                                         "manifests (with its files if they differ) and merge again",
-                                        f.number, paths[it->second], paths[i]));
+                                        f.number, p.paths[it->second], p.paths[i]));
     }
   }
   std::vector<int> missing;
   for (int n = sequence.first; n <= sequence.last; ++n)
     if (!owner.count(n)) missing.push_back(n);
-  if (!missing.empty()) {
-    const bool one_range = missing.back() - missing.front() + 1 == int(missing.size());
-    throw ManifestError(fmt::format(
-        "frame{} {} of {} {} missing: no shard manifest in {} lists {}: bake {} into {} (the missing --shard, or {}), "
-        "then merge again",
-        missing.size() == 1 ? "" : "s", RangesText(missing), FrameRangeText(sequence),
-        missing.size() == 1 ? "is" : "are", options.dir, missing.size() == 1 ? "it" : "them",
-        missing.size() == 1 ? "it" : "them", options.dir,
-        one_range ? fmt::format("--frames {}:{}", missing.front(), missing.back())
-                  : "--frames FIRST:LAST for each missing range"));
-  }
+  if (missing.empty()) return;
+  const bool one_range = missing.back() - missing.front() + 1 == int(missing.size());
+  throw ManifestError(fmt::format(
+      "frame{} {} of {} {} missing: no shard manifest in {} lists {}: bake {} into {} (the missing --shard, or {}), "
+      "then merge again",
+      missing.size() == 1 ? "" : "s", RangesText(missing), FrameRangeText(sequence),
+      missing.size() == 1 ? "is" : "are", dir, missing.size() == 1 ? "it" : "them",
+      missing.size() == 1 ? "it" : "them", dir,
+      one_range ? fmt::format("--frames {}:{}", missing.front(), missing.back())
+                : "--frames FIRST:LAST for each missing range"));
+}
 
-  // Every listed file in place, as the part recorded it.
-  Manifest merged = shared;
-  merged.part.reset();
-  merged.frames.clear();
-  merged.scene.clear();
-  for (size_t i : order) {
-    for (const ManifestFrame& f : parts[i].first.frames) {
-      for (const ManifestFile& file : f.files) {
-        const fs::path path = dir / file.file;  // a plain name (ReadManifest): inside dir
-        // A link is not followed: only a regular file of the folder is read.
-        const fs::file_status status = fs::symlink_status(path, ec);
-        if (fs::exists(status) && !fs::is_regular_file(status))
-          throw ManifestError(fmt::format("{}, listed in {}, is not a regular file (links are not followed): put the "
-                                          "file itself in the folder",
-                                          path.string(), paths[i]));
-        if (!fs::is_regular_file(status))
-          throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
-                                          "{}, or bake them again with --frames {}:{} --resume",
-                                          path.string(), paths[i], FrameRangeText(*parts[i].first.part),
-                                          parts[i].first.part->first, parts[i].first.part->last));
-        const uint64_t bytes = fs::file_size(path);
-        if (bytes != file.bytes || (options.verify_checksums && Sha256OfFile(path.string()) != file.sha256))
-          throw ManifestError(fmt::format("{} does not match {} ({}): it is truncated, changed or from another bake; "
-                                          "bake frame {} again with --frames {}:{} --resume",
-                                          path.string(), paths[i],
-                                          bytes != file.bytes ? fmt::format("{} bytes, listed with {}", bytes, file.bytes)
-                                                              : "SHA-256 differs",
-                                          f.number, f.number, f.number));
-      }
-      merged.frames.push_back(f);
-    }
-  }
+// A listed file in place, as part `part_path` recorded it for frame `f`.
+void CheckListedFile(const fs::path& dir, const ManifestFile& file, const ManifestFrame& f, const Manifest& part,
+                     const std::string& part_path, bool verify_checksums) {
+  std::error_code ec;
+  const fs::path path = dir / file.file;  // a plain name (ReadManifest): inside dir
+  // A link is not followed: only a regular file of the folder is read.
+  const fs::file_status status = fs::symlink_status(path, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status))
+    throw ManifestError(fmt::format("{}, listed in {}, is not a regular file (links are not followed): put the "
+                                    "file itself in the folder",
+                                    path.string(), part_path));
+  if (!fs::is_regular_file(status))
+    throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
+                                    "{}, or bake them again with --frames {}:{} --resume",
+                                    path.string(), part_path, FrameRangeText(*part.part), part.part->first,
+                                    part.part->last));
+  const uint64_t bytes = fs::file_size(path);
+  if (bytes != file.bytes || (verify_checksums && Sha256OfFile(path.string()) != file.sha256))
+    throw ManifestError(fmt::format("{} does not match {} ({}): it is truncated, changed or from another bake; "
+                                    "bake frame {} again with --frames {}:{} --resume",
+                                    path.string(), part_path,
+                                    bytes != file.bytes ? fmt::format("{} bytes, listed with {}", bytes, file.bytes)
+                                                        : "SHA-256 differs",
+                                    f.number, f.number, f.number));
+}
 
-  // The frames are the ones the parts say they baked: their numbers,
-  // times, suns and styles give the parts' sequence_sha256, and the scene's
-  // texture is the texture frame's PNG.
+// The frames are the ones the parts say they baked: their numbers, times,
+// suns and styles give the parts' sequence_sha256, and the scene's texture
+// is the texture frame's PNG.
+void CheckMergedIdentity(const Manifest& merged, const std::string& dir) {
   std::string identity;
   std::string texture;
   for (const ManifestFrame& f : merged.frames) {
@@ -737,12 +767,39 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
     throw ManifestError(fmt::format("the frames of the shard manifests in {} (their numbers, times, suns and "
                                     "style_sha256) do not give their sequence_sha256: a manifest was edited, or "
                                     "the parts come from different bakes; bake the parts again with --force",
-                                    options.dir));
+                                    dir));
   if (merged.gltf.enabled && texture != merged.gltf.texture_file)
     throw ManifestError(fmt::format("gltf.texture.file {} of the shard manifests in {} is not the PNG of texture "
                                     "frame {} ({}): a manifest was edited; bake the parts again with --force",
-                                    EscapedText(merged.gltf.texture_file), options.dir, merged.texture_frame,
+                                    EscapedText(merged.gltf.texture_file), dir, merged.texture_frame,
                                     texture.empty() ? "none" : EscapedText(texture)));
+}
+
+}  // namespace
+
+MergeResult MergeShardManifests(const MergeOptions& options) {
+  const fs::path dir(options.dir);
+  std::error_code ec;
+  // The parts, from one bake, with every frame once.
+  const MergeParts parts = ReadMergeParts(options);
+  CheckOneBake(parts);
+  const Manifest& shared = parts[parts.order.front()];
+  CheckEveryFrameOnce(parts, *shared.sequence, options.dir);
+
+  // The names of all parts together (one name per face in every frame),
+  // then every listed file in place, as the part recorded it.
+  Manifest merged = shared;
+  merged.part.reset();
+  merged.frames.clear();
+  merged.scene.clear();
+  for (size_t i : parts.order)
+    for (const ManifestFrame& f : parts[i].frames) merged.frames.push_back(f);
+  CheckNames(fmt::format("the shard manifests in {}", options.dir), merged);
+  for (size_t i : parts.order)
+    for (const ManifestFrame& f : parts[i].frames)
+      for (const ManifestFile& file : f.files)
+        CheckListedFile(dir, file, f, parts[i], parts.paths[i], options.verify_checksums);
+  CheckMergedIdentity(merged, options.dir);
 
   // What the merge writes, locked against any other live bake or merge
   // writing it (OutputLock), then new unless --force.
@@ -757,7 +814,7 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
   }
 
   MergeResult result;
-  for (size_t i : order) result.parts.push_back(paths[i]);
+  for (size_t i : parts.order) result.parts.push_back(parts.paths[i]);
   result.frames = int(merged.frames.size());
   result.scene_files = WriteSceneAndManifest(merged, options.dir);
   result.manifest_path = (dir / ManifestFileName(std::nullopt)).string();

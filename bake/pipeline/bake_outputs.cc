@@ -14,6 +14,7 @@ std::string OutputPath(const BakeOptions& options, const std::string& name) {
 
 OutputLock ClaimOutputs(const RenderPlan& plan, const BakeOptions& options) {
   for (const FramePlan& frame : plan.frames) CheckBudget(*frame.style, options);
+  CheckSequenceBudget(plan, options);
   std::error_code ec;
   const std::filesystem::file_status out = std::filesystem::status(options.out_dir, ec);
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))

@@ -8,6 +8,7 @@
 #include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
+#include "skybake/pipeline/render_plan.h"
 
 namespace skybake {
 
@@ -78,6 +79,44 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
         "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
         "--max-frame-seconds (README \"Limits\")",
         e.samples, e.seconds, options.max_frame_seconds));
+}
+
+// What a sequence keeps of a frame until its last manifest is written: the
+// frame's record (its files' names, sizes and checksums, its Sun, SH and
+// timings) and its manifest entry, which the progress manifests build in
+// memory whole; the more files a frame writes, the more. Measured with
+// tests/benchmark/long_sequence.py: 104 KiB per frame for the default
+// style at --size 1 with 9 files a frame, over 1,000 frames (RSS after the
+// first tenth; docs/performance.md "Long sequences"), which 64 KiB + 6 KiB
+// per file (118 KiB) bounds.
+constexpr double kFrameRecordBytes = 64.0 * 1024.0;
+constexpr double kFileRecordBytes = 6.0 * 1024.0;
+
+double SequenceRecordMiB(const RenderPlan& plan) {
+  double bytes = 0.0;
+  for (const FramePlan& f : plan.frames) {
+    bytes += double(f.style->resolved_toml.size());  // every frame's style, for the whole sequence's values
+    if (plan.Bakes(f)) bytes += kFrameRecordBytes + kFileRecordBytes * double(f.names.All().size());
+  }
+  return bytes / (1024.0 * 1024.0);
+}
+
+void CheckSequenceBudget(const RenderPlan& plan, const BakeOptions& options) {
+  if (!plan.sequence) return;
+  double frame_mib = 0.0;
+  int baked = 0;
+  for (const FramePlan& f : plan.frames) {
+    frame_mib = std::max(frame_mib, EstimateResources(*f.style).memory_mib);
+    baked += plan.Bakes(f) ? 1 : 0;
+  }
+  const double records_mib = SequenceRecordMiB(plan);
+  if (frame_mib + records_mib <= options.max_memory_mib) return;
+  throw BudgetError(fmt::format(
+      "the sequence needs an estimated {:.0f} MiB of memory: {:.0f} MiB for its largest frame and {:.0f} MiB for "
+      "what it keeps of its {} frames (their records and manifest entries), above the budget of {:.0f} MiB: bake "
+      "it in parts (--frames A:B or --shard I/N, then merge-manifest), or raise --max-memory-mib (README "
+      "\"Limits\")",
+      frame_mib + records_mib, frame_mib, records_mib, baked, options.max_memory_mib));
 }
 
 }  // namespace skybake

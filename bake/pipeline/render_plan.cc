@@ -1,5 +1,6 @@
 #include "skybake/pipeline/render_plan.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -35,19 +36,19 @@ std::vector<std::string> FrameNames::Kinds(const SkyStyle& style) const {
   return kinds;
 }
 
-FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_dfg) {
+FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_dfg, int number_width) {
   const OutputSettings& o = style.output;
-  const std::string number = FrameNumberSuffix(number_in_name);
+  const std::string number = FrameNumberSuffix(number_in_name, number_width);
   FrameNames names;
   if (o.faces)
     for (int face = 0; face < 6; ++face) names.faces.push_back(o.basename + "_" + o.face_names[face] + number + ".exr");
   if (o.cube_strip) names.cube = o.basename + "_cube" + number + ".exr";
   if (o.latlong) names.latlong = o.basename + "_latlong" + number + ".exr";
   if (WritesLatlongPng(style)) names.png = o.basename + "_latlong" + number + ".png";
-  names.ibl = IblFileNames(style, number_in_name, with_dfg);
+  names.ibl = IblFileNames(style, number_in_name, with_dfg, number_width);
   names.with_dfg = with_dfg;
-  names.engine = EngineFileNames(style, number_in_name);
-  if (style.cloud_shadow.enabled) names.cloud_shadow = CloudShadowFileName(o.basename, number_in_name);
+  names.engine = EngineFileNames(style, number_in_name, number_width);
+  if (style.cloud_shadow.enabled) names.cloud_shadow = CloudShadowFileName(o.basename, number_in_name, number_width);
   return names;
 }
 
@@ -71,10 +72,14 @@ namespace {
 // The decisions that follow from the frames: views, names, the reference
 // frame, the files of this run.
 RenderPlan Completed(RenderPlan plan) {
+  // One width for every frame number of the sequence (its whole schedule's).
+  int last_number = 0;
+  for (const FramePlan& f : plan.frames) last_number = std::max(last_number, f.number);
+  const int number_width = FrameNumberWidth(last_number);
   for (size_t i = 0; i < plan.frames.size(); ++i) {
     FramePlan& f = plan.frames[i];
     f.views = PlanViews(*f.style);
-    f.names = FrameFileNames(*f.style, f.number, i == 0);
+    f.names = FrameFileNames(*f.style, f.number, i == 0, number_width);
   }
   for (size_t i = 1; i < plan.frames.size(); ++i)
     if (plan.frames[i].elevation_deg > plan.frames[plan.reference].elevation_deg) plan.reference = i;

@@ -6,6 +6,7 @@
 
 #include "skybake/base/errors.h"
 #include "skybake/input/config.h"
+#include "skybake/model/envmap.h"
 #include "skybake/output/sha256.h"
 
 namespace skybake {
@@ -64,6 +65,15 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
           "bake every frame again",
           out_dir, EscapedText(entry.file), EscapedText(entry.kind), frame.number,
           index < expected.size() ? EscapedText(expected[index]) : "no more files"));
+    // A face file is listed as the face the bake writes under its name
+    // (the faces come first, +X to -Z).
+    const std::string face = kinds[index] == "face" ? CubeFaceLabel(int(index)) : "";
+    if (entry.face != face)
+      throw ManifestError(fmt::format(
+          "the manifest in {} lists {} as face {} for frame {}, where this bake of the same style writes face {} "
+          "under that name: the manifest was edited or is not skybake's. Pass --force instead of --resume to bake "
+          "every frame again",
+          out_dir, EscapedText(entry.file), EscapedText(entry.face), frame.number, face.empty() ? "none" : face));
     ++index;
   }
   if (index != expected.size()) return std::nullopt;

@@ -47,6 +47,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_CLOUDS 6           // uniform GpuClouds, the volumetric cloud layers (clouds.h)
 #define BINDING_CLOUD_NOISE 7      // storage float[], per layer: shape volume, detail volume, weather map
 #define BINDING_CLOUD_LUT 8        // storage vec4[], aerial perspective LUT, then the ambient light table
+#define BINDING_DISPATCH 9         // storage SkyPush[], each dispatch's constants (the push constant is its index)
 
 // Output mappings (SkyPush.view.x).
 #define MAPPING_LATLONG 0      // OpenEXR latlong, 2N x N, Imf::LatLongMap

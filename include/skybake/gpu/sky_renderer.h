@@ -166,7 +166,8 @@ class SkyRenderer {
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
-  void EnsureCloudLutCapacity(size_t texels);  // the cloud tables and the panorama after them
+  void EnsureCloudLutCapacity(size_t texels);
+  void EnsureDispatchCapacity(size_t dispatches);  // room for a submission's SkyPush constants  // the cloud tables and the panorama after them
   void UpdateDescriptors();
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
@@ -193,7 +194,7 @@ class SkyRenderer {
   std::unique_ptr<SpectralSky> spectral_;
   void SyncSpectral();
 
-  static constexpr uint32_t kBindingCount = 9;  // bindings 0..8 of gpu_shared.h
+  static constexpr uint32_t kBindingCount = 10;  // bindings 0..9 of gpu_shared.h
 
   VulkanContext& context_;
   gpu::GpuAtmosphere gpu_atmosphere_{};
@@ -221,6 +222,7 @@ class SkyRenderer {
   Buffer clouds_buffer_;       // GpuClouds
   Buffer cloud_noise_buffer_;  // noise volumes and weather maps
   Buffer cloud_lut_buffer_;    // aerial-perspective LUT and ambient table
+  Buffer dispatch_buffer_;     // a submission's SkyPush constants, one per dispatch (BINDING_DISPATCH)
   std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
   VkBuffer bound_output_ = VK_NULL_HANDLE;                // what the output binding points at
 

@@ -17,6 +17,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/input/frame_numbering.h"
 #include "skybake/input/style.h"
 
 namespace skybake {
@@ -53,7 +54,8 @@ std::vector<EngineImage> EngineImages(const EnginePreset& preset, int cube_size,
 
 // The file names of a frame's engine images (FrameNumberSuffix numbering),
 // in EngineImages order; empty when no preset is set.
-std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name);
+std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name,
+                                         int number_width = kFrameNumberMinDigits);
 
 // What is wrong with the style's preset and the rest of its outputs (a face
 // name that is one of the preset's files), or nothing.
@@ -62,7 +64,8 @@ std::optional<std::string> EngineStyleError(const SkyStyle& style);
 // A manifest's engine file of a frame: BASE_ENGINE_SUFFIX.NNNN.exr for a
 // known preset and suffix. Returns the BASE, or nothing when the name is not
 // one skybake gives.
-std::optional<std::string> EngineFileBase(const std::string& file, int number_in_name);
+std::optional<std::string> EngineFileBase(const std::string& file, int number_in_name,
+                                          int number_width = kFrameNumberMinDigits);
 
 // The engines' own lookups, written from their sources (docs/engines.md),
 // used to build the images above.

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "skybake/gpu/ibl.h"
+#include "skybake/input/frame_numbering.h"
 #include "skybake/input/style.h"
 #include "skybake/output/exr_io.h"
 
@@ -20,7 +21,8 @@ struct IblFileName {
   std::string name;
   std::string kind;  // "ibl_specular", "ibl_irradiance", "ibl_dfg"
 };
-std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name, bool with_dfg);
+std::vector<IblFileName> IblFileNames(const SkyStyle& style, int number_in_name, bool with_dfg,
+                                      int number_width = kFrameNumberMinDigits);
 
 // Every image of the maps, for the half-range check of the frame's scale.
 std::vector<RgbaImage> IblImagesForRangeCheck(const IblMaps& maps);

@@ -37,6 +37,10 @@ struct ManifestFile {
   std::string kind;  // as BakedFile::kind
   uint64_t bytes = 0;
   std::string sha256;  // lowercase hex
+  // Kind "face": which cube face the file is, "+X" ... "-Z" (CubeFaceLabel),
+  // so that a face file renamed to another face's name is found; empty for
+  // every other kind.
+  std::string face;
 };
 
 struct ManifestFrame {

@@ -58,6 +58,14 @@ ResourceEstimate EstimateResources(const SkyStyle& style);
 // estimate, the budget and the keys to lower.
 void CheckBudget(const SkyStyle& style, const BakeOptions& options);
 
+// What a bake keeps of each of its frames until the end (budget.cc), in MiB:
+// the styles of every frame of `plan`, and the record and manifest entry of
+// each frame it bakes. Throws BudgetError when the largest frame's estimate
+// plus this is over options.max_memory_mib.
+struct RenderPlan;
+double SequenceRecordMiB(const RenderPlan& plan);
+void CheckSequenceBudget(const RenderPlan& plan, const BakeOptions& options);
+
 // Bakes one style (one sun position) into options.out_dir, which is created
 // if needed: EXR maps, preview, glTF scene, manifest.json, timings.json.
 // Before any GPU work: BudgetError over the budget, OutputExistsError when a

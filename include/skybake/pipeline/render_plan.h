@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 
+#include "skybake/input/frame_numbering.h"
 #include "skybake/input/schedule.h"
 #include "skybake/input/shard.h"
 #include "skybake/input/style.h"
@@ -31,7 +32,8 @@ struct FrameNames {
   // The manifest's kind of each file, in the order of All().
   std::vector<std::string> Kinds(const SkyStyle& style) const;
 };
-FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_dfg = false);
+FrameNames FrameFileNames(const SkyStyle& style, int number_in_name, bool with_dfg = false,
+                          int number_width = kFrameNumberMinDigits);
 
 // One frame to bake: its style, sun, place in the sequence, views and files.
 struct FramePlan {
