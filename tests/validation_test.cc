@@ -447,6 +447,19 @@ basename = "aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa
 )toml", nullptr, "", 3,
          "skybake: error: style.toml:2:12: output.basename: a name of 153 characters is longer than the 128 a plain file name may have\n"
          "skybake: 1 error; nothing was baked\n"},
+    {"FaceNameLeadingDash", R"toml([output]
+face_names = ["-px", "nx", "py", "ny", "pz", "nz"]
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:15: output.face_names[0]: expected a plain file name (letters, digits, '_', '-', '.', '+')\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"FaceNameWindowsReserved", R"toml([output]
+face_names = ["px", "nx", "py", "ny", "pz", "con"]
+)toml", nullptr, "", 3,
+         "skybake: error: style.toml:2:45: output.face_names[5]: expected a plain file name (letters, digits, '_', '-', '.', '+')\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ControlCharacterInAValueIsEscaped", "[output]\nbasename = \"a\\u001b[2J\"\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: output.basename: 'a\\x1b[2J' is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or '..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, ...)\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"FaceNamesEqualUpToCase", R"toml([output]
 face_names = ["px", "PX", "py", "ny", "pz", "nz"]
 )toml", nullptr, "", 3,

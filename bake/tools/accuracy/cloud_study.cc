@@ -252,6 +252,11 @@ std::vector<CloudQuality> MarchCases(bool quick) {
   return cases;
 }
 
+// The relative scatter of a case's CPU time per megapixel between runs on
+// the shared machine (load 18-22: 48/12 at 6.7k-7.9k ms with other volumes
+// whose cost is the same).
+constexpr double kCloudTimeNoise = 0.10;
+
 std::string Fixed(double v, int digits) { return fmt::format("{:.{}f}", v, digits); }
 
 }  // namespace
@@ -341,14 +346,29 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
           (o.cpu_ms_per_mp < c.cpu_ms_per_mp || o.mean_error < c.mean_error))
         c.pareto = false;
   }
+  // Each preset: the cheapest case of the front within its bound; the front's
+  // cases within kCloudTimeNoise of that one's time are ties (the CPU time
+  // of one case repeated scatters by that much on the shared machine), and
+  // the tie with the lowest error is chosen.
   result.presets = CloudPresetBounds();
-  for (CloudPresetChoice& p : result.presets)
+  for (CloudPresetChoice& p : result.presets) {
+    int cheapest = -1;
     for (size_t i = 0; i < result.cases.size(); ++i) {
       const CloudStudyCase& c = result.cases[i];
       if (c.pareto && c.mean_error <= p.bound &&
-          (p.choice < 0 || c.cpu_ms_per_mp < result.cases[size_t(p.choice)].cpu_ms_per_mp))
+          (cheapest < 0 || c.cpu_ms_per_mp < result.cases[size_t(cheapest)].cpu_ms_per_mp))
+        cheapest = int(i);
+    }
+    p.choice = cheapest;
+    if (cheapest < 0) continue;
+    const double limit = (1.0 + kCloudTimeNoise) * result.cases[size_t(cheapest)].cpu_ms_per_mp;
+    for (size_t i = 0; i < result.cases.size(); ++i) {
+      const CloudStudyCase& c = result.cases[i];
+      if (c.pareto && c.mean_error <= p.bound && c.cpu_ms_per_mp <= limit &&
+          c.mean_error < result.cases[size_t(p.choice)].mean_error)
         p.choice = int(i);
     }
+  }
 
   // 3. The panorama: a bake's views (the latlong and six faces of half its
   // height, as W3), the clouds marched once into a panorama of `scale` times
@@ -442,7 +462,11 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
   for (const CloudStudyCase& c : result.cases)
     md += fmt::format("| {} | {} | {} | {:.2e} | {:.2e} | {} |\n", c.name, Fixed(c.cpu_ms_per_mp, 0),
                       Fixed(c.ms_per_mp, 0), c.mean_error, c.rmse, c.pareto ? "yes" : "");
-  md += "\n### Cloud presets chosen from the front\n\n| preset | bound (mean relative error) | case | mean relative error | "
+  md += fmt::format(
+      "\n### Cloud presets chosen from the front\n\nThe cheapest case of the front within each bound; cases of the "
+      "front within {:g}% of its CPU time are ties, and the lowest error among them is chosen.\n\n",
+      kCloudTimeNoise * 100);
+  md += "| preset | bound (mean relative error) | case | mean relative error | "
         "CPU ms per megapixel |\n| --- | --- | --- | ---: | ---: |\n";
   for (const CloudPresetChoice& p : result.presets) {
     if (p.choice >= 0) {

@@ -70,7 +70,7 @@ struct CloudLayer {
 // refine them.
 struct CloudQuality {
   int view_steps = 48;          // view samples per layer crossing of a texel
-  int light_steps = 6;          // samples toward the Sun per lit view sample
+  int light_steps = 24;         // samples toward the Sun per lit view sample
   int octaves = 8;              // Wrenninge multiple-scattering octaves
   int shape_resolution = 64;    // shape noise volume edge, voxels
   int detail_resolution = 32;   // detail noise volume edge, voxels
