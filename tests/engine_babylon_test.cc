@@ -64,13 +64,9 @@ TEST(EngineBabylonTest, TestPatternFacesAreWhereTheySayInBabylon) {
   for (size_t i = 0; i < dirs.size(); ++i)
     query += (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
              std::to_string(dirs[i].z);
-  const std::string command = "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs "
-                              "engine_babylon_cube.html '" + dir + "' '" + dir + "/babylon.png' '" + query + "'";
-  auto [code, output] = testing::RunCommand(command);
-  ASSERT_EQ(code, 0) << command << "\n" << output;
-  const size_t at = output.find("{\"chromium_exit\"");
-  ASSERT_NE(at, std::string::npos) << output;
-  const nlohmann::json report = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at))["report"];
+  const nlohmann::json line = testing::RunViewerPage("engine_babylon_cube.html", dir, dir + "/babylon.png", query);
+  ASSERT_FALSE(line.is_null());
+  const nlohmann::json report = line["report"];
   ASSERT_EQ(report.value("ok", false), true) << report.dump();
   std::printf("Babylon.js pattern: %s\n", report.dump().c_str());
   EXPECT_EQ(report["handedness"], "left") << "Babylon's default scene";

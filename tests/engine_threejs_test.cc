@@ -22,21 +22,9 @@
 namespace skybake {
 namespace {
 
-std::string ViewerDir() { return testing::SourceDir() + "/tests/viewer"; }
-
 nlohmann::json RunPage(const std::string& page, const std::string& dir, const std::string& query = "") {
-  const std::string command = "cd '" + ViewerDir() + "' && node run_page.mjs " + page + " '" + dir + "' '" + dir +
-                              "/screenshot.png' '" + query + "'";
-  auto [code, output] = testing::RunCommand(command);
-  EXPECT_EQ(code, 0) << command << "\n" << output;
-  const size_t at = output.find("{\"chromium_exit\"");
-  if (at == std::string::npos) {
-    ADD_FAILURE() << "no report from " << page << ":\n" << output;
-    return {};
-  }
-  nlohmann::json line = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at), nullptr, false);
-  EXPECT_FALSE(line.is_discarded()) << output;
-  return line.is_discarded() ? nlohmann::json() : line["report"];
+  const nlohmann::json line = testing::RunViewerPage(page, dir, dir + "/screenshot.png", query);
+  return line.is_null() ? nlohmann::json() : line["report"];
 }
 
 TEST(EngineThreejsTest, SkysSunIsAlongTheSceneSunLight) {

@@ -131,13 +131,10 @@ TEST(GltfIblTest, BabylonLoadsTheImageBasedLight) {
                                               " --size 32 -q --set ibl.specular=true --set ibl.size=32 "
                                               "--set gltf.image_based_light=true --out " + dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const std::string command = "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs engine_babylon.html '" +
-                              dir + "' '" + dir + "/babylon.png' 'scene=sky.gltf&level=2'";
-  auto [code, output] = testing::RunCommand(command);
-  ASSERT_EQ(code, 0) << command << "\n" << output;
-  const size_t at = output.find("{\"chromium_exit\"");
-  ASSERT_NE(at, std::string::npos) << output;
-  const nlohmann::json report = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at))["report"];
+  const nlohmann::json line =
+      testing::RunViewerPage("engine_babylon.html", dir, dir + "/babylon.png", "scene=sky.gltf&level=2");
+  ASSERT_FALSE(line.is_null());
+  const nlohmann::json report = line["report"];
   ASSERT_EQ(report.value("ok", false), true) << report.dump();
   nlohmann::json gltf = nlohmann::json::parse(std::ifstream(dir + "/sky.gltf"));
   const nlohmann::json& light = gltf["extensions"]["EXT_lights_image_based"]["lights"][0];

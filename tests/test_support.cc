@@ -83,6 +83,22 @@ std::pair<int, std::string> RunCommand(const std::string& command) {
   return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, output};
 }
 
+nlohmann::json RunViewerPage(const std::string& page, const std::string& dir, const std::string& png,
+                             const std::string& query) {
+  const std::string command = "cd '" + SourceDir() + "/tests/viewer' && node run_page.mjs " + page + " '" + dir +
+                              "' '" + png + "' '" + query + "'";
+  auto [code, output] = RunCommand(command);
+  EXPECT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("{\"chromium_exit\"");
+  if (at == std::string::npos) {
+    ADD_FAILURE() << "no report from " << page << ":\n" << output;
+    return {};
+  }
+  nlohmann::json line = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at), nullptr, false);
+  EXPECT_FALSE(line.is_discarded()) << output;
+  return line.is_discarded() ? nlohmann::json() : line;
+}
+
 std::string FreshTempDir(const std::string& name) {
   auto dir = std::filesystem::temp_directory_path() / ("skybake_" + name + "_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);

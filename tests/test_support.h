@@ -11,6 +11,7 @@
 
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "skybake/gpu/vulkan_context.h"
 
@@ -43,6 +44,13 @@ CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix =
 
 // Any shell command: its exit status and its stdout and stderr together.
 std::pair<int, std::string> RunCommand(const std::string& command);
+
+// A page of tests/viewer opened in headless Chromium by run_page.mjs, with
+// `dir` served and its screenshot written to `png`: the page's report line
+// ({"chromium_exit", "report", "requests", ...}), or null after adding a test
+// failure (the command failed or printed no report).
+nlohmann::json RunViewerPage(const std::string& page, const std::string& dir, const std::string& png,
+                             const std::string& query);
 
 // A new, empty folder under the temporary directory, unique to this process.
 std::string FreshTempDir(const std::string& name);

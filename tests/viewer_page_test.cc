@@ -47,16 +47,8 @@ Shot Open(const std::string& dir, const std::string& test) {
   Shot shot;
   const std::string png = dir + "/shot.png";
   std::remove(png.c_str());
-  const std::string command = "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs bake/view.html '" +
-                              dir + "' '" + png + "' 'test=" + test + "'";
-  auto [code, output] = testing::RunCommand(command);
-  EXPECT_EQ(code, 0) << command << "\n" << output;
-  const size_t at = output.find("{\"chromium_exit\"");
-  if (at == std::string::npos) {
-    ADD_FAILURE() << output;
-    return shot;
-  }
-  nlohmann::json line = nlohmann::json::parse(output.substr(at, output.find('\n', at) - at));
+  const nlohmann::json line = testing::RunViewerPage("bake/view.html", dir, png, "test=" + test);
+  if (line.is_null()) return shot;
   shot.report = line["report"];
   shot.requests = line["requests"];
   auto in = OIIO::ImageInput::open(png);

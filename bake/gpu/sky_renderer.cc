@@ -377,10 +377,14 @@ void SkyRenderer::EnsureDispatchCapacity(size_t dispatches) {
   DestroyBuffer(dispatch_buffer_);
   dispatch_buffer_ = CreateBuffer(2 * bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
   // Only this binding: the output binding may point at a frame slot.
-  const VkDescriptorBufferInfo info{dispatch_buffer_.buffer, 0, VK_WHOLE_SIZE};
+  WriteStorageBinding(BINDING_DISPATCH, dispatch_buffer_.buffer);
+}
+
+void SkyRenderer::WriteStorageBinding(uint32_t binding, VkBuffer buffer) {
+  const VkDescriptorBufferInfo info{buffer, 0, VK_WHOLE_SIZE};
   VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
   write.dstSet = descriptor_set_;
-  write.dstBinding = BINDING_DISPATCH;
+  write.dstBinding = binding;
   write.descriptorCount = 1;
   write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
   write.pBufferInfo = &info;
@@ -416,14 +420,7 @@ void SkyRenderer::UpdateDescriptors() {
 
 void SkyRenderer::BindOutput(const Buffer& target) {
   if (target.buffer == bound_output_) return;
-  const VkDescriptorBufferInfo info{target.buffer, 0, VK_WHOLE_SIZE};
-  VkWriteDescriptorSet write{VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-  write.dstSet = descriptor_set_;
-  write.dstBinding = BINDING_OUTPUT;
-  write.descriptorCount = 1;
-  write.descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-  write.pBufferInfo = &info;
-  vkUpdateDescriptorSets(context_.device(), 1, &write, 0, nullptr);
+  WriteStorageBinding(BINDING_OUTPUT, target.buffer);
   bound_output_ = target.buffer;
 }
 

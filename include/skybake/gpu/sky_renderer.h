@@ -166,9 +166,11 @@ class SkyRenderer {
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
-  void EnsureCloudLutCapacity(size_t texels);
-  void EnsureDispatchCapacity(size_t dispatches);  // room for a submission's SkyPush constants  // the cloud tables and the panorama after them
+  void EnsureCloudLutCapacity(size_t texels);  // the cloud tables and the panorama after them
+  void EnsureDispatchCapacity(size_t dispatches);  // room for a submission's SkyPush constants
   void UpdateDescriptors();
+  // Points one storage-buffer binding of the descriptor set at `buffer`.
+  void WriteStorageBinding(uint32_t binding, VkBuffer buffer);
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
   void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
