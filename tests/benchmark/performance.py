@@ -12,6 +12,15 @@ blender_sky.py) renders the same frames in the same run when it is installed.
 
     python3 tests/benchmark/performance.py [--reps 3] [--no-blender]
     python3 tests/benchmark/performance.py --only-ibl [--reps 5] [--skybake-before OLD/skybake]
+    python3 tests/benchmark/performance.py --blender-clouds --work DIR [--reps-w3 3] [--reuse-blender]
+
+--blender-clouds: W3 against Blender Cycles (docs/performance.md, "W3
+against Blender Cycles"): skybake's W3 as a 2048 x 1024 float latlong alone
+and with its usual outputs, then tests/benchmark/blender_clouds.py at 16 and
+64 samples (two 16-sample renders with different seeds), the noise of each
+and the cloud cover of both. Results go to DIR/blender_clouds.json as each
+run ends; --reuse-blender keeps the Blender runs found there (re-times
+skybake alone against them), --report-only runs nothing and reports them.
 
 Every case but one runs with Mesa's shader disk cache as a second bake on a
 machine finds it; "W1 half, Mesa shader cache off" is a machine's first bake.
@@ -20,7 +29,10 @@ Prints a markdown report (stdout) with the stage times of skybake's own
 timings.json and how close each stage is to its limit.
 """
 import argparse
+import array
+import hashlib
 import json
+import math
 import os
 import shutil
 import statistics
@@ -33,7 +45,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 def run(cmd, cwd=ROOT, log=None, env=None):
-    """Runs cmd; returns (wall seconds, peak RSS MiB). Fails loudly."""
+    """Runs cmd; returns (wall seconds, peak RSS MiB, CPU seconds: user +
+    system of the process and the children it waited for). Fails loudly."""
     start = time.monotonic()
     proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             env=dict(os.environ, **env) if env else None)
@@ -46,22 +59,25 @@ def run(cmd, cwd=ROOT, log=None, env=None):
     if log:
         with open(log, "wb") as f:
             f.write(out)
-    return wall, usage.ru_maxrss / 1024.0
+    return wall, usage.ru_maxrss / 1024.0, usage.ru_utime + usage.ru_stime
 
 
 def median_run(label, cmd, reps, before=None, env=None, after=None):
-    walls, peaks = [], []
+    walls, peaks, cpus, loads = [], [], [], []
     for i in range(reps):
         if before:
             before()
-        wall, peak = run(cmd, env=env)
+        wall, peak, cpu = run(cmd, env=env)
+        loads.append(os.getloadavg()[0])
         if after:
             after()
         walls.append(wall)
         peaks.append(peak)
-        sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, peak {peak:.0f} MiB\n")
+        cpus.append(cpu)
+        sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, CPU {cpu:.2f} s, peak {peak:.0f} MiB, "
+                         f"load {loads[-1]:.1f}\n")
     return {"label": label, "wall": statistics.median(walls), "walls": walls, "peak": statistics.median(peaks),
-            "peak_max": max(peaks)}
+            "peak_max": max(peaks), "cpu": statistics.median(cpus), "cpus": cpus, "loads": loads}
 
 
 def cpu_peak_gflops():
@@ -102,6 +118,14 @@ def main():
                         help="the IBL prefilter's share of a bake: default.toml with a 512 specular cube, float files")
     parser.add_argument("--skybake-before", default=None,
                         help="--only-ibl: a second skybake build, run alternately with --skybake (before / after)")
+    parser.add_argument("--blender-clouds", action="store_true",
+                        help="W3 against Blender Cycles at 16 and 64 samples (2048 x 1024; slow: about an hour)")
+    parser.add_argument("--reuse-blender", action="store_true",
+                        help="--blender-clouds: keep the Blender runs already in WORK/blender_clouds.json")
+    parser.add_argument("--full-64", action="store_true",
+                        help="--blender-clouds: also the whole 2048 x 1024 render at 64 samples (slow)")
+    parser.add_argument("--report-only", action="store_true",
+                        help="--blender-clouds: run nothing, report the runs in WORK/blender_clouds.json")
     args = parser.parse_args()
     work = args.work or tempfile.mkdtemp(prefix="skybake-bench-")
     os.makedirs(work, exist_ok=True)
@@ -110,10 +134,13 @@ def main():
     floats = ["--set", 'output.pixel_type="float"']
 
     def bake(extra, out):
-        return [args.skybake, "bake", *extra, "--out", os.path.join(work, out), "--force", "--quiet"]
+        return bake_command(args.skybake, extra, os.path.join(work, out))
 
     if args.only_ibl:
         print_ibl(args, work)
+        return
+    if args.blender_clouds:
+        print_blender_clouds(args, work)
         return
 
     results = {}
@@ -238,6 +265,236 @@ def main():
     print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs)
 
 
+def bake_command(skybake, extra, out_dir):
+    return [skybake, "bake", *extra, "--out", out_dir, "--force", "--quiet"]
+
+
+def sha256(path):
+    with open(path, "rb") as f:
+        return hashlib.sha256(f.read()).hexdigest()
+
+
+def latlong_luminance(exr, rows=None):
+    """Rec.709 luminance of the first `rows` rows of a latlong EXR (default
+    its upper half: row 0 the zenith, row h/2 - 1 just above the horizon), as
+    (width, rows, values row by row from the top); read through
+    `oiiotool --dumpdata`."""
+    proc = subprocess.Popen(["oiiotool", "--dumpdata", exr], stdout=subprocess.PIPE, text=True)
+    header = proc.stdout.readline()  # "NAME : W x H, 3 channel, float openexr"
+    size = header.split(":", 1)[1].split(",")[0].split("x")
+    width, height = int(size[0]), int(size[1])
+    rows = rows or height // 2
+    y = array.array("f", bytes(4 * width * rows))
+    for line in proc.stdout:  # "    Pixel (x, y): r g b"
+        position, values = line.split(":")
+        px, py = (int(v) for v in position.strip()[7:-1].split(","))
+        if py >= rows:
+            continue
+        r, g, b = (float(v) for v in values.split()[:3])
+        y[py * width + px] = 0.2126 * r + 0.7152 * g + 0.0722 * b
+    if proc.wait() != 0:
+        raise SystemExit(f"oiiotool --dumpdata {exr} failed")
+    return width, rows, y
+
+
+def solid_angle_weights(width, rows, sun_index, sun_box_px, min_elevation_deg=0.0, first_row=0):
+    """Per texel of `rows` rows of a latlong (width x width / 2) from
+    `first_row`: its solid angle (cos latitude), 0 below min_elevation_deg and
+    within sun_box_px texels of the Sun (sun_index: in the whole latlong)."""
+    w = array.array("f", bytes(4 * width * rows))
+    sx, sy = sun_index % width, sun_index // width - first_row
+    for r in range(rows):
+        elevation = 90.0 - (first_row + r + 0.5) * 360.0 / width
+        if elevation < min_elevation_deg:
+            continue
+        c = math.cos(math.radians(elevation))
+        for x in range(width):
+            dx = min(abs(x - sx), width - abs(x - sx))
+            if dx <= sun_box_px and abs(r - sy) <= sun_box_px:
+                continue
+            w[r * width + x] = c
+    return w
+
+
+def argmax(values):
+    return max(range(len(values)), key=values.__getitem__)
+
+
+def cloud_cover(cloudy, clear, weights):
+    """Solid-angle fraction of the weighted texels where the layer changes
+    the sky's luminance by more than 10%, that mask, and the weighted mean of
+    cloudy / clear over the texels it marks (how bright the clouds are
+    against the sky they hide)."""
+    covered = total = ratio_sum = 0.0
+    mask = array.array("b", bytes(len(weights)))
+    for i, w in enumerate(weights):
+        if w <= 0.0 or clear[i] <= 0.0:
+            continue
+        total += w
+        ratio = cloudy[i] / clear[i]
+        if abs(ratio - 1.0) > 0.1:
+            covered += w
+            ratio_sum += w * ratio
+            mask[i] = 1
+    return covered / total, mask, ratio_sum / max(covered, 1e-30)
+
+
+def noise_of(a, b, weights, mask, reference=None):
+    """The RMS noise of one render over its weighted mean luminance, from
+    independent renders: with reference None, a and b have the same samples
+    (variance = mean (a - b)^2 / 2); else a is a render of N samples and b
+    the mean of two renders of N/4 (its variance, `reference`, known):
+    variance = mean (a - b)^2 - reference. Over all weighted texels and over
+    those `mask` marks. Returns ((relative, variance) all, (relative,
+    variance) masked)."""
+    out = []
+    for use_mask in (False, True):
+        sw = sy = sd = 0.0
+        for i, w in enumerate(weights):
+            if w <= 0.0 or (use_mask and not mask[i]):
+                continue
+            d = a[i] - b[i]
+            sw += w
+            sy += w * 0.5 * (a[i] + b[i])
+            sd += w * d * d
+        variance = sd / sw / 2.0 if reference is None else sd / sw - reference[len(out)]
+        out.append((math.sqrt(max(variance, 0.0)) / (sy / sw), variance))
+    return out
+
+
+STRIP_ROWS = (224, 256)  # of a 2048 x 1024 latlong: elevation 50.6 to 45 deg
+
+
+def print_blender_clouds(args, work):
+    """W3 against Blender Cycles: whole-process wall and CPU time of skybake
+    (W3 as a float latlong alone, and W3 as it is) and of Blender's Cycles
+    at 16 and 64 samples, in one run; each render's noise, and the cloud
+    cover of both against their clear skies."""
+    if not args.blender:
+        raise SystemExit("--blender-clouds needs Blender (--blender PATH)")
+    script = os.path.join(ROOT, "tests", "benchmark", "blender_clouds.py")
+    stored_path = os.path.join(work, "blender_clouds.json")
+    reuse = args.reuse_blender or args.report_only
+    stored = json.load(open(stored_path)) if reuse and os.path.exists(stored_path) else {}
+    results = stored if args.report_only else {key: value for key, value in stored.items() if key.startswith("blender")}
+
+    def save():
+        with open(stored_path, "w") as f:
+            json.dump(results, f, indent=1)
+
+    w3, w1 = ["configs/benchmark/w3.toml"], ["configs/benchmark/w1.toml"]
+    latlong_only = ["--set", "output.faces=false", "--set", "output.cube_strip=false", "--set",
+                    'output.pixel_type="float"']
+    hashes = {"w3_latlong": [], "w3": []}
+
+    def keep_hash(out):
+        return lambda: hashes[out].append(sha256(os.path.join(work, out, "sky_latlong.exr")))
+    def time_skybake():
+        git = subprocess.run(["git", "-C", ROOT, "log", "-1", "--format=%h %cI"], capture_output=True, text=True)
+        results["skybake_commit"] = git.stdout.strip()
+        results["skybake_w1_latlong"] = median_run(
+            "skybake W1 latlong (the clear sky)", bake_command(args.skybake, w1 + latlong_only,
+                                                               os.path.join(work, "w1_latlong")), 1)
+        results["skybake_w3_latlong"] = median_run(
+            "skybake W3 latlong", bake_command(args.skybake, w3 + latlong_only, os.path.join(work, "w3_latlong")),
+            args.reps_w3, after=keep_hash("w3_latlong"))
+        results["skybake_w3"] = median_run(
+            "skybake W3 (faces, strip, latlong; half)", bake_command(args.skybake, w3, os.path.join(work, "w3")),
+            args.reps_w3, after=keep_hash("w3"))
+        for out in hashes:
+            results["skybake_" + out]["identical_bytes"] = len(set(hashes[out])) == 1
+        save()
+
+    # In this order, so that the 16-sample render and skybake share one
+    # spell of the machine's load. The noise is measured on a strip of 32
+    # rows (elevation 50.6 to 45 deg) rendered again with other seeds: the
+    # 16-sample render's strip against a second 16-sample strip, and a
+    # 64-sample strip against their mean; --full-64 adds the whole 64-sample
+    # render (4 times the 16-sample one's time; an hour or more here).
+    base = [args.blender, "-b", "--factory-startup", "--python", script, "--"]
+    strip = ["--rows", str(STRIP_ROWS[0]), str(STRIP_ROWS[1])]
+    blender_runs = [("blender_clear", "Blender clear sky", 1, ["--clear"]),
+                    ("blender_16a", "Blender 16 samples", 16, ["--seed", "1"]),
+                    ("skybake", None, None, None),
+                    ("blender_16b_strip", "Blender 16 samples, strip, second seed", 16, ["--seed", "2"] + strip),
+                    ("blender_64_strip", "Blender 64 samples, strip", 64, ["--seed", "3"] + strip)]
+    if args.full_64:
+        blender_runs.append(("blender_64", "Blender 64 samples", 64, ["--seed", "3"]))
+    for key, label, samples, extra in [] if args.report_only else blender_runs:
+        if key == "skybake":
+            time_skybake()
+            continue
+        image = os.path.join(work, key + ".exr")
+        if key in results and os.path.exists(image):
+            sys.stderr.write(f"{label}: kept from {stored_path}\n")
+            continue
+        results[key] = median_run(label, base + [image, str(samples)] + extra, 1)
+        results[key]["samples"] = samples
+        save()
+
+    # Cloud cover over the sky above 30 deg and noise over the strip, the
+    # Sun's box left out.
+    width, rows, sky_clear = latlong_luminance(os.path.join(work, "w1_latlong", "sky_latlong.exr"))
+    _, _, sky_cloudy = latlong_luminance(os.path.join(work, "w3_latlong", "sky_latlong.exr"))
+    lum = {key: latlong_luminance(os.path.join(work, key + ".exr"))[2] for key in ("blender_clear", "blender_16a")}
+    box = 20  # texels: 3.5 deg around the Sun's texel
+    cap = 30.0  # cloud cover: above 30 deg elevation, where both layers are seen through the same air
+    sky_cover = cloud_cover(sky_cloudy, sky_clear, solid_angle_weights(width, rows, argmax(sky_clear), box, cap))
+    blender_sun = argmax(lum["blender_clear"])
+    blender_cover = cloud_cover(lum["blender_16a"], lum["blender_clear"],
+                                solid_angle_weights(width, rows, blender_sun, box, cap))
+    first, end = STRIP_ROWS
+    n = end - first
+    # The first seed's strip: the whole render's rows (a strip rendered with
+    # the same seed has the same pixels: `oiiotool --diff` passes).
+    strip = {key: latlong_luminance(os.path.join(work, f"blender_{key}_strip.exr"), n)[2] for key in ("16b", "64")}
+    strip["16a"] = lum["blender_16a"][first * width:end * width]
+    strip_clear = lum["blender_clear"][first * width:end * width]
+    strip_w = solid_angle_weights(width, n, blender_sun, box, 0.0, first)
+    _, strip_mask, _ = cloud_cover(strip["16a"], strip_clear, strip_w)
+    n16 = noise_of(strip["16a"], strip["16b"], strip_w, strip_mask)
+    mean32 = array.array("f", (0.5 * (p + q) for p, q in zip(strip["16a"], strip["16b"])))
+    n64 = noise_of(strip["64"], mean32, strip_w, strip_mask, reference=[v / 2.0 for _, v in n16])
+    results["noise"] = {"blender_16": [r for r, _ in n16], "blender_64": [r for r, _ in n64],
+                        "strip_cloud_fraction": sum(w for w, m in zip(strip_w, strip_mask) if m) / sum(strip_w)}
+    results["cover"] = {"skybake": [sky_cover[0], sky_cover[2]], "blender": [blender_cover[0], blender_cover[2]]}
+    save()
+
+    b16 = results["blender_16a"]
+    print("| case | samples per texel | wall | process CPU | peak memory | load (1 min) | noise, strip | "
+          "noise, strip's cloud texels | Blender 16 / this, wall | Blender 16 / this, CPU |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    rows_out = [("skybake_w3_latlong", "skybake W3, 2048 x 1024 float latlong alone", "march", None),
+                ("skybake_w3", "skybake W3 (six 512^2 faces, strip, latlong; half)", "march", None),
+                ("blender_16a", "Blender Cycles, 2048 x 1024", "16", "blender_16"),
+                ("blender_64", "Blender Cycles, 2048 x 1024", "64", "blender_64"),
+                ("blender_clear", "Blender Cycles, clear sky (no layer)", "1", None),
+                ("blender_16b_strip", f"Blender Cycles, rows {first}-{end - 1} alone, second seed", "16", "blender_16"),
+                ("blender_64_strip", f"Blender Cycles, rows {first}-{end - 1} alone", "64", "blender_64")]
+    for key, label, samples, noise in rows_out:
+        if key not in results:
+            continue
+        r = results[key]
+        if noise:
+            noise_cells = f"{100 * results['noise'][noise][0]:.1f}% | {100 * results['noise'][noise][1]:.1f}%"
+        elif key.startswith("skybake_w3"):
+            noise_cells = {True: "0 | 0", False: "runs differ | ", None: "not checked | "}[r.get("identical_bytes")]
+        else:
+            noise_cells = " | "
+        print(f"| {label} | {samples} | {r['wall']:.1f} s | {r['cpu']:.1f} s | {r['peak_max']:.0f} MiB | "
+              f"{min(r['loads']):.1f}-{max(r['loads']):.1f} | {noise_cells} | {b16['wall'] / r['wall']:.1f}x | "
+              f"{b16['cpu'] / r['cpu']:.1f}x |")
+    latlong = results["skybake_w3_latlong"]
+    print(f"\nskybake: {results['skybake_commit']}; {len(latlong['walls'])} runs of each case (medians); noise 0: "
+          f"the latlong's bytes were the same in every run of the case.")
+    print(f"Cloud cover above 30 deg (texels the layer changes by more than 10%): skybake "
+          f"{100 * results['cover']['skybake'][0]:.0f}%, Blender {100 * results['cover']['blender'][0]:.0f}% "
+          f"(16 samples); mean cloudy / clear luminance there: skybake {results['cover']['skybake'][1]:.2f}, "
+          f"Blender {results['cover']['blender'][1]:.2f}.")
+    print(f"Noise: over rows {first}-{end - 1} (elevation 50.6-45 deg; cloud texels "
+          f"{100 * results['noise']['strip_cloud_fraction']:.0f}% of them).")
+
+
 def print_ibl(args, work):
     """The specular prefilter (GPU timestamps of its passes) against the whole
     bake (timings.json total_s) in each run, for one build or two run
@@ -249,7 +506,7 @@ def print_ibl(args, work):
     for i in range(args.reps):
         for label, binary in builds:
             out = os.path.join(work, "ibl_" + label)
-            wall, _ = run([binary, "bake", *ibl, "--out", out, "--force", "--quiet"])
+            wall, _, _ = run([binary, "bake", *ibl, "--out", out, "--force", "--quiet"])
             t = json.load(open(os.path.join(out, "timings.json")))
             spec = sum(p["gpu_ms"] for f in t["frames"] for p in f["gpu_passes"] if p["name"] == "IBL specular") / 1e3
             stages = {st["stage"]: st["seconds"] for st in t["stages"]}
