@@ -279,11 +279,14 @@ def latlong_luminance(exr, rows=None):
     its upper half: row 0 the zenith, row h/2 - 1 just above the horizon), as
     (width, rows, values row by row from the top); read through
     `oiiotool --dumpdata`."""
-    proc = subprocess.Popen(["oiiotool", "--dumpdata", exr], stdout=subprocess.PIPE, text=True)
-    header = proc.stdout.readline()  # "NAME : W x H, 3 channel, float openexr"
-    size = header.split(":", 1)[1].split(",")[0].split("x")
+    info = subprocess.run(["oiiotool", "--info", exr], capture_output=True, text=True, check=True).stdout
+    size = info.split(":", 1)[1].split(",")[0].split("x")  # "NAME : W x H, 3 channel, float openexr"
     width, height = int(size[0]), int(size[1])
     rows = rows or height // 2
+    top = exr + ".top.exr"  # the rows alone: half the text to read
+    subprocess.run(["oiiotool", exr, "--ch", "R,G,B", "--crop", f"{width}x{rows}+0+0", "-o", top], check=True)
+    proc = subprocess.Popen(["oiiotool", "--dumpdata", top], stdout=subprocess.PIPE, text=True)
+    proc.stdout.readline()
     y = array.array("f", bytes(4 * width * rows))
     for line in proc.stdout:  # "    Pixel (x, y): r g b"
         position, values = line.split(":")
@@ -293,7 +296,8 @@ def latlong_luminance(exr, rows=None):
         r, g, b = (float(v) for v in values.split()[:3])
         y[py * width + px] = 0.2126 * r + 0.7152 * g + 0.0722 * b
     if proc.wait() != 0:
-        raise SystemExit(f"oiiotool --dumpdata {exr} failed")
+        raise SystemExit(f"oiiotool --dumpdata {top} failed")
+    os.remove(top)
     return width, rows, y
 
 
