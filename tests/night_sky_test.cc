@@ -3,6 +3,7 @@
 // a night schedule on lavapipe under the validation layer (moonlit sky,
 // manifest, glTF, SH, bad input, byte identity when off).
 #include "skybake/pipeline/night_sky.h"
+#include "skybake/pipeline/night_prune.h"
 
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <limits>
 #include <random>
+#include <sstream>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -25,6 +27,7 @@
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/input/schedule.h"
+#include "skybake/model/view.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -492,6 +495,8 @@ TEST(NightSky, PlanSaysWhatPrunesTheSplatByDay) {
     EXPECT_NE(p.frequency.find(fmt::format("{} of {} frames with the Sun up", day, frames.size())), std::string::npos)
         << p.frequency;
     EXPECT_NE(p.frequency.find("tile bound"), std::string::npos) << p.frequency;
+    EXPECT_NE(p.frequency.find("bounded before any star is placed"), std::string::npos) << p.frequency;
+    EXPECT_NE(p.frequency.find("places no star and splats nothing"), std::string::npos) << p.frequency;
   }
   EXPECT_EQ(found, 2);
   // Every frame at night: nothing to prune.
@@ -501,6 +506,65 @@ TEST(NightSky, PlanSaysWhatPrunesTheSplatByDay) {
     if (p.name == "star and Moon splat (host)") {
       EXPECT_NE(p.frequency.find("every view splatted"), std::string::npos) << p.frequency;
     }
+}
+
+// A day frame does no night work: with the Sun 50 deg up and the Moon down
+// (the 24-hour schedule at 12:30) no star is placed and nothing splatted,
+// and every map is the same bytes as with the stars off; a twilight frame
+// (19:30, the Sun 10 deg down) places its stars and shows them.
+TEST_F(NightBake, DayFramePlacesNoStarAndTwilightDoes) {
+  const std::string root = SourceDir();
+  const std::string common = fmt::format("bake '{0}/configs/night/moonlit.toml' --schedule '{0}/configs/schedules/24h.toml' "
+                                         "--size 64 --set output.preview=false --set gltf.enabled=false",
+                                         root);
+  auto night_line = [](const std::string& output, int frame) {
+    const std::string key = fmt::format("frame {}: ", frame);
+    std::istringstream lines(output);
+    for (std::string line; std::getline(lines, line);)
+      if (line.find("night sky") != std::string::npos && line.find(key) != std::string::npos) return line;
+    return std::string();
+  };
+  const testing::CommandRun day = RunSkybake(common + fmt::format(" --frames 26:26 --out '{}/day'", dir_),
+                                             "SKYBAKE_VULKAN_VALIDATION=1");
+  const testing::CommandRun day_off = RunSkybake(
+      common + fmt::format(" --frames 26:26 --out '{}/day_off' --quiet --set night.stars=false", dir_));
+  const testing::CommandRun dusk = RunSkybake(common + fmt::format(" --frames 40:40 --out '{}/dusk'", dir_),
+                                              "SKYBAKE_VULKAN_VALIDATION=1");
+  const testing::CommandRun dusk_off = RunSkybake(
+      common + fmt::format(" --frames 40:40 --out '{}/dusk_off' --quiet --set night.stars=false", dir_));
+  ASSERT_EQ(day.exit_code, 0) << day.output;
+  ASSERT_EQ(day_off.exit_code, 0) << day_off.output;
+  ASSERT_EQ(dusk.exit_code, 0) << dusk.output;
+  ASSERT_EQ(dusk_off.exit_code, 0) << dusk_off.output;
+  EXPECT_NE(night_line(day.output, 26).find("no star placed"), std::string::npos) << day.output;
+  const std::string dusk_line = night_line(dusk.output, 40);
+  EXPECT_EQ(dusk_line.find("no star placed"), std::string::npos) << dusk.output;
+  EXPECT_NE(dusk_line.find(" stars"), std::string::npos) << dusk.output;
+  const json manifest = json::parse(std::ifstream(dir_ + "/day/manifest.shard-0026-0026.json"));
+  EXPECT_GT(manifest["frames"][0]["sun"]["elevation_deg"].get<double>(), 45.0);
+  EXPECT_LT(manifest["frames"][0]["moon"]["elevation_deg"].get<double>(), 0.0);
+  const json dusk_manifest = json::parse(std::ifstream(dir_ + "/dusk/manifest.shard-0040-0040.json"));
+  EXPECT_LT(dusk_manifest["frames"][0]["sun"]["elevation_deg"].get<double>(), -6.0);
+  // Each map against the same with the stars off: how many have the same
+  // texels (the files' headers record the style).
+  auto same_maps = [&](const std::string& on, const std::string& off, size_t& maps) {
+    size_t same = 0;
+    maps = 0;
+    for (const auto& f : fs::directory_iterator(dir_ + "/" + on)) {
+      if (f.path().extension() != ".exr") continue;
+      ++maps;
+      int w = 0, h = 0, w_off = 0, h_off = 0;
+      const std::vector<float> a = ReadExr(f.path().string(), w, h);
+      const std::vector<float> b = ReadExr(dir_ + "/" + off + "/" + f.path().filename().string(), w_off, h_off);
+      same += !a.empty() && a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
+    }
+    return same;
+  };
+  size_t day_maps = 0, dusk_maps = 0;
+  EXPECT_EQ(same_maps("day", "day_off", day_maps), day_maps);
+  EXPECT_GT(day_maps, 2u);
+  EXPECT_LT(same_maps("dusk", "dusk_off", dusk_maps), dusk_maps);  // the stars show at dusk
+  EXPECT_GT(dusk_maps, 2u);
 }
 
 // night.airglow replaces the flat floor: the same zenith luminance, brighter
@@ -582,6 +646,9 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
   const Rgb scale = OutputScale(style.output.units);
   SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, scale);
   NightSkyRenderer bounded(testing::Vulkan()), exact(testing::Vulkan()), whole(testing::Vulkan());
+  // The frames whose stars wait for a view that needs them (night_prune.h).
+  NightSkyRenderer deferred(testing::Vulkan());
+  const StarGrid grid(*catalogue, style.night.star_magnitude_limit, style.output.units);
   exact.set_tile_bound(false);
   whole.set_splat_bound(false);
   std::vector<ViewRequest> views = ViewsOfSize(64);
@@ -599,25 +666,42 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
       const std::string what = fmt::format("sun {} deg, Moon {}", elevation, up ? "up" : "down");
       const glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 290.0);
       const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
-      NightFrame night = ComputeNightFrame(style, &*catalogue, table, julian_day_ut, paranal, sun);
-      night.airglow = airglow;
-      ASSERT_GT(night.stars, 1000u);
-      ASSERT_TRUE(night.moon);
-      if (up) ASSERT_GT(night.moon->sky.elevation_deg, 30.0);
-      else ASSERT_LT(night.moon->sky.elevation_deg, -5.0);
-      std::vector<RgbaImage> a, b, c;
-      for (size_t i = 0; i < views.size(); ++i) {
-        a.push_back({views[i].width, views[i].height, sky[i], nullptr});
-        b.push_back({views[i].width, views[i].height, sky[i], nullptr});
-        c.push_back({views[i].width, views[i].height, sky[i], nullptr});
-      }
-      const size_t skipped_before = bounded.splats_skipped(), tiles_before = bounded.splats_skipped_by_tiles();
       // This thread's CPU time (the machine is shared; wall time is not).
       auto cpu_ms = []() {
         timespec t{};
         clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
         return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
       };
+      const double p0 = cpu_ms();
+      NightFrame night = ComputeNightFrame(style, &*catalogue, table, julian_day_ut, paranal, sun);
+      const double p1 = cpu_ms();
+      night.airglow = airglow;
+      ASSERT_GT(night.stars, 1000u);
+      ASSERT_TRUE(night.moon);
+      if (up) ASSERT_GT(night.moon->sky.elevation_deg, 30.0);
+      else ASSERT_LT(night.moon->sky.elevation_deg, -5.0);
+      // Of the frame, the Moon's ephemeris (libnova's ELP 2000-82B), which
+      // the manifest records every frame.
+      const double m0 = cpu_ms();
+      (void)ComputeMoon(julian_day_ut, paranal, style.atmosphere.observer_altitude_m);
+      const double m1 = cpu_ms();
+      const double p2 = cpu_ms();
+      NightFrame later = ComputeNightFrame(style, &*catalogue, table, julian_day_ut, paranal, sun, &grid);
+      const double p3 = cpu_ms();
+      later.airglow = airglow;
+      // Only a frame with the Sun up waits; a twilight frame places its stars.
+      ASSERT_EQ(bool(later.pending), elevation > 0.0) << what;
+      if (!later.pending) {
+        ASSERT_EQ(later.stars, night.stars) << what;
+      }
+      std::vector<RgbaImage> a, b, c, d;
+      for (size_t i = 0; i < views.size(); ++i) {
+        a.push_back({views[i].width, views[i].height, sky[i], nullptr});
+        b.push_back({views[i].width, views[i].height, sky[i], nullptr});
+        c.push_back({views[i].width, views[i].height, sky[i], nullptr});
+        d.push_back({views[i].width, views[i].height, sky[i], nullptr});
+      }
+      const size_t skipped_before = bounded.splats_skipped(), tiles_before = bounded.splats_skipped_by_tiles();
       const double t0 = cpu_ms();
       bounded.AddToViews(style, night, views, a);
       const double t1 = cpu_ms();
@@ -625,6 +709,11 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
       const double t2 = cpu_ms();
       whole.AddToViews(style, night, views, b);
       const double t3 = cpu_ms();
+      const size_t cleared_before = deferred.views_cleared_before_placement();
+      deferred.AddToViews(style, later, views, d);
+      const double t4 = cpu_ms();
+      const size_t cleared = deferred.views_cleared_before_placement() - cleared_before;
+      const bool placed = !later.pending || later.pending->placed();
       const size_t skipped = bounded.splats_skipped() - skipped_before;
       const size_t by_tiles = bounded.splats_skipped_by_tiles() - tiles_before;
       size_t changed = 0;
@@ -635,12 +724,31 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
             << what << ", view " << i;
         EXPECT_EQ(std::memcmp(c[i].rgba.data(), b[i].rgba.data(), c[i].rgba.size() * sizeof(float)), 0)
             << what << ", view " << i;
+        ASSERT_EQ(d[i].rgba.size(), b[i].rgba.size());
+        EXPECT_EQ(std::memcmp(d[i].rgba.data(), b[i].rgba.data(), d[i].rgba.size() * sizeof(float)), 0)
+            << what << ", view " << i << " (stars placed on need)";
         changed += a[i].rgba != sky[i];
       }
-      // For the record (docs/performance.md), not a target.
-      std::printf("%s: the night's additions (thread CPU) with both bounds %.1f ms, SplatBound alone %.1f ms, "
-                  "whole %.1f ms; %zu of %zu views skipped (%zu by the tiles), %zu changed\n",
-                  what.c_str(), t1 - t0, t2 - t1, t3 - t2, skipped, views.size(), by_tiles, changed);
+      // For the record (docs/performance.md), not a target: the frame
+      // (ComputeNightFrame: stars placed, or waiting) and its additions.
+      std::printf("%s: thread CPU, frame %.2f ms + additions with both bounds %.1f ms, SplatBound alone %.1f ms, "
+                  "whole %.1f ms; %zu of %zu views skipped (%zu by the tiles), %zu changed; stars placed on need: "
+                  "frame %.2f ms + additions %.1f ms, %zu of %zu views cleared before placement, stars %s; the "
+                  "Moon's ephemeris alone %.2f ms\n",
+                  what.c_str(), p1 - p0, t1 - t0, t2 - t1, t3 - t2, skipped, views.size(), by_tiles, changed, p3 - p2,
+                  t4 - t3, cleared, views.size(), placed ? "placed" : "not placed", m1 - m0);
+      if (elevation >= 50.0 && !up) {
+        // High noon with the Moon down: no star is placed, nothing splatted.
+        EXPECT_EQ(cleared, views.size()) << what;
+        EXPECT_FALSE(placed) << what;
+      }
+      if (elevation > 0.0 && up) {
+        EXPECT_TRUE(placed) << what;     // the Moon's disc shows in daylight
+        EXPECT_GT(cleared, 0u) << what;  // the faces away from it
+      }
+      if (elevation < 0.0) {
+        EXPECT_EQ(cleared, 0u) << what;  // twilight and night: placed, splatted
+      }
       if (elevation >= 20.0 && !up) {
         // Nothing to splat anywhere, and the tiles alone show it but for a
         // few of the larger views, where a tile's stars together outweigh
@@ -696,6 +804,112 @@ TEST(NightSky, SplatTilesHoldTheirSmallestSolidAngle) {
         EXPECT_GT(texels[size_t(t)], 0);
         EXPECT_LE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 + 1e-12)) << n << " " << view.mapping << " " << t;
         EXPECT_GE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 - 1e-12)) << n << " " << view.mapping << " " << t;
+      }
+    }
+}
+
+// The catalogue binned by J2000 position bounds the light of the stars in
+// any cone (at least the sum of those within it, by brute force) and holds
+// all of them; a small cone in an empty part of the sky is empty.
+TEST(NightSky, StarGridBoundsTheStarsInEveryCone) {
+  std::string error;
+  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
+  ASSERT_TRUE(catalogue) << error;
+  const double limit = NightSettings().star_magnitude_limit;
+  const StarGrid grid(*catalogue, limit, OutputUnits::kLuminance);
+  // E: in luminance units the largest channel of the luminance-normalized colour, in lux.
+  std::vector<std::pair<glm::dvec3, double>> stars;
+  double total = 0.0;
+  for (const CatalogueStar& s : catalogue->stars) {
+    if (s.v_magnitude > limit) continue;
+    const Rgb color = StarColorFromBMinusV(s.b_minus_v);
+    const double e = StarIlluminanceLux(s.v_magnitude) * std::max({color[0], color[1], color[2]});
+    stars.push_back({UnitFromEquatorial(s.ra_j2000_deg, s.dec_j2000_deg), e});
+    total += e;
+  }
+  ASSERT_GT(stars.size(), 1000u);
+  EXPECT_NEAR(grid.total() / total, 1.0, 1e-9);
+  std::mt19937 rng(20);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int empty = 0, cones = 0;
+  for (int i = 0; i < 3000; ++i) {
+    glm::dvec3 d(u(rng), u(rng), u(rng));
+    // Near the poles and across RA 0 too.
+    if (i % 10 == 0) d = glm::dvec3(0.01 * u(rng), 0.01 * u(rng), i % 20 == 0 ? 1.0 : -1.0);
+    if (i % 10 == 5) d = glm::dvec3(1.0, 1e-3 * u(rng), u(rng));
+    if (glm::length(d) < 0.1) continue;
+    d = glm::normalize(d);
+    const double r = std::pow(10.0, -4.0 + 3.7 * (0.5 + 0.5 * u(rng)));  // 1e-4 to 0.5 rad
+    const double cos_r = std::cos(r);
+    double brute = 0.0;
+    for (const auto& [v, e] : stars)
+      if (glm::dot(v, d) >= cos_r) brute += e;
+    const double bound = grid.SumWithin(d, r);
+    EXPECT_GE(bound, brute) << "cone " << i << " radius " << r;
+    if (r < 0.01) {
+      EXPECT_LT(bound, 0.01 * total) << "cone " << i;
+    }
+    empty += bound == 0.0;
+    ++cones;
+  }
+  EXPECT_GT(empty, cones / 20);
+}
+
+// A rectangle's cone holds the directions and mu of its texels, its
+// smallest solid angle is no larger than any of its texels', and every
+// source with a splat target in it is within its reach (faces, strips,
+// latlongs, texels and the tiles of SplatTiles).
+TEST(NightSky, RectConesHoldTheirTexelsAndTheirSources) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto angle = [](const glm::dvec3& a, const glm::dvec3& b) {
+    return std::acos(std::clamp(glm::dot(glm::normalize(a), glm::normalize(b)), -1.0, 1.0));
+  };
+  for (const int n : {9, 16, 37, 64})
+    for (const ViewRequest& view : ViewsOfSize(n)) {
+      const bool latlong = view.mapping == MAPPING_LATLONG;
+      const int face_rows = view.mapping == MAPPING_CUBE_STRIP ? n : view.height;
+      const std::string what = fmt::format("size {} mapping {} face {}", n, view.mapping, view.face);
+      for (int k = 0; k < 40; ++k) {
+        std::uniform_int_distribution<int> fx(0, view.width - 1), fy(0, face_rows - 1),
+            ff(0, view.mapping == MAPPING_CUBE_STRIP ? 5 : 0);
+        int xa = fx(rng), xb = fx(rng), ya = fy(rng), yb = fy(rng);
+        if (xa > xb) std::swap(xa, xb);
+        if (ya > yb) std::swap(ya, yb);
+        const int offset = ff(rng) * face_rows;
+        const int x0 = xa, x1 = xb + 1, y0 = ya + offset, y1 = yb + 1 + offset;
+        const RectCone c = ConeOfRect(view, x0, x1, y0, y1);
+        for (int y = y0; y < y1; ++y)
+          for (int x = x0; x < x1; ++x) {
+            const glm::dvec3 d = ViewTexelDirection(view, x, y);
+            EXPECT_LE(angle(c.centre, d), c.texel_radius_rad + 1e-12) << what << " " << x << "," << y;
+            EXPECT_LE(c.texel_radius_rad, c.reach_rad);
+            EXPECT_GE(float(d.y), c.min_mu) << what;
+            EXPECT_LE(float(d.y), c.max_mu) << what;
+            if (!(latlong && x == view.width - 1)) {
+              EXPECT_GE(ViewTexelSolidAngle(view, x, y), c.min_solid_angle * (1.0 - 1e-12)) << what;
+            }
+          }
+      }
+      const SplatTiles tiles(view, {});
+      std::vector<RectCone> tile_cones;
+      for (int t = 0; t < tiles.count(); ++t) {
+        int x0, x1, y0, y1;
+        tiles.Rect(t, x0, x1, y0, y1);
+        tile_cones.push_back(ConeOfRect(view, x0, x1, y0, y1));
+      }
+      for (int k = 0; k < 3000; ++k) {
+        glm::dvec3 s(u(rng), u(rng), u(rng));
+        if (k % 7 == 0) s = glm::dvec3(0.01 * s.x, 1.0, 0.01 * s.z);  // near the zenith (a latlong's first rows)
+        if (glm::length(s) < 0.1) continue;
+        s = glm::normalize(s);
+        for (const TexelAdd& a : SplatPointSources(view, {{s, {1.0, 1.0, 1.0}}})) {
+          const int x = int(a.texel % size_t(view.width)), y = int(a.texel / size_t(view.width));
+          const RectCone texel = ConeOfRect(view, x, x + 1, y, y + 1);
+          EXPECT_LE(angle(s, texel.centre), texel.reach_rad) << what << " texel " << x << "," << y;
+          const RectCone& tile = tile_cones[size_t(tiles.TileOf(x, y))];
+          EXPECT_LE(angle(s, tile.centre), tile.reach_rad) << what << " tile of " << x << "," << y;
+        }
       }
     }
 }

@@ -265,6 +265,20 @@ times = {{ start = 09:00:00, end = {}, step_minutes = 15 }}
 {})", end, per_hour), name);
 }
 
+// MorningDrift's frames of the default style at kSmall.
+struct SmallDrift {
+  ScheduleResult schedule;
+  FrameStyles styles;
+};
+SmallDrift SmallDriftOf(const std::string& end, const std::string& per_hour, const std::string& name) {
+  SmallDrift drift{MorningDrift(end, per_hour, name), {}};
+  EXPECT_TRUE(drift.schedule.ok());
+  if (!drift.schedule.ok()) return drift;
+  drift.styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", kSmall, drift.schedule.schedule);
+  if (!drift.styles.ok()) ADD_FAILURE() << drift.styles.errors[0].Format();
+  return drift;
+}
+
 // A bake into a fresh temporary folder under the validation layer.
 BakeOptions ValidatedBakeOptions(const std::string& name) {
   BakeOptions options;
@@ -278,15 +292,13 @@ BakeOptions ValidatedBakeOptions(const std::string& name) {
 // only: one renderer, its pipelines compiled once, the transmittance and
 // multiple-scattering LUTs rebuilt per frame; and the frames differ.
 TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
-  ScheduleResult schedule = MorningDrift("09:30:00", R"(
+  const SmallDrift drift = SmallDriftOf("09:30:00", R"(
 "atmosphere.mie.scattering_per_km" = 0.004
 "atmosphere.mie.extinction_per_km" = 0.0044
 )", "drift.toml");
-  ASSERT_TRUE(schedule.ok());
-  FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", kSmall, schedule.schedule);
-  ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
+  ASSERT_TRUE(drift.styles.ok());
   const BakeOptions options = ValidatedBakeOptions("drift");
-  const BakeResult result = BakeSequence(styles.styles, schedule.schedule, options);
+  const BakeResult result = BakeSequence(drift.styles.styles, drift.schedule.schedule, options);
   EXPECT_EQ(result.validation_messages, 0);
   ASSERT_EQ(result.frames.size(), 3u);
   EXPECT_EQ(result.renderer_builds, 1);
@@ -354,6 +366,68 @@ TEST(SequenceCost, ProgressManifestsAddUpToAFewFinalManifests) {
   EXPECT_LE(timings["manifest_writes"].get<int>(), 40 + int(seconds / 30.0)) << "100 before";
   EXPECT_LE(timings["manifest_bytes_written"].get<uint64_t>(), (14 + uint64_t(seconds / 30.0)) * final_bytes) << "about 50 times before";
   std::filesystem::remove_all(root);
+}
+
+// The CLI keeps no frame records (BakeOptions::keep_frame_records = false):
+// each frame's files go to the callback as they are recorded, the frames'
+// manifest entries and timings stay on disk until the end, and the bake
+// writes the same manifest, byte for byte, and the same timings entries as
+// one that keeps every record.
+TEST(SequenceCost, BakeWithoutFrameRecordsWritesTheSameManifest) {
+  const SmallDrift drift = SmallDriftOf("09:45:00", R"(
+"atmosphere.ground_albedo" = 0.05
+)", "records.toml");
+  ASSERT_TRUE(drift.styles.ok());
+  const std::vector<SkyStyle>& styles = drift.styles.styles;
+  const Schedule& schedule = drift.schedule.schedule;
+  const BakeOptions kept = ValidatedBakeOptions("records-kept");
+  const BakeResult with_records = BakeSequence(styles, schedule, kept);
+  BakeOptions streamed = ValidatedBakeOptions("records-streamed");
+  streamed.keep_frame_records = false;
+  std::vector<BakedFile> reported;
+  streamed.frame_files = [&](const std::vector<BakedFile>& files) {
+    reported.insert(reported.end(), files.begin(), files.end());
+  };
+  const BakeResult without = BakeSequence(styles, schedule, streamed);
+  EXPECT_EQ(without.validation_messages, 0);
+  ASSERT_EQ(with_records.frames.size(), 4u);
+  EXPECT_TRUE(without.frames.empty());
+  EXPECT_TRUE(without.stages.empty());
+  // The frames' files reported in order, then the rest kept.
+  ASSERT_EQ(reported.size() + without.files.size(), with_records.files.size());
+  for (size_t i = 0; i < with_records.files.size(); ++i) {
+    const BakedFile& a = with_records.files[i];
+    const BakedFile& b = i < reported.size() ? reported[i] : without.files[i - reported.size()];
+    EXPECT_EQ(fs::path(a.path).filename(), fs::path(b.path).filename());
+    EXPECT_EQ(a.kind, b.kind);
+    EXPECT_EQ(a.sha256, b.sha256) << a.path;
+  }
+  EXPECT_EQ(testing::ReadFileBytes(kept.out_dir + "/manifest.json"),
+            testing::ReadFileBytes(streamed.out_dir + "/manifest.json"));
+  EXPECT_EQ(testing::ReadFileBytes(kept.out_dir + "/sky.gltf"), testing::ReadFileBytes(streamed.out_dir + "/sky.gltf"));
+  // timings.json: the same entries (their times differ from run to run).
+  const json a = json::parse(std::ifstream(kept.out_dir + "/timings.json"));
+  const json b = json::parse(std::ifstream(streamed.out_dir + "/timings.json"));
+  ASSERT_EQ(a["frames"].size(), 4u);
+  ASSERT_EQ(b["frames"].size(), 4u);
+  for (size_t i = 0; i < 4; ++i) {
+    EXPECT_EQ(a["frames"][i]["frame"], b["frames"][i]["frame"]);
+    EXPECT_EQ(a["frames"][i]["gpu_passes"].size(), b["frames"][i]["gpu_passes"].size());
+  }
+  // The stages in the same order ("waiting for files" apart: it shows only
+  // when a wait took over 5 ms).
+  auto stage_names = [](const json& timings) {
+    std::vector<std::string> names;
+    for (const json& stage : timings["stages"])
+      if (stage["stage"] != "waiting for files") names.push_back(stage["stage"].get<std::string>());
+    return names;
+  };
+  EXPECT_EQ(stage_names(a), stage_names(b));
+  EXPECT_GT(stage_names(a).size(), 8u);
+  // Nothing left beside the outputs: the records on disk had no name.
+  EXPECT_EQ(testing::FileNames(kept.out_dir), testing::FileNames(streamed.out_dir));
+  fs::remove_all(kept.out_dir);
+  fs::remove_all(streamed.out_dir);
 }
 
 }  // namespace

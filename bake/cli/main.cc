@@ -231,6 +231,13 @@ int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstim
   return kExitOk;
 }
 
+// One line a file, as each frame's are recorded and, at the end, the scene's,
+// manifest's and timings'.
+void PrintFiles(const std::vector<BakedFile>& files) {
+  for (const BakedFile& f : files)
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+}
+
 // The bake's options from the command line (and the environment main read).
 void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, BakeOptions& options) {
   options.out_dir = args.out_dir;
@@ -242,6 +249,10 @@ void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part,
   options.vulkan.software_driver_selection = args.software_driver_selection;
   options.shaders = args.shaders;
   options.star_catalogue = args.star_catalogue;
+  // A frame's files are printed as they are recorded, and not kept: a long
+  // sequence's memory stays flat.
+  options.keep_frame_records = false;
+  options.frame_files = PrintFiles;
   if (!args.quiet) {
     options.progress = [](const StageReport& s) {
       std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
@@ -249,10 +260,9 @@ void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part,
   }
 }
 
-// The files, then anything the validation layer said.
+// The last files, then anything the validation layer said.
 int ReportBake(const BakeResult& result) {
-  for (const BakedFile& f : result.files)
-    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+  PrintFiles(result.files);
   if (result.half_scale != 1.0)
     std::fprintf(stderr,
                  "skybake: warning: values exceeded half range; every EXR was scaled by %.9g "

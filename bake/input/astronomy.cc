@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include <fmt/format.h>
+#include <glm/geometric.hpp>
 #include <libnova/lunar.h>
 #include <libnova/nutation.h>
 #include <libnova/parallax.h>
@@ -172,12 +173,23 @@ Rgb StarColorFromBMinusV(double bv) {
   return rgb;
 }
 
-namespace {
 glm::dvec3 UnitFromEquatorial(double ra_deg, double dec_deg) {
   const double ra = ra_deg * kDeg, dec = dec_deg * kDeg;
   return {std::cos(dec) * std::cos(ra), std::cos(dec) * std::sin(ra), std::sin(dec)};
 }
-}  // namespace
+
+J2000Axes J2000AxesAt(double julian_day_ut, const GeoLocation& place) {
+  ResetLibnovaCaches(julian_day_ut);
+  J2000Axes a;
+  a.x = HorizontalFromJ2000(0.0, 0.0, julian_day_ut, place).direction;
+  a.y = HorizontalFromJ2000(90.0, 0.0, julian_day_ut, place).direction;
+  a.z = HorizontalFromJ2000(0.0, 90.0, julian_day_ut, place).direction;
+  return a;
+}
+
+glm::dvec3 J2000Axes::ToJ2000(const glm::dvec3& world) const {
+  return {glm::dot(world, x), glm::dot(world, y), glm::dot(world, z)};
+}
 
 std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,
                                    const GeoLocation& place, double min_elevation_deg) {
@@ -186,10 +198,8 @@ std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnit
   // world directions once per frame, and each star's J2000 unit vector is
   // rotated by the matrix they make (the same place as HorizontalFromJ2000
   // per star, to 1e-9; tests/astronomy_test.cc).
-  ResetLibnovaCaches(julian_day_ut);
-  const glm::dvec3 x = HorizontalFromJ2000(0.0, 0.0, julian_day_ut, place).direction;
-  const glm::dvec3 y = HorizontalFromJ2000(90.0, 0.0, julian_day_ut, place).direction;
-  const glm::dvec3 z = HorizontalFromJ2000(0.0, 90.0, julian_day_ut, place).direction;
+  const J2000Axes axes = J2000AxesAt(julian_day_ut, place);
+  const glm::dvec3 &x = axes.x, &y = axes.y, &z = axes.z;
   const double min_y = std::sin(min_elevation_deg * kDeg);
   std::vector<PlacedStar> placed;
   for (const CatalogueStar& s : catalogue.stars) {

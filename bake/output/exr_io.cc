@@ -99,6 +99,10 @@ int CreateExclusiveFile(std::string& temporary, const std::string& path) {
 }
 
 void WriteFileAtomically(const std::string& path, std::string_view bytes) {
+  WriteFileAtomically(path, [bytes](const ByteSink& write) { write(bytes); });
+}
+
+void WriteFileAtomically(const std::string& path, const std::function<void(const ByteSink&)>& produce) {
   std::string temporary;
   bool created = false;
   auto fail = [&](const char* what, int error, int fd) {
@@ -110,11 +114,22 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes) {
   int fd = CreateExclusiveFile(temporary, path);
   if (fd < 0) fail("creating", errno, -1);
   created = true;
-  for (size_t done = 0; done < bytes.size();) {
-    ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) fail("writing", n < 0 ? errno : EIO, fd);
-    done += size_t(n);
+  const ByteSink write = [&](std::string_view bytes) {
+    for (size_t done = 0; done < bytes.size();) {
+      ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) fail("writing", n < 0 ? errno : EIO, fd);
+      done += size_t(n);
+    }
+  };
+  try {
+    produce(write);
+  } catch (const OutputError&) {
+    throw;  // from `write`: the descriptor is closed and the temporary removed
+  } catch (...) {
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    throw;
   }
   // On disk before the rename, so that even a power cut leaves the old file
   // or the whole new one.

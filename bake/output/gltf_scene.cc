@@ -30,6 +30,7 @@
 
 #include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/output/json_spool.h"
 
 namespace skybake {
 namespace {
@@ -63,6 +64,9 @@ int AddAccessor(tinygltf::Model& model, int view, int component, size_t count, i
   model.accessors.push_back(a);
   return int(model.accessors.size() - 1);
 }
+
+// The scene's extras hold this string until the texts are written.
+constexpr const char* kExtrasPlaceholder = "\x01skybake provenance\x01";
 
 tinygltf::Value ToValue(const json& j) {
   if (j.is_object()) {
@@ -430,8 +434,9 @@ tinygltf::Model BuildSceneModel(const SceneDescription& scene) {
   if (!scene.ibl_images.empty()) AddImageBasedLight(scene, model, gltf_scene);
   if (!scene.moons.empty()) AddMoonLight(model, scene.moons, gltf_scene);
   if (scene.ground) AddCloudShadowGround(scene, model, gltf_scene);
-  json extras = scene.extras_json.empty() ? json::object() : json::parse(scene.extras_json);
-  gltf_scene.extras = ToValue(json{{"skybake", extras}});
+  // The provenance (one entry a frame) goes into the written texts in
+  // place of this string (WriteGltfAndBin, WriteGlb), never into the model.
+  gltf_scene.extras = ToValue(json{{"skybake", scene.extras_json.empty() ? json::object() : json(kExtrasPlaceholder)}});
   model.scenes.push_back(gltf_scene);
   model.defaultScene = 0;
   json asset_extras = {
@@ -445,22 +450,62 @@ tinygltf::Model BuildSceneModel(const SceneDescription& scene) {
   return model;
 }
 
+// `text` with the placeholder string (as JSON) replaced by `provenance`, its
+// lines after the first indented as the placeholder's line (dump(2)), or
+// not at all (`pretty` false: compact JSON).
+std::string WithProvenance(const std::string& text, const std::string& provenance, bool pretty) {
+  const std::string marker = json(kExtrasPlaceholder).dump();
+  const size_t at = text.find(marker);
+  if (at == std::string::npos) return text;  // no provenance (an empty extras_json)
+  std::string indent;
+  if (pretty) {
+    const size_t line = text.rfind('\n', at) + 1;
+    indent = text.substr(line, text.find_first_not_of(' ', line) - line);
+  }
+  return SplicedJson(text, marker, pretty ? IndentedJson(provenance, indent) : provenance);
+}
+
 // name.gltf + name.bin: the JSON references the .bin and the PNG by name.
-void WriteGltfAndBin(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const std::string& name,
+void WriteGltfAndBin(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const SceneDescription& scene,
                      const WrittenScene& written) {
   std::string bin(model.buffers[0].data.begin(), model.buffers[0].data.end());
   std::ostringstream out;
   if (!writer.WriteGltfSceneToStream(&model, out, true, false))
     throw OutputError(fmt::format("cannot serialise {}", written.gltf_path));
   json document = json::parse(out.str());
-  document["buffers"][0]["uri"] = name + ".bin";
+  document["buffers"][0]["uri"] = scene.name + ".bin";
   WriteFileAtomically(written.bin_path, bin);
-  WriteFileAtomically(written.gltf_path, document.dump(2) + "\n");
+  const std::string pretty = scene.extras_json_pretty.empty() && !scene.extras_json.empty()
+                                 ? json::parse(scene.extras_json).dump(2)
+                                 : scene.extras_json_pretty;
+  WriteFileAtomically(written.gltf_path, WithProvenance(document.dump(2) + "\n", pretty, true));
+}
+
+uint32_t ReadU32(const std::string& bytes, size_t at) {
+  uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + at, 4);  // little-endian, as the hosts skybake runs on
+  return v;
+}
+
+void PutU32(std::string& bytes, size_t at, uint32_t v) { std::memcpy(bytes.data() + at, &v, 4); }
+
+// A GLB (header, JSON chunk padded with spaces to 4 bytes, BIN chunk) with
+// the provenance in its JSON chunk, the lengths as tinygltf writes them.
+std::string GlbWithProvenance(const std::string& glb, const std::string& provenance) {
+  const uint32_t json_length = ReadU32(glb, 12);
+  std::string content = glb.substr(20, json_length);
+  content.erase(content.find_last_not_of(' ') + 1);  // the padding
+  content = WithProvenance(content, provenance, false);
+  content.append((4 - content.size() % 4) % 4, ' ');
+  std::string out = glb.substr(0, 20) + content + glb.substr(20 + json_length);
+  PutU32(out, 8, uint32_t(out.size()));
+  PutU32(out, 12, uint32_t(content.size()));
+  return out;
 }
 
 // name.glb: the PNGs move into the binary chunk.
 void WriteGlb(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const std::filesystem::path& dir,
-              const std::string& texture_file, const std::string& glb_path) {
+              const std::string& texture_file, const std::string& provenance, const std::string& glb_path) {
   std::string png = ReadFile((dir / texture_file).string());
   tinygltf::Model glb = model;
   glb.images[0].uri.clear();
@@ -473,7 +518,7 @@ void WriteGlb(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const st
   std::ostringstream out;
   if (!writer.WriteGltfSceneToStream(&glb, out, false, true))
     throw OutputError(fmt::format("cannot serialise {}", glb_path));
-  WriteFileAtomically(glb_path, out.str());
+  WriteFileAtomically(glb_path, GlbWithProvenance(out.str(), provenance));
 }
 
 }  // namespace
@@ -497,8 +542,8 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
   const tinygltf::Model model = BuildSceneModel(scene);
   tinygltf::TinyGLTF writer;
   writer.SetImageWriter(nullptr, nullptr);
-  WriteGltfAndBin(writer, model, scene.name, written);
-  WriteGlb(writer, model, dir, scene.texture_file, written.glb_path);
+  WriteGltfAndBin(writer, model, scene, written);
+  WriteGlb(writer, model, dir, scene.texture_file, scene.extras_json, written.glb_path);
   return written;
 }
 

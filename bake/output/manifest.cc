@@ -16,6 +16,7 @@
 #include "skybake/output/cloud_shadow_json.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/output/gltf_scene.h"
+#include "skybake/output/json_spool.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/input/engine_preset.h"
 #include "skybake/model/envmap.h"
@@ -447,8 +448,12 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame) {
   return f;
 }
 
+std::string ManifestText(const Manifest& manifest) { return ManifestJson(manifest).dump(2) + "\n"; }
+
+std::string ManifestFrameText(const ManifestFrame& frame) { return FrameJson(frame).dump(2); }
+
 void WriteManifest(const Manifest& manifest, const std::string& path) {
-  WriteFileAtomically(path, ManifestJson(manifest).dump(2) + "\n");
+  WriteFileAtomically(path, ManifestText(manifest));
 }
 
 namespace {
@@ -538,13 +543,16 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
   return m;
 }
 
-std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir) {
+std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir) {
   // Scene: the dome textured with the reference frame, the sun (animated
   // for a sequence), all from the manifest's frames.
   std::vector<BakedFile> scene_files;
   manifest.scene.clear();
   if (manifest.gltf.enabled && !manifest.frames.empty()) {
-    json frame_extras = json::array();
+    // The provenance's frames as text, one frame's small JSON at a time:
+    // the whole list as one JSON value (and again in the glTF writer's
+    // forms) cost about 60 KiB a frame at the end of a long sequence.
+    std::string frames_compact, frames_pretty;
     SceneDescription scene;
     scene.name = manifest.gltf.name;
     scene.out_dir = out_dir;
@@ -577,22 +585,27 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
       if (peak > 0.0) sun.color = {f.sun_irradiance[0] / peak, f.sun_irradiance[1] / peak, f.sun_irradiance[2] / peak};
       scene.suns.push_back(sun);
       if (f.moon && f.moon->light) scene.moons.push_back(SceneMoonOf(*f.moon, f.animation_time_s));
-      frame_extras.push_back({{"frame", f.number},
-                              {"time", f.time.value_or("")},
-                              {"animation_time_s", f.animation_time_s},
-                              {"sun_direction", VectorJson(f.sun_direction)},
-                              {"sun_illuminance_lux", f.sun_illuminance_lux},
-                              {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
-                              {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}});
+      json extras = {{"frame", f.number},
+                     {"time", f.time.value_or("")},
+                     {"animation_time_s", f.animation_time_s},
+                     {"sun_direction", VectorJson(f.sun_direction)},
+                     {"sun_illuminance_lux", f.sun_illuminance_lux},
+                     {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                     {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)}};
+      if (f.moon && f.moon->light) extras["moon"] = MoonJson(*f.moon);
+      frames_compact += (i == 0 ? "" : ",") + extras.dump();
+      frames_pretty += (i == 0 ? "\n    " : ",\n    ") + IndentedJson(extras.dump(2), "    ");
     }
-    for (size_t i = 0; i < manifest.frames.size(); ++i)
-      if (manifest.frames[i].moon && manifest.frames[i].moon->light)
-        frame_extras[i]["moon"] = MoonJson(*manifest.frames[i].moon);
-    json provenance = {{"version", manifest.version},       {"style", manifest.style},
-                       {"schedule", manifest.schedule},     {"units", manifest.units},
-                       {"exposure_ev100", manifest.exposure_ev100}, {"texture_frame", manifest.texture_frame},
-                       {"sh_basis", kShBasis},              {"frames", frame_extras}};
-    scene.extras_json = provenance.dump();
+    const json provenance = {{"version", manifest.version},       {"style", manifest.style},
+                             {"schedule", manifest.schedule},     {"units", manifest.units},
+                             {"exposure_ev100", manifest.exposure_ev100}, {"texture_frame", manifest.texture_frame},
+                             {"sh_basis", kShBasis},              {"frames", json::array()}};
+    // The frames in place of the empty list: the bytes dump() and dump(2)
+    // give the whole object (json_spool.h).
+    scene.extras_json = SplicedJson(provenance.dump(), "\"frames\":[]", "\"frames\":[" + frames_compact + "]");
+    frames_compact = {};
+    scene.extras_json_pretty =
+        SplicedJson(provenance.dump(2), "\n  \"frames\": []", "\n  \"frames\": [" + frames_pretty + "\n  ]");
     WrittenScene written = WriteGltfScene(scene);
     std::vector<std::pair<std::string, const char*>> files = {
         {written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"}, {written.glb_path, "glb"}};
@@ -603,23 +616,39 @@ std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::stri
                                 scene_files.back().sha256});
     }
   }
+  return scene_files;
+}
+
+std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir) {
+  std::vector<BakedFile> scene_files = WriteScene(manifest, out_dir);
   // Manifest: written last, once every file it lists is in place.
   manifest.complete = true;
   WriteManifest(manifest, (fs::path(out_dir) / ManifestFileName(std::nullopt)).string());
   return scene_files;
 }
 
+namespace {
+
+json TimingsStageJson(const StageReport& s) { return {{"stage", s.name}, {"seconds", s.seconds}}; }
+
+json TimingsFrameJson(const FrameResult& f) {
+  json passes = json::array();
+  for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
+  return {{"frame", f.number}, {"render_s", f.render_seconds}, {"write_s", f.write_seconds}, {"gpu_passes", passes}};
+}
+
+}  // namespace
+
+std::string TimingsStageText(const StageReport& stage) { return TimingsStageJson(stage).dump(2); }
+
+std::string TimingsFrameText(const FrameResult& frame) { return TimingsFrameJson(frame).dump(2); }
+
 void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds,
-                  const std::string& path) {
+                  const std::string& path, const TimingsSpools* spools) {
   json stages = json::array();
-  for (const StageReport& s : result.stages) stages.push_back({{"stage", s.name}, {"seconds", s.seconds}});
+  for (const StageReport& s : result.stages) stages.push_back(TimingsStageJson(s));
   json frames = json::array();
-  for (const FrameResult& f : result.frames) {
-    json passes = json::array();
-    for (const PassTiming& t : f.gpu_passes) passes.push_back({{"name", t.name}, {"gpu_ms", t.gpu_ms}});
-    frames.push_back({{"frame", f.number}, {"render_s", f.render_seconds}, {"write_s", f.write_seconds},
-                      {"gpu_passes", passes}});
-  }
+  for (const FrameResult& f : result.frames) frames.push_back(TimingsFrameJson(f));
   json timings = {{"out_dir", out_dir},
                   {"renderer_builds", result.renderer_builds},
                   {"manifest_writes", result.manifest_writes},
@@ -627,7 +656,9 @@ void WriteTimings(const BakeResult& result, const std::string& out_dir, double t
                   {"total_s", total_seconds},
                   {"stages", stages},
                   {"frames", frames}};
-  WriteFileAtomically(path, timings.dump(2) + "\n");
+  if (!spools) return WriteFileAtomically(path, timings.dump(2) + "\n");
+  // The entries on disk (a bake that keeps no frame records: result's lists are empty).
+  WriteJsonWithSpools(path, timings.dump(2) + "\n", {{"stages", &spools->stages}, {"frames", &spools->frames}});
 }
 
 namespace {

@@ -81,22 +81,28 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
         e.samples, e.seconds, options.max_frame_seconds));
 }
 
-// What a sequence keeps of a frame until its last manifest is written: the
-// frame's record (its files' names, sizes and checksums, its Sun, SH and
-// timings) and its manifest entry, which the progress manifests build in
-// memory whole; the more files a frame writes, the more. Measured with
-// tests/benchmark/long_sequence.py: 104 KiB per frame for the default
-// style at --size 1 with 9 files a frame, over 1,000 frames (RSS after the
-// first tenth; docs/performance.md "Long sequences"), which 64 KiB + 6 KiB
-// per file (118 KiB) bounds.
+// What a sequence keeps of a frame until it ends. A bake that keeps its
+// frame records (BakeOptions::keep_frame_records, the library's default):
+// each frame's record (its files' names, sizes and checksums, its Sun, SH
+// and timings), measured before the manifest streamed as 104 KiB per frame
+// for the default style at --size 1 with 9 files a frame over 1,000 frames
+// with the progress manifests built whole in memory, which 64 KiB + 6 KiB
+// per file bounds (an upper bound now). The CLI keeps no records (its
+// manifest entries and timings stay on disk, json_spool.h): what is left is
+// what the glTF scene needs of a frame and the scene's texts at the end,
+// kStreamedFrameBytes measured with tests/benchmark/long_sequence.py
+// (docs/performance.md "Long sequences").
 constexpr double kFrameRecordBytes = 64.0 * 1024.0;
 constexpr double kFileRecordBytes = 6.0 * 1024.0;
+constexpr double kStreamedFrameBytes = 16.0 * 1024.0;
 
-double SequenceRecordMiB(const RenderPlan& plan) {
+double SequenceRecordMiB(const RenderPlan& plan, const BakeOptions& options) {
   double bytes = 0.0;
   for (const FramePlan& f : plan.frames) {
     bytes += double(f.style->resolved_toml.size());  // every frame's style, for the whole sequence's values
-    if (plan.Bakes(f)) bytes += kFrameRecordBytes + kFileRecordBytes * double(f.names.All().size());
+    if (!plan.Bakes(f)) continue;
+    bytes += options.keep_frame_records ? kFrameRecordBytes + kFileRecordBytes * double(f.names.All().size())
+                                        : kStreamedFrameBytes;
   }
   return bytes / (1024.0 * 1024.0);
 }
@@ -109,7 +115,7 @@ void CheckSequenceBudget(const RenderPlan& plan, const BakeOptions& options) {
     frame_mib = std::max(frame_mib, EstimateResources(*f.style).memory_mib);
     baked += plan.Bakes(f) ? 1 : 0;
   }
-  const double records_mib = SequenceRecordMiB(plan);
+  const double records_mib = SequenceRecordMiB(plan, options);
   if (frame_mib + records_mib <= options.max_memory_mib) return;
   throw BudgetError(fmt::format(
       "the sequence needs an estimated {:.0f} MiB of memory: {:.0f} MiB for its largest frame and {:.0f} MiB for "

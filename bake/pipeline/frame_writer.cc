@@ -262,8 +262,15 @@ void FrameWriter::Collect() {
 }
 
 void FrameWriter::Record(FrameResult frame) {
-  for (const BakedFile& f : frame.files) result_.files.push_back(f);
-  result_.frames.push_back(std::move(frame));
+  manifest_.Add(frame);
+  if (TimingsSpools* spools = timer_.spools()) {
+    // Kept on disk, not in memory: a sequence's memory stays flat.
+    spools->frames.Add(TimingsFrameText(frame));
+    if (options_.frame_files) options_.frame_files(frame.files);
+  } else {
+    for (const BakedFile& f : frame.files) result_.files.push_back(f);
+    result_.frames.push_back(std::move(frame));
+  }
   // The manifest as frames are done: a killed bake leaves a valid record of them.
   manifest_.WriteProgress();
 }

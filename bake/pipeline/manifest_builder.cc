@@ -10,24 +10,29 @@ namespace skybake {
 
 ManifestBuilder::ManifestBuilder(const RenderPlan& plan, const BakeOptions& options, const BakeExposure& exposure,
                                  BakeResult& result)
-    : plan_(plan), options_(options), exposure_(exposure), result_(result), written_(Clock::now()) {
+    : plan_(plan), options_(options), exposure_(exposure), result_(result), spool_(options.out_dir),
+      written_(Clock::now()) {
+  std::string sequence_identity;
   for (size_t i = 0; i < plan.frames.size(); ++i) {
     const FramePlan& frame = plan.frames[i];
     style_sha256_.push_back(Sha256OfText(frame.style->resolved_toml));
-    sequence_identity_ +=
+    sequence_identity +=
         SequenceIdentityLine(frame.number, frame.time ? frame.time->Iso8601() : "", frame.sun, style_sha256_.back());
     frame_index_[frame.number] = i;
   }
+  sequence_sha256_ = Sha256OfText(sequence_identity);
+  keeps_scene_frames_ = !plan.part && plan.first().gltf.enabled;
+  result_.manifest_path = OutputPath(options_, plan_.manifest_name);
 }
 
-Manifest ManifestBuilder::Build() const {
+Manifest ManifestBuilder::Head() const {
   const SkyStyle& first = plan_.first();
   const Schedule* schedule = plan_.schedule;
   Manifest m;
   m.version = SKYBAKE_VERSION;
   m.style = first.source_path;
   m.schedule = schedule ? schedule->source_path : "";
-  m.sequence_sha256 = Sha256OfText(sequence_identity_);
+  m.sequence_sha256 = sequence_sha256_;
   m.units = first.output.units == OutputUnits::kLuminance ? "luminance cd/m^2 (sky), lux (irradiance)"
                                                           : "spectral W m^-2 sr^-1 nm^-1 at 680/550/440 nm";
   m.exposure_ev100 = exposure_.ev100.value_or(0.0);
@@ -44,27 +49,41 @@ Manifest ManifestBuilder::Build() const {
   const SkyStyle& ref = *reference.style;
   m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, reference.names.png,
             2 * ref.render.latlong_height, ref.render.latlong_height};
-  for (const FrameResult& f : result_.frames) {
-    const size_t i = frame_index_.at(f.number);
-    ManifestFrame frame = ManifestFrameOf(f);
-    frame.style_sha256 = style_sha256_[i];
-    frame.hours_from_start = plan_.frames[i].hours_from_start;
-    frame.animation_time_s = schedule && schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
-    m.frames.push_back(std::move(frame));
-  }
   return m;
 }
 
-void ManifestBuilder::Write(const std::vector<BakedFile>& scene, bool complete) {
-  Manifest m = Build();
-  for (const BakedFile& f : scene)
-    m.scene.push_back({std::filesystem::path(f.path).filename().string(), f.kind, f.bytes, f.sha256});
+void ManifestBuilder::Add(const FrameResult& f) {
+  const size_t i = frame_index_.at(f.number);
+  ManifestFrame frame = ManifestFrameOf(f);
+  frame.style_sha256 = style_sha256_[i];
+  frame.hours_from_start = plan_.frames[i].hours_from_start;
+  frame.animation_time_s =
+      plan_.schedule && plan_.schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
+  spool_.Add(ManifestFrameText(frame));
+  if (!keeps_scene_frames_) return;
+  frame.style_sha256 = {};
+  if (frame.number != plan_.frames[plan_.reference].number) frame.files = {};
+  scene_frames_.push_back(std::move(frame));
+}
+
+void ManifestBuilder::Write(bool complete) {
+  Manifest m = Head();
   m.complete = complete;
-  result_.manifest_path = OutputPath(options_, plan_.manifest_name);
-  WriteManifest(m, result_.manifest_path);
+  WriteJsonWithSpools(result_.manifest_path, ManifestText(m), {{"frames", &spool_}});
   ++result_.manifest_writes;
   std::error_code ec;
   result_.manifest_bytes_written += std::filesystem::file_size(result_.manifest_path, ec);
+}
+
+std::vector<BakedFile> ManifestBuilder::WriteSceneAndManifest() {
+  Manifest m = Head();
+  m.frames = std::move(scene_frames_);
+  scene_frames_ = {};
+  std::vector<BakedFile> scene_files = WriteScene(m, options_.out_dir);
+  m.frames.clear();
+  m.complete = true;
+  WriteJsonWithSpools(result_.manifest_path, ManifestText(m), {{"frames", &spool_}});
+  return scene_files;
 }
 
 // A write costs time in proportion to the frames done, so rewriting the
@@ -79,12 +98,12 @@ void ManifestBuilder::Write(const std::vector<BakedFile>& scene, bool complete) 
 void ManifestBuilder::WriteProgress() {
   constexpr double kManifestSpacing = 9.0;
   constexpr double kManifestSeconds = 30.0;
-  const size_t done = result_.frames.size();
+  const size_t done = spool_.size();
   if (done - written_frames_ < std::max<size_t>(1, written_frames_ / 10) &&
       SecondsSince(written_) < std::max(kManifestSeconds, kManifestSpacing * write_seconds_))
     return;
   const Clock::time_point start = Clock::now();
-  Write({}, false);
+  Write(false);
   written_frames_ = done;
   written_ = Clock::now();
   write_seconds_ = std::chrono::duration<double>(written_ - start).count();

@@ -15,6 +15,7 @@
 #include "skybake/model/aoas.h"
 #include "skybake/input/config.h"
 #include "skybake/pipeline/gallery.h"
+#include "skybake/pipeline/night_prune.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/model/shared_glsl.h"
 #include "skybake/input/schedule.h"
@@ -445,28 +446,14 @@ TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const s
     for (size_t i = begin; i < reached.size(); ++i) load[size_t(reached[i])] += e;
   }
   first_tile[sources.size()] = int(reached.size());
-  // The glow: its table's first and last entries for a range of mu (as AirglowAt).
-  auto glow_max = [&](float lo, float hi) {
-    if (airglow.empty()) return 0.0;
-    auto index = [&](double mu) { return (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * double(airglow.size() - 1); };
-    const size_t i0 = std::min(size_t(index(lo)), airglow.size() - 2);
-    const size_t i1 = std::min(size_t(index(hi)), airglow.size() - 2) + 1;
-    double m = 0.0;
-    for (size_t i = i0; i <= i1; ++i) m = std::max(m, LargestChannel(airglow[i]));
-    return m;
-  };
   // Each tile that may matter: its floor against the load and the glow.
   std::vector<char> open(size_t(tiles.count()), 0);
   for (int t = 0; t < tiles.count(); ++t) {
-    const double glow = glow_max(tiles.min_mu(t), tiles.max_mu(t));
+    const double glow = airglow.empty() ? 0.0 : AirglowMaxOver(airglow, tiles.min_mu(t), tiles.max_mu(t));
     if (load[size_t(t)] <= 0.0 && glow <= 0.0) continue;
     int x0, x1, y0, y1;
     tiles.Rect(t, x0, x1, y0, y1);
-    float floor = std::numeric_limits<float>::infinity();
-    for (int y = y0; y < y1; ++y) {
-      const float* row = rgba + 4 * (size_t(y) * w);
-      for (int x = x0; x < x1; ++x) floor = std::min(floor, std::max({row[4 * x], row[4 * x + 1], row[4 * x + 2]}));
-    }
+    const float floor = RectFloor(rgba, w, x0, x1, y0, y1);
     ++b.tiles_read;
     // The margins: SplatBound's, and a millionth for the glow's blend.
     const double capacity = min_relative * double(floor) * tiles.min_solid_angle(t) * (1.0 - 1e-4);
@@ -481,6 +468,25 @@ TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const s
       }
   b.splat = !b.sources.empty();
   return b;
+}
+
+float RectFloor(const float* rgba, int width, int x0, int x1, int y0, int y1) {
+  float floor = std::numeric_limits<float>::infinity();
+  for (int y = y0; y < y1; ++y) {
+    const float* row = rgba + 4 * (size_t(y) * width);
+    for (int x = x0; x < x1; ++x) floor = std::min(floor, std::max({row[4 * x], row[4 * x + 1], row[4 * x + 2]}));
+  }
+  return floor;
+}
+
+double AirglowMaxOver(const std::vector<Rgb>& table, double lo, double hi) {
+  // The table's first and last entries for the range (as AirglowAt).
+  auto index = [&](double mu) { return (std::clamp(mu, -1.0, 1.0) + 1.0) * 0.5 * double(table.size() - 1); };
+  const size_t i0 = std::min(size_t(index(lo)), table.size() - 2);
+  const size_t i1 = std::min(size_t(index(hi)), table.size() - 2) + 1;
+  double m = 0.0;
+  for (size_t i = i0; i <= i1; ++i) m = std::max(m, LargestChannel(table[i]));
+  return m;
 }
 
 size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, float* rgba_out, double min_relative) {
@@ -525,6 +531,12 @@ Rgb TransmittanceTable::At(double mu) const {
   Rgb out;
   for (int c = 0; c < 3; ++c) out[c] = table_[i][c] * (1.0 - a) + table_[i + 1][c] * a;
   return out;
+}
+
+double TransmittanceTable::LargestEntry() const {
+  double m = 0.0;
+  for (const Rgb& t : table_) m = std::max(m, LargestChannel(t));
+  return m;
 }
 
 std::vector<Rgb> AirglowTable(const AtmosphereParams& atmosphere, const TransmittanceTable& t, double height_km,
@@ -593,22 +605,36 @@ std::vector<PointSource> MoonDiscSources(const glm::dvec3& moon_direction, doubl
   return samples;
 }
 
+std::vector<PointSource> StarSources(const StarCatalogue& catalogue, double magnitude_limit, OutputUnits units,
+                                     const TransmittanceTable& t, double julian_day_ut, const GeoLocation& place) {
+  const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
+  const Rgb output = OutputScale(units);
+  std::vector<PointSource> sources;
+  for (const PlacedStar& s : PlaceStars(catalogue, magnitude_limit, julian_day_ut, place, kStarMinElevationDeg)) {
+    const Rgb tr = t.At(s.direction.y);
+    PointSource p;
+    p.direction = s.direction;
+    // Luminance-normalized Rec.709 colour x lux -> spectral -> output units.
+    for (int c = 0; c < 3; ++c) p.irradiance[c] = s.illuminance_lux * s.color[c] / to_luminance[c] * output[c] * tr[c];
+    if (Luminance(tr) > 0.0) sources.push_back(p);
+  }
+  return sources;
+}
+
 NightFrame ComputeNightFrame(const SkyStyle& style, const StarCatalogue* catalogue, const TransmittanceTable& t,
-                             double julian_day_ut, const GeoLocation& place, const glm::dvec3& sun) {
+                             double julian_day_ut, const GeoLocation& place, const glm::dvec3& sun,
+                             const StarGrid* defer) {
   NightFrame night;
   night.daylight = sun.y > 0.0;
   const NightSettings& n = style.night;
   const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
   const Rgb output = OutputScale(style.output.units);
   if (n.stars && catalogue) {
-    for (const PlacedStar& s : PlaceStars(*catalogue, n.star_magnitude_limit, julian_day_ut, place, -5.0)) {
-      const Rgb tr = t.At(s.direction.y);
-      PointSource p;
-      p.direction = s.direction;
-      // Luminance-normalized Rec.709 colour x lux -> spectral -> output units.
-      for (int c = 0; c < 3; ++c) p.irradiance[c] = s.illuminance_lux * s.color[c] / to_luminance[c] * output[c] * tr[c];
-      if (Luminance(tr) > 0.0) night.sources.push_back(p);
-    }
+    if (defer && night.daylight)
+      night.pending = std::make_shared<PendingStars>(*catalogue, *defer, t, n.star_magnitude_limit, style.output.units,
+                                                     julian_day_ut, place);
+    else
+      night.sources = StarSources(*catalogue, n.star_magnitude_limit, style.output.units, t, julian_day_ut, place);
     night.stars = night.sources.size();
   }
   if (n.moon || n.moonlight) {
@@ -701,19 +727,48 @@ TileBound NightSkyRenderer::Bound(const ViewRequest& view, const NightFrame& nig
     for (size_t k = 0; k < sources.size(); ++k) all.sources.push_back(k);
     return all;
   }
-  const bool with_mu = !night.airglow.empty();
+  TileBound b = BoundByTiles(view, TilesOf(view, !night.airglow.empty()), sources, night.airglow, rgba,
+                             kNightSplatMinRelative);
+  if (!b.splat) {
+    ++splats_skipped_;
+    ++tiles_skipped_;
+  }
+  return b;
+}
+
+const SplatTiles& NightSkyRenderer::TilesOf(const ViewRequest& view, bool with_mu) {
   const std::array<int, 5> key = {view.mapping, view.width, view.height, view.face, int(with_mu)};
   auto it = tiles_.find(key);
   if (it == tiles_.end()) {
     static const std::vector<float> none;
     it = tiles_.emplace(key, std::make_unique<SplatTiles>(view, with_mu ? TexelMu(view) : none)).first;
   }
-  TileBound b = BoundByTiles(view, *it->second, sources, night.airglow, rgba, kNightSplatMinRelative);
-  if (!b.splat) {
-    ++splats_skipped_;
-    ++tiles_skipped_;
+  return *it->second;
+}
+
+const NightFrame* NightSkyRenderer::ForView(const ViewRequest& view, const NightFrame& night, const float* rgba,
+                                            bool with_moon) {
+  if (!night.pending) return &night;
+  if (splat_bound_ && tile_bound_) {
+    const SplatTiles& tiles = TilesOf(view, false);
+    const std::array<int, 4> key = {view.mapping, view.width, view.height, view.face};
+    auto it = cones_.find(key);
+    if (it == cones_.end()) {
+      auto cones = std::make_unique<std::vector<RectCone>>();
+      for (int t = 0; t < tiles.count(); ++t) {
+        int x0, x1, y0, y1;
+        tiles.Rect(t, x0, x1, y0, y1);
+        cones->push_back(ConeOfRect(view, x0, x1, y0, y1));
+      }
+      it = cones_.emplace(key, std::move(cones)).first;
+    }
+    if (ClearsBeforePlacement(view, tiles, *it->second, night.pending->Light(night, with_moon), rgba,
+                              kNightSplatMinRelative)) {
+      ++cleared_before_placement_;
+      return nullptr;
+    }
   }
-  return b;
+  return &night.pending->Placed(night);
 }
 
 namespace {
@@ -762,15 +817,19 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
       for (size_t k = 0; k < image.rgba.size(); ++k)
         if (k % 4 != 3) image.rgba[k] += moonlit[i][k];
     }
+    // A day frame's stars wait for a view the bound before placement
+    // cannot clear (night_prune.h).
+    const NightFrame* frame = ForView(views[i], night, image.data(), true);
+    if (!frame) continue;
     // The tile bound first (BoundByTiles): the glow and the splat only
     // where they may change a byte. Its floors, read before the glow, are
     // still floors after it (the glow only adds).
-    const TileBound bound = Bound(views[i], night, night.sources, image.data());
+    const TileBound bound = Bound(views[i], *frame, frame->sources, image.data());
     if (bound.airglow) {
       const std::vector<float>& mu = TexelMu(views[i]);
-      if (AddAirglow(night.airglow, mu, image.data(), nullptr)) {
+      if (AddAirglow(frame->airglow, mu, image.data(), nullptr)) {
         own();
-        AddAirglow(night.airglow, mu, image.rgba.data(), image.rgba.data());
+        AddAirglow(frame->airglow, mu, image.rgba.data(), image.rgba.data());
       }
     }
     if (!bound.splat) continue;
@@ -778,7 +837,7 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
     // texel they reach is in a closed tile, and every source reaching an
     // open tile is here, in its order (the same sums).
     const std::vector<TexelAdd> adds =
-        BoundedSplat(views[i], SourcesOf(night.sources, bound.sources), image.data(), night.daylight);
+        BoundedSplat(views[i], SourcesOf(frame->sources, bound.sources), image.data(), frame->daylight);
     if (ApplyTexelAdds(adds, image.data(), nullptr, kNightSplatMinRelative) == 0) continue;
     own();
     ApplyTexelAdds(adds, image.rgba.data(), image.rgba.data(), kNightSplatMinRelative);
@@ -787,18 +846,25 @@ void NightSkyRenderer::AddToViews(const SkyStyle& style, const NightFrame& night
 
 void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night, const std::vector<ViewRequest>& views,
                                   std::vector<std::vector<float>>& faces) {
-  // The stars only: the Moon's disc is a directional light there, as the Sun's.
-  const std::vector<PointSource> stars(night.sources.begin(), night.sources.begin() + long(night.stars));
   std::vector<std::vector<float>> moonlit;
   if (night.moonlight_scale > 0.0 && night.moon) moonlit = MoonlitSky(style, night, views);
+  // The stars only: the Moon's disc is a directional light there, as the Sun's.
+  const NightFrame* stars_of = nullptr;
+  std::vector<PointSource> stars;
   for (size_t i = 0; i < views.size(); ++i) {
     if (!moonlit.empty())
       for (size_t k = 0; k < faces[i].size(); ++k)
         if (k % 4 != 3) faces[i][k] += moonlit[i][k];
-    const TileBound bound = Bound(views[i], night, stars, faces[i].data());
-    if (bound.airglow) AddAirglow(night.airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
+    const NightFrame* frame = ForView(views[i], night, faces[i].data(), false);
+    if (!frame) continue;
+    if (frame != stars_of) {
+      stars.assign(frame->sources.begin(), frame->sources.begin() + long(frame->stars));
+      stars_of = frame;
+    }
+    const TileBound bound = Bound(views[i], *frame, stars, faces[i].data());
+    if (bound.airglow) AddAirglow(frame->airglow, TexelMu(views[i]), faces[i].data(), faces[i].data());
     if (!bound.splat) continue;
-    ApplyTexelAdds(BoundedSplat(views[i], SourcesOf(stars, bound.sources), faces[i].data(), night.daylight),
+    ApplyTexelAdds(BoundedSplat(views[i], SourcesOf(stars, bound.sources), faces[i].data(), frame->daylight),
                    faces[i].data(), faces[i].data(), kNightSplatMinRelative);
   }
 }
@@ -810,8 +876,11 @@ void AddNightSkyPlan(const std::vector<SkyStyle>& frames, PassPlan& plan) {
                                     [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
   const std::string pruned =
       day == 0 ? std::string("no frame has the Sun up: every view splatted")
-               : fmt::format("in the {} of {} frames with the Sun up each view first goes through the tile bound, "
-                             "skipped where no addition can reach 2^-13 of a texel (the daylit sky outshines it)",
+               : fmt::format("in the {} of {} frames with the Sun up each view is first bounded before any star is "
+                             "placed (the catalogue binned by J2000 position against each tile's darkest texel): a "
+                             "frame whose views no star, Moon or glow can change places no star and splats nothing; "
+                             "a view that may change then goes through the tile bound, skipped where no addition can "
+                             "reach 2^-13 of a texel (the daylit sky outshines it)",
                              day, int(frames.size()));
   if (night.stars || night.moon)
     plan.passes.push_back({"star and Moon splat (host)",
@@ -836,6 +905,8 @@ const StarCatalogue& StarCatalogues::Get(const std::string& path) {
   }
   return loaded_.emplace(path, std::move(*c)).first->second;
 }
+
+NightSkyBake::~NightSkyBake() = default;
 
 std::unique_ptr<NightSkyBake> NightSkyBake::For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
                                                 const std::string& default_catalogue) {
@@ -868,8 +939,17 @@ std::optional<NightFrame> NightSkyBake::Frame(const SkyStyle& unpruned, const st
     tables_.emplace_back(key, std::make_unique<TransmittanceTable>(atmosphere, style.quality, style.effects));
     table = tables_.back().second.get();
   }
-  const StarCatalogue* catalogue = style.night.stars ? &catalogues_.Get(StarCataloguePathOf(style, default_catalogue_)) : nullptr;
-  NightFrame frame = ComputeNightFrame(style, catalogue, *table, JulianDayUt(*time), place_, sun);
+  const StarCatalogue* catalogue = nullptr;
+  const StarGrid* grid = nullptr;
+  if (style.night.stars) {
+    const std::string path = StarCataloguePathOf(style, default_catalogue_);
+    catalogue = &catalogues_.Get(path);
+    // The catalogue binned once per bake, for the bound before placement.
+    std::unique_ptr<StarGrid>& g = grids_[{path, style.night.star_magnitude_limit, int(style.output.units)}];
+    if (!g) g = std::make_unique<StarGrid>(*catalogue, style.night.star_magnitude_limit, style.output.units);
+    grid = g.get();
+  }
+  NightFrame frame = ComputeNightFrame(style, catalogue, *table, JulianDayUt(*time), place_, sun, grid);
   // The glow's zenith luminance is the floor's, which the pruned style has
   // taken out of the shaders (PrunedStyle).
   if (style.night.airglow)
@@ -933,7 +1013,10 @@ double NightSkyBake::TakeSeconds() {
 }
 
 std::string NightSkyBake::Describe(const NightFrame& night) {
-  std::string d = fmt::format("{} stars", night.stars);
+  std::string d = !night.pending         ? fmt::format("{} stars", night.stars)
+                  : night.pending->placed() ? fmt::format("{} stars (placed for the views the daylight may not hide them in)",
+                                                          night.pending->stars())
+                                            : std::string("no star placed (the daylit sky outshines them in every view)");
   if (night.moon)
     d += fmt::format(", Moon at {:.1f} deg, phase angle {:.1f} deg, {:.3g} lux{}", night.moon->sky.elevation_deg,
                      night.moon->phase_angle_deg, night.moon_illuminance_lux,

@@ -168,26 +168,25 @@ void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
 void FinishBake(const RenderPlan& plan, const BakeOptions& options, ManifestBuilder& manifest, StageTimer& timer,
                 Clock::time_point bake_start, BakeResult& result) {
   if (plan.part) {
-    manifest.Write({}, true);
+    manifest.Write(true);
   } else {
-    Manifest m = manifest.Build();
-    std::vector<BakedFile> scene_files = WriteSceneAndManifest(m, options.out_dir);
+    std::vector<BakedFile> scene_files = manifest.WriteSceneAndManifest();
     for (const BakedFile& f : scene_files) result.files.push_back(f);
     if (!scene_files.empty())
-      timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", scene_files.front().path, m.frames.size(),
-                                       m.frames.size() == 1 ? "" : "s"));
-    result.manifest_path = OutputPath(options, plan.manifest_name);
+      timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", scene_files.front().path, manifest.frames(),
+                                       manifest.frames() == 1 ? "" : "s"));
   }
   result.files.push_back({result.manifest_path, "manifest", std::filesystem::file_size(result.manifest_path), ""});
   timer.Finish("manifest", result.manifest_path);
   const std::string timings_path = OutputPath(options, TimingsFileName(plan.part));
-  WriteTimings(result, options.out_dir, SecondsSince(bake_start), timings_path);
+  WriteTimings(result, options.out_dir, SecondsSince(bake_start), timings_path, timer.spools());
   result.files.push_back({timings_path, "timings", std::filesystem::file_size(timings_path), ""});
 }
 
 BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   BakeResult result;
   StageTimer timer(result, options.progress);
+  if (!options.keep_frame_records) timer.SpoolRecords(options.out_dir);
   const Clock::time_point bake_start = Clock::now();
   // OpenEXR compresses line blocks on its own pool, one thread per core.
   SetExrThreads(int(std::max(1u, std::thread::hardware_concurrency())));

@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "skybake/output/bake_record.h"
+#include "skybake/output/manifest.h"
 
 namespace skybake {
 
@@ -42,16 +44,23 @@ class StageTimer {
   void Report(const std::string& name, double seconds, const std::string& detail = "") {
     Add({name, seconds, detail});
   }
+  // From now on, stages go to timings.json's record on disk, not into
+  // result.stages, and so do the frames' timings (FrameWriter): a bake that
+  // keeps no frame records (BakeOptions::keep_frame_records).
+  void SpoolRecords(const std::string& dir) { spools_ = std::make_unique<TimingsSpools>(dir); }
+  TimingsSpools* spools() const { return spools_.get(); }
 
  private:
   void Add(const StageReport& report) {
-    result_.stages.push_back(report);
+    if (spools_) spools_->stages.Add(TimingsStageText(report));
+    else result_.stages.push_back(report);
     if (progress_) progress_(report);
   }
 
   BakeResult& result_;
   const Callback& progress_;
   Clock::time_point start_;
+  std::unique_ptr<TimingsSpools> spools_;
 };
 
 }  // namespace skybake

@@ -4,7 +4,7 @@
 # float32 ZIP EXR (what `skybake bake` writes with pixel_type = "float").
 #
 #   blender -b --factory-startup --python tests/benchmark/blender_clouds.py -- OUT.exr SAMPLES
-#       [--width 2048] [--seed N] [--rows FIRST END] [--clear] [--probe]
+#       [--width 2048] [--seed N] [--sun-elevation 45] [--rows FIRST END] [--clear] [--probe]
 #
 # --rows renders only the panorama's rows [FIRST, END) (0 the zenith row),
 # cropped to them: a strip to measure noise on at less cost.
@@ -13,8 +13,9 @@
 # whole process and measures the noise (docs/performance.md, "W3 against
 # Blender Cycles"). Blender units are metres, Z is up.
 #
-# The scene is W3's (configs/benchmark/w3.toml with configs/default.toml):
-# - the Sun at 35 deg elevation, azimuth 135 deg (Blender's sun rotation),
+# The scene is W3's (configs/benchmark/w3.toml):
+# - the Sun at 45 deg elevation (W3's; --sun-elevation), azimuth 135 deg
+#   (Blender's sun rotation),
 #   Nishita's own sun disc (0.545 deg) as the only sun: Cycles samples the
 #   disc of a Nishita sky as a cone, as it samples a sun lamp;
 # - one layer from 1.5 to 3 km, 600 km x 600 km (skybake marches clouds to
@@ -55,6 +56,7 @@ parser.add_argument("out")
 parser.add_argument("samples", type=int)
 parser.add_argument("--width", type=int, default=2048)
 parser.add_argument("--seed", type=int, default=1)
+parser.add_argument("--sun-elevation", type=float, default=45.0)
 parser.add_argument("--rows", type=int, nargs=2, default=None)
 parser.add_argument("--clear", action="store_true")
 parser.add_argument("--probe", action="store_true")
@@ -108,7 +110,7 @@ sky = wn.new("ShaderNodeTexSky")
 sky.sky_type = "NISHITA"
 sky.sun_disc = True
 sky.altitude = 0.0
-sky.sun_elevation = math.radians(35.0)
+sky.sun_elevation = math.radians(args.sun_elevation)
 sky.sun_rotation = math.radians(135.0)
 background = wn.new("ShaderNodeBackground")
 world_out = wn.new("ShaderNodeOutputWorld")

@@ -3,10 +3,19 @@
 faces, a 2 x 1 latlong, every output on), the Sun stepping from 0 to 89 deg
 over N frames. Prints, per N, the wall time, the peak RSS, the memory the
 frames after the first tenth added per frame (sampled from /proc while the
-bake runs), the folder's size and the progress manifests' writes (from
-timings.json). Out of ctest; docs/performance.md "Long sequences" quotes it.
+bake runs: to its end, and while frames are baked), the folder's size and
+the progress manifests' writes (from timings.json). Out of ctest;
+docs/performance.md "Long sequences" quotes it.
 
-  python3 tests/benchmark/long_sequence.py --frames 100,1000,10000
+  python3 tests/benchmark/long_sequence.py --frames 100,1000,10000 \
+      --set quality.sky_view_lut=false
+
+--set passes settings to every bake (the same for each frame count, so the
+lines compare); --schedule bakes that schedule instead of the Sun's ramp
+(its frame count is the schedule's), e.g. drifting clouds:
+
+  python3 tests/benchmark/long_sequence.py --style configs/benchmark/w3.toml \
+      --schedule configs/schedules/day.toml --size 8
 """
 import argparse
 import json
@@ -46,14 +55,18 @@ def frames_done(path, basename="sky_px."):
         return 0
 
 
-def run(binary, frames, tmp, style):
-    sched = os.path.join(tmp, f"sun_{frames}.toml")
-    with open(sched, "w") as f:
-        f.write(schedule_text(frames))
+def run(args, frames, tmp):
+    sched = args.schedule
+    if not sched:
+        sched = os.path.join(tmp, f"sun_{frames}.toml")
+        with open(sched, "w") as f:
+            f.write(schedule_text(frames))
     out = os.path.join(tmp, f"out_{frames}")
+    command = [args.binary, "bake", args.style, "--schedule", sched, "--size", str(args.size), "-q", "--out", out]
+    for setting in args.set:
+        command += ["--set", setting]
     t0 = time.perf_counter()
-    proc = subprocess.Popen([binary, "bake", style, "--schedule", sched, "--size", "1", "-q", "--out", out],
-                            stdout=subprocess.DEVNULL, cwd=ROOT)
+    proc = subprocess.Popen(command, stdout=subprocess.DEVNULL, cwd=ROOT)
     samples = []  # (frames done, RSS KiB)
     peak = 0
     while proc.poll() is None:
@@ -65,15 +78,21 @@ def run(binary, frames, tmp, style):
     seconds = time.perf_counter() - t0
     if proc.returncode != 0:
         raise SystemExit(f"skybake exited with {proc.returncode} for {frames} frames")
-    # Memory added per frame from the first tenth of the frames to the last sample.
-    tenth = [s for s in samples if s[0] >= frames // 10]
-    per_frame = None
-    if len(tenth) >= 2 and tenth[-1][0] > tenth[0][0]:
-        per_frame = (tenth[-1][1] - tenth[0][1]) / (tenth[-1][0] - tenth[0][0])
     with open(os.path.join(out, "timings.json")) as f:
         timings = json.load(f)
+    frames = len(timings["frames"])
+    # Memory added per frame from the first tenth of the frames to the last
+    # sample (the bake's end, its glTF scene, included), and to the last
+    # sample before the last frame's files (the frames alone).
+    tenth = [s for s in samples if s[0] >= frames // 10]
+    per_frame = during = None
+    if len(tenth) >= 2 and tenth[-1][0] > tenth[0][0]:
+        per_frame = (tenth[-1][1] - tenth[0][1]) / (tenth[-1][0] - tenth[0][0])
+    before_end = [s for s in tenth if s[0] < frames]
+    if len(before_end) >= 2 and before_end[-1][0] > before_end[0][0]:
+        during = (before_end[-1][1] - before_end[0][1]) / (before_end[-1][0] - before_end[0][0])
     manifest = os.path.getsize(os.path.join(out, "manifest.json"))
-    return {"frames": frames, "seconds": seconds, "peak_mib": peak / 1024.0, "per_frame_kib": per_frame,
+    return {"frames": frames, "seconds": seconds, "peak_mib": peak / 1024.0, "per_frame_kib": per_frame, "during_kib": during,
             "folder_mb": folder_bytes(out) / 1e6, "manifest_writes": timings["manifest_writes"],
             "manifest_ratio": timings["manifest_bytes_written"] / manifest}
 
@@ -83,14 +102,20 @@ def main():
     ap.add_argument("--binary", default=os.path.join(ROOT, "build", "skybake"))
     ap.add_argument("--style", default=os.path.join(ROOT, "configs", "default.toml"))
     ap.add_argument("--frames", default="100,1000,10000", help="frame counts, comma separated")
+    ap.add_argument("--size", type=int, default=1, help="--size of the bakes (cube face edge, texels)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="a setting for every bake")
+    ap.add_argument("--schedule", default="", help="bake this schedule (once) instead of the Sun's ramp")
     args = ap.parse_args()
     print(os.popen("uptime").read().strip())
+    print(" ".join(["settings: --size", str(args.size)] + [f"--set {x}" for x in args.set]), flush=True)
     with tempfile.TemporaryDirectory() as tmp:
-        for n in [int(x) for x in args.frames.split(",")]:
-            r = run(args.binary, n, tmp, args.style)
+        for n in [int(x) for x in args.frames.split(",")] if not args.schedule else [0]:
+            r = run(args, n, tmp)
             per = "n/a" if r["per_frame_kib"] is None else f"{r['per_frame_kib']:.1f} KiB"
-            print(f"{r['frames']:>6} frames: {r['seconds']:.1f} s ({1000 * r['seconds'] / n:.1f} ms a frame), "
-                  f"peak RSS {r['peak_mib']:.0f} MiB, {per} more a frame after the first tenth, "
+            during = "n/a" if r["during_kib"] is None else f"{r['during_kib']:.1f} KiB"
+            print(f"{r['frames']:>6} frames: {r['seconds']:.1f} s ({1000 * r['seconds'] / r['frames']:.1f} ms a frame), "
+                  f"peak RSS {r['peak_mib']:.0f} MiB, {per} more a frame after the first tenth ({during} while frames "
+                  f"are baked), "
                   f"folder {r['folder_mb']:.1f} MB, {r['manifest_writes']} progress manifests "
                   f"({r['manifest_ratio']:.1f}x the final one)", flush=True)
             subprocess.run(["rm", "-rf", os.path.join(tmp, f"out_{n}")], check=True)

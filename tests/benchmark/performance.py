@@ -12,7 +12,7 @@ blender_sky.py) renders the same frames in the same run when it is installed.
 
     python3 tests/benchmark/performance.py [--reps 3] [--no-blender]
     python3 tests/benchmark/performance.py --only-ibl [--reps 5] [--skybake-before OLD/skybake]
-    python3 tests/benchmark/performance.py --blender-clouds --work DIR [--reps-w3 3] [--reuse-blender]
+    python3 tests/benchmark/performance.py --blender-clouds --work DIR [--reps-w3 3] [--sun-elevation 45] [--reuse-blender]
 
 --blender-clouds: W3 against Blender Cycles (docs/performance.md, "W3
 against Blender Cycles"): skybake's W3 as a 2048 x 1024 float latlong alone
@@ -122,6 +122,8 @@ def main():
                         help="W3 against Blender Cycles at 16 and 64 samples (2048 x 1024; slow: about an hour)")
     parser.add_argument("--reuse-blender", action="store_true",
                         help="--blender-clouds: keep the Blender runs already in WORK/blender_clouds.json")
+    parser.add_argument("--sun-elevation", type=float, default=45.0,
+                        help="--blender-clouds: the Sun's elevation in both scenes, deg (W3's: 45)")
     parser.add_argument("--full-64", action="store_true",
                         help="--blender-clouds: also the whole 2048 x 1024 render at 64 samples (slow)")
     parser.add_argument("--report-only", action="store_true",
@@ -279,11 +281,14 @@ def latlong_luminance(exr, rows=None):
     its upper half: row 0 the zenith, row h/2 - 1 just above the horizon), as
     (width, rows, values row by row from the top); read through
     `oiiotool --dumpdata`."""
-    proc = subprocess.Popen(["oiiotool", "--dumpdata", exr], stdout=subprocess.PIPE, text=True)
-    header = proc.stdout.readline()  # "NAME : W x H, 3 channel, float openexr"
-    size = header.split(":", 1)[1].split(",")[0].split("x")
+    info = subprocess.run(["oiiotool", "--info", exr], capture_output=True, text=True, check=True).stdout
+    size = info.split(":", 1)[1].split(",")[0].split("x")  # "NAME : W x H, 3 channel, float openexr"
     width, height = int(size[0]), int(size[1])
     rows = rows or height // 2
+    top = exr + ".top.exr"  # the rows alone: half the text to read
+    subprocess.run(["oiiotool", exr, "--ch", "R,G,B", "--crop", f"{width}x{rows}+0+0", "-o", top], check=True)
+    proc = subprocess.Popen(["oiiotool", "--dumpdata", top], stdout=subprocess.PIPE, text=True)
+    proc.stdout.readline()
     y = array.array("f", bytes(4 * width * rows))
     for line in proc.stdout:  # "    Pixel (x, y): r g b"
         position, values = line.split(":")
@@ -293,7 +298,8 @@ def latlong_luminance(exr, rows=None):
         r, g, b = (float(v) for v in values.split()[:3])
         y[py * width + px] = 0.2126 * r + 0.7152 * g + 0.0722 * b
     if proc.wait() != 0:
-        raise SystemExit(f"oiiotool --dumpdata {exr} failed")
+        raise SystemExit(f"oiiotool --dumpdata {top} failed")
+    os.remove(top)
     return width, rows, y
 
 
@@ -376,13 +382,19 @@ def print_blender_clouds(args, work):
     stored_path = os.path.join(work, "blender_clouds.json")
     reuse = args.reuse_blender or args.report_only
     stored = json.load(open(stored_path)) if reuse and os.path.exists(stored_path) else {}
+    if stored.get("sun_elevation_deg", args.sun_elevation) != args.sun_elevation:
+        raise SystemExit(f"{stored_path}: its runs have the Sun at {stored['sun_elevation_deg']} deg, not "
+                         f"{args.sun_elevation}")
     results = stored if args.report_only else {key: value for key, value in stored.items() if key.startswith("blender")}
+    results["sun_elevation_deg"] = args.sun_elevation
 
     def save():
         with open(stored_path, "w") as f:
             json.dump(results, f, indent=1)
 
     w3, w1 = ["configs/benchmark/w3.toml"], ["configs/benchmark/w1.toml"]
+    sun = ["--set", f"sun.elevation_deg={args.sun_elevation}"]
+    w3, w1 = w3 + sun, w1 + sun
     latlong_only = ["--set", "output.faces=false", "--set", "output.cube_strip=false", "--set",
                     'output.pixel_type="float"']
     hashes = {"w3_latlong": [], "w3": []}
@@ -412,6 +424,7 @@ def print_blender_clouds(args, work):
     # 64-sample strip against their mean; --full-64 adds the whole 64-sample
     # render (4 times the 16-sample one's time; an hour or more here).
     base = [args.blender, "-b", "--factory-startup", "--python", script, "--"]
+    extra_all = ["--sun-elevation", str(args.sun_elevation)]
     strip = ["--rows", str(STRIP_ROWS[0]), str(STRIP_ROWS[1])]
     blender_runs = [("blender_clear", "Blender clear sky", 1, ["--clear"]),
                     ("blender_16a", "Blender 16 samples", 16, ["--seed", "1"]),
@@ -428,7 +441,7 @@ def print_blender_clouds(args, work):
         if key in results and os.path.exists(image):
             sys.stderr.write(f"{label}: kept from {stored_path}\n")
             continue
-        results[key] = median_run(label, base + [image, str(samples)] + extra, 1)
+        results[key] = median_run(label, base + [image, str(samples)] + extra + extra_all, 1)
         results[key]["samples"] = samples
         save()
 
@@ -485,7 +498,7 @@ def print_blender_clouds(args, work):
               f"{min(r['loads']):.1f}-{max(r['loads']):.1f} | {noise_cells} | {b16['wall'] / r['wall']:.1f}x | "
               f"{b16['cpu'] / r['cpu']:.1f}x |")
     latlong = results["skybake_w3_latlong"]
-    print(f"\nskybake: {results['skybake_commit']}; {len(latlong['walls'])} runs of each case (medians); noise 0: "
+    print(f"\nThe Sun at {results['sun_elevation_deg']:g} deg in both. skybake: {results['skybake_commit']}; {len(latlong['walls'])} runs of each case (medians); noise 0: "
           f"the latlong's bytes were the same in every run of the case.")
     print(f"Cloud cover above 30 deg (texels the layer changes by more than 10%): skybake "
           f"{100 * results['cover']['skybake'][0]:.0f}%, Blender {100 * results['cover']['blender'][0]:.0f}% "

@@ -117,6 +117,19 @@ struct PlacedStar {
   Rgb color{1.0, 1.0, 1.0};      // linear Rec.709, luminance 1
 };
 
+// The world directions (skybake's frame) of the J2000 equatorial axes at
+// `julian_day_ut` and `place` (RA 0 and 90 deg on the equator, the pole):
+// precession and the horizontal transform, a rotation. A J2000 unit vector
+// v is at v.x * x + v.y * y + v.z * z; a world direction d at J2000
+// (d.x, d.y, d.z) . (x, y, z) (orthonormal to 1e-9).
+struct J2000Axes {
+  glm::dvec3 x{1.0, 0.0, 0.0}, y{0.0, 1.0, 0.0}, z{0.0, 0.0, 1.0};
+  glm::dvec3 ToJ2000(const glm::dvec3& world) const;
+};
+J2000Axes J2000AxesAt(double julian_day_ut, const GeoLocation& place);
+// The J2000 unit vector of (RA, Dec): x towards RA 0, z the pole.
+glm::dvec3 UnitFromEquatorial(double ra_deg, double dec_deg);
+
 // The catalogue's stars brighter than `magnitude_limit` and above the
 // observer's astronomical horizon (elevation > `min_elevation_deg`).
 std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,

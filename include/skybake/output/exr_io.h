@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
@@ -89,6 +90,13 @@ uint64_t WritePng(const std::string& path, int width, int height, const std::vec
 // failure the temporary is removed and OutputError names the file, the
 // system error and the fix (a full disk, a file-size limit).
 void WriteFileAtomically(const std::string& path, std::string_view bytes);
+
+// The same for a file given in pieces: `produce` calls the sink with each
+// piece in turn (a manifest written from its frames' entries on disk, never
+// whole in memory). An exception from `produce` removes the temporary and
+// passes on.
+using ByteSink = std::function<void(std::string_view)>;
+void WriteFileAtomically(const std::string& path, const std::function<void(const ByteSink&)>& produce);
 
 // Removes hidden temporaries (TemporaryPathFor) of the given file names in
 // `dir` left by processes that no longer run (a killed bake), and links at

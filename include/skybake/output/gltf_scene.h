@@ -80,6 +80,10 @@ struct SceneDescription {
   // (a light's intensity is not animated in core glTF). Empty: no Moon.
   std::vector<SceneSun> moons;
   std::string extras_json;         // JSON object merged into the scene's extras (skybake provenance)
+  // The same object as nlohmann's dump(2) writes it, or empty (then made
+  // from extras_json): the writer puts the texts in place, never holding the
+  // object in its JSON forms.
+  std::string extras_json_pretty;
   // EXT_lights_image_based (gltf_ibl.h): levels x 6 RGBD PNGs in out_dir, level-major,
   // +X -X +Y -Y +Z -Z; none: no image-based light.
   std::vector<std::string> ibl_images;

@@ -26,6 +26,7 @@
 #include "skybake/input/frame_numbering.h"
 #include "skybake/base/errors.h"
 #include "skybake/output/bake_record.h"
+#include "skybake/output/json_spool.h"
 #include "skybake/model/sh.h"
 #include "skybake/input/shard.h"
 #include "skybake/model/solar_position.h"
@@ -107,6 +108,11 @@ ManifestFrame ManifestFrameOf(const FrameResult& frame);
 
 // Writes `manifest` as JSON to `path`, atomically. Throws OutputError.
 void WriteManifest(const Manifest& manifest, const std::string& path);
+// The bytes WriteManifest writes; a frame's entry in them (at indent 0):
+// a bake keeps its frames' entries on disk (json_spool.h) and writes the
+// manifest around them, with the same bytes.
+std::string ManifestText(const Manifest& manifest);
+std::string ManifestFrameText(const ManifestFrame& frame);
 
 // ReadManifest's error for a file that cannot be read or is not a JSON
 // object (a ManifestError, exit 8, as any other): apart, so that --resume
@@ -137,11 +143,24 @@ Manifest ReadManifest(const std::string& path, ManifestNames names = ManifestNam
 // and writes out_dir/manifest.json. Returns the scene's files. Throws
 // OutputError.
 std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir);
+// Its first half: the scene alone, listed in manifest.scene. It reads of
+// the frames their suns, SH, times and Moons, and the files of the texture
+// frame only.
+std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir);
 
 // Run-dependent facts of a bake, kept out of the manifest: the output folder,
 // wall-clock and GPU timings per stage and frame, renderer builds.
+// With `spools`, its stages and frames are the entries there (a bake that
+// keeps no frame records, BakeOptions::keep_frame_records), each made by
+// TimingsStageText or TimingsFrameText.
+struct TimingsSpools {
+  explicit TimingsSpools(const std::string& dir) : stages(dir), frames(dir) {}
+  JsonArraySpool stages, frames;
+};
+std::string TimingsStageText(const StageReport& stage);
+std::string TimingsFrameText(const FrameResult& frame);
 void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds,
-                  const std::string& path);
+                  const std::string& path, const TimingsSpools* spools = nullptr);
 
 struct MergeOptions {
   std::string dir;                // holds the parts' manifests and files

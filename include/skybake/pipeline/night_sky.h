@@ -49,6 +49,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <glm/vec3.hpp>
@@ -66,6 +67,9 @@ namespace skybake {
 struct SkyStyle;
 struct ConfigError;
 struct Schedule;
+class StarGrid;
+class PendingStars;
+struct RectCone;
 
 // Relative addition below which a splat is left out (see above).
 inline constexpr double kNightSplatMinRelative = 1.0 / 8192.0;
@@ -179,6 +183,11 @@ struct TileBound {
 TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const std::vector<PointSource>& sources,
                        const std::vector<Rgb>& airglow, const float* rgba, double min_relative);
 
+// The darkest texel of a rectangle of RGBA texels (row width `width`):
+// the smallest of their largest channels, over columns [x0, x1) and rows
+// [y0, y1).
+float RectFloor(const float* rgba, int width, int x0, int x1, int y0, int y1);
+
 // The atmosphere's transmittance from the observer to space along a
 // direction, as a table over mu = cos(zenith angle): the shared integral
 // (ReferenceModel::TransmittanceDirect, 256 steps) at 4096 values of mu,
@@ -188,6 +197,10 @@ class TransmittanceTable {
   TransmittanceTable(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                      const EffectSettings& effects);
   Rgb At(double mu) const;
+  // The largest entry of any channel: no At is above it.
+  double LargestEntry() const;
+  // Rays below it meet the ground (At is zero there).
+  double mu_horizon() const { return mu_horizon_; }
 
  private:
   std::vector<Rgb> table_;
@@ -203,6 +216,10 @@ struct NightFrame {
   double moon_illuminance_lux = 0.0;  // the same as illuminance
   double moonlight_scale = 0.0;       // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
   bool daylight = false;              // the Sun above the horizon: splats go through SplatBound
+  // A day frame's stars before placement (night_prune.h): `sources` holds
+  // the Moon's samples alone and `stars` is 0 until a view needs the stars
+  // (PendingStars::Placed). Null when the stars are placed (or off).
+  std::shared_ptr<PendingStars> pending;
   // With night.airglow: the glow's radiance by mu = cos(zenith angle) of
   // the view (output units), AirglowTable.
   std::vector<Rgb> airglow;
@@ -220,11 +237,25 @@ std::vector<Rgb> AirglowTable(const AtmosphereParams& atmosphere, const Transmit
                               double zenith_cd_m2, OutputUnits output);
 // The table read at `mu` (nearest entry below, linear).
 Rgb AirglowAt(const std::vector<Rgb>& table, double mu);
+// At least the largest channel of AirglowAt over mu in [lo, hi]: the
+// largest of the entries that range reads.
+double AirglowMaxOver(const std::vector<Rgb>& table, double lo, double hi);
+
+// Stars are placed above this elevation (the splat's targets near the
+// horizon), and shown where the transmittance is not zero.
+inline constexpr double kStarMinElevationDeg = -5.0;
+// The catalogue's stars to `magnitude_limit` placed at `julian_day_ut` and
+// `place`, attenuated by `t`, in `units` (x sr): the splat's star sources.
+std::vector<PointSource> StarSources(const StarCatalogue& catalogue, double magnitude_limit, OutputUnits units,
+                                     const TransmittanceTable& t, double julian_day_ut, const GeoLocation& place);
 
 // The night of one frame at `julian_day_ut` and `place`, with the Sun along
 // `sun` (unit). `catalogue` is needed with night.stars. `style`: pruned.
+// With `defer` (the catalogue's StarGrid) and the Sun up, the stars wait
+// (NightFrame::pending) for a view that needs them.
 NightFrame ComputeNightFrame(const SkyStyle& style, const StarCatalogue* catalogue, const TransmittanceTable& t,
-                             double julian_day_ut, const GeoLocation& place, const glm::dvec3& sun);
+                             double julian_day_ut, const GeoLocation& place, const glm::dvec3& sun,
+                             const StarGrid* defer = nullptr);
 
 // The Moon's disc as point sources (before the atmosphere) with total
 // irradiance `disc_irradiance` (output units x sr, at the top of the
@@ -263,6 +294,10 @@ class NightSkyRenderer {
   size_t splats_skipped() const { return splats_skipped_; }
   size_t splats_skipped_by_tiles() const { return tiles_skipped_; }
   size_t splats_run() const { return splats_run_; }
+  // Views (and faces) of frames with their stars pending that the bound
+  // before placement (night_prune.h) cleared: neither stars placed nor
+  // anything splatted or copied for them.
+  size_t views_cleared_before_placement() const { return cleared_before_placement_; }
   double last_moonlight_seconds() const { return last_moonlight_seconds_; }
 
  private:
@@ -278,9 +313,15 @@ class NightSkyRenderer {
   // bounds off everything.
   TileBound Bound(const ViewRequest& view, const NightFrame& night, const std::vector<PointSource>& sources,
                   const float* rgba);
+  // The frame to add to the view: null when its stars are pending and the
+  // bound before placement clears the view, else the frame with its stars
+  // placed. `with_moon`: the Moon's samples are splatted here.
+  const NightFrame* ForView(const ViewRequest& view, const NightFrame& night, const float* rgba, bool with_moon);
+  const SplatTiles& TilesOf(const ViewRequest& view, bool with_mu);
   bool splat_bound_ = true, tile_bound_ = true;
-  size_t splats_skipped_ = 0, splats_run_ = 0, tiles_skipped_ = 0;
+  size_t splats_skipped_ = 0, splats_run_ = 0, tiles_skipped_ = 0, cleared_before_placement_ = 0;
   std::map<std::array<int, 5>, std::unique_ptr<SplatTiles>> tiles_;
+  std::map<std::array<int, 4>, std::unique_ptr<std::vector<RectCone>>> cones_;  // per view, of TilesOf(view, false)
   VulkanContext& context_;
   std::map<std::array<int, 4>, std::vector<float>> texel_mu_;
   std::unique_ptr<SkyRenderer> moonlight_;
@@ -311,6 +352,7 @@ class StarCatalogues {
 // serves each frame. Null when no frame has any of it.
 class NightSkyBake {
  public:
+  ~NightSkyBake();
   // `default_catalogue`: the catalogue of a style that names none
   // (BakeOptions::star_catalogue).
   static std::unique_ptr<NightSkyBake> For(const std::vector<const SkyStyle*>& styles, const Schedule* schedule,
@@ -345,6 +387,7 @@ class NightSkyBake {
   std::string default_catalogue_;
   StarCatalogues catalogues_;
   std::vector<std::pair<std::vector<unsigned char>, std::unique_ptr<TransmittanceTable>>> tables_;
+  std::map<std::tuple<std::string, double, int>, std::unique_ptr<StarGrid>> grids_;  // by catalogue, limit, units
 };
 
 }  // namespace skybake

@@ -44,6 +44,14 @@ struct BakeOptions {
   std::optional<FrameRange> frames;
   double max_memory_mib = 4096.0;       // budget for one frame's host + device memory (README "Limits")
   double max_frame_seconds = 3600.0;    // budget for one frame's estimated lavapipe render time
+  // What BakeResult keeps of each frame. On (the library's default): frames,
+  // each frame's files in files, every stage in stages. Off (the CLI): a
+  // sequence's memory stays flat however long it is: each frame's files go
+  // to frame_files as they are recorded, its timings and the stages to
+  // timings.json's record on disk; BakeResult keeps the scene's, manifest's
+  // and timings' files alone.
+  bool keep_frame_records = true;
+  std::function<void(const std::vector<BakedFile>&)> frame_files;  // may be empty
 };
 
 // Estimated peak memory and lavapipe time of one frame of `style`.
@@ -59,11 +67,12 @@ ResourceEstimate EstimateResources(const SkyStyle& style);
 void CheckBudget(const SkyStyle& style, const BakeOptions& options);
 
 // What a bake keeps of each of its frames until the end (budget.cc), in MiB:
-// the styles of every frame of `plan`, and the record and manifest entry of
-// each frame it bakes. Throws BudgetError when the largest frame's estimate
-// plus this is over options.max_memory_mib.
+// the styles of every frame of `plan`, and what it keeps of each frame it
+// bakes (its record, with options.keep_frame_records; else what the glTF
+// scene needs). Throws BudgetError when the largest frame's estimate plus
+// this is over options.max_memory_mib.
 struct RenderPlan;
-double SequenceRecordMiB(const RenderPlan& plan);
+double SequenceRecordMiB(const RenderPlan& plan, const BakeOptions& options);
 void CheckSequenceBudget(const RenderPlan& plan, const BakeOptions& options);
 
 // Bakes one style (one sun position) into options.out_dir, which is created
