@@ -88,6 +88,16 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
   }
 }
 
+// The study's integral: single scattering alone (no multiple scattering,
+// ground or disc).
+EffectSettings SingleScatteringOnly() {
+  EffectSettings single;
+  single.multiple_scattering = false;
+  single.sun_disc = false;
+  single.ground = false;
+  return single;
+}
+
 // Twilight (sun 3 deg below the horizon, observer on the ground), where the
 // sky-view LUT was weakest: the Earth's shadow and the band above it, 90 to
 // 180 deg from the sun and up to 10 deg above the horizon. GPU (both paths)
@@ -100,10 +110,7 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
 // of the planet's umbra (9.9e-4; 4.6e-3 before).
 TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
   AtmosphereParams a;
-  EffectSettings single;
-  single.multiple_scattering = false;
-  single.sun_disc = false;
-  single.ground = false;
+  const EffectSettings single = SingleScatteringOnly();
   ConvergedReference ref(a, 4.0);
   const glm::dvec3 sun = SunDirectionFromElevationAzimuth(-3.0, 180.0);
   std::vector<glm::dvec3> dirs;
@@ -138,10 +145,7 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
 // pipeline for it.
 TEST(ConvergedReferenceTest, TwilightBandIsMarchedBelowItsSunAndPrunedAbove) {
   AtmosphereParams a;
-  EffectSettings single;
-  single.multiple_scattering = false;
-  single.sun_disc = false;
-  single.ground = false;
+  const EffectSettings single = SingleScatteringOnly();
   QualitySettings band = QualityPreset("production");
   band.twilight_march_band_deg = 6.0;
   band.twilight_march_steps = 48;
