@@ -300,9 +300,16 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
     sun_local = RotateApexToZenith(sun, apex);
   }
   // The sky-view LUT is built for the configured observer and Sun; the
-  // skydome moves the observer and turns the Sun, so it ray-marches instead.
+  // skydome moves the observer and turns the Sun, so it ray-marches instead,
+  // as does the low sky at twilight (InTwilightMarchBand) with its own steps.
   vec3 radiance;
-  if (use_sky_view && !aoas.skydome) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
+#ifdef SKYBAKE_NO_TWILIGHT_MARCH
+  const bool twilight_march = false;  // the sky-view variant: no ray march in its SPIR-V
+#else
+  bool twilight_march = use_sky_view && !aoas.skydome && InTwilightMarchBand(earth, view, sun_local);
+  if (twilight_march) earth.view_steps = earth.twilight_march_steps;
+#endif
+  if (use_sky_view && !aoas.skydome && !twilight_march) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
   else radiance = ComputeSkyRadiance(earth, view, sun_local);
   if (aoas.cloud_noise || aoas.cloud_shapes) {
     Real keep = 1.0;

@@ -836,6 +836,18 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
   return disc;
 }
 
+// Whether `view` is ray-marched per texel rather than read from the sky-view
+// LUT: at twilight (the Sun below twilight_march_band of elevation), the sky
+// from the observer's horizon up to twilight_march_band above it, where the
+// Earth's shadow and the band above it fall by orders of magnitude within
+// the spacing of the LUT's rows (docs/accuracy.md, "Twilight"). Hillaire
+// 2020 section 5.3 suggests the same fall-back for accuracy.
+bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  if (!(atm.twilight_march_band > 0.0) || sun.y >= sin(atm.twilight_march_band)) return false;
+  Real above_horizon = HorizonZenithAngle(atm) - atan(length(vec2(view.x, view.z)), view.y);
+  return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band;
+}
+
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
 // the solar disc seen through the transmittance LUT.
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {

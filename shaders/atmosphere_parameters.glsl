@@ -35,6 +35,8 @@ struct AtmosphereParameters {
   int step_distribution;        // STEPS_UNIFORM or STEPS_QUADRATIC (gpu_shared.h)
   int sky_view_width;           // sky-view LUT texels along the azimuth from the Sun
   int sky_view_height;          // sky-view LUT texels along the zenith angle
+  Real twilight_march_band;     // rad; 0: every texel reads the sky-view LUT
+  int twilight_march_steps;     // view steps of the twilight band's march
   bool multiple_scattering;     // add Hillaire's multiple-scattering term
   bool sun_disc;                // add the limb-darkened solar disc
   bool ground;                  // add the sunlit Lambertian ground

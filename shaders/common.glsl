@@ -5,6 +5,11 @@
 #define SKYBAKE_COMMON_GLSL
 
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+// The sky-view variant with the twilight band's march compiled in
+// (SkyRenderer::TwilightSkyPipeline).
+#ifdef SKYBAKE_VARIANT_SKY_VIEW_TWILIGHT
+#define SKYBAKE_VARIANT_SKY_VIEW
+#endif
 #include "glsl_prelude.glsl"
 #include "skybake/gpu_shared.h"
 
@@ -92,6 +97,17 @@ const bool kUseSkyView = true;
 #else
 layout(constant_id = SPEC_USE_SKY_VIEW) const bool kUseSkyView = false;
 #endif
+// The per-texel march of the twilight band (InTwilightMarchBand): off in the
+// sky-view variant, so that its SPIR-V keeps no ray march, on in its
+// twilight form; the pipeline of a frame whose Sun is below the band has it.
+#ifdef SKYBAKE_VARIANT_SKY_VIEW_TWILIGHT
+const bool kTwilightMarch = true;
+#elif defined(SKYBAKE_VARIANT_SKY_VIEW)
+const bool kTwilightMarch = false;
+#define SKYBAKE_NO_TWILIGHT_MARCH
+#else
+layout(constant_id = SPEC_TWILIGHT_MARCH) const bool kTwilightMarch = false;
+#endif
 
 vec3 TransmittanceLutTexel(int x, int y) {
   return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;
@@ -160,6 +176,8 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.step_distribution = gpu_atmosphere.render.w;
   atm.sky_view_width = gpu_atmosphere.render.y;
   atm.sky_view_height = gpu_atmosphere.render.z;
+  atm.twilight_march_band = kTwilightMarch ? gpu_atmosphere.twilight.x : 0.0;
+  atm.twilight_march_steps = int(gpu_atmosphere.twilight.y);
   atm.multiple_scattering = kMultipleScattering;
   atm.sun_disc = kSunDisc;
   atm.ground = kGround;

@@ -88,6 +88,16 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
   }
 }
 
+// The study's integral: single scattering alone (no multiple scattering,
+// ground or disc).
+EffectSettings SingleScatteringOnly() {
+  EffectSettings single;
+  single.multiple_scattering = false;
+  single.sun_disc = false;
+  single.ground = false;
+  return single;
+}
+
 // Twilight (sun 3 deg below the horizon, observer on the ground), where the
 // sky-view LUT was weakest: the Earth's shadow and the band above it, 90 to
 // 180 deg from the sun and up to 10 deg above the horizon. GPU (both paths)
@@ -100,10 +110,7 @@ TEST(ConvergedReferenceTest, RendererConvergesToIt) {
 // of the planet's umbra (9.9e-4; 4.6e-3 before).
 TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
   AtmosphereParams a;
-  EffectSettings single;
-  single.multiple_scattering = false;
-  single.sun_disc = false;
-  single.ground = false;
+  const EffectSettings single = SingleScatteringOnly();
   ConvergedReference ref(a, 4.0);
   const glm::dvec3 sun = SunDirectionFromElevationAzimuth(-3.0, 180.0);
   std::vector<glm::dvec3> dirs;
@@ -129,6 +136,53 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
     std::printf("twilight -3 deg, %s: max relative error %.3e\n", b.preset, worst);
     EXPECT_LT(worst, b.max_relative) << b.preset;
   }
+}
+
+// The twilight band's march (quality.twilight_march_band_deg): with the Sun
+// below the band, the texels in it are the per-texel ray march of the band's
+// steps and the texels above it the sky-view LUT's; with the Sun above it the
+// renderer is the one without the band, texel for texel, and builds no
+// pipeline for it.
+TEST(ConvergedReferenceTest, TwilightBandIsMarchedBelowItsSunAndPrunedAbove) {
+  AtmosphereParams a;
+  const EffectSettings single = SingleScatteringOnly();
+  QualitySettings band = QualityPreset("production");
+  band.twilight_march_band_deg = 6.0;
+  band.twilight_march_steps = 48;
+  QualitySettings lut = band, march = band;
+  lut.twilight_march_band_deg = 0.0;
+  march.sky_view_lut = false;
+  march.view_steps = 48;
+  SkyRenderer with_band(testing::Vulkan(), a, band, single, {1, 1, 1});
+  SkyRenderer lut_only(testing::Vulkan(), a, lut, single, {1, 1, 1});
+  SkyRenderer marched(testing::Vulkan(), a, march, single, {1, 1, 1});
+  std::vector<glm::dvec3> low, high;
+  for (double azimuth : {0.0, 45.0, 90.0, 135.0, 180.0}) {
+    for (double elevation : {0.5, 2.0, 4.0, 5.5}) low.push_back(SunDirectionFromElevationAzimuth(elevation, azimuth));
+    for (double elevation : {6.5, 10.0, 30.0}) high.push_back(SunDirectionFromElevationAzimuth(elevation, azimuth));
+  }
+  auto max_relative = [](const std::vector<float>& a, const std::vector<float>& b) {
+    double worst = 0.0;
+    for (size_t i = 0; i < a.size(); ++i)
+      if (i % 4 != 3) worst = std::max(worst, std::abs(double(a[i]) - b[i]) / std::max(std::abs(double(b[i])), 1e-30));
+    return worst;
+  };
+  const glm::dvec3 day = SunDirectionFromElevationAzimuth(30.0, 180.0);
+  for (const std::vector<glm::dvec3>& dirs : {low, high})
+    EXPECT_EQ(with_band.RenderDirections(day, dirs), lut_only.RenderDirections(day, dirs)) << "by day: the same bytes";
+  EXPECT_EQ(with_band.counters().pipelines, lut_only.counters().pipelines) << "no twilight pipeline by day";
+  const glm::dvec3 dusk = SunDirectionFromElevationAzimuth(-3.0, 180.0);
+  const double in_band = max_relative(with_band.RenderDirections(dusk, low), marched.RenderDirections(dusk, low));
+  const double above = max_relative(with_band.RenderDirections(dusk, high), lut_only.RenderDirections(dusk, high));
+  const double lut_in_band = max_relative(lut_only.RenderDirections(dusk, low), marched.RenderDirections(dusk, low));
+  std::printf("sun -3 deg: band against the march %.2e, above it against the LUT %.2e; the LUT in the band %.2e\n",
+              in_band, above, lut_in_band);
+  // Two compiles of the same march and of the same LUT read: float rounding.
+  EXPECT_LT(in_band, 1e-4);
+  EXPECT_LT(above, 1e-5);
+  EXPECT_GT(lut_in_band, 1e-3) << "the LUT differs from the march in the band";
+  EXPECT_EQ(with_band.counters().pipelines, lut_only.counters().pipelines + 1);
+  testing::ExpectNoValidationMessages();
 }
 
 // Every preset against its budget (draft 5%, production 1%, reference

@@ -3,9 +3,15 @@
 // three-wavelength renderer, the combination, and the style's checks.
 #include "skybake/gpu/spectral_sky.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <map>
 #include <sstream>
+
+#include <fmt/format.h>
 
 #include <OpenEXR/ImfFrameBuffer.h>
 #include <OpenEXR/ImfHeader.h>
@@ -15,8 +21,14 @@
 #include <gtest/gtest.h>
 
 #include "skybake/input/config.h"
+#include "skybake/input/schedule.h"
+#include "skybake/model/aoas.h"
 #include "skybake/model/spectrum.h"
+#include "skybake/pipeline/pipeline.h"
+#include "skybake/tools/accuracy.h"
+#include "skybake/tools/kider_spectral_study.h"
 #include "skybake/tools/spectral_study.h"
+#include "schedule_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -274,6 +286,144 @@ TEST(SpectralSkyTest, StudyQuickRunWritesItsTablesAndPictures) {
   EXPECT_EQ(rows, 6);  // 3 counts (quick: 3, 4, 48) x 2 elevations
   EXPECT_NE(md.find("Twilight pictures"), std::string::npos);
   testing::ExpectNoValidationMessages();
+}
+
+// The Sun of a spectral bake (the manifest's irradiance, the SH's sun and
+// the glTF light's colour) is the spectral sun: each bin's solar irradiance
+// through the atmosphere, with the CIE weights, here from the converged
+// double-precision transmittance of every group's atmosphere, not from the
+// renderer. The three-wavelength bake's sun is another colour.
+TEST(SpectralSkyTest, SunOfASpectralBakeIsTheSpectralSun) {
+  using nlohmann::json;
+  const double elevation_deg = 12.0;
+  std::vector<std::string> sets = {"render.cube_size=8", "render.latlong_height=8",
+                                   fmt::format("sun.elevation_deg={}", elevation_deg)};
+  std::string args = "bake " + testing::SourceDir() + "/configs/default.toml -q";
+  for (const std::string& s : sets) args += " --set " + s;
+  sets.push_back("quality.wavelengths=16");
+  std::map<int, json> manifests, gltfs;
+  for (int n : {3, 16}) {
+    const std::string out = testing::FreshTempDir(fmt::format("spectral_sun_{}", n));
+    const testing::CommandRun run = testing::RunSkybake(args + fmt::format(" --set quality.wavelengths={} --out ", n) + out);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    manifests[n] = json::parse(std::ifstream(out + "/manifest.json"));
+    gltfs[n] = json::parse(std::ifstream(out + "/sky.gltf"));
+  }
+  // The expected sun: sum over the groups of to_rgb (T E), lux per Rec.709 channel.
+  const ConfigResult style = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml", sets);
+  ASSERT_TRUE(style.ok());
+  const AtmosphereParams atmosphere = StyledAtmosphere(style.style.atmosphere, style.style.aoas);
+  const double mu = std::sin(elevation_deg * M_PI / 180.0);
+  std::array<double, 3> expected{};
+  for (const SpectralGroup& g : SpectralGroups(atmosphere, WavelengthBins(16))) {
+    const glm::dvec3 t = ConvergedReference(g.atmosphere, 4.0).Transmittance(atmosphere.observer_altitude_m * 1e-3, mu);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) expected[i] += g.to_rgb[i][j] * t[j] * g.atmosphere.solar_irradiance[j];
+  }
+  const json& sun = manifests[16]["frames"][0]["sun"];
+  const double peak = std::max({expected[0], expected[1], expected[2]});
+  const json& light = gltfs[16]["extensions"]["KHR_lights_punctual"]["lights"][0];
+  const json& sh_with = manifests[16]["frames"][0]["sh_irradiance_with_sun"][0];
+  const json& sh_without = manifests[16]["frames"][0]["sh_irradiance_without_sun"][0];
+  for (int c = 0; c < 3; ++c) {
+    const double irradiance = sun["irradiance"][c].get<double>();
+    EXPECT_NEAR(irradiance, expected[c], 0.01 * expected[c]) << "channel " << c;
+    EXPECT_NEAR(light["color"][c].get<double>(), expected[c] / peak, 0.01) << "channel " << c;
+    // The SH's sun (band 0) is the same colour.
+    const double sh_sun = sh_with[c].get<double>() - sh_without[c].get<double>();
+    EXPECT_NEAR(sh_sun / irradiance, (sh_with[1].get<double>() - sh_without[1].get<double>()) /
+                                         sun["irradiance"][1].get<double>(), 1e-4 * sh_sun / irradiance)
+        << "channel " << c;
+  }
+  // Three wavelengths give a sun of another colour (blue against red).
+  const json& sun3 = manifests[3]["frames"][0]["sun"]["irradiance"];
+  const double ratio3 = sun3[2].get<double>() / sun3[0].get<double>();
+  const double ratio16 = sun["irradiance"][2].get<double>() / sun["irradiance"][0].get<double>();
+  std::printf("sun at %.0f deg, blue / red: 3 wavelengths %.4f, 16 bins %.4f, expected %.4f\n", elevation_deg,
+              ratio3, ratio16, expected[2] / expected[0]);
+  EXPECT_GT(std::abs(ratio3 / ratio16 - 1.0), 0.03);
+}
+
+// A sequence whose frames differ in their number of wavelengths gets a
+// renderer for each (the renderer cache keys on it): every frame's files
+// equal those of a bake of that frame alone.
+TEST(SpectralSkyTest, SequenceChangingTheWavelengthsRendersEachFrameWithItsOwn) {
+  ScheduleResult schedule =
+      ParseSchedule(testing::IthacaSchedule("09:00:00", "09:30:00", 30), "spectral_sequence.toml");
+  ASSERT_TRUE(schedule.ok()) << schedule.errors[0].Format();
+  FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml",
+                                          {"render.cube_size=16", "render.latlong_height=16"}, schedule.schedule);
+  ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
+  ASSERT_EQ(styles.styles.size(), 2u);
+  styles.styles[1].quality.wavelengths = 6;
+  BakeOptions options;
+  options.out_dir = testing::FreshTempDir("spectral_sequence");
+  options.vulkan.validation = true;
+  options.force = true;
+  const BakeResult whole = BakeSequence(styles.styles, schedule.schedule, options);
+  EXPECT_EQ(whole.validation_messages, 0);
+  ASSERT_EQ(whole.frames.size(), 2u);
+  EXPECT_GE(whole.renderer_builds, 2);
+  // The spectral frame (2) baked alone: the same files' checksums.
+  BakeOptions alone = options;
+  alone.out_dir += "-frame2";
+  alone.frames = FrameRange{2, 2};
+  const BakeResult spectral = BakeSequence(styles.styles, schedule.schedule, alone);
+  ASSERT_EQ(spectral.frames.size(), 1u);
+  std::vector<std::string> sums_whole, sums_alone;
+  for (const BakedFile& f : whole.frames[1].files) sums_whole.push_back(f.sha256);
+  for (const BakedFile& f : spectral.frames[0].files) sums_alone.push_back(f.sha256);
+  EXPECT_EQ(sums_whole, sums_alone);
+  std::filesystem::remove_all(alone.out_dir);
+  std::filesystem::remove_all(options.out_dir);
+}
+
+// A spectral style's memory and time estimates count its groups of bins:
+// 48 bins (16 groups) are budgeted above what the same style needs with 3
+// wavelengths, and refused by a budget that the latter passes.
+TEST(SpectralSkyTest, BudgetCountsTheWavelengthBins) {
+  ConfigResult rgb = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml");
+  ConfigResult spectral = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml", {"quality.wavelengths=48"});
+  ASSERT_TRUE(rgb.ok() && spectral.ok());
+  const ResourceEstimate e3 = EstimateResources(rgb.style), e48 = EstimateResources(spectral.style);
+  // Every sky pass runs once per group; each group has an output buffer of its own.
+  EXPECT_GT(e48.samples, 10.0 * e3.samples);
+  EXPECT_GT(e48.memory_mib, 4.0 * e3.memory_mib);
+  BakeOptions options;
+  options.max_memory_mib = 0.5 * (e3.memory_mib + e48.memory_mib);
+  options.max_frame_seconds = 1e9;
+  EXPECT_NO_THROW(CheckBudget(rgb.style, options));
+  try {
+    CheckBudget(spectral.style, options);
+    ADD_FAILURE() << "48 bins are within a budget they exceed";
+  } catch (const BudgetError& e) {
+    EXPECT_NE(std::string(e.what()).find("48 wavelengths in 16 groups of 3"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("lower quality.wavelengths"), std::string::npos) << e.what();
+  }
+  options.max_memory_mib = 1e9;
+  options.max_frame_seconds = 0.5 * (e3.seconds + e48.seconds);
+  EXPECT_NO_THROW(CheckBudget(rgb.style, options));
+  EXPECT_THROW(CheckBudget(spectral.style, options), BudgetError);
+}
+
+// Kider 2014 with Bruneton's protocol (`skybake accuracy --only
+// kider-spectral`) in its quick form: the single-scattering 16/8 model over
+// every capture at the 31 wavelengths, whose RMSE docs/accuracy.md gives as
+// 37.4 mW/(m2 sr nm).
+TEST(SpectralSkyTest, KiderSpectralQuickScoreIsTheDocumentedOne) {
+  AccuracyStudyOptions options;
+  options.quick = true;
+  options.shared_dir = testing::SharedDir();
+  options.out_dir = testing::FreshTempDir("kider_spectral");
+  const std::vector<KiderSpectralScore> scores = ScoreKiderSpectral(testing::Vulkan(), options);
+  testing::ExpectNoValidationMessages();
+  ASSERT_EQ(scores.size(), 1u);
+  EXPECT_EQ(scores[0].model, "single scattering, midpoint 16/8");
+  EXPECT_EQ(scores[0].captures, 15);
+  ASSERT_TRUE(std::isfinite(scores[0].rmse_mw));
+  EXPECT_NEAR(scores[0].rmse_mw, 37.4, 0.5);
+  const std::string csv = testing::ReadFileBytes(options.out_dir + "/kider2014_spectral.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 16) << csv;  // header + 15 captures
 }
 
 }  // namespace

@@ -539,9 +539,10 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
                            "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\" or \"kider-spectral\": that study alone");
   cli.accuracy->add_option("--study", cli.study.study,
                            "Which studies: sky (integrators, Kider 2014), clouds (cloud settings: cloud_study.csv), "
-                           "spectral (wavelength counts: spectral.csv), all")
+                           "spectral (wavelength counts: spectral.csv), twilight (presets and sky-view variants at sun "
+                           "3..-10 deg: twilight.csv), all")
       ->capture_default_str()
-      ->check(CLI::IsMember({"all", "sky", "clouds", "spectral"}));
+      ->check(CLI::IsMember({"all", "sky", "clouds", "spectral", "twilight"}));
   cli.accuracy->add_option("--observer-altitude-m", cli.study.observer_altitude_m, "Observer altitude of the study (m)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1e6));

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -22,6 +23,7 @@
 #include "shaders/kTransmittanceLutSpv.spv.h"
 #include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
 #include "shaders/kSkyRenderSkyViewSpv.spv.h"
+#include "shaders/kSkyRenderSkyViewTwilightSpv.spv.h"
 #include "shaders/kSkyRenderSunDiscPassSpv.spv.h"
 #include "shaders/kSkyviewLutAnalyticSpv.spv.h"
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
@@ -146,6 +148,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
         job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
   if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
   jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+  sky_view_variant_ = sources.sky_view_render;
   for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
   if (disc_pass_) {
     // The sky pass without the disc, and the disc pass that adds it.
@@ -257,7 +260,7 @@ void SkyRenderer::DestroyAll() {
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
                         &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
-                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_}) {
+                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -424,7 +427,28 @@ void SkyRenderer::BindOutput(const Buffer& target) {
   bound_output_ = target.buffer;
 }
 
-VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass) {
+bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
+  const double band = quality_.twilight_march_band_deg * M_PI / 180.0;
+  return quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ && band > 0.0 &&
+         sun.y < std::sin(band);
+}
+
+VkPipeline SkyRenderer::TwilightSkyPipeline() {
+  if (!twilight_sky_pipeline_) {
+    // The sky pass of sky_pipeline_ with the twilight band's march compiled in.
+    const bool sun_disc = effects_.sun_disc && !disc_pass_;
+    twilight_sky_pipeline_ =
+        sky_view_variant_
+            ? CreatePipeline(kSkyRenderSkyViewTwilightSpv, sizeof(kSkyRenderSkyViewTwilightSpv), sun_disc, false, true)
+            : CreatePipeline(kSkyRenderSpv, sizeof(kSkyRenderSpv), sun_disc, false, true);
+    ++counters_.pipelines;
+    if (sky_view_variant_) ++counters_.variant_pipelines;
+  }
+  return twilight_sky_pipeline_;
+}
+
+VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
+                                       bool twilight_march) {
   // Specialization constants (SPEC_* of gpu_shared.h). Every pipeline gets
   // them all; a shader that does not use one ignores it.
   struct {
@@ -433,18 +457,21 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
+    VkBool32 twilight_march;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
-              effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1)};
-  const VkSpecializationMapEntry entries[15] = {
+              effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
+              twilight_march};
+  const VkSpecializationMapEntry entries[16] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
-      {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4}};
-  VkSpecializationInfo specialization{15, entries, sizeof(values), &values};
+      {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
+      {SPEC_TWILIGHT_MARCH, 60, 4}};
+  VkSpecializationInfo specialization{16, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
@@ -745,7 +772,8 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   }
   const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
   BindOutput(target);
-  const VkPipeline sky_pipeline = sky_pipeline_;
+  // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
+  const VkPipeline sky_pipeline = MarchesTwilightBand(sun) ? TwilightSkyPipeline() : sky_pipeline_;
 
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
@@ -871,8 +899,8 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
   auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   if (!same(g.lut_sizes, gpu_atmosphere_.lut_sizes) || !same(g.samples, gpu_atmosphere_.samples) ||
       !same(g.effects, gpu_atmosphere_.effects) || !same(g.render, gpu_atmosphere_.render) ||
-      quality.sky_view_lut != quality_.sky_view_lut || effects.mie != effects_.mie ||
-      effects.ozone != effects_.ozone || effects.night_dimming != effects_.night_dimming)
+      !same(g.twilight, gpu_atmosphere_.twilight) || quality.sky_view_lut != quality_.sky_view_lut ||
+      effects.mie != effects_.mie || effects.ozone != effects_.ozone || effects.night_dimming != effects_.night_dimming)
     return false;
   if (same(g, gpu_atmosphere_)) return true;
   // Every submission waits for its fence, so no dispatch reads the buffer now.

@@ -73,6 +73,8 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, q.step_distribution};
   g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
   g.night = v4(NightSkyRadiance(effects), effects.night_dimming_strength);
+  g.twilight = {float(q.twilight_march_band_deg * M_PI / 180.0),
+                float(q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps), 0.0f, 0.0f};
   return g;
 }
 

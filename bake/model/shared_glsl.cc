@@ -2,6 +2,8 @@
 // then shaders/atmosphere.glsl, aoas.glsl and envmap.glsl compiled in double.
 #include "skybake/model/shared_glsl.h"
 
+#include <cmath>
+
 #include "skybake/model/shared_params.h"
 
 namespace skybake::glsl {
@@ -33,6 +35,8 @@ AtmosphereParameters SharedAtmosphere(const AtmosphereParams& a, const QualitySe
   atm.step_distribution = q.step_distribution;
   atm.sky_view_width = q.sky_view_width;
   atm.sky_view_height = q.sky_view_height;
+  atm.twilight_march_band = q.twilight_march_band_deg * M_PI / 180.0;
+  atm.twilight_march_steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
   atm.multiple_scattering = effects.multiple_scattering;
   atm.sun_disc = effects.sun_disc;
   atm.ground = effects.ground;

@@ -1,10 +1,12 @@
 // The resource estimate of one frame and the budget check (pipeline.h).
 #include <algorithm>
+#include <string>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 
+#include "skybake/model/spectrum.h"
 #include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
@@ -16,6 +18,19 @@ namespace skybake {
 // on the default style's production bake (3.67 Mtexels x 48 steps in 14.5 s;
 // README "Limits"). A slower or faster machine scales every estimate alike.
 constexpr double kLavapipeSamplesPerSecond = 1.2e7;
+
+namespace {
+
+// The spectral mode in the budget's messages (empty without it).
+std::string SpectralNote(const SkyStyle& style) {
+  const int n = style.quality.wavelengths;
+  return n > kRgbWavelengths ? fmt::format(", {} wavelengths in {} groups of 3", n, (n + 2) / 3) : "";
+}
+std::string SpectralAdvice(const SkyStyle& style) {
+  return style.quality.wavelengths > kRgbWavelengths ? ", lower quality.wavelengths" : "";
+}
+
+}  // namespace
 
 ResourceEstimate EstimateResources(const SkyStyle& style) {
   const std::vector<ViewRequest> views = PlanViews(style);
@@ -37,9 +52,15 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   const double engine_growth = 32.0 * std::max(0.0, largest_engine - texels);
   largest = std::max(largest, largest_engine);
   const QualitySettings& q = style.quality;
-  const double luts = 16.0 * (double(q.transmittance_width) * q.transmittance_height +
-                              double(q.multiscattering_size) * q.multiscattering_size +
-                              (q.sky_view_lut ? double(q.sky_view_width) * q.sky_view_height : 0.0));
+  // The spectral mode (spectral_sky.h): one renderer per group of three
+  // bins, each with its LUTs and an output buffer of its own (RGBA float, 16
+  // bytes a texel), their sum on the host in place of the one renderer's.
+  const double groups = q.wavelengths > kRgbWavelengths ? double((q.wavelengths + 2) / 3) : 1.0;
+  const double spectral_buffers = q.wavelengths > kRgbWavelengths ? 16.0 * groups * texels : 0.0;
+  const double luts = groups * 16.0 *
+                      (double(q.transmittance_width) * q.transmittance_height +
+                       double(q.multiscattering_size) * q.multiscattering_size +
+                       (q.sky_view_lut ? double(q.sky_view_width) * q.sky_view_height : 0.0));
   const double channel = style.output.pixel_type == PixelType::kHalf ? 2.0 : 4.0;
   ResourceEstimate e;
   // Device output buffer and its host copy (RGBA float each), the largest
@@ -47,11 +68,12 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   // the engine images.
   const bool preview = WritesLatlongPng(style);
   const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts +
-                       (24.0 + 16.0) * engine_texels + engine_growth;
+                       (24.0 + 16.0) * engine_texels + engine_growth + spectral_buffers;
   e.memory_mib = bytes / (1024.0 * 1024.0);
   // Samples: the pass plan's count for one frame (each ray-marched texel
   // marches view_steps, times light_steps when the Sun's transmittance is
-  // marched too; a sky-view texel is one LUT read; plus the LUTs).
+  // marched too; a sky-view texel is one LUT read; plus the LUTs), each
+  // sky pass once per group of three bins in the spectral mode.
   e.samples = PlanPasses({style}).total_samples;
   e.seconds = e.samples / kLavapipeSamplesPerSecond;
   return e;
@@ -68,17 +90,18 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
   if (e.memory_mib > options.max_memory_mib) {
     const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
     throw BudgetError(fmt::format(
-        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}), above the budget "
-        "of {} MiB: lower render.cube_size or render.latlong_height, turn off outputs, or raise "
+        "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}{}), above the budget "
+        "of {} MiB: lower render.cube_size or render.latlong_height{}, turn off outputs, or raise "
         "--max-memory-mib (README \"Limits\")",
-        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, budget));
+        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height,
+        SpectralNote(style), budget, SpectralAdvice(style)));
   }
   if (e.seconds > options.max_frame_seconds)
     throw BudgetError(fmt::format(
         "the bake needs an estimated {:.3g} ray-march samples per frame, about {:.0f} s of lavapipe time, above "
-        "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes, or raise "
+        "the budget of {:.0f} s per frame: lower quality.view_steps, quality.light_steps or the sizes{}, or raise "
         "--max-frame-seconds (README \"Limits\")",
-        e.samples, e.seconds, options.max_frame_seconds));
+        e.samples, e.seconds, options.max_frame_seconds, SpectralAdvice(style)));
 }
 
 // What a sequence keeps of a frame until it ends. A bake that keeps its

@@ -4,6 +4,7 @@
 #include "skybake/gpu/ibl.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include <fmt/format.h>
@@ -188,6 +189,25 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
                            double(e.width) * e.height * per_texel});
 }
 
+// The twilight band's march (quality.twilight_march_band_deg): in the
+// frames whose Sun is below the band, the texels up to the band above the
+// horizon (a fraction sin(band) / 2 of each view's directions, which it
+// estimates) are ray-marched by a sky pass of their own pipeline.
+void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
+                      PassPlan& plan) {
+  const QualitySettings& q = first.quality;
+  const double band = q.twilight_march_band_deg;
+  if (!(band > 0.0) || !NeedsSkyViewLut(pruned)) return;
+  const int runs = int(std::count_if(frames.begin(), frames.end(),
+                                     [&](const SkyStyle& f) { return f.sun.elevation_deg < band; }));
+  double texels = 0.0;
+  for (const ViewRequest& v : PlanViews(first)) texels += double(v.width) * v.height;
+  const int steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
+  plan.passes.push_back({"twilight band march", fmt::format("0..{:g} deg above the horizon", band),
+                         fmt::format("frames with the Sun below {:g} deg", band), runs,
+                         texels * 0.5 * std::sin(band * M_PI / 180.0) * steps * std::max(q.light_steps, 1)});
+}
+
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).
 bool PlansSunDiscPass(const SkyStyle& first, const SkyStyle& pruned, const ShaderSwitches& shaders) {
   const AoasSettings& xp = pruned.aoas;
@@ -340,6 +360,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   plan.atmospheres = DistinctAtmospheres(frames);
   // The passes in the order they run; medium samples over the bake.
   PlanSkyPasses(first, pruned, plan);
+  PlanTwilightBand(frames, first, pruned, plan);
   const bool disc_pass = PlansSunDiscPass(first, pruned, shaders);
   if (disc_pass) plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
   // The spectral mode (spectral_sky.h): the passes so far run once per group of three bins.

@@ -20,8 +20,10 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
                                      std::filesystem::path(style.source_path).parent_path().string(), cloud_time_s);
   ApplyGroundCloudShadow(style.cloud_shadow, clouds);  // the ground below the horizon in the clouds' shadow
-  // New cloud parameters (the wind's offsets of this frame) in place, or a new renderer.
-  const bool clouds_kept = !main_ || main_->UpdateClouds(clouds);
+  // New cloud parameters (the wind's offsets of this frame) in place, or a
+  // new renderer; so is another number of wavelengths (the spectral mode's
+  // groups of bins, which the atmosphere's key does not hold).
+  const bool clouds_kept = !main_ || (wavelengths_ == style.quality.wavelengths && main_->UpdateClouds(clouds));
   gpu::GpuAtmosphere key =
       ToGpuAtmosphere(in.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
   // A new atmosphere with the same shader variant (a scheduled drift of
@@ -53,6 +55,7 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   main_ = std::make_unique<SkyRenderer>(context_, in.atmosphere, style.quality, style.effects,
                                         OutputScale(style.output.units), false, in.aoas, clouds, shaders_);
   ++result_.renderer_builds;
+  wavelengths_ = style.quality.wavelengths;
   key_ = key;
   aoas_key_ = in.aoas;
 }

@@ -48,6 +48,7 @@ class RendererCache {
   std::unique_ptr<SkyRenderer> main_;
   std::vector<std::unique_ptr<SkyRenderer>> retired_;
   gpu::GpuAtmosphere key_{};
+  int wavelengths_ = 0;  // quality.wavelengths of main_
   AoasInputs aoas_key_;
 };
 

@@ -35,6 +35,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_OZONE 13               // bool
 #define SPEC_NIGHT 14               // bool
 #define SPEC_SUN_DISC_PASS 15       // bool: sky_render as the sun-disc pass
+#define SPEC_TWILIGHT_MARCH 16      // bool: the twilight band is ray-marched (quality.twilight_march_band_deg)
 #define SPEC_CLOUD_LAYERS 20        // int: the active volumetric cloud layers
 
 // Descriptor bindings, all in set 0.
@@ -86,6 +87,7 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
   vec4 strengths;              // x: multiple-scattering strength; y: sun-disc strength; zw: unused
   vec4 night;                  // xyz: night-sky radiance (output units before output_scale); w: strength
+  vec4 twilight;               // x: twilight march band, rad (0: off); y: its view steps; zw: unused
 };
 
 // Most cloud-shape segments a style can have (GpuAoas.shape_segments). A
@@ -213,7 +215,7 @@ SKYBAKE_GPU_STRUCT(IblPush) {
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
 static_assert(sizeof(GpuClouds) == (7 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(IblPush) == 7 * 16, "IblPush must be vec4-packed");
-static_assert(sizeof(GpuAtmosphere) == 14 * 16, "GpuAtmosphere must be vec4-packed");
+static_assert(sizeof(GpuAtmosphere) == 15 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
               "GpuAoas must be vec4-packed");

@@ -13,6 +13,7 @@
 
 #include <fmt/format.h>
 
+#include "skybake/tools/kider_spectral_study.h"
 #include "skybake/gpu/sky_renderer.h"
 #include "skybake/model/spectrum.h"
 #include "skybake/output/exr_io.h"
@@ -59,24 +60,28 @@ std::map<std::string, SpectralCapture> ReadSpectralCaptures(const std::string& s
 
 }  // namespace
 
-std::string RunKiderSpectralStudy(StudyContext& context) {
-  context.Say("kider2014, 31 wavelengths 360..712.5 nm: 15 captures");
+std::vector<KiderSpectralScore> ScoreKiderSpectral(VulkanContext& vulkan, const AccuracyStudyOptions& options) {
+  auto say = [&](const std::string& text) {
+    if (options.progress) options.progress(text);
+  };
   AtmosphereParams bruneton;  // as RunKiderStudy
   bruneton.top_radius_km = 6420.0;
   bruneton.ground_albedo = {0.1, 0.1, 0.1};
-  const std::map<std::string, SpectralCapture> captures = ReadSpectralCaptures(context.options.shared_dir);
+  const std::map<std::string, SpectralCapture> captures = ReadSpectralCaptures(options.shared_dir);
+  say(fmt::format("kider2014, 31 wavelengths 360..712.5 nm: {} captures", captures.size()));
   std::vector<double> lambda;
   for (int k = 0; k < kProtocolWavelengths; ++k) lambda.push_back(360.0 + 11.75 * k);
   // Point wavelengths (width 0): the tables interpolated at each, as the
   // framework samples its spectra.
   const std::vector<SpectralGroup> groups = SpectralGroups(bruneton, BinsAt(lambda, 0.0));
 
-  const std::vector<std::pair<std::string, QualitySettings>> models = {
+  std::vector<std::pair<std::string, QualitySettings>> models = {
       {"single scattering, midpoint 16/8", MakeCase(INTEGRATOR_MIDPOINT, 16, 8).quality},
       {"single scattering, midpoint 512/256", MakeCase(INTEGRATOR_MIDPOINT, 512, 256).quality},
       {"full model: multiple scattering + ground + production preset", QualityPreset("production")}};
+  if (options.quick) models.resize(1);
   std::string csv = "model,capture,rmse_mW_m2_sr_nm\n";
-  std::vector<std::string> rows;
+  std::vector<KiderSpectralScore> scores;
   for (const auto& [label, quality] : models) {
     EffectSettings effects;
     effects.sun_disc = false;
@@ -86,7 +91,7 @@ std::string RunKiderSpectralStudy(StudyContext& context) {
     // Every capture's radiance [capture][direction][k], group by group.
     std::map<std::string, std::vector<std::vector<double>>> model;
     for (const SpectralGroup& g : groups) {
-      SkyRenderer renderer(context.vulkan, g.atmosphere, quality, effects, {1, 1, 1});
+      SkyRenderer renderer(vulkan, g.atmosphere, quality, effects, {1, 1, 1});
       for (const auto& [id, c] : captures) {
         const glm::dvec3 sun = SunDirectionFromElevationAzimuth(90.0 - c.sun_zenith, c.sun_azimuth);
         const std::vector<float> gpu = renderer.RenderDirections(sun, c.directions);
@@ -110,14 +115,19 @@ std::string RunKiderSpectralStudy(StudyContext& context) {
       sum_sq_rmse += rmse * rmse;
     }
     const double total = std::sqrt(sum_sq_rmse / double(std::max<size_t>(captures.size(), 1)));
-    rows.push_back(fmt::format("| {} | {} | {:.1f} |", label, captures.size(), total));
-    context.Say(fmt::format("kider2014 spectral: {}: {:.1f} mW/(m2 sr nm)", label, total));
+    scores.push_back({label, int(captures.size()), total});
+    say(fmt::format("kider2014 spectral: {}: {:.1f} mW/(m2 sr nm)", label, total));
   }
-  WriteFileAtomically(context.OutPath("kider2014_spectral.csv"), csv);
+  WriteFileAtomically(options.out_dir + "/kider2014_spectral.csv", csv);
+  return scores;
+}
+
+std::string RunKiderSpectralStudy(StudyContext& context) {
   std::string md =
       "\n## Against the measured skies of Kider et al. 2014 (Bruneton's protocol: 31 wavelengths 360..712.5 nm)\n\n"
       "| model | captures | RMSE mW/(m2 sr nm) |\n| --- | ---: | ---: |\n";
-  for (const std::string& row : rows) md += row + "\n";
+  for (const KiderSpectralScore& s : ScoreKiderSpectral(context.vulkan, context.options))
+    md += fmt::format("| {} | {} | {:.1f} |\n", s.model, s.captures, s.rmse_mw);
   md += "| Galaj & Wojciechowski 2019, single scattering 16/8 | | 31.3-33.7 |\n"
         "| Galaj & Wojciechowski 2019, single scattering 512/256 | | 25.6 |\n";
   return md;

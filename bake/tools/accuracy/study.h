@@ -49,6 +49,9 @@ std::string RunSpectralStudy(StudyContext& context);
 // cloud_study.csv, cloud_study.png; the tables of cases, the reference's
 // convergence, the cloud presets and the panorama sizes.
 std::string RunCloudQualityStudy(StudyContext& context);
+// The presets and the sky-view variants tried at twilight (sun 3 .. -10 deg)
+// against the converged reference, timed: twilight.csv and its table.
+std::string RunTwilightStudy(StudyContext& context);
 // Kider 2014 with Bruneton's protocol as published: 31 wavelengths
 // 360..712.5 nm (kider2014_spectral.csv) beside Galaj & Wojciechowski's table.
 std::string RunKiderSpectralStudy(StudyContext& context);
@@ -83,9 +86,11 @@ glm::dvec3 DisplayLab(const glm::dvec3& radiance, const Rgb& to_luminance, doubl
 double Median(std::vector<double> v);
 
 // GPU time of one render per megapixel (lavapipe, GPU timestamps, median of
-// 3 renders), with a latlong sized to the cost.
+// 3 renders, each with its Sun moved 0.5 deg from `sun_elevation_deg`), with a
+// latlong sized to the cost.
 double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere,
-                        const QualitySettings& quality, const EffectSettings& effects);
+                        const QualitySettings& quality, const EffectSettings& effects,
+                        double sun_elevation_deg = 45.0);
 
 std::vector<std::string> SplitCsv(const std::string& line);
 

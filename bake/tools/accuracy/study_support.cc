@@ -58,7 +58,8 @@ double Median(std::vector<double> v) {
 }
 
 double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere,
-                        const QualitySettings& quality, const EffectSettings& effects) {
+                        const QualitySettings& quality, const EffectSettings& effects,
+                        double sun_elevation_deg) {
   SkyRenderer renderer(vulkan, atmosphere, quality, effects, {1, 1, 1});
   renderer.PrecomputeLuts();
   double cost = double(quality.view_steps + 1) * double(std::max(quality.light_steps, 1));
@@ -69,7 +70,7 @@ double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmospher
   for (int run = 0; run < 3; ++run) {
     // A new sun per run, as per frame of a time-lapse: a sky-view LUT is
     // rebuilt and counted in the frame's time.
-    renderer.Render(SunDirectionFromElevationAzimuth(45.0 + 0.5 * run, 180.0), {view});
+    renderer.Render(SunDirectionFromElevationAzimuth(sun_elevation_deg + 0.5 * run, 180.0), {view});
     double ms = 0.0;
     for (const PassTiming& t : renderer.last_timings()) ms += t.gpu_ms;
     samples.push_back(ms / (2.0 * height * height * 1e-6));

@@ -172,7 +172,12 @@ class SkyRenderer {
   // Points one storage-buffer binding of the descriptor set at `buffer`.
   void WriteStorageBinding(uint32_t binding, VkBuffer buffer);
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
-  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass);
+  VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
+                            bool twilight_march = false);
+  // Whether this Sun's views march the twilight band (quality.twilight_march_band_deg),
+  // and the sky pass that does, built on the first such frame.
+  bool MarchesTwilightBand(const glm::dvec3& sun) const;
+  VkPipeline TwilightSkyPipeline();
   void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
@@ -241,6 +246,8 @@ class SkyRenderer {
   VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
   VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
+  VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;  // built on the first frame that marches the twilight band
+  bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -72,6 +72,13 @@ struct QualitySettings {
   // is the spectral mode (spectrum.h): that many bins over 355..835 nm,
   // rendered three at a time and integrated to CIE XYZ, then Rec.709.
   int wavelengths = 3;
+  // At twilight (the Sun below this elevation, deg), the sky within this
+  // elevation above the observer's horizon is ray-marched per texel instead
+  // of read from the sky-view LUT: the Earth's shadow crosses it faster than
+  // the LUT's rows resolve (docs/accuracy.md, "Twilight"). 0: off.
+  double twilight_march_band_deg = 0.0;
+  // View steps of that march (0: view_steps).
+  int twilight_march_steps = 0;
 };
 
 // The named presets, chosen from the accuracy study (docs/accuracy.md):

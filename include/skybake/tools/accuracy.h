@@ -43,7 +43,7 @@ struct AccuracyStudyOptions {
   bool quick = false;             // fewer cases and directions (for tests)
   double observer_altitude_m = 0.0;  // the study's observer (0 m and 8000 m in docs/accuracy.md)
   std::string only;               // when set, only the cases whose name contains it
-  std::string study = "all";      // "sky" (integrators, Kider 2014), "clouds" (tools/cloud_study.h), "spectral" or "all"
+  std::string study = "all";      // "sky" (integrators, Kider 2014), "clouds" (tools/cloud_study.h), "spectral", "twilight" or "all"
   std::function<void(const std::string&)> progress;
 };
 
