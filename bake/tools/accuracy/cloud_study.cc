@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -361,18 +360,6 @@ void MeasureMarchCases(const Study& study, const Renders& reference, CloudStudyR
   }
 }
 
-// A case is on the front when no other case is as cheap and as accurate
-// and better in one of the two.
-void MarkParetoFront(std::vector<CloudStudyCase>& cases) {
-  for (CloudStudyCase& c : cases) {
-    c.pareto = true;
-    for (const CloudStudyCase& o : cases)
-      if (&o != &c && o.cpu_ms_per_mp <= c.cpu_ms_per_mp && o.mean_error <= c.mean_error &&
-          (o.cpu_ms_per_mp < c.cpu_ms_per_mp || o.mean_error < c.mean_error))
-        c.pareto = false;
-  }
-}
-
 // Each preset: the cheapest case of the front within its bound; the front's
 // cases within kCloudTimeNoise of that one's time are ties (the CPU time
 // of one case repeated scatters by that much on the shared machine), and
@@ -448,33 +435,13 @@ void WriteCasesCsv(const std::string& out_dir, const CloudStudyResult& result) {
 // became of it, for the report.
 std::string WritePlot(const std::string& out_dir, const std::vector<CloudStudyCase>& cases) {
   if (cases.empty()) return "not written (no case)";
-  std::ostringstream data, front;
+  std::vector<PlotPoint> points;
   for (const CloudStudyCase& c : cases)
-    data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", std::max(c.cpu_ms_per_mp, 1e-3), std::max(c.mean_error, 1e-7),
-                        c.pareto ? 1 : 0, c.name);
-  std::vector<const CloudStudyCase*> sorted;
-  for (const CloudStudyCase& c : cases)
-    if (c.pareto) sorted.push_back(&c);
-  std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->cpu_ms_per_mp < b->cpu_ms_per_mp; });
-  for (const CloudStudyCase* c : sorted)
-    front << fmt::format("{:.6g} {:.6g}\n", std::max(c->cpu_ms_per_mp, 1e-3), std::max(c->mean_error, 1e-7));
-  std::ostringstream plot;
-  plot << "set terminal pngcairo size 1100,750 noenhanced\n"
-       << "set output '" << out_dir << "/cloud_study.png'\n"
-       << "set logscale xy\nset grid\n"
-       << "set xlabel 'CPU time of a render per megapixel (ms, lavapipe, all threads)'\n"
-       << "set ylabel 'mean relative error, sky half, worst sun elevation'\n"
-       << "set title 'skybake clouds: what accuracy costs (W3 layer vs converged reference)'\n"
-       << "set key top right\n"
-       << "plot '" << out_dir << "/cloud_study_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
-       << "     '" << out_dir << "/cloud_study_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
-       << "     '" << out_dir << "/cloud_study_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
-  WriteFileAtomically(out_dir + "/cloud_study_plot.dat", data.str());
-  WriteFileAtomically(out_dir + "/cloud_study_front.dat", front.str());
-  WriteFileAtomically(out_dir + "/cloud_study.gnuplot", plot.str());
-  if (std::system(fmt::format("gnuplot '{}/cloud_study.gnuplot' 2>/dev/null", out_dir).c_str()) != 0)
-    return "not written (gnuplot missing: apt-get install gnuplot-nox)";
-  return "written";
+    points.push_back({std::max(c.cpu_ms_per_mp, 1e-3), c.mean_error, c.pareto, c.name});
+  return PlotParetoFront(out_dir, "cloud_study", points,
+                         {"CPU time of a render per megapixel (ms, lavapipe, all threads)",
+                          "mean relative error, sky half, worst sun elevation",
+                          "skybake clouds: what accuracy costs (W3 layer vs converged reference)"});
 }
 
 // The report's first tables: the scene, the reference's convergence, the
@@ -546,7 +513,7 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
   // 2. The march settings on one latlong, their Pareto front and the presets
   // chosen from it.
   MeasureMarchCases(study, reference, result);
-  MarkParetoFront(result.cases);
+  MarkParetoFront(result.cases, &CloudStudyCase::cpu_ms_per_mp, &CloudStudyCase::mean_error);
   ChoosePresets(result);
   // 3. The panorama sizes on a bake's views.
   MeasurePanorama(study, result);
