@@ -59,15 +59,8 @@ Scene StudyScene() {
 
 CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather, int octaves = 8,
                          double panorama_scale = 0.0) {
-  CloudQuality q;
-  q.view_steps = view;
-  q.light_steps = light;
-  q.shape_resolution = shape;
-  q.detail_resolution = detail;
-  q.weather_resolution = weather;
-  q.octaves = octaves;
-  q.panorama_scale = panorama_scale;
-  return q;
+  return {.view_steps = view, .light_steps = light, .octaves = octaves, .shape_resolution = shape,
+          .detail_resolution = detail, .weather_resolution = weather, .panorama_scale = panorama_scale};
 }
 
 std::string CaseName(const CloudQuality& q) {
