@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
@@ -212,15 +211,7 @@ struct Exr {
 };
 Exr ReadExr(const std::string& path) {
   Exr e;
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
-  if (!in) return e;
-  e.width = in->spec().width;
-  e.height = in->spec().height;
-  e.rgb.resize(size_t(e.width) * e.height * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, e.rgb.data());
-  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
-    if (p.type() == OIIO::TypeDesc::STRING) e.attributes[p.name().string()] = p.get_string();
+  testing::ReadRgb(path, e.width, e.height, e.rgb, &e.attributes);
   return e;
 }
 

@@ -154,6 +154,33 @@ void WriteTestImage(const std::string& path, int w, int h, int channels,
   out->close();
 }
 
+namespace {
+template <class T>
+bool ReadRgbAs(const std::string& path, OIIO::TypeDesc type, int& width, int& height, std::vector<T>& rgb,
+               std::map<std::string, std::string>* string_attributes) {
+  auto in = OIIO::ImageInput::open(path);
+  EXPECT_TRUE(in) << path;
+  if (!in) return false;
+  width = in->spec().width;
+  height = in->spec().height;
+  rgb.resize(size_t(width) * height * 3);
+  in->read_image(0, 0, 0, 3, type, rgb.data());
+  if (string_attributes)
+    for (const OIIO::ParamValue& p : in->spec().extra_attribs)
+      if (p.type() == OIIO::TypeDesc::STRING) (*string_attributes)[p.name().string()] = p.get_string();
+  return true;
+}
+}  // namespace
+
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<float>& rgb,
+             std::map<std::string, std::string>* string_attributes) {
+  return ReadRgbAs(path, OIIO::TypeDesc::FLOAT, width, height, rgb, string_attributes);
+}
+
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<unsigned char>& rgb) {
+  return ReadRgbAs(path, OIIO::TypeDesc::UINT8, width, height, rgb, nullptr);
+}
+
 CubeFaceHit SpecCubeFace(const glm::dvec3& r) {
   const double ax = std::abs(r.x), ay = std::abs(r.y), az = std::abs(r.z);
   int face;
