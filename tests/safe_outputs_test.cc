@@ -33,6 +33,7 @@ using testing::FreshTempDir;
 using testing::FileNames;
 using testing::ReadFileBytes;
 using testing::RunSkybake;
+using testing::WriteFile;
 
 std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 
@@ -40,12 +41,6 @@ std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 constexpr const char* kTwentyFrames = R"([schedule]
 sun = { elevation_deg = { start = 0, end = 38, step = 2 }, azimuth_deg = 135 }
 )";
-
-std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text) {
-  std::string path = dir + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
 
 // What differs between any two runs of a bake: its wall-clock timings, kept
 // out of manifest.json.

@@ -57,6 +57,10 @@ nlohmann::json RunViewerPage(const std::string& page, const std::string& dir, co
 // A new, empty folder under the temporary directory, unique to this process.
 std::string FreshTempDir(const std::string& name);
 
+// Writes `text` to DIR/NAME and returns that path (a test failure naming it
+// when it cannot be written).
+std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text);
+
 // A file's bytes ("" when it cannot be read), and the names in a folder
 // (none when it does not exist).
 std::string ReadFileBytes(const std::string& path);
