@@ -18,25 +18,20 @@
 namespace skybake {
 
 // The shared source instantiated here in double and in float. The LUT hooks
-// are never reached by the geometry functions tested with these copies.
+// (glsl_test_hooks.h) are never reached by the geometry functions tested
+// with these copies.
 namespace f64 {
 #define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
+#include "glsl_test_hooks.h"
 #undef SKYBAKE_REAL
-vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #include "atmosphere.glsl"
 }  // namespace f64
 #undef SKYBAKE_ATMOSPHERE_GLSL
 #undef SKYBAKE_ATMOSPHERE_PARAMETERS_GLSL
 namespace f32 {
 #define SKYBAKE_REAL float
-#include "skybake/model/glsl_compat.h"
+#include "glsl_test_hooks.h"
 #undef SKYBAKE_REAL
-vec3 TransmittanceLutTexel(int, int) { return vec3(1.0f); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0f); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0f); }
 #include "atmosphere.glsl"
 }  // namespace f32
 
