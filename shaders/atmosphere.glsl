@@ -412,7 +412,9 @@ struct SkyRay {
   Real t_max;
 };
 
-SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+// The ray at the observer, before any move: in the atmosphere, not yet
+// traced to the ground, no length.
+SkyRay SkyRayAtObserver(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   SkyRay ray;
   ray.altitude = atm.observer_altitude;
   ray.r = atm.bottom_radius + ray.altitude;
@@ -422,6 +424,11 @@ SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   ray.in_atmosphere = true;
   ray.hits_ground = false;
   ray.t_max = 0.0;
+  return ray;
+}
+
+SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray = SkyRayAtObserver(atm, view, sun);
   if (ray.altitude > atm.top_radius - atm.bottom_radius) {
     Real t_entry = DistanceToAtmosphereEntry(atm, ray.r, ray.altitude, ray.mu);
     if (t_entry < 0.0) {
