@@ -15,21 +15,20 @@
 # Perlin noise, not Nubis' Perlin-Worley), so only the cost and the
 # noise of a comparable scene are compared.
 import math
+import os
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_scene import cycles_cpu_scene, make_equirectangular, nishita_world  # noqa: E402
 
 argv = sys.argv[sys.argv.index("--") + 1:]
 out_path, samples = argv[0], int(argv[1])
 width = int(argv[2]) if len(argv) > 2 else 2048
 
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"
-scene.cycles.device = "CPU"
-scene.cycles.samples = samples
+scene = cycles_cpu_scene(samples)
 scene.cycles.seed = samples  # renders of different sample counts are independent (their difference is noise)
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
 scene.cycles.volume_step_rate = 1.0
 scene.cycles.volume_max_steps = 1024
 scene.render.resolution_x = width
@@ -40,24 +39,10 @@ scene.render.image_settings.color_depth = "32"
 scene.render.image_settings.color_mode = "RGB"
 scene.render.filepath = out_path
 
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-
 # The sky: Nishita, sun at 45 degrees (W3's), its disc on.
-world = bpy.data.worlds.new("sky")
-scene.world = world
-world.use_nodes = True
-nodes = world.node_tree.nodes
-nodes.clear()
-sky = nodes.new("ShaderNodeTexSky")
-sky.sky_type = "NISHITA"
-sky.sun_disc = True
+sky = nishita_world(scene, bpy.data.worlds.new("sky"))
 sky.sun_elevation = math.radians(45.0)
 sky.sun_rotation = 0.0
-background = nodes.new("ShaderNodeBackground")
-output = nodes.new("ShaderNodeOutputWorld")
-world.node_tree.links.new(sky.outputs["Color"], background.inputs["Color"])
-world.node_tree.links.new(background.outputs["Background"], output.inputs["Surface"])
 
 # The Sun as a lamp too, so that the volume is lit by it directly.
 sun_data = bpy.data.lights.new("sun", "SUN")
@@ -97,11 +82,7 @@ links.new(volume.outputs["Volume"], out.inputs["Volume"])
 slab.data.materials.append(material)
 
 cam_data = bpy.data.cameras.new("pano")
-cam_data.type = "PANO"
-if hasattr(cam_data, "panorama_type"):
-    cam_data.panorama_type = "EQUIRECTANGULAR"
-else:
-    cam_data.cycles.panorama_type = "EQUIRECTANGULAR"
+make_equirectangular(cam_data)
 cam_data.clip_end = 1e6
 cam = bpy.data.objects.new("pano", cam_data)
 cam.location = (0.0, 0.0, 2.0)
