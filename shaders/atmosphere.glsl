@@ -120,37 +120,44 @@ Real UnitRangeFromTextureCoord(Real u, int size) {
 }
 
 // Bilinear interpolation computed by hand from texel fetches (hardware
-// filtering quantises its weights to 1/256 on lavapipe).
+// filtering quantises its weights to 1/256 on lavapipe): the four texels
+// around `uv` in a width x height table, and the weights between them.
+struct LutBilinear {
+  int x0;
+  int y0;
+  int x1;
+  int y1;
+  Real fx;
+  Real fy;
+};
+
+LutBilinear LutBilinearAt(vec2 uv, int width, int height) {
+  Real x = clamp(uv.x, 0.0, 1.0) * Real(width) - 0.5;
+  Real y = clamp(uv.y, 0.0, 1.0) * Real(height) - 0.5;
+  Real x0f = clamp(floor(x), 0.0, Real(width - 1));
+  Real y0f = clamp(floor(y), 0.0, Real(height - 1));
+  LutBilinear b;
+  b.fx = clamp(x - x0f, 0.0, 1.0);
+  b.fy = clamp(y - y0f, 0.0, 1.0);
+  b.x0 = int(x0f);
+  b.y0 = int(y0f);
+  b.x1 = min(b.x0 + 1, width - 1);
+  b.y1 = min(b.y0 + 1, height - 1);
+  return b;
+}
+
 vec3 SampleTransmittanceLut(IN(AtmosphereParameters) atm, vec2 uv) {
-  Real x = clamp(uv.x, 0.0, 1.0) * Real(atm.transmittance_width) - 0.5;
-  Real y = clamp(uv.y, 0.0, 1.0) * Real(atm.transmittance_height) - 0.5;
-  Real x0f = clamp(floor(x), 0.0, Real(atm.transmittance_width - 1));
-  Real y0f = clamp(floor(y), 0.0, Real(atm.transmittance_height - 1));
-  Real fx = clamp(x - x0f, 0.0, 1.0);
-  Real fy = clamp(y - y0f, 0.0, 1.0);
-  int x0 = int(x0f);
-  int y0 = int(y0f);
-  int x1 = min(x0 + 1, atm.transmittance_width - 1);
-  int y1 = min(y0 + 1, atm.transmittance_height - 1);
-  vec3 a = mix(TransmittanceLutTexel(x0, y0), TransmittanceLutTexel(x1, y0), fx);
-  vec3 b = mix(TransmittanceLutTexel(x0, y1), TransmittanceLutTexel(x1, y1), fx);
-  return mix(a, b, fy);
+  LutBilinear b = LutBilinearAt(uv, atm.transmittance_width, atm.transmittance_height);
+  vec3 lower = mix(TransmittanceLutTexel(b.x0, b.y0), TransmittanceLutTexel(b.x1, b.y0), b.fx);
+  vec3 upper = mix(TransmittanceLutTexel(b.x0, b.y1), TransmittanceLutTexel(b.x1, b.y1), b.fx);
+  return mix(lower, upper, b.fy);
 }
 
 vec3 SampleMultipleScatteringLut(IN(AtmosphereParameters) atm, vec2 uv) {
-  Real x = clamp(uv.x, 0.0, 1.0) * Real(atm.multiscattering_width) - 0.5;
-  Real y = clamp(uv.y, 0.0, 1.0) * Real(atm.multiscattering_height) - 0.5;
-  Real x0f = clamp(floor(x), 0.0, Real(atm.multiscattering_width - 1));
-  Real y0f = clamp(floor(y), 0.0, Real(atm.multiscattering_height - 1));
-  Real fx = clamp(x - x0f, 0.0, 1.0);
-  Real fy = clamp(y - y0f, 0.0, 1.0);
-  int x0 = int(x0f);
-  int y0 = int(y0f);
-  int x1 = min(x0 + 1, atm.multiscattering_width - 1);
-  int y1 = min(y0 + 1, atm.multiscattering_height - 1);
-  vec3 a = mix(MultipleScatteringLutTexel(x0, y0), MultipleScatteringLutTexel(x1, y0), fx);
-  vec3 b = mix(MultipleScatteringLutTexel(x0, y1), MultipleScatteringLutTexel(x1, y1), fx);
-  return mix(a, b, fy);
+  LutBilinear b = LutBilinearAt(uv, atm.multiscattering_width, atm.multiscattering_height);
+  vec3 lower = mix(MultipleScatteringLutTexel(b.x0, b.y0), MultipleScatteringLutTexel(b.x1, b.y0), b.fx);
+  vec3 upper = mix(MultipleScatteringLutTexel(b.x0, b.y1), MultipleScatteringLutTexel(b.x1, b.y1), b.fx);
+  return mix(lower, upper, b.fy);
 }
 
 // ---------------------------------------------------------------- transmittance LUT
@@ -405,7 +412,9 @@ struct SkyRay {
   Real t_max;
 };
 
-SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+// The ray at the observer, before any move: in the atmosphere, not yet
+// traced to the ground, no length.
+SkyRay SkyRayAtObserver(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   SkyRay ray;
   ray.altitude = atm.observer_altitude;
   ray.r = atm.bottom_radius + ray.altitude;
@@ -415,6 +424,11 @@ SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   ray.in_atmosphere = true;
   ray.hits_ground = false;
   ray.t_max = 0.0;
+  return ray;
+}
+
+SkyRay SetUpSkyRay(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray = SkyRayAtObserver(atm, view, sun);
   if (ray.altitude > atm.top_radius - atm.bottom_radius) {
     Real t_entry = DistanceToAtmosphereEntry(atm, ray.r, ray.altitude, ray.mu);
     if (t_entry < 0.0) {

@@ -278,14 +278,7 @@ vec3 CloudApDirection(int x, int y, out vec3 sun_frame_sun, float mu_s) {
 void ComputeCloudApColumn(IN(AtmosphereParameters) atm, int x, int y, vec3 sun_world) {
   vec3 sun;
   vec3 view = CloudApDirection(x, y, sun, ClampCosine(sun_world.y));
-  SkyRay ray;
-  ray.altitude = atm.observer_altitude;
-  ray.r = atm.bottom_radius + ray.altitude;
-  ray.mu = ClampCosine(view.y);
-  ray.mu_s = ClampCosine(sun.y);
-  ray.nu = ClampCosine(dot(view, sun));
-  ray.in_atmosphere = true;
-  ray.hits_ground = false;
+  SkyRay ray = SkyRayAtObserver(atm, view, sun);
   ray.t_max = gpu_clouds.range.x;
   float rayleigh_phase = RayleighPhase(ray.nu);
   float mie_phase = atm.mie ? MiePhase(atm.mie_g, view, sun) : 0.0;

@@ -35,11 +35,8 @@ namespace skybake {
 // need (the LUTs are never read by these functions).
 namespace f64 {
 #define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
+#include "glsl_test_hooks.h"
 #undef SKYBAKE_REAL
-vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 vec4 ShapeSegmentStart(int) { return vec4(0.0); }
 vec4 ShapeSegmentEnd(int) { return vec4(0.0); }
 constexpr int kSharedPermutation[256] = {SKYBAKE_PERLIN_PERMUTATION};

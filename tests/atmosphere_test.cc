@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <type_traits>
@@ -18,25 +19,20 @@
 namespace skybake {
 
 // The shared source instantiated here in double and in float. The LUT hooks
-// are never reached by the geometry functions tested with these copies.
+// (glsl_test_hooks.h) are never reached by the geometry functions tested
+// with these copies.
 namespace f64 {
 #define SKYBAKE_REAL double
-#include "skybake/model/glsl_compat.h"
+#include "glsl_test_hooks.h"
 #undef SKYBAKE_REAL
-vec3 TransmittanceLutTexel(int, int) { return vec3(1.0); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0); }
 #include "atmosphere.glsl"
 }  // namespace f64
 #undef SKYBAKE_ATMOSPHERE_GLSL
 #undef SKYBAKE_ATMOSPHERE_PARAMETERS_GLSL
 namespace f32 {
 #define SKYBAKE_REAL float
-#include "skybake/model/glsl_compat.h"
+#include "glsl_test_hooks.h"
 #undef SKYBAKE_REAL
-vec3 TransmittanceLutTexel(int, int) { return vec3(1.0f); }
-vec3 MultipleScatteringLutTexel(int, int) { return vec3(0.0f); }
-vec3 SkyViewLutTexel(int, int) { return vec3(0.0f); }
 #include "atmosphere.glsl"
 }  // namespace f32
 
@@ -219,28 +215,28 @@ TEST(AtmosphereTransmittanceTest, MatchesBruneton2017Table) {
 // Qualitative facts of a clear sky, on the double reference.
 class SkyFactsTest : public ::testing::Test {
  protected:
-  static glm::dvec3 Sky(const ReferenceModel& m, double elevation_deg, double azimuth_deg,
-                        const glm::dvec3& sun) {
-    return m.Radiance(SunDirectionFromElevationAzimuth(elevation_deg, azimuth_deg), sun);
+  struct Direction {
+    double elevation_deg, azimuth_deg;
+  };
+  // The default sky's radiance (reference model) toward `a` and toward `b`
+  // with the Sun toward `sun`.
+  static std::pair<glm::dvec3, glm::dvec3> TwoSkies(Direction sun, Direction a, Direction b) {
+    ReferenceModel m(AtmosphereParams{}, QualitySettings{}, EffectSettings{}, {1, 1, 1});
+    m.PrecomputeLuts();
+    const glm::dvec3 s = SunDirectionFromElevationAzimuth(sun.elevation_deg, sun.azimuth_deg);
+    return {m.Radiance(SunDirectionFromElevationAzimuth(a.elevation_deg, a.azimuth_deg), s),
+            m.Radiance(SunDirectionFromElevationAzimuth(b.elevation_deg, b.azimuth_deg), s)};
   }
 };
 
 TEST_F(SkyFactsTest, NoonZenithIsBluerThanHorizon) {
-  ReferenceModel m(AtmosphereParams{}, QualitySettings{}, EffectSettings{}, {1, 1, 1});
-  m.PrecomputeLuts();
-  glm::dvec3 sun = SunDirectionFromElevationAzimuth(80.0, 180.0);
-  glm::dvec3 zenith = Sky(m, 90.0, 0.0, sun);
-  glm::dvec3 horizon = Sky(m, 1.0, 0.0, sun);
+  const auto [zenith, horizon] = TwoSkies({80.0, 180.0}, {90.0, 0.0}, {1.0, 0.0});
   EXPECT_GT(zenith.b / zenith.r, horizon.b / horizon.r);
   EXPECT_GT(zenith.b, zenith.r);
 }
 
 TEST_F(SkyFactsTest, SunsetSkyNearTheSunIsRedderThanOpposite) {
-  ReferenceModel m(AtmosphereParams{}, QualitySettings{}, EffectSettings{}, {1, 1, 1});
-  m.PrecomputeLuts();
-  glm::dvec3 sun = SunDirectionFromElevationAzimuth(1.0, 270.0);
-  glm::dvec3 near_sun = Sky(m, 3.0, 260.0, sun);
-  glm::dvec3 opposite = Sky(m, 3.0, 90.0, sun);
+  const auto [near_sun, opposite] = TwoSkies({1.0, 270.0}, {3.0, 260.0}, {3.0, 90.0});
   EXPECT_GT(near_sun.r / near_sun.b, opposite.r / opposite.b);
 }
 

@@ -92,15 +92,18 @@ TEST(CloudFormationRules, NeighbourhoodIsDobashis) {
   EXPECT_EQ(l.act[l.Index(5, 5, 0)], 0);
 }
 
+// An enabled formation on a `cells` lattice, `warmup_steps` before the first
+// frame at `steps_per_hour`, with the probabilities Pext, Phum and Pact; the
+// rest as CloudFormation's defaults.
+CloudFormation Formation(std::array<int, 3> cells, double steps_per_hour, int warmup_steps, double extinction,
+                         double humidity, double phase) {
+  return {.enabled = true, .cells = cells, .steps_per_hour = steps_per_hour, .warmup_steps = warmup_steps,
+          .extinction_probability = extinction, .humidity_probability = humidity, .phase_probability = phase};
+}
+
+// Most tests': 32 x 32 x 6 cells from step 0, half of them humid.
 CloudFormation Formation() {
-  CloudFormation f;
-  f.enabled = true;
-  f.cells = {32, 32, 6};
-  f.warmup_steps = 0;
-  f.steps_per_hour = 60.0;
-  f.extinction_probability = 0.02;
-  f.humidity_probability = 0.05;
-  f.phase_probability = 0.01;
+  CloudFormation f = Formation({32, 32, 6}, 60.0, 0, 0.02, 0.05, 0.01);
   f.initial_humidity = 0.5;
   return f;
 }
@@ -218,15 +221,8 @@ TEST(CloudFormationRules, ClockTimeStepsAndDrift) {
 // cell (c, ny - 1 - r, k) (row 0 north), for a whole step; between two
 // steps it is linear in time.
 TEST(CloudFormationRules, DensityVolumeIsTheSmoothedLattice) {
-  CloudFormation f;
-  f.enabled = true;
+  CloudFormation f = Formation({8, 8, 8}, 10.0, 6, 0.1, 0.3, 0.05);
   f.density = true;
-  f.cells = {8, 8, 8};
-  f.steps_per_hour = 10.0;
-  f.warmup_steps = 6;
-  f.humidity_probability = 0.3;
-  f.phase_probability = 0.05;
-  f.extinction_probability = 0.1;
   const uint32_t seed = 7;
   const CloudLattice at6 = SimulateFormation(f, nullptr, seed, 6), at7 = SimulateFormation(f, nullptr, seed, 7);
   const std::vector<float> d6 = SmoothFormation(at6, f.smoothing_cells), d7 = SmoothFormation(at7, f.smoothing_cells);

@@ -74,10 +74,7 @@ const std::string kSlab = SlabLayer("1.0", "0.002", "0.0");
 TEST(CloudShadow, UniformLayerCastsExpOfTauOverCosine) {
   const SkyStyle style = Style(kSlab);
   std::unique_ptr<SkyRenderer> r = RendererOf(style);
-  CloudShadowSettings s;
-  s.enabled = true;
-  s.resolution = 16;
-  s.extent_m = 4000.0;
+  CloudShadowSettings s{.enabled = true, .resolution = 16, .extent_m = 4000.0};
   for (double elevation : {90.0, 60.0, 30.0, 10.0}) {
     for (double strength : {1.0, 0.5}) {
       s.strength = strength;
@@ -103,9 +100,7 @@ TEST(CloudShadow, UniformLayerCastsExpOfTauOverCosine) {
 // is marched) both give a map of ones; the sun below the horizon gives
 // zeros (no direct sunlight), also at exactly 0 deg.
 TEST(CloudShadow, NoCloudsAllOnesSunBelowHorizonAllZeros) {
-  CloudShadowSettings s;
-  s.enabled = true;
-  s.resolution = 16;
+  const CloudShadowSettings s{.enabled = true, .resolution = 16};
   const std::vector<float> ones(256, 1.0f), zeros(256, 0.0f);
   EXPECT_EQ(RendererOf(Style("[[cloud_layer]]\ncoverage = 0.0\n"))->RenderCloudShadow(Sun(40.0), s), ones);
   const SkyStyle cleared = Style(R"(
@@ -133,10 +128,8 @@ extinction_probability = 1.0
 TEST(CloudShadow, SunAtTheHorizonStretchesTheShadow) {
   const SkyStyle style = Style(kSlab);
   std::unique_ptr<SkyRenderer> r = RendererOf(style);
-  CloudShadowSettings s;
-  s.enabled = true;
-  s.resolution = 16;
-  s.strength = 0.01;  // tau 0.01 vertically: the horizon's long path still lets light through
+  // tau 0.01 vertically: the horizon's long path still lets light through.
+  const CloudShadowSettings s{.enabled = true, .resolution = 16, .strength = 0.01};
   const glm::dvec3 sun = Sun(0.5);
   for (float t : r->RenderCloudShadow(sun, s)) {
     ASSERT_TRUE(std::isfinite(t));
@@ -167,10 +160,7 @@ TEST(CloudShadow, TilingMapWrapsWithoutASeam) {
   EXPECT_TRUE(CloudShadowTiles(PrunedStyle(style).clouds, 8000.0));
   EXPECT_FALSE(CloudShadowTiles(PrunedStyle(style).clouds, 7000.0));
   std::unique_ptr<SkyRenderer> r = RendererOf(style);
-  CloudShadowSettings s;
-  s.enabled = true;
-  s.resolution = 64;
-  s.extent_m = 8000.0;
+  CloudShadowSettings s{.enabled = true, .resolution = 64, .extent_m = 8000.0};
   const glm::dvec3 sun = Sun(50.0);
   const std::vector<float> a = r->RenderCloudShadow(sun, s);
   const auto [lo, hi] = std::minmax_element(a.begin(), a.end());
@@ -220,10 +210,7 @@ warmup_steps = 40
 phase_probability = 0.01
 velocity_cells_per_hour = [1.0, 0.0, 0.0]
 )");
-  CloudShadowSettings s;
-  s.enabled = true;
-  s.resolution = 32;
-  s.extent_m = 8000.0;
+  const CloudShadowSettings s{.enabled = true, .resolution = 32, .extent_m = 8000.0};
   const glm::dvec3 sun(0.0, 1.0, 0.0);  // overhead: the map is the clouds' own pattern
   std::unique_ptr<SkyRenderer> r = RendererOf(style, 0.0);
   const std::vector<float> t0 = r->RenderCloudShadow(sun, s);

@@ -17,6 +17,13 @@ std::vector<std::string> Messages(const ConfigResult& r) {
   return out;
 }
 
+// The one error of `r`, formatted (a test failure listing them when there
+// is not exactly one).
+std::string OnlyError(const ConfigResult& r) {
+  EXPECT_EQ(r.errors.size(), 1u) << ::testing::PrintToString(Messages(r));
+  return r.errors.size() == 1 ? r.errors[0].Format() : "";
+}
+
 TEST(ConfigTest, DefaultStyleParsesToEarthDefaults) {
   ConfigResult r = LoadSkyStyle(testing::SourceDir() + "/configs/default.toml");
   ASSERT_TRUE(r.ok()) << ::testing::PrintToString(Messages(r));
@@ -59,9 +66,7 @@ TEST(ConfigTest, OverridesApplyOnTop) {
 }
 
 TEST(ConfigTest, UnknownKeyIsLocatedWithSuggestion) {
-  ConfigResult r = ParseSkyStyle("[atmosphere.mie]\nscale_heigth_km = 1.2\n", "noon.toml");
-  ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0].Format(),
+  EXPECT_EQ(OnlyError(ParseSkyStyle("[atmosphere.mie]\nscale_heigth_km = 1.2\n", "noon.toml")),
             "noon.toml:2:1: atmosphere.mie.scale_heigth_km: unknown key 'scale_heigth_km' "
             "(did you mean 'atmosphere.mie.scale_height_km'?)");
 }
@@ -77,18 +82,15 @@ TEST(ConfigTest, AllErrorsAreReportedAtOnce) {
       "[output]\n"
       "pixel_type = \"double\"\n",
       "bad.toml");
-  std::vector<std::string> m = Messages(r);
-  ASSERT_EQ(m.size(), 4u) << ::testing::PrintToString(m);
-  EXPECT_EQ(m[0], "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range (0, inf)");
-  EXPECT_EQ(m[1], "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)");
-  EXPECT_EQ(m[2], "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]");
-  EXPECT_EQ(m[3], "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'");
+  EXPECT_EQ(Messages(r), (std::vector<std::string>{
+                "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range (0, inf)",
+                "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)",
+                "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]",
+                "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'"}));
 }
 
 TEST(ConfigTest, TopRadiusMustBeAboveBottom) {
-  ConfigResult r = ParseSkyStyle("[atmosphere]\ntop_radius_km = 6000.0\n", "r.toml");
-  ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0].Format(),
+  EXPECT_EQ(OnlyError(ParseSkyStyle("[atmosphere]\ntop_radius_km = 6000.0\n", "r.toml")),
             "r.toml:2:17: atmosphere.top_radius_km: top radius 6000 km must be above the bottom "
             "radius 6360 km");
 }
@@ -98,14 +100,12 @@ TEST(ConfigTest, WrongTypesAndNonFiniteNumbers) {
       "[sun]\nelevation_deg = \"high\"\nazimuth_deg = nan\n[effects]\nsun_disc = 1\n"
       "[atmosphere]\nground_albedo = [0.1, 0.2]\n",
       "t.toml");
-  std::vector<std::string> m = Messages(r);
-  ASSERT_EQ(m.size(), 4u) << ::testing::PrintToString(m);
-  EXPECT_EQ(m[0],
-            "t.toml:7:17: atmosphere.ground_albedo: expected a number or an array of 3 numbers "
-            "[680 nm, 550 nm, 440 nm]");
-  EXPECT_EQ(m[1], "t.toml:2:17: sun.elevation_deg: expected a number, got a string");
-  EXPECT_EQ(m[2], "t.toml:3:15: sun.azimuth_deg: must be a finite number (got nan)");
-  EXPECT_EQ(m[3], "t.toml:5:12: effects.sun_disc: expected true or false, got an integer");
+  EXPECT_EQ(Messages(r), (std::vector<std::string>{
+                "t.toml:7:17: atmosphere.ground_albedo: expected a number or an array of 3 numbers "
+                "[680 nm, 550 nm, 440 nm]",
+                "t.toml:2:17: sun.elevation_deg: expected a number, got a string",
+                "t.toml:3:15: sun.azimuth_deg: must be a finite number (got nan)",
+                "t.toml:5:12: effects.sun_disc: expected true or false, got an integer"}));
 }
 
 TEST(ConfigTest, OutputNamesCannotEscapeTheOutputFolder) {
@@ -129,16 +129,14 @@ TEST(ConfigTest, SyntaxErrorIsLocated) {
 
 TEST(ConfigTest, BadOverrideIsReported) {
   ConfigResult r = ParseSkyStyle("", "s.toml", {"sun.elevation_deg", "sun.elevation_deg=200"});
-  std::vector<std::string> m = Messages(r);
-  ASSERT_EQ(m.size(), 2u) << ::testing::PrintToString(m);
-  EXPECT_EQ(m[0], "--set: sun.elevation_deg: expected key.path=value, e.g. --set sun.elevation_deg=10");
-  EXPECT_EQ(m[1], "--set sun.elevation_deg=200:1:5: sun.elevation_deg: 200 is out of range [-90, 90]");
+  EXPECT_EQ(Messages(r), (std::vector<std::string>{
+                "--set: sun.elevation_deg: expected key.path=value, e.g. --set sun.elevation_deg=10",
+                "--set sun.elevation_deg=200:1:5: sun.elevation_deg: 200 is out of range [-90, 90]"}));
 }
 
 TEST(ConfigTest, MissingFileIsReported) {
-  ConfigResult r = LoadSkyStyle("/nonexistent/style.toml");
-  ASSERT_EQ(r.errors.size(), 1u);
-  EXPECT_EQ(r.errors[0].Format(), "/nonexistent/style.toml: (file): cannot open the style file: check the path");
+  EXPECT_EQ(OnlyError(LoadSkyStyle("/nonexistent/style.toml")),
+            "/nonexistent/style.toml: (file): cannot open the style file: check the path");
 }
 
 // configs/default.toml is the template the README says to copy: naming a

@@ -12,7 +12,6 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
@@ -195,11 +194,7 @@ TEST(EnginePresetCliTest, UnknownNamesAndImpossibleCombinationsAreRefusedBeforeG
   }
   // In a style file: file:line:col.
   const std::string dir = testing::FreshTempDir("engine_bad_file");
-  const std::string style = dir + "/style.toml";
-  FILE* f = std::fopen(style.c_str(), "w");
-  ASSERT_TRUE(f);
-  std::fputs("[output]\nengine = \"unity3d\"\n", f);
-  std::fclose(f);
+  const std::string style = testing::WriteFile(dir, "style.toml", "[output]\nengine = \"unity3d\"\n");
   testing::CommandRun r = testing::RunSkybake("bake " + style + " --out " + dir + "/out");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find(style + ":2:10: output.engine: 'unity3d' is not one of"), std::string::npos) << r.output;
@@ -212,15 +207,7 @@ struct Exr {
 };
 Exr ReadExr(const std::string& path) {
   Exr e;
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
-  if (!in) return e;
-  e.width = in->spec().width;
-  e.height = in->spec().height;
-  e.rgb.resize(size_t(e.width) * e.height * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, e.rgb.data());
-  for (const OIIO::ParamValue& p : in->spec().extra_attribs)
-    if (p.type() == OIIO::TypeDesc::STRING) e.attributes[p.name().string()] = p.get_string();
+  testing::ReadRgb(path, e.width, e.height, e.rgb, &e.attributes);
   return e;
 }
 
@@ -319,11 +306,9 @@ TEST(EnginePresetCliTest, PresetKeepsTheHalfScaleOfTheBakesOwnFiles) {
 // A sequence with a preset resumes: every frame's engine files verified by checksum.
 TEST(EnginePresetCliTest, ResumeVerifiesTheEngineFiles) {
   const std::string dir = testing::FreshTempDir("engine_resume");
-  const std::string schedule = dir + "/schedule.toml";
-  FILE* f = std::fopen(schedule.c_str(), "w");
-  ASSERT_TRUE(f);
-  std::fputs("[schedule]\nsun = { elevation_deg = { start = 20, end = 30, step = 10 }, azimuth_deg = 135 }\n", f);
-  std::fclose(f);
+  const std::string schedule = testing::WriteFile(
+      dir, "schedule.toml",
+      "[schedule]\nsun = { elevation_deg = { start = 20, end = 30, step = 10 }, azimuth_deg = 135 }\n");
   const std::string args = "bake " + Style() + " --schedule " + schedule + " --size 8 --engine godot --out " + dir +
                            "/out";
   testing::CommandRun first = testing::RunSkybake(args);

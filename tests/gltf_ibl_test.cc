@@ -24,6 +24,13 @@ namespace {
 
 std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 
+// The default style at 32 with its specular levels (32) as the glTF scene's
+// image-based light, into `dir`; `extra` after -q.
+testing::CommandRun BakeWithImageBasedLight(const std::string& dir, const std::string& extra = "") {
+  return testing::RunSkybake("bake " + Style() + " --size 32 -q " + extra +
+                             "--set ibl.specular=true --set ibl.size=32 --set gltf.image_based_light=true --out " + dir);
+}
+
 struct Image {
   int width = 0, height = 0, channels = 0;
   std::vector<float> data;
@@ -54,9 +61,7 @@ Image Read(const std::string& path, bool raw_alpha = false) {
 
 TEST(GltfIblTest, SceneCarriesTheSpecularLevelsAndTheSh) {
   const std::string dir = testing::FreshTempDir("gltf_ibl");
-  testing::CommandRun r = testing::RunSkybake("bake " + Style() +
-                                              " --size 32 -q --vulkan-validation --set ibl.specular=true "
-                                              "--set ibl.size=32 --set gltf.image_based_light=true --out " + dir);
+  testing::CommandRun r = BakeWithImageBasedLight(dir, "--vulkan-validation ");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto [status, report] = testing::RunCommand("cd '" + testing::SourceDir() + "/tests/viewer' && node validate.mjs '" +
                                               dir + "/sky.gltf' '" + dir + "/sky.glb'");
@@ -127,9 +132,7 @@ TEST(GltfIblTest, SceneCarriesTheSpecularLevelsAndTheSh) {
 // SceneCarriesTheSpecularLevelsAndTheSh; measured at most 0.43%).
 TEST(GltfIblTest, BabylonLoadsTheImageBasedLight) {
   const std::string dir = testing::FreshTempDir("gltf_ibl_babylon");
-  testing::CommandRun r = testing::RunSkybake("bake " + Style() +
-                                              " --size 32 -q --set ibl.specular=true --set ibl.size=32 "
-                                              "--set gltf.image_based_light=true --out " + dir);
+  testing::CommandRun r = BakeWithImageBasedLight(dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json line =
       testing::RunViewerPage("engine_babylon.html", dir, dir + "/babylon.png", "scene=sky.gltf&level=2");

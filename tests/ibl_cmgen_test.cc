@@ -26,7 +26,6 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
 
@@ -55,13 +54,7 @@ struct Image {
 };
 Image Read(const std::string& path) {
   Image image;
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
-  if (!in) return image;
-  image.width = in->spec().width;
-  image.height = in->spec().height;
-  image.rgb.resize(size_t(image.width) * image.height * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, image.rgb.data());
+  testing::ReadRgb(path, image.width, image.height, image.rgb);
   return image;
 }
 

@@ -13,7 +13,6 @@
 #include <sys/wait.h>
 
 #include <Imath/half.h>
-#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -72,14 +71,8 @@ struct Level {
   std::vector<float> rgb;  // rows from the top, faces stacked
 };
 Level ReadExr(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
   Level level;
-  if (!in) return level;
-  level.width = in->spec().width;
-  level.height = in->spec().height;
-  level.rgb.resize(size_t(level.width) * level.height * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, level.rgb.data());
+  testing::ReadRgb(path, level.width, level.height, level.rgb);
   return level;
 }
 

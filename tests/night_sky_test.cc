@@ -1017,13 +1017,7 @@ struct Rgb8 {
 };
 Rgb8 ReadPng(const std::string& path) {
   Rgb8 image;
-  auto in = OIIO::ImageInput::open(path);
-  EXPECT_TRUE(in) << path;
-  if (!in) return image;
-  image.w = in->spec().width;
-  image.h = in->spec().height;
-  image.rgb.resize(size_t(image.w) * image.h * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, image.rgb.data());
+  testing::ReadRgb(path, image.w, image.h, image.rgb);
   return image;
 }
 

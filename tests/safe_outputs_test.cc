@@ -33,6 +33,7 @@ using testing::FreshTempDir;
 using testing::FileNames;
 using testing::ReadFileBytes;
 using testing::RunSkybake;
+using testing::WriteFile;
 
 std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 
@@ -40,12 +41,6 @@ std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 constexpr const char* kTwentyFrames = R"([schedule]
 sun = { elevation_deg = { start = 0, end = 38, step = 2 }, azimuth_deg = 135 }
 )";
-
-std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text) {
-  std::string path = dir + "/" + name;
-  std::ofstream(path) << text;
-  return path;
-}
 
 // What differs between any two runs of a bake: its wall-clock timings, kept
 // out of manifest.json.
@@ -251,6 +246,20 @@ std::string SlowSequenceBake(const std::string& schedule, const std::string& out
   return "bake '" + Style() + "' --schedule '" + schedule + "' --size 48 -q --out '" + out + "' " + extra;
 }
 
+// A fresh ROOT for a lock test, the twenty frames' schedule in it, and an
+// empty ROOT/out for the bakes.
+struct LockTest {
+  std::string root, schedule, out;
+};
+LockTest FreshLockTest(const std::string& name) {
+  LockTest t;
+  t.root = FreshTempDir(name);
+  t.schedule = WriteFile(t.root, "twenty.toml", kTwentyFrames);
+  t.out = t.root + "/out";
+  fs::create_directories(t.out);
+  return t;
+}
+
 // Waits until `dir` holds a lock claim (a bake got past its start).
 bool WaitForClaim(const std::string& dir, pid_t child) {
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(60);
@@ -283,10 +292,7 @@ int WaitExit(pid_t pid) {
 // --force, stops before any GPU work with exit 6 naming the first; the first
 // completes with every file matching its manifest.
 TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
-  const std::string root = FreshTempDir("lockbake");
-  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
-  const std::string out = root + "/out";
-  fs::create_directories(out);
+  const auto [root, schedule, out] = FreshLockTest("lockbake");
   // A holder the test controls: this process claims one frame's file.
   {
     OutputLock held = OutputLock::Claim(out, {"sky_px.0007.exr"});
@@ -319,10 +325,7 @@ TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
 // Shards of one sequence write into one folder at the same time; a part that
 // overlaps a running one is refused; the merge gives the unsharded bake.
 TEST(SafeOutputs, DisjointShardsShareAFolderOverlappingPartsAreRefused) {
-  const std::string root = FreshTempDir("lockshards");
-  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
-  const std::string out = root + "/out";
-  fs::create_directories(out);
+  const auto [root, schedule, out] = FreshLockTest("lockshards");
   pid_t one = Spawn(SlowSequenceBake(schedule, out, "--shard 1/2"));
   pid_t two = Spawn(SlowSequenceBake(schedule, out, "--shard 2/2"));
   ASSERT_TRUE(WaitForClaim(out, one));
@@ -340,10 +343,7 @@ TEST(SafeOutputs, DisjointShardsShareAFolderOverlappingPartsAreRefused) {
 // kill -9 of a bake releases its lock (the kernel drops the flock): the
 // next bake into the folder proceeds and removes the dead claim.
 TEST(SafeOutputs, KilledBakesLockIsReleased) {
-  const std::string root = FreshTempDir("lockkill");
-  const std::string schedule = WriteFile(root, "twenty.toml", kTwentyFrames);
-  const std::string out = root + "/out";
-  fs::create_directories(out);
+  const auto [root, schedule, out] = FreshLockTest("lockkill");
   pid_t first = Spawn(SlowSequenceBake(schedule, out));
   ASSERT_TRUE(WaitForClaim(out, first));
   ASSERT_EQ(kill(first, SIGKILL), 0);
@@ -405,45 +405,41 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   EXPECT_EQ(garbage.output, "skybake: error: " + manifest_path + " is not valid JSON, so --resume cannot tell which "
                             "frames are done: pass --force instead to bake every frame again\n");
 
-  nlohmann::json m = nlohmann::json::parse(good);
-  m["half_scale"] = "one";
-  std::ofstream(manifest_path) << m.dump(2);
-  CommandRun typed = RunSkybake(bake + " --resume");
+  // `command` --resume after the good manifest's value at `pointer` is
+  // changed to `value`.
+  auto resume_edited = [&](const std::string& pointer, const nlohmann::json& value, const std::string& command) {
+    nlohmann::json m = nlohmann::json::parse(good);
+    m[nlohmann::json::json_pointer(pointer)] = value;
+    std::ofstream(manifest_path) << m.dump(2);
+    return RunSkybake(command + " --resume");
+  };
+  CommandRun typed = resume_edited("/half_scale", "one", bake);
   EXPECT_EQ(typed.exit_code, 0) << typed.output;
   EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
 
   // --resume reads through merge-manifest's reader (ReadManifest), which
   // type-checks sizes: a size that is not a byte count proves no frame.
-  m = nlohmann::json::parse(good);
-  m["frames"][0]["files"][0]["bytes"] = -1;
-  std::ofstream(manifest_path) << m.dump(2);
-  CommandRun sized = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 --out '" + out +
-                                "' --resume");
+  CommandRun sized = resume_edited("/frames/0/files/0/bytes", -1,
+                                   "bake '" + Style() + "' --schedule '" + schedule + "' --size 8 --out '" + out + "'");
   EXPECT_EQ(sized.exit_code, 0) << sized.output;
   EXPECT_NE(sized.output.find("resuming from 0 frame(s) in manifest.json"), std::string::npos) << sized.output;
   EXPECT_EQ(sized.output.find("files verified by checksum"), std::string::npos) << sized.output;
   EXPECT_EQ(ReadFileBytes(manifest_path), good) << "every frame baked again, to the same bytes";
 
+  // A name or face that is not the one this bake gives the file stops it:
+  // exit 8, saying so.
+  auto expect_stopped = [&](const std::string& pointer, const nlohmann::json& value, const std::string& message) {
+    CommandRun run = resume_edited(pointer, value, bake);
+    EXPECT_EQ(run.exit_code, 8) << run.output;
+    EXPECT_NE(run.output.find(message), std::string::npos) << run.output;
+  };
   // A face listed as another face (its name kept) is refused too.
-  m = nlohmann::json::parse(good);
-  m["frames"][0]["files"][1]["face"] = "+X";
-  std::ofstream(manifest_path) << m.dump(2);
-  CommandRun face = RunSkybake(bake + " --resume");
-  EXPECT_EQ(face.exit_code, 8) << face.output;
-  EXPECT_NE(face.output.find("lists 'sky_nx.0001.exr' as face '+X' for frame 1, where this bake of the same style "
-                             "writes face -X under that name"),
-            std::string::npos)
-      << face.output;
-
-  m = nlohmann::json::parse(good);
-  m["frames"][1]["files"][7]["file"] = "../../../etc/passwd";
-  std::ofstream(manifest_path) << m.dump(2);
-  CommandRun hostile = RunSkybake(bake + " --resume");
-  EXPECT_EQ(hostile.exit_code, 8) << hostile.output;
-  EXPECT_NE(hostile.output.find("lists '../../../etc/passwd' ('latlong') for frame 2, where this bake of the same "
-                                "style writes 'sky_latlong.0002.exr': the manifest was edited"),
-            std::string::npos)
-      << hostile.output;
+  expect_stopped("/frames/0/files/1/face", "+X",
+                 "lists 'sky_nx.0001.exr' as face '+X' for frame 1, where this bake of the same style writes face -X "
+                 "under that name");
+  expect_stopped("/frames/1/files/7/file", "../../../etc/passwd",
+                 "lists '../../../etc/passwd' ('latlong') for frame 2, where this bake of the same style writes "
+                 "'sky_latlong.0002.exr': the manifest was edited");
   fs::remove_all(root);
 }
 
@@ -530,17 +526,23 @@ TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
   fs::remove_all(root);
 }
 
+// `skybake check` of the default style with `sets` refuses before any GPU
+// work: exit 7 and exactly "skybake: error: MESSAGE".
+void ExpectCheckRefuses(const std::string& sets, const std::string& message) {
+  CommandRun run = RunSkybake("check '" + Style() + "' " + sets);
+  EXPECT_EQ(run.exit_code, 7) << run.output;
+  EXPECT_EQ(run.output, "skybake: error: " + message + "\n");
+}
+
 // Cube 4096 with latlong 8192x4096: 235 Mtexels x 32 bytes (device buffer
 // and host copy), the 101 Mtexel cube strip's RGB half copy and encoding
 // (x 12 bytes), the preview (34 Mtexels x 22 bytes), the LUTs (the
 // production preset's 256 x 144 sky-view LUT among them): 9025 MiB.
 TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
-  CommandRun run = RunSkybake("check '" + Style() + "' --set render.cube_size=4096 --set render.latlong_height=4096");
-  EXPECT_EQ(run.exit_code, 7) << run.output;
-  EXPECT_EQ(run.output,
-            "skybake: error: the bake needs an estimated 9025 MiB of memory per frame (cube 4096, latlong "
-            "8192x4096), above the budget of 4096 MiB: lower render.cube_size or render.latlong_height, turn off "
-            "outputs, or raise --max-memory-mib (README \"Limits\")\n");
+  ExpectCheckRefuses("--set render.cube_size=4096 --set render.latlong_height=4096",
+                     "the bake needs an estimated 9025 MiB of memory per frame (cube 4096, latlong 8192x4096), above "
+                     "the budget of 4096 MiB: lower render.cube_size or render.latlong_height, turn off outputs, or "
+                     "raise --max-memory-mib (README \"Limits\")");
   CommandRun small_budget = RunSkybake("bake '" + Style() + "' --size 64 --max-memory-mib 1 --out /nonexistent/x");
   EXPECT_EQ(small_budget.exit_code, 7) << small_budget.output;
   EXPECT_NE(small_budget.output.find("estimated 3 MiB of memory per frame"), std::string::npos) << small_budget.output;
@@ -576,13 +578,11 @@ TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
 // steps = 2.41e11 samples, at lavapipe's measured 1.2e7 samples/s. (The
 // default sky-view LUT reads each texel once: 1.1 s for the default style.)
 TEST(SafeOutputs, TimeBudgetRefusesWithTheEstimate) {
-  CommandRun run = RunSkybake("check '" + Style() + "' --set render.cube_size=2048 --set render.latlong_height=2048 "
-                              "--set quality.view_steps=4096 --set quality.sky_view_lut=false");
-  EXPECT_EQ(run.exit_code, 7) << run.output;
-  EXPECT_EQ(run.output,
-            "skybake: error: the bake needs an estimated 2.41e+11 ray-march samples per frame, about 20044 s of "
-            "lavapipe time, above the budget of 3600 s per frame: lower quality.view_steps, quality.light_steps or "
-            "the sizes, or raise --max-frame-seconds (README \"Limits\")\n");
+  ExpectCheckRefuses("--set render.cube_size=2048 --set render.latlong_height=2048 --set quality.view_steps=4096 "
+                     "--set quality.sky_view_lut=false",
+                     "the bake needs an estimated 2.41e+11 ray-march samples per frame, about 20044 s of lavapipe "
+                     "time, above the budget of 3600 s per frame: lower quality.view_steps, quality.light_steps or "
+                     "the sizes, or raise --max-frame-seconds (README \"Limits\")");
   CommandRun ok = RunSkybake("check '" + Style() + "'");
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_NE(ok.output.find("estimate per frame: 142 MiB of memory (budget 4096), 0.9 s of lavapipe time"),

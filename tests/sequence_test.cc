@@ -265,20 +265,6 @@ times = {{ start = 09:00:00, end = {}, step_minutes = 15 }}
 {})", end, per_hour), name);
 }
 
-// MorningDrift's frames of the default style at kSmall.
-struct SmallDrift {
-  ScheduleResult schedule;
-  FrameStyles styles;
-};
-SmallDrift SmallDriftOf(const std::string& end, const std::string& per_hour, const std::string& name) {
-  SmallDrift drift{MorningDrift(end, per_hour, name), {}};
-  EXPECT_TRUE(drift.schedule.ok());
-  if (!drift.schedule.ok()) return drift;
-  drift.styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", kSmall, drift.schedule.schedule);
-  if (!drift.styles.ok()) ADD_FAILURE() << drift.styles.errors[0].Format();
-  return drift;
-}
-
 // A bake into a fresh temporary folder under the validation layer.
 BakeOptions ValidatedBakeOptions(const std::string& name) {
   BakeOptions options;
@@ -288,18 +274,36 @@ BakeOptions ValidatedBakeOptions(const std::string& name) {
   return options;
 }
 
+// MorningDrift of the default style with `overrides`, baked into a fresh
+// folder NAME under the validation layer (which says nothing): the schedule,
+// the frames' styles, the options and the bake.
+struct DriftBake {
+  ScheduleResult schedule;
+  FrameStyles styles;
+  BakeOptions options;
+  BakeResult result;
+};
+void BakeDrift(const std::string& end, const std::string& per_hour, const std::vector<std::string>& overrides,
+               const std::string& name, DriftBake& bake) {
+  bake.schedule = MorningDrift(end, per_hour, name + ".toml");
+  ASSERT_TRUE(bake.schedule.ok());
+  bake.styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", overrides, bake.schedule.schedule);
+  ASSERT_TRUE(bake.styles.ok()) << bake.styles.errors[0].Format();
+  bake.options = ValidatedBakeOptions(name);
+  bake.result = BakeSequence(bake.styles.styles, bake.schedule.schedule, bake.options);
+  EXPECT_EQ(bake.result.validation_messages, 0);
+}
+
 // A scheduled drift of the atmosphere's constants changes uniforms and LUTs
 // only: one renderer, its pipelines compiled once, the transmittance and
 // multiple-scattering LUTs rebuilt per frame; and the frames differ.
 TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
-  const SmallDrift drift = SmallDriftOf("09:30:00", R"(
+  DriftBake drift;
+  ASSERT_NO_FATAL_FAILURE(BakeDrift("09:30:00", R"(
 "atmosphere.mie.scattering_per_km" = 0.004
 "atmosphere.mie.extinction_per_km" = 0.0044
-)", "drift.toml");
-  ASSERT_TRUE(drift.styles.ok());
-  const BakeOptions options = ValidatedBakeOptions("drift");
-  const BakeResult result = BakeSequence(drift.styles.styles, drift.schedule.schedule, options);
-  EXPECT_EQ(result.validation_messages, 0);
+)", kSmall, "drift", drift));
+  const BakeResult& result = drift.result;
   ASSERT_EQ(result.frames.size(), 3u);
   EXPECT_EQ(result.renderer_builds, 1);
   // Frames 1, then 3 (the highest sun, for the exposure), then 1, 2, 3.
@@ -309,7 +313,7 @@ TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
   EXPECT_EQ(result.counters.multiscattering_lut_builds, 5);
   // The haze grows: frames differ in their files.
   EXPECT_NE(result.frames[0].files[0].sha256, result.frames[2].files[0].sha256);
-  fs::remove_all(options.out_dir);
+  fs::remove_all(drift.options.out_dir);
 }
 
 // A drift that switches an effect on mid-sequence needs another shader
@@ -318,26 +322,20 @@ TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
 // renderer must live until that frame is written. Every frame's files equal
 // those of a bake of that frame alone.
 TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact) {
-  ScheduleResult schedule = MorningDrift("09:45:00", R"(
-"effects.sun_disc_strength" = 1.5
-)", "variants.toml");
-  ASSERT_TRUE(schedule.ok());
   // The disc pruned in the first frame (strength 0), on from the second.
-  const std::vector<std::string> overrides = {"render.cube_size=128", "render.latlong_height=128",
-                                              "effects.sun_disc_strength=0"};
-  FrameStyles styles = ResolveFrameStyles(testing::SourceDir() + "/configs/default.toml", overrides,
-                                          schedule.schedule);
-  ASSERT_TRUE(styles.ok()) << styles.errors[0].Format();
-  const BakeOptions options = ValidatedBakeOptions("variants");
-  const BakeResult whole = BakeSequence(styles.styles, schedule.schedule, options);
-  EXPECT_EQ(whole.validation_messages, 0);
+  DriftBake drift;
+  ASSERT_NO_FATAL_FAILURE(BakeDrift("09:45:00", R"(
+"effects.sun_disc_strength" = 1.5
+)", {"render.cube_size=128", "render.latlong_height=128", "effects.sun_disc_strength=0"}, "variants", drift));
+  const BakeResult& whole = drift.result;
+  const BakeOptions& options = drift.options;
   ASSERT_EQ(whole.frames.size(), 4u);
   EXPECT_GE(whole.renderer_builds, 2);
   for (int number = 1; number <= 4; ++number) {
     BakeOptions alone = options;
     alone.out_dir = options.out_dir + fmt::format("-frame{}", number);
     alone.frames = FrameRange{number, number};
-    const BakeResult part = BakeSequence(styles.styles, schedule.schedule, alone);
+    const BakeResult part = BakeSequence(drift.styles.styles, drift.schedule.schedule, alone);
     ASSERT_EQ(part.frames.size(), 1u);
     const std::vector<BakedFile>& a = whole.frames[size_t(number - 1)].files;
     const std::vector<BakedFile>& b = part.frames[0].files;
@@ -374,14 +372,14 @@ TEST(SequenceCost, ProgressManifestsAddUpToAFewFinalManifests) {
 // writes the same manifest, byte for byte, and the same timings entries as
 // one that keeps every record.
 TEST(SequenceCost, BakeWithoutFrameRecordsWritesTheSameManifest) {
-  const SmallDrift drift = SmallDriftOf("09:45:00", R"(
+  DriftBake drift;
+  ASSERT_NO_FATAL_FAILURE(BakeDrift("09:45:00", R"(
 "atmosphere.ground_albedo" = 0.05
-)", "records.toml");
-  ASSERT_TRUE(drift.styles.ok());
+)", kSmall, "records-kept", drift));
   const std::vector<SkyStyle>& styles = drift.styles.styles;
   const Schedule& schedule = drift.schedule.schedule;
-  const BakeOptions kept = ValidatedBakeOptions("records-kept");
-  const BakeResult with_records = BakeSequence(styles, schedule, kept);
+  const BakeOptions& kept = drift.options;
+  const BakeResult& with_records = drift.result;
   BakeOptions streamed = ValidatedBakeOptions("records-streamed");
   streamed.keep_frame_records = false;
   std::vector<BakedFile> reported;

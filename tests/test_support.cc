@@ -106,6 +106,14 @@ std::string FreshTempDir(const std::string& name) {
   return dir.string();
 }
 
+std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text) {
+  const std::string path = dir + "/" + name;
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  EXPECT_TRUE(out.good()) << "could not write " << path;
+  return path;
+}
+
 std::string ReadFileBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   std::stringstream s;
@@ -152,6 +160,33 @@ void WriteTestImage(const std::string& path, int w, int h, int channels,
   ASSERT_TRUE(out->open(path, spec));
   ASSERT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()));
   out->close();
+}
+
+namespace {
+template <class T>
+bool ReadRgbAs(const std::string& path, OIIO::TypeDesc type, int& width, int& height, std::vector<T>& rgb,
+               std::map<std::string, std::string>* string_attributes) {
+  auto in = OIIO::ImageInput::open(path);
+  EXPECT_TRUE(in) << path;
+  if (!in) return false;
+  width = in->spec().width;
+  height = in->spec().height;
+  rgb.resize(size_t(width) * height * 3);
+  in->read_image(0, 0, 0, 3, type, rgb.data());
+  if (string_attributes)
+    for (const OIIO::ParamValue& p : in->spec().extra_attribs)
+      if (p.type() == OIIO::TypeDesc::STRING) (*string_attributes)[p.name().string()] = p.get_string();
+  return true;
+}
+}  // namespace
+
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<float>& rgb,
+             std::map<std::string, std::string>* string_attributes) {
+  return ReadRgbAs(path, OIIO::TypeDesc::FLOAT, width, height, rgb, string_attributes);
+}
+
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<unsigned char>& rgb) {
+  return ReadRgbAs(path, OIIO::TypeDesc::UINT8, width, height, rgb, nullptr);
 }
 
 CubeFaceHit SpecCubeFace(const glm::dvec3& r) {

@@ -4,10 +4,12 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <set>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <glm/vec3.hpp>
 #include <gtest/gtest.h>
@@ -55,6 +57,10 @@ nlohmann::json RunViewerPage(const std::string& page, const std::string& dir, co
 // A new, empty folder under the temporary directory, unique to this process.
 std::string FreshTempDir(const std::string& name);
 
+// Writes `text` to DIR/NAME and returns that path (a test failure naming it
+// when it cannot be written).
+std::string WriteFile(const std::string& dir, const std::string& name, const std::string& text);
+
 // A file's bytes ("" when it cannot be read), and the names in a folder
 // (none when it does not exist).
 std::string ReadFileBytes(const std::string& path);
@@ -80,6 +86,15 @@ void ExpectSameBytes(const std::string& dir, const std::string& reference_dir, c
 // and `channels` channels, value(x, y, channel) each, through OpenImageIO.
 void WriteTestImage(const std::string& path, int w, int h, int channels,
                     const std::function<float(int, int, int)>& value);
+
+// The first three channels of an image file through OpenImageIO, rows from
+// the top, converted to the vector's type (float, or 8 bits), and its size;
+// with `string_attributes`, its string attributes too. False, after a test
+// failure naming the file, when the file cannot be opened (then nothing is
+// set).
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<float>& rgb,
+             std::map<std::string, std::string>* string_attributes = nullptr);
+bool ReadRgb(const std::string& path, int& width, int& height, std::vector<unsigned char>& rgb);
 
 // The OpenGL 4.6 / Vulkan specifications' "Cube Map Face Selection": the
 // major axis of `r` picks the face (0..5: +X -X +Y -Y +Z -Z), then (sc, tc)

@@ -14,7 +14,6 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
@@ -51,13 +50,7 @@ Shot Open(const std::string& dir, const std::string& test) {
   if (line.is_null()) return shot;
   shot.report = line["report"];
   shot.requests = line["requests"];
-  auto in = OIIO::ImageInput::open(png);
-  EXPECT_TRUE(in) << png;
-  if (!in) return shot;
-  shot.width = in->spec().width;
-  shot.height = in->spec().height;
-  shot.rgb.resize(size_t(shot.width) * shot.height * 3);
-  in->read_image(0, 0, 0, 3, OIIO::TypeDesc::UINT8, shot.rgb.data());
+  testing::ReadRgb(png, shot.width, shot.height, shot.rgb);
   return shot;
 }
 

@@ -248,64 +248,68 @@ struct Frame {
   double scale = 1.0;
 };
 
-}  // namespace
-
-std::string WriteViewPage(const ViewPageOptions& options) {
-  const fs::path dir(options.dir);
-  const fs::path page = dir / "view.html";
-  if (!fs::is_directory(dir)) throw OutputError(fmt::format("{} is not a folder: give a bake's --out folder", options.dir));
-  if (!options.force && fs::exists(fs::symlink_status(page)))
-    throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", page.string()));
-
+// What the page shows: each frame's latlong, and the bake's exposure.
+struct ShownFrames {
   std::vector<Frame> frames;
-  double exposure_ev100 = 0.0, half_scale = 1.0;
+  double exposure_ev100 = 0.0;
   bool metered = false;
-  const fs::path manifest_path = dir / "manifest.json";
-  if (fs::is_regular_file(manifest_path)) {
-    json m = json::parse(Slurp(manifest_path), nullptr, false);
-    if (m.is_discarded() || !m.is_object())
-      throw OutputError(fmt::format("{} is not valid JSON: bake the folder again", manifest_path.string()));
-    if (m.contains("exposure_ev100") && m["exposure_ev100"].is_number()) {
-      exposure_ev100 = m["exposure_ev100"].get<double>();
-      metered = true;
-    }
-    if (m.contains("half_scale") && m["half_scale"].is_number()) half_scale = m["half_scale"].get<double>();
-    for (const json& f : m.value("frames", json::array())) {
-      Frame frame;
-      for (const json& file : f.value("files", json::array())) {
-        const std::string kind = file.value("kind", ""), name = file.value("file", "");
-        if (kind == "latlong") frame = {name, "exr", "", half_scale};
-        if ((kind == "preview" || kind == "gltf_texture") && frame.file.empty()) frame = {name, "png", "", 1.0};
-      }
-      if (frame.file.empty()) continue;
-      const int number = f.value("frame", 0);
-      frame.label = number > 0 ? fmt::format("frame {}", number) : "the bake";
-      if (f.contains("time") && f["time"].is_string()) frame.label += ", " + f["time"].get<std::string>();
-      frames.push_back(frame);
-    }
-  } else {
-    // A folder without a manifest (skybake testpattern): its OpenEXR latlongs, in name order.
-    std::vector<std::string> names;
-    const std::regex latlong(R"(.+_latlong(\.[0-9]+)?\.exr)");
-    for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
-      const std::string name = e.path().filename().string();
-      if (e.is_regular_file() && std::regex_match(name, latlong) && name.find("_latlong") == name.rfind("_latlong") &&
-          name.find('_') == name.find("_latlong"))
-        names.push_back(name);
-    }
-    std::sort(names.begin(), names.end());
-    for (const std::string& n : names) frames.push_back({n, "exr", n, 1.0});
-  }
-  if (frames.empty())
-    throw OutputError(fmt::format("{} holds no latlong to show (no manifest.json frame with a latlong EXR or "
-                                  "preview, no BASE_latlong.exr): bake into it first", options.dir));
+};
 
+// A bake's frames from its manifest.json: each frame's latlong EXR (at the
+// manifest's half scale), else its preview or glTF texture PNG.
+ShownFrames ManifestFrames(const fs::path& manifest_path) {
+  ShownFrames shown;
+  double half_scale = 1.0;
+  json m = json::parse(Slurp(manifest_path), nullptr, false);
+  if (m.is_discarded() || !m.is_object())
+    throw OutputError(fmt::format("{} is not valid JSON: bake the folder again", manifest_path.string()));
+  if (m.contains("exposure_ev100") && m["exposure_ev100"].is_number()) {
+    shown.exposure_ev100 = m["exposure_ev100"].get<double>();
+    shown.metered = true;
+  }
+  if (m.contains("half_scale") && m["half_scale"].is_number()) half_scale = m["half_scale"].get<double>();
+  for (const json& f : m.value("frames", json::array())) {
+    Frame frame;
+    for (const json& file : f.value("files", json::array())) {
+      const std::string kind = file.value("kind", ""), name = file.value("file", "");
+      if (kind == "latlong") frame = {name, "exr", "", half_scale};
+      if ((kind == "preview" || kind == "gltf_texture") && frame.file.empty()) frame = {name, "png", "", 1.0};
+    }
+    if (frame.file.empty()) continue;
+    const int number = f.value("frame", 0);
+    frame.label = number > 0 ? fmt::format("frame {}", number) : "the bake";
+    if (f.contains("time") && f["time"].is_string()) frame.label += ", " + f["time"].get<std::string>();
+    shown.frames.push_back(frame);
+  }
+  return shown;
+}
+
+// A folder without a manifest (skybake testpattern): its OpenEXR latlongs, in name order.
+ShownFrames FolderLatlongs(const fs::path& dir) {
+  std::vector<std::string> names;
+  const std::regex latlong(R"(.+_latlong(\.[0-9]+)?\.exr)");
+  for (const fs::directory_entry& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (e.is_regular_file() && std::regex_match(name, latlong) && name.find("_latlong") == name.rfind("_latlong") &&
+        name.find('_') == name.find("_latlong"))
+      names.push_back(name);
+  }
+  std::sort(names.begin(), names.end());
+  ShownFrames shown;
+  for (const std::string& n : names) shown.frames.push_back({n, "exr", n, 1.0});
+  return shown;
+}
+
+// The page's frame list: each frame's type, label, scale and size, its file
+// embedded (base64) while the embedded bytes stay within embed_mib (the
+// first always), else named beside the page.
+json FrameEntries(const std::vector<Frame>& frames, const fs::path& dir, double embed_mib) {
   json list = json::array();
   double embedded_bytes = 0.0;
   for (const Frame& f : frames) {
     const std::string data = Slurp(dir / f.file);
     embedded_bytes += double(data.size());
-    const bool embed = list.empty() || embedded_bytes <= options.embed_mib * 1024.0 * 1024.0;
+    const bool embed = list.empty() || embedded_bytes <= embed_mib * 1024.0 * 1024.0;
     int width = 0, height = 0;
     if (f.type == "png") {
       if (data.size() < 24) throw OutputError(fmt::format("{} is not a PNG", f.file));
@@ -324,10 +328,12 @@ std::string WriteViewPage(const ViewPageOptions& options) {
       entry["url"] = f.file;  // the manifest's names are plain file names of DIR
     list.push_back(entry);
   }
-  // Exposure of the bake's EV100 (ISO 2720 calibration K = 12.5: H = 1 / (1.2 2^EV100)), 1 unmetered.
-  const double exposure = metered ? 1.0 / (1.2 * std::exp2(exposure_ev100)) : 1.0;
-  json meta = {{"exposure", exposure}, {"exposure_ev100", exposure_ev100}, {"source", options.dir}};
+  return list;
+}
 
+// The page's import map: three.js and its EXR loader (with fflate), each
+// embedded as a data: module.
+json ThreeImportMap(const ViewPageOptions& options) {
   const fs::path three = ThreeDir(options);
   const fs::path core = three / "build" / "three.module.min.js";
   if (!fs::is_regular_file(core))
@@ -339,10 +345,31 @@ std::string WriteViewPage(const ViewPageOptions& options) {
   const size_t at = loader.find(relative);
   if (at == std::string::npos) throw OutputError("EXRLoader.js of " + three.string() + " does not import fflate as expected");
   loader.replace(at, relative.size(), "'three/fflate'");
-  json importmap = {{"imports",
-                     {{"three", DataModule(Slurp(core))},
-                      {"three/EXRLoader", DataModule(loader)},
-                      {"three/fflate", DataModule(Slurp(three / "examples" / "jsm" / "libs" / "fflate.module.js"))}}}};
+  return {{"imports",
+           {{"three", DataModule(Slurp(core))},
+            {"three/EXRLoader", DataModule(loader)},
+            {"three/fflate", DataModule(Slurp(three / "examples" / "jsm" / "libs" / "fflate.module.js"))}}}};
+}
+
+}  // namespace
+
+std::string WriteViewPage(const ViewPageOptions& options) {
+  const fs::path dir(options.dir);
+  const fs::path page = dir / "view.html";
+  if (!fs::is_directory(dir)) throw OutputError(fmt::format("{} is not a folder: give a bake's --out folder", options.dir));
+  if (!options.force && fs::exists(fs::symlink_status(page)))
+    throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", page.string()));
+
+  const fs::path manifest_path = dir / "manifest.json";
+  const ShownFrames shown = fs::is_regular_file(manifest_path) ? ManifestFrames(manifest_path) : FolderLatlongs(dir);
+  if (shown.frames.empty())
+    throw OutputError(fmt::format("{} holds no latlong to show (no manifest.json frame with a latlong EXR or "
+                                  "preview, no BASE_latlong.exr): bake into it first", options.dir));
+  const json list = FrameEntries(shown.frames, dir, options.embed_mib);
+  // Exposure of the bake's EV100 (ISO 2720 calibration K = 12.5: H = 1 / (1.2 2^EV100)), 1 unmetered.
+  const double exposure = shown.metered ? 1.0 / (1.2 * std::exp2(shown.exposure_ev100)) : 1.0;
+  json meta = {{"exposure", exposure}, {"exposure_ev100", shown.exposure_ev100}, {"source", options.dir}};
+  const json importmap = ThreeImportMap(options);
 
   std::string html = kPage;
   auto put = [&](const std::string& key, const std::string& value) {

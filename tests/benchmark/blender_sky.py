@@ -17,6 +17,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_scene import cycles_cpu_scene, make_equirectangular, nishita_world  # noqa: E402
+
 argv = sys.argv[sys.argv.index("--") + 1:]
 manifest_path, out_dir = argv[0], argv[1]
 with open(manifest_path) as f:
@@ -24,12 +27,7 @@ with open(manifest_path) as f:
 if len(argv) > 2:
     frames = frames[: int(argv[2])]
 
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"
-scene.cycles.device = "CPU"
-scene.cycles.samples = 1
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
+scene = cycles_cpu_scene(1)
 scene.render.use_persistent_data = True  # keeps the scene between frames, as an animation render does
 scene.render.image_settings.file_format = "OPEN_EXR"
 scene.render.image_settings.color_depth = "16"
@@ -40,21 +38,8 @@ scene.frame_start = 1
 scene.frame_end = len(frames)
 
 # The world: a Nishita sky with its sun disc, keyframed per frame.
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-world = bpy.data.worlds.new("sky") if scene.world is None else scene.world
-scene.world = world
-world.use_nodes = True
-nodes = world.node_tree.nodes
-nodes.clear()
-sky = nodes.new("ShaderNodeTexSky")
-sky.sky_type = "NISHITA"
-sky.sun_disc = True
+sky = nishita_world(scene, bpy.data.worlds.new("sky") if scene.world is None else scene.world)
 sky.altitude = 0.0
-background = nodes.new("ShaderNodeBackground")
-output = nodes.new("ShaderNodeOutputWorld")
-world.node_tree.links.new(sky.outputs["Color"], background.inputs["Color"])
-world.node_tree.links.new(background.outputs["Background"], output.inputs["Surface"])
 for i, frame in enumerate(frames, start=1):
     sky.sun_elevation = math.radians(frame["sun"]["elevation_deg"])
     sky.sun_rotation = math.radians(frame["sun"]["azimuth_deg"])
@@ -65,11 +50,7 @@ for i, frame in enumerate(frames, start=1):
 def camera(name, rotation, panorama):
     data = bpy.data.cameras.new(name)
     if panorama:
-        data.type = "PANO"
-        if hasattr(data, "panorama_type"):
-            data.panorama_type = "EQUIRECTANGULAR"
-        else:
-            data.cycles.panorama_type = "EQUIRECTANGULAR"
+        make_equirectangular(data)
     else:
         data.type = "PERSP"
         data.angle = math.pi / 2

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -60,15 +59,8 @@ Scene StudyScene() {
 
 CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather, int octaves = 8,
                          double panorama_scale = 0.0) {
-  CloudQuality q;
-  q.view_steps = view;
-  q.light_steps = light;
-  q.shape_resolution = shape;
-  q.detail_resolution = detail;
-  q.weather_resolution = weather;
-  q.octaves = octaves;
-  q.panorama_scale = panorama_scale;
-  return q;
+  return {.view_steps = view, .light_steps = light, .octaves = octaves, .shape_resolution = shape,
+          .detail_resolution = detail, .weather_resolution = weather, .panorama_scale = panorama_scale};
 }
 
 std::string CaseName(const CloudQuality& q) {
@@ -265,91 +257,107 @@ std::vector<CloudPresetChoice> CloudPresetBounds() {
   return {{"draft", 0.10, -1}, {"production", 0.05, -1}, {"reference", 0.01, -1}};
 }
 
-CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& options) {
-  auto say = [&](const std::string& text) {
+namespace {
+
+// What every stage of the study reads: its options, the renderers, the suns
+// and the latlong every march case is measured on.
+struct Study {
+  Study(const CloudStudyOptions& o, Renderers& r) : options(o), renderers(r) {}
+  const CloudStudyOptions& options;
+  Renderers& renderers;
+  int height = 0;       // rows of the latlong
+  int timing_runs = 0;  // timed renders per case
+  std::vector<glm::dvec3> suns;
+  std::vector<ViewRequest> latlong;
+  std::vector<std::vector<char>> latlong_masks;
+
+  void Say(const std::string& text) const {
     if (options.progress) options.progress(text);
-  };
-  std::filesystem::create_directories(options.out_dir);
-  const Scene scene = StudyScene();
-  Renderers renderers(vulkan, scene);
-  CloudStudyResult result;
-  const int height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 128);
-  const int timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 2);
-  result.latlong_height = height;
+  }
+};
+
+Study SetUpStudy(const CloudStudyOptions& options, const Scene& scene, Renderers& renderers,
+                 CloudStudyResult& result) {
+  Study study(options, renderers);
+  study.height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 128);
+  study.timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 2);
+  result.latlong_height = study.height;
   // A high sun and a low one (long light paths through the layer, long view
   // paths through the air), the Sun's azimuth of the style.
   result.sun_elevations_deg = options.quick ? std::vector<double>{45.0} : std::vector<double>{45.0, 10.0};
-  std::vector<glm::dvec3> suns;
   for (double e : result.sun_elevations_deg)
-    suns.push_back(SunDirectionFromElevationAzimuth(e, scene.style.sun.azimuth_deg));
+    study.suns.push_back(SunDirectionFromElevationAzimuth(e, scene.style.sun.azimuth_deg));
+  study.latlong = {ViewRequest{MAPPING_LATLONG, 2 * study.height, study.height, 0}};
+  study.latlong_masks = SkyMasks(study.latlong);
+  return study;
+}
 
-  // 1. The reference and its convergence: each setting halved in turn.
-  result.reference = options.quick ? MakeQuality(128, 24, 32, 16, 64) : MakeQuality(384, 64, 128, 64, 512);
+// The reference's renders of the latlong at every sun.
+Renders RenderReference(const Study& study, CloudStudyResult& result) {
+  result.reference = study.options.quick ? MakeQuality(128, 24, 32, 16, 64) : MakeQuality(384, 64, 128, 64, 512);
   const CloudQuality& ref = result.reference;
-  const std::vector<ViewRequest> latlong = {ViewRequest{MAPPING_LATLONG, 2 * height, height, 0}};
-  const auto latlong_masks = SkyMasks(latlong);
-  say(fmt::format("clouds: reference {} on a {} x {} latlong, {} sun elevation(s)", CaseName(ref), 2 * height,
-                  height, suns.size()));
-  const Renders reference = RenderCase(renderers, ref, suns, latlong, 0);
-  auto converge = [&](const std::string& change, const CloudQuality& q) {
-    Renders r = RenderCase(renderers, q, suns, latlong, 0);
-    StudyError e = WorstError(r.per_sun, reference.per_sun, latlong_masks);
-    result.convergence.push_back({change, e.mean, e.rmse});
-    say(fmt::format("clouds: reference with {}: {:.2e} from it", change, e.mean));
-  };
-  {
-    CloudQuality q = ref;
-    q.view_steps /= 2;
-    converge(fmt::format("view steps {} -> {}", ref.view_steps, q.view_steps), q);
-    q = ref;
-    q.light_steps /= 2;
-    converge(fmt::format("light steps {} -> {}", ref.light_steps, q.light_steps), q);
-    if (!options.quick) {
-      q = ref;
-      q.shape_resolution /= 2;
-      q.detail_resolution /= 2;
-      q.weather_resolution /= 2;
-      converge(fmt::format("volumes {}/{}/{} -> {}/{}/{}", ref.shape_resolution, ref.detail_resolution,
-                           ref.weather_resolution, q.shape_resolution, q.detail_resolution, q.weather_resolution),
-               q);
-      // And doubled: the volumes are the model's noise sampled at their
-      // voxels, so the finer side shows how far 128/64/512 is from the
-      // continuous noise.
-      q = ref;
-      q.shape_resolution *= 2;
-      q.detail_resolution *= 2;
-      q.weather_resolution *= 2;
-      converge(fmt::format("volumes {}/{}/{} -> {}/{}/{}", ref.shape_resolution, ref.detail_resolution,
-                           ref.weather_resolution, q.shape_resolution, q.detail_resolution, q.weather_resolution),
-               q);
-      q = ref;
-      q.octaves = 16;
-      converge("octaves 8 -> 16", q);
-    }
-  }
+  study.Say(fmt::format("clouds: reference {} on a {} x {} latlong, {} sun elevation(s)", CaseName(ref),
+                        2 * study.height, study.height, study.suns.size()));
+  return RenderCase(study.renderers, ref, study.suns, study.latlong, 0);
+}
 
-  // 2. The march settings on one latlong (marched texel by texel).
-  std::vector<CloudQuality> cases = MarchCases(options.quick);
-  for (const CloudQuality& q : cases) {
+// The reference with its volumes' edges times num / den.
+std::pair<std::string, CloudQuality> VolumesChange(const CloudQuality& ref, int num, int den) {
+  CloudQuality q = ref;
+  for (int* edge : {&q.shape_resolution, &q.detail_resolution, &q.weather_resolution}) *edge = *edge * num / den;
+  return {fmt::format("volumes {}/{}/{} -> {}/{}/{}", ref.shape_resolution, ref.detail_resolution,
+                      ref.weather_resolution, q.shape_resolution, q.detail_resolution, q.weather_resolution),
+          q};
+}
+
+// The reference with one setting changed at a time: its steps halved and
+// (full study) its volumes halved and doubled (the volumes are the model's
+// noise sampled at their voxels, so the finer side shows how far 128/64/512
+// is from the continuous noise), its octaves doubled.
+std::vector<std::pair<std::string, CloudQuality>> ConvergenceChanges(const CloudQuality& ref, bool quick) {
+  std::vector<std::pair<std::string, CloudQuality>> changes;
+  CloudQuality q = ref;
+  q.view_steps /= 2;
+  changes.emplace_back(fmt::format("view steps {} -> {}", ref.view_steps, q.view_steps), q);
+  q = ref;
+  q.light_steps /= 2;
+  changes.emplace_back(fmt::format("light steps {} -> {}", ref.light_steps, q.light_steps), q);
+  if (quick) return changes;
+  changes.push_back(VolumesChange(ref, 1, 2));
+  changes.push_back(VolumesChange(ref, 2, 1));
+  q = ref;
+  q.octaves = 16;
+  changes.emplace_back("octaves 8 -> 16", q);
+  return changes;
+}
+
+void MeasureConvergence(const Study& study, const Renders& reference, CloudStudyResult& result) {
+  for (const auto& [change, q] : ConvergenceChanges(result.reference, study.options.quick)) {
+    Renders r = RenderCase(study.renderers, q, study.suns, study.latlong, 0);
+    StudyError e = WorstError(r.per_sun, reference.per_sun, study.latlong_masks);
+    result.convergence.push_back({change, e.mean, e.rmse});
+    study.Say(fmt::format("clouds: reference with {}: {:.2e} from it", change, e.mean));
+  }
+}
+
+// The march settings on the latlong (marched texel by texel), timed.
+void MeasureMarchCases(const Study& study, const Renders& reference, CloudStudyResult& result) {
+  for (const CloudQuality& q : MarchCases(study.options.quick)) {
     const std::string name = CaseName(q);
-    if (!options.only.empty() && name.find(options.only) == std::string::npos) continue;
-    Renders r = RenderCase(renderers, q, suns, latlong, timing_runs);
-    StudyError e = WorstError(r.per_sun, reference.per_sun, latlong_masks);
+    if (!study.options.only.empty() && name.find(study.options.only) == std::string::npos) continue;
+    Renders r = RenderCase(study.renderers, q, study.suns, study.latlong, study.timing_runs);
+    StudyError e = WorstError(r.per_sun, reference.per_sun, study.latlong_masks);
     result.cases.push_back({name, q, e.mean, e.rmse, r.ms_per_mp, r.cpu_ms_per_mp, false});
-    say(fmt::format("clouds: {:<28} {:8.0f} CPU ms/MP {:8.0f} GPU ms/MP  mean error {:.2e}  RMSE {:.2e}", name,
-                    r.cpu_ms_per_mp, r.ms_per_mp, e.mean, e.rmse));
+    study.Say(fmt::format("clouds: {:<28} {:8.0f} CPU ms/MP {:8.0f} GPU ms/MP  mean error {:.2e}  RMSE {:.2e}", name,
+                          r.cpu_ms_per_mp, r.ms_per_mp, e.mean, e.rmse));
   }
-  for (CloudStudyCase& c : result.cases) {
-    c.pareto = true;
-    for (const CloudStudyCase& o : result.cases)
-      if (&o != &c && o.cpu_ms_per_mp <= c.cpu_ms_per_mp && o.mean_error <= c.mean_error &&
-          (o.cpu_ms_per_mp < c.cpu_ms_per_mp || o.mean_error < c.mean_error))
-        c.pareto = false;
-  }
-  // Each preset: the cheapest case of the front within its bound; the front's
-  // cases within kCloudTimeNoise of that one's time are ties (the CPU time
-  // of one case repeated scatters by that much on the shared machine), and
-  // the tie with the lowest error is chosen.
+}
+
+// Each preset: the cheapest case of the front within its bound; the front's
+// cases within kCloudTimeNoise of that one's time are ties (the CPU time
+// of one case repeated scatters by that much on the shared machine), and
+// the tie with the lowest error is chosen.
+void ChoosePresets(CloudStudyResult& result) {
   result.presets = CloudPresetBounds();
   for (CloudPresetChoice& p : result.presets) {
     int cheapest = -1;
@@ -369,80 +377,71 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
         p.choice = int(i);
     }
   }
+}
 
-  // 3. The panorama: a bake's views (the latlong and six faces of half its
-  // height, as W3), the clouds marched once into a panorama of `scale` times
-  // the finest view's height and resampled, against every view marched at
-  // the reference's steps.
-  {
-    std::vector<ViewRequest> views = latlong;
-    for (int face = 0; face < 6; ++face) views.push_back(ViewRequest{MAPPING_VULKAN_FACE, height / 2, height / 2, face});
-    const auto masks = SkyMasks(views);
-    auto panorama_name = [](double scale) {
-      return scale > 0.0 ? fmt::format("panorama {} x the finest view", scale) : std::string("every view marched");
-    };
-    std::vector<double> scales;
-    for (double scale : options.quick ? std::vector<double>{0.0, 1.0} : std::vector<double>{0.0, 0.5, 0.75, 1.0})
-      if (options.only.empty() || panorama_name(scale).find(options.only) != std::string::npos) scales.push_back(scale);
-    const Renders marched_ref = scales.empty() ? Renders{} : RenderCase(renderers, ref, suns, views, 0);
-    const CloudQuality production =
-        options.quick ? MakeQuality(48, 6, 32, 16, 64) : CloudQualityPreset("production");
-    for (double scale : scales) {
-      CloudQuality q = production;
-      q.panorama_scale = scale;
-      const std::string name = panorama_name(scale);
-      Renders r = RenderCase(renderers, q, suns, views, timing_runs);
-      StudyError e = WorstError(r.per_sun, marched_ref.per_sun, masks);
-      result.panorama.push_back({name, q, e.mean, e.rmse, r.ms_per_mp, r.cpu_ms_per_mp, false});
-      say(fmt::format("clouds: {:<28} {:8.0f} CPU ms/MP {:8.0f} GPU ms/MP  mean error {:.2e}", name, r.cpu_ms_per_mp,
-                      r.ms_per_mp, e.mean));
-    }
+// The panorama: a bake's views (the latlong and six faces of half its
+// height, as W3), the clouds marched once into a panorama of `scale` times
+// the finest view's height and resampled, against every view marched at
+// the reference's steps.
+void MeasurePanorama(const Study& study, CloudStudyResult& result) {
+  std::vector<ViewRequest> views = study.latlong;
+  for (int face = 0; face < 6; ++face)
+    views.push_back(ViewRequest{MAPPING_VULKAN_FACE, study.height / 2, study.height / 2, face});
+  const auto masks = SkyMasks(views);
+  auto panorama_name = [](double scale) {
+    return scale > 0.0 ? fmt::format("panorama {} x the finest view", scale) : std::string("every view marched");
+  };
+  const CloudStudyOptions& options = study.options;
+  std::vector<double> scales;
+  for (double scale : options.quick ? std::vector<double>{0.0, 1.0} : std::vector<double>{0.0, 0.5, 0.75, 1.0})
+    if (options.only.empty() || panorama_name(scale).find(options.only) != std::string::npos) scales.push_back(scale);
+  const Renders marched_ref =
+      scales.empty() ? Renders{} : RenderCase(study.renderers, result.reference, study.suns, views, 0);
+  const CloudQuality production = options.quick ? MakeQuality(48, 6, 32, 16, 64) : CloudQualityPreset("production");
+  for (double scale : scales) {
+    CloudQuality q = production;
+    q.panorama_scale = scale;
+    const std::string name = panorama_name(scale);
+    Renders r = RenderCase(study.renderers, q, study.suns, views, study.timing_runs);
+    StudyError e = WorstError(r.per_sun, marched_ref.per_sun, masks);
+    result.panorama.push_back({name, q, e.mean, e.rmse, r.ms_per_mp, r.cpu_ms_per_mp, false});
+    study.Say(fmt::format("clouds: {:<28} {:8.0f} CPU ms/MP {:8.0f} GPU ms/MP  mean error {:.2e}", name,
+                          r.cpu_ms_per_mp, r.ms_per_mp, e.mean));
   }
+}
 
-  // 4. Files.
-  {
-    std::ostringstream csv;
-    csv << "case,view_steps,light_steps,octaves,shape_resolution,detail_resolution,weather_resolution,"
-           "panorama_scale,cpu_ms_per_megapixel,gpu_ms_per_megapixel,mean_relative_error,relative_rmse,pareto\n";
-    for (const auto* list : {&result.cases, &result.panorama})
-      for (const CloudStudyCase& c : *list)
-        csv << fmt::format("{},{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", c.name, c.quality.view_steps,
-                           c.quality.light_steps, c.quality.octaves, c.quality.shape_resolution,
-                           c.quality.detail_resolution, c.quality.weather_resolution, c.quality.panorama_scale,
-                           c.cpu_ms_per_mp, c.ms_per_mp, c.mean_error, c.rmse, c.pareto ? 1 : 0);
-    WriteFileAtomically(options.out_dir + "/cloud_study.csv", csv.str());
-  }
-  std::string plot_status = "not written (no case)";
-  if (!result.cases.empty()) {
-    std::ostringstream data, front;
-    for (const CloudStudyCase& c : result.cases)
-      data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", std::max(c.cpu_ms_per_mp, 1e-3), std::max(c.mean_error, 1e-7),
-                          c.pareto ? 1 : 0, c.name);
-    std::vector<const CloudStudyCase*> sorted;
-    for (const CloudStudyCase& c : result.cases)
-      if (c.pareto) sorted.push_back(&c);
-    std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->cpu_ms_per_mp < b->cpu_ms_per_mp; });
-    for (const CloudStudyCase* c : sorted)
-      front << fmt::format("{:.6g} {:.6g}\n", std::max(c->cpu_ms_per_mp, 1e-3), std::max(c->mean_error, 1e-7));
-    std::ostringstream plot;
-    plot << "set terminal pngcairo size 1100,750 noenhanced\n"
-         << "set output '" << options.out_dir << "/cloud_study.png'\n"
-         << "set logscale xy\nset grid\n"
-         << "set xlabel 'CPU time of a render per megapixel (ms, lavapipe, all threads)'\n"
-         << "set ylabel 'mean relative error, sky half, worst sun elevation'\n"
-         << "set title 'skybake clouds: what accuracy costs (W3 layer vs converged reference)'\n"
-         << "set key top right\n"
-         << "plot '" << options.out_dir << "/cloud_study_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
-         << "     '" << options.out_dir << "/cloud_study_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
-         << "     '" << options.out_dir << "/cloud_study_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
-    WriteFileAtomically(options.out_dir + "/cloud_study_plot.dat", data.str());
-    WriteFileAtomically(options.out_dir + "/cloud_study_front.dat", front.str());
-    WriteFileAtomically(options.out_dir + "/cloud_study.gnuplot", plot.str());
-    plot_status = "written";
-    if (std::system(fmt::format("gnuplot '{}/cloud_study.gnuplot' 2>/dev/null", options.out_dir).c_str()) != 0)
-      plot_status = "not written (gnuplot missing: apt-get install gnuplot-nox)";
-  }
+// cloud_study.csv: every march case, then every panorama case.
+void WriteCasesCsv(const std::string& out_dir, const CloudStudyResult& result) {
+  std::ostringstream csv;
+  csv << "case,view_steps,light_steps,octaves,shape_resolution,detail_resolution,weather_resolution,"
+         "panorama_scale,cpu_ms_per_megapixel,gpu_ms_per_megapixel,mean_relative_error,relative_rmse,pareto\n";
+  for (const auto* list : {&result.cases, &result.panorama})
+    for (const CloudStudyCase& c : *list)
+      csv << fmt::format("{},{},{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{}\n", c.name, c.quality.view_steps,
+                         c.quality.light_steps, c.quality.octaves, c.quality.shape_resolution,
+                         c.quality.detail_resolution, c.quality.weather_resolution, c.quality.panorama_scale,
+                         c.cpu_ms_per_mp, c.ms_per_mp, c.mean_error, c.rmse, c.pareto ? 1 : 0);
+  WriteFileAtomically(out_dir + "/cloud_study.csv", csv.str());
+}
 
+// cloud_study.png, the march cases and their front, through gnuplot; what
+// became of it, for the report.
+std::string WritePlot(const std::string& out_dir, const std::vector<CloudStudyCase>& cases) {
+  if (cases.empty()) return "not written (no case)";
+  std::vector<PlotPoint> points;
+  for (const CloudStudyCase& c : cases)
+    points.push_back({std::max(c.cpu_ms_per_mp, 1e-3), c.mean_error, c.pareto, c.name});
+  return PlotParetoFront(out_dir, "cloud_study", points,
+                         {"CPU time of a render per megapixel (ms, lavapipe, all threads)",
+                          "mean relative error, sky half, worst sun elevation",
+                          "skybake clouds: what accuracy costs (W3 layer vs converged reference)"});
+}
+
+// The report's first tables: the scene, the reference's convergence, the
+// march cases.
+std::string CasesMarkdown(const CloudStudyResult& result) {
+  const int height = result.latlong_height;
+  const CloudQuality& ref = result.reference;
   std::string elevations;
   for (double e : result.sun_elevations_deg) elevations += (elevations.empty() ? "" : ", ") + fmt::format("{}", e);
   std::string md;
@@ -462,7 +461,12 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
   for (const CloudStudyCase& c : result.cases)
     md += fmt::format("| {} | {} | {} | {:.2e} | {:.2e} | {} |\n", c.name, Fixed(c.cpu_ms_per_mp, 0),
                       Fixed(c.ms_per_mp, 0), c.mean_error, c.rmse, c.pareto ? "yes" : "");
-  md += fmt::format(
+  return md;
+}
+
+// The presets' table, then the panorama's.
+std::string PresetsAndPanoramaMarkdown(const CloudStudyResult& result) {
+  std::string md = fmt::format(
       "\n### Cloud presets chosen from the front\n\nThe cheapest case of the front within each bound; cases of the "
       "front within {:g}% of its CPU time are ties, and the lowest error among them is chosen.\n\n",
       kCloudTimeNoise * 100);
@@ -481,13 +485,37 @@ CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& o
       "\n### The panorama (production steps; the latlong and six {}^2 faces; against every view marched at the "
       "reference's steps; time per megapixel of all the views)\n\n| case | CPU ms per megapixel | cloud passes' GPU ms "
       "per megapixel | mean relative error | relative RMSE |\n| --- | ---: | ---: | ---: | ---: |\n",
-      height / 2);
+      result.latlong_height / 2);
   for (const CloudStudyCase& c : result.panorama)
     md += fmt::format("| {} | {} | {} | {:.2e} | {:.2e} |\n", c.name, Fixed(c.cpu_ms_per_mp, 0), Fixed(c.ms_per_mp, 0),
                       c.mean_error, c.rmse);
-  md += fmt::format("\nPlot {}: {}/cloud_study.png\n", plot_status, options.out_dir);
-  WriteFileAtomically(options.out_dir + "/cloud_study_results.md", md);
-  result.markdown = md;
+  return md;
+}
+
+}  // namespace
+
+CloudStudyResult RunCloudStudy(VulkanContext& vulkan, const CloudStudyOptions& options) {
+  std::filesystem::create_directories(options.out_dir);
+  const Scene scene = StudyScene();
+  Renderers renderers(vulkan, scene);
+  CloudStudyResult result;
+  const Study study = SetUpStudy(options, scene, renderers, result);
+  // 1. The reference and its convergence: each setting changed in turn.
+  const Renders reference = RenderReference(study, result);
+  MeasureConvergence(study, reference, result);
+  // 2. The march settings on one latlong, their Pareto front and the presets
+  // chosen from it.
+  MeasureMarchCases(study, reference, result);
+  MarkParetoFront(result.cases, &CloudStudyCase::cpu_ms_per_mp, &CloudStudyCase::mean_error);
+  ChoosePresets(result);
+  // 3. The panorama sizes on a bake's views.
+  MeasurePanorama(study, result);
+  // 4. Files: the CSV, the plot, the report.
+  WriteCasesCsv(options.out_dir, result);
+  const std::string plot_status = WritePlot(options.out_dir, result.cases);
+  result.markdown = CasesMarkdown(result) + PresetsAndPanoramaMarkdown(result) +
+                    fmt::format("\nPlot {}: {}/cloud_study.png\n", plot_status, options.out_dir);
+  WriteFileAtomically(options.out_dir + "/cloud_study_results.md", result.markdown);
   return result;
 }
 

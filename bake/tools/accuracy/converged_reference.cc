@@ -140,6 +140,38 @@ glm::dvec3 SunTransmittance(const AtmosphereParameters& atm, double r_t, double 
   return glm::exp(-OpticalDepth(atm, r_t, h, mu_eff, segment)) * visible;
 }
 
+// The planet's shadow on the ray (r, altitude, mu) up to t_max, the Sun at
+// mu_s with nu = cos(view, sun): where the sun visibility ramps, g(t) =
+// +/-eps, found by sampling then bisection, added to `points`.
+void AddShadowEdges(const AtmosphereParameters& atm, double r, double altitude, double mu, double mu_s, double nu,
+                    double t_max, std::vector<double>& points) {
+  auto shadow_offset = [&](double t, double sign) {
+    double h = glsl::AltitudeAlongRay(atm, r, altitude, mu, t);
+    double r_t = atm.bottom_radius + h;
+    double mu_s_t = (r * mu_s + t * nu) / r_t;
+    double cos_theta_h = -std::sqrt(std::max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
+    return mu_s_t - cos_theta_h - sign * (atm.bottom_radius / r_t) * atm.sun_angular_radius;
+  };
+  for (double sign : {-1.0, 1.0}) {
+    const int samples = 512;
+    double previous = shadow_offset(0.0, sign);
+    for (int i = 1; i <= samples; ++i) {
+      double t1 = t_max * i / samples;
+      double value = shadow_offset(t1, sign);
+      if ((previous < 0.0) != (value < 0.0)) {
+        double lo = t_max * (i - 1) / samples, hi = t1;
+        for (int k = 0; k < 80; ++k) {
+          double mid = 0.5 * (lo + hi);
+          if ((shadow_offset(lo, sign) < 0.0) == (shadow_offset(mid, sign) < 0.0)) lo = mid;
+          else hi = mid;
+        }
+        points.push_back(0.5 * (lo + hi));
+      }
+      previous = value;
+    }
+  }
+}
+
 }  // namespace
 
 ConvergedReference::ConvergedReference(const AtmosphereParams& atmosphere, double segment_km)
@@ -170,33 +202,7 @@ glm::dvec3 ConvergedReference::Radiance(const glm::dvec3& view, const glm::dvec3
   double t_max = ground ? glsl::DistanceToBottomBoundary(atm, r, altitude, mu)
                         : glsl::DistanceToTopBoundary(atm, r, altitude, mu);
   std::vector<double> points = RayBreakpoints(atm, r, altitude, mu, t_max);
-
-  // The planet's shadow: where the sun visibility ramps, g(t) = +/-eps.
-  auto shadow_offset = [&](double t, double sign) {
-    double h = glsl::AltitudeAlongRay(atm, r, altitude, mu, t);
-    double r_t = atm.bottom_radius + h;
-    double mu_s_t = (r * mu_s + t * nu) / r_t;
-    double cos_theta_h = -std::sqrt(std::max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
-    return mu_s_t - cos_theta_h - sign * (atm.bottom_radius / r_t) * atm.sun_angular_radius;
-  };
-  for (double sign : {-1.0, 1.0}) {
-    const int samples = 512;
-    double previous = shadow_offset(0.0, sign);
-    for (int i = 1; i <= samples; ++i) {
-      double t1 = t_max * i / samples;
-      double value = shadow_offset(t1, sign);
-      if ((previous < 0.0) != (value < 0.0)) {
-        double lo = t_max * (i - 1) / samples, hi = t1;
-        for (int k = 0; k < 80; ++k) {
-          double mid = 0.5 * (lo + hi);
-          if ((shadow_offset(lo, sign) < 0.0) == (shadow_offset(mid, sign) < 0.0)) lo = mid;
-          else hi = mid;
-        }
-        points.push_back(0.5 * (lo + hi));
-      }
-      previous = value;
-    }
-  }
+  AddShadowEdges(atm, r, altitude, mu, mu_s, nu, t_max, points);
   std::sort(points.begin(), points.end());
 
   const double rayleigh_phase = glsl::RayleighPhase(nu);

@@ -228,13 +228,7 @@ std::vector<Summary> Summarize(const std::vector<StudyCase>& cases, const std::v
     }
     summaries.push_back(s);
   }
-  for (Summary& s : summaries) {
-    s.pareto = true;
-    for (const Summary& o : summaries)
-      if (&o != &s && o.ms_per_mp <= s.ms_per_mp && o.day_error <= s.day_error &&
-          (o.ms_per_mp < s.ms_per_mp || o.day_error < s.day_error))
-        s.pareto = false;
-  }
+  MarkParetoFront(summaries, &Summary::ms_per_mp, &Summary::day_error);
   return summaries;
 }
 
@@ -270,32 +264,13 @@ void WriteResultsCsv(const StudyContext& context, const std::vector<CaseResult>&
 
 // accuracy.png: the cases and the front, through gnuplot.
 void PlotFront(StudyContext& context, const std::vector<Summary>& summaries) {
-  const std::string& out_dir = context.options.out_dir;
-  std::ostringstream data;
-  for (const Summary& s : summaries)
-    data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", s.ms_per_mp, std::max(s.day_error, 1e-7), s.pareto ? 1 : 0,
-                        s.name);
-  std::ostringstream front;
-  std::vector<const Summary*> sorted;
-  for (const Summary& s : summaries)
-    if (s.pareto) sorted.push_back(&s);
-  std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->ms_per_mp < b->ms_per_mp; });
-  for (const Summary* s : sorted) front << fmt::format("{:.6g} {:.6g}\n", s->ms_per_mp, std::max(s->day_error, 1e-7));
-  std::ostringstream plot;
-  plot << "set terminal pngcairo size 1100,750 noenhanced\n"
-       << "set output '" << out_dir << "/accuracy.png'\n"
-       << "set logscale xy\nset grid\n"
-       << "set xlabel 'lavapipe time per megapixel (ms, 2 cores)'\n"
-       << "set ylabel 'max relative error, upper hemisphere, sun 3..90 deg'\n"
-       << "set title 'skybake: what accuracy costs (single scattering vs converged reference)'\n"
-       << "set key top right\n"
-       << "plot '" << out_dir << "/accuracy_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
-       << "     '" << out_dir << "/accuracy_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
-       << "     '" << out_dir << "/accuracy_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
-  WriteFileAtomically(context.OutPath("accuracy_plot.dat"), data.str());
-  WriteFileAtomically(context.OutPath("accuracy_front.dat"), front.str());
-  WriteFileAtomically(context.OutPath("accuracy.gnuplot"), plot.str());
-  RunGnuplot(context, "accuracy.gnuplot", "accuracy.png");
+  std::vector<PlotPoint> points;
+  for (const Summary& s : summaries) points.push_back({s.ms_per_mp, s.day_error, s.pareto, s.name});
+  const std::string status =
+      PlotParetoFront(context.options.out_dir, "accuracy", points,
+                      {"lavapipe time per megapixel (ms, 2 cores)", "max relative error, upper hemisphere, sun 3..90 deg",
+                       "skybake: what accuracy costs (single scattering vs converged reference)"});
+  context.notes.push_back(fmt::format("Plot {}: {}/accuracy.png", status, context.options.out_dir));
 }
 
 std::string Markdown(const AccuracyStudyOptions& options, const std::vector<Summary>& summaries,

@@ -94,8 +94,34 @@ double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmospher
 
 std::vector<std::string> SplitCsv(const std::string& line);
 
-// Runs gnuplot on `script` (in the output folder), which draws `png` there,
-// and adds the note "Plot written: <out>/<png>" (or why not) to the report.
-void RunGnuplot(StudyContext& context, const std::string& script, const std::string& png);
+// Sets `pareto` of each case: on the front of (cost, error) when no other
+// case is as cheap and as accurate and better in one of the two.
+template <class Case>
+void MarkParetoFront(std::vector<Case>& cases, double Case::*cost, double Case::*error) {
+  for (Case& c : cases) {
+    c.pareto = true;
+    for (const Case& o : cases)
+      if (&o != &c && o.*cost <= c.*cost && o.*error <= c.*error && (o.*cost < c.*cost || o.*error < c.*error))
+        c.pareto = false;
+  }
+}
+
+// One case of a study on its (cost, error) plot.
+struct PlotPoint {
+  double cost = 0.0;   // the x axis (log scale: above 0)
+  double error = 0.0;  // the y axis, drawn at 1e-7 at the least
+  bool pareto = false;
+  std::string name;
+};
+// The axes' and the plot's titles.
+struct PlotLabels {
+  std::string x, y, title;
+};
+// A study's cases and their Pareto front on log-log axes, through gnuplot:
+// STEM_plot.dat, STEM_front.dat and STEM.gnuplot written into `out_dir`,
+// which draw STEM.png there. Returns what became of the plot: "written", or
+// "not written (...)" and why.
+std::string PlotParetoFront(const std::string& out_dir, const std::string& stem,
+                            const std::vector<PlotPoint>& points, const PlotLabels& labels);
 
 }  // namespace skybake

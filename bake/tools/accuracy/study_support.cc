@@ -10,6 +10,7 @@
 
 #include "skybake/gpu/sky_renderer.h"
 #include "skybake/model/tonemap.h"
+#include "skybake/output/exr_io.h"
 
 namespace skybake {
 
@@ -86,11 +87,34 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   return out;
 }
 
-void RunGnuplot(StudyContext& context, const std::string& script, const std::string& png) {
-  std::string plot_status = "written";
-  if (std::system(fmt::format("gnuplot '{}/{}' 2>/dev/null", context.options.out_dir, script).c_str()) != 0)
-    plot_status = "not written (gnuplot missing: apt-get install gnuplot-nox)";
-  context.notes.push_back(fmt::format("Plot {}: {}/{}", plot_status, context.options.out_dir, png));
+std::string PlotParetoFront(const std::string& out_dir, const std::string& stem,
+                            const std::vector<PlotPoint>& points, const PlotLabels& labels) {
+  std::ostringstream data, front;
+  for (const PlotPoint& p : points)
+    data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", p.cost, std::max(p.error, 1e-7), p.pareto ? 1 : 0, p.name);
+  std::vector<const PlotPoint*> sorted;
+  for (const PlotPoint& p : points)
+    if (p.pareto) sorted.push_back(&p);
+  std::sort(sorted.begin(), sorted.end(), [](auto a, auto b) { return a->cost < b->cost; });
+  for (const PlotPoint* p : sorted) front << fmt::format("{:.6g} {:.6g}\n", p->cost, std::max(p->error, 1e-7));
+  const std::string base = out_dir + "/" + stem;
+  std::ostringstream plot;
+  plot << "set terminal pngcairo size 1100,750 noenhanced\n"
+       << "set output '" << base << ".png'\n"
+       << "set logscale xy\nset grid\n"
+       << "set xlabel '" << labels.x << "'\n"
+       << "set ylabel '" << labels.y << "'\n"
+       << "set title '" << labels.title << "'\n"
+       << "set key top right\n"
+       << "plot '" << base << "_front.dat' using 1:2 with lines lw 2 lc rgb '#cc3333' title 'Pareto front', \\\n"
+       << "     '" << base << "_plot.dat' using 1:2:3 with points pt 7 ps 1.2 lc variable title 'cases', \\\n"
+       << "     '" << base << "_plot.dat' using 1:2:4 with labels offset 0.5,0.5 left font ',7' notitle\n";
+  WriteFileAtomically(base + "_plot.dat", data.str());
+  WriteFileAtomically(base + "_front.dat", front.str());
+  WriteFileAtomically(base + ".gnuplot", plot.str());
+  if (std::system(fmt::format("gnuplot '{}.gnuplot' 2>/dev/null", base).c_str()) != 0)
+    return "not written (gnuplot missing: apt-get install gnuplot-nox)";
+  return "written";
 }
 
 }  // namespace skybake
