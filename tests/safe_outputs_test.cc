@@ -549,22 +549,23 @@ TEST(SafeOutputs, MemoryBudgetRefusesWithTheEstimate) {
   EXPECT_EQ(small_budget.output.find("skybake: device"), std::string::npos) << "no GPU work";
 }
 
-// A sequence counts what it keeps of each frame (its record and manifest
-// entry, 118 KiB at 9 files a frame, and every frame's style): 1,000 frames
-// at --size 1 need about 118 MiB beyond their tiny frames, above a 20 MiB
-// budget, before any GPU work; ten of them (--frames) fit.
+// A sequence counts what it keeps of each frame (the CLI: what the glTF
+// scene needs of it, its manifest entry and timings on disk; and every
+// frame's style): 1,000 frames at --size 1 need about 34 MiB beyond their
+// tiny frames, above a 10 MiB budget, before any GPU work; ten of them
+// (--frames) fit.
 TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
   const std::string root = FreshTempDir("seqbudget");
   const std::string schedule = root + "/long.toml";
   std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = { start = 0, end = 89, step = "
                           << fmt::format("{:.17g}", 89.0 / 999) << " }, azimuth_deg = 135 }\n";
   const std::string out = root + "/out";
-  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 -q --max-memory-mib 20 ";
+  const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 -q --max-memory-mib 10 ";
   CommandRun run = RunSkybake(bake + "--out '" + out + "'");
   EXPECT_EQ(run.exit_code, 7) << run.output;
   EXPECT_NE(run.output.find("the sequence needs an estimated "), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their records and manifest entries), above the "
-                            "budget of 20 MiB: bake it in parts"),
+                            "budget of 10 MiB: bake it in parts"),
             std::string::npos)
       << run.output;
   EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
