@@ -33,7 +33,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 
 
 def run(cmd, cwd=ROOT, log=None, env=None):
-    """Runs cmd; returns (wall seconds, peak RSS MiB). Fails loudly."""
+    """Runs cmd; returns (wall seconds, peak RSS MiB, CPU seconds of all its threads). Fails loudly."""
     start = time.monotonic()
     proc = subprocess.Popen(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             env=dict(os.environ, **env) if env else None)
@@ -46,22 +46,24 @@ def run(cmd, cwd=ROOT, log=None, env=None):
     if log:
         with open(log, "wb") as f:
             f.write(out)
-    return wall, usage.ru_maxrss / 1024.0
+    return wall, usage.ru_maxrss / 1024.0, usage.ru_utime + usage.ru_stime
 
 
 def median_run(label, cmd, reps, before=None, env=None, after=None):
-    walls, peaks = [], []
+    walls, peaks, loads, cpus = [], [], [], []
     for i in range(reps):
         if before:
             before()
-        wall, peak = run(cmd, env=env)
+        wall, peak, cpu = run(cmd, env=env)
         if after:
             after()
         walls.append(wall)
         peaks.append(peak)
-        sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, peak {peak:.0f} MiB\n")
+        cpus.append(cpu)
+        loads.append(os.getloadavg()[0])  # the 1-minute load average as the run ends
+        sys.stderr.write(f"{label} run {i + 1}/{reps}: {wall:.2f} s, CPU {cpu:.2f} s, peak {peak:.0f} MiB, load {loads[-1]:.1f}\n")
     return {"label": label, "wall": statistics.median(walls), "walls": walls, "peak": statistics.median(peaks),
-            "peak_max": max(peaks)}
+            "peak_max": max(peaks), "loads": loads, "cpu": statistics.median(cpus)}
 
 
 def cpu_peak_gflops():
@@ -249,7 +251,7 @@ def print_ibl(args, work):
     for i in range(args.reps):
         for label, binary in builds:
             out = os.path.join(work, "ibl_" + label)
-            wall, _ = run([binary, "bake", *ibl, "--out", out, "--force", "--quiet"])
+            wall, _, _ = run([binary, "bake", *ibl, "--out", out, "--force", "--quiet"])
             t = json.load(open(os.path.join(out, "timings.json")))
             spec = sum(p["gpu_ms"] for f in t["frames"] for p in f["gpu_passes"] if p["name"] == "IBL specular") / 1e3
             stages = {st["stage"]: st["seconds"] for st in t["stages"]}
@@ -285,10 +287,12 @@ def print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs):
     print(f"| W3 | {w3_render:.3f} s ({w3_render / w1_render:.1f}x W1; target 8x) | {len(w3_stage_runs)} |")
     w3m_render = render(w3m_stage_runs)
     print(f"| W3, every view marched | {w3m_render:.3f} s ({w3m_render / w1_render:.1f}x W1) | {len(w3m_stage_runs)} |")
-    for key in ("w3_half", "w3_marched", "w3_sequence"):
+    for key in ("w1_half", "w3_half", "w3_marched", "w3_sequence"):
         if key in results:
             r = results[key]
-            print(f"| {r['label']}, whole process | {r['wall']:.2f} s, {r['peak_max']:.0f} MiB peak | {len(r['walls'])} |")
+            print(f"| {r['label']}, whole process | {r['wall']:.2f} s wall, {r['cpu']:.2f} s CPU, "
+                  f"{r['peak_max']:.0f} MiB peak, load "
+                  f"{min(r['loads']):.1f}-{max(r['loads']):.1f} | {len(r['walls'])} |")
     print(f"\nW3's cloud passes (GPU, last run, frame and SH views): {cloud_ms:.0f} ms")
     for p in passes:
         if p["name"].startswith("cloud"):
