@@ -351,8 +351,11 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
 // deck above darkens the sunlight of the clouds below it): each band the
 // Sun's ray crosses on its way up, min(light_steps, 4) uniform samples over
 // the crossing (a band above is crossed whole). Both without the detail
-// erosion. One loop over both parts with one density call: lavapipe inlines
-// every call, and each inlined density is a large part of the shader.
+// erosion. One loop over both parts with one density call, its trip count
+// the samples there are: lavapipe inlines every call, never branches over an
+// `if` (a block no lane takes still runs, masked), and runs a loop's body at
+// least once, so a loop per band (the four a one-band style does not have
+// among them) cost four density reads per view sample for nothing.
 const float kCloudLightDistanceKm = 8.0;
 float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top) {
   float reach = (band_top - h) / max(mu_s, 0.1);
@@ -360,56 +363,56 @@ float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, flo
   int n = gpu_clouds.counts.z;
   float r = atm.bottom_radius + h;
   float depth = 0.0, depth_above = 0.0;
-  // Part 0 is the own band, part 1 + b band b (when above band_top).
+  // The samples: n in the own band, then n_above in each band b (when above band_top).
   int bands = gpu_clouds.resolution.w > 1 ? gpu_clouds.resolution.w : 0;
   int n_above = min(n, 4);
-  for (int part = 0; part <= CLOUD_MAX_LAYERS; ++part) {
-    int steps = n;
-    float s_lo = 0.0, ds = 0.0;
-    if (part > 0) {
-      int b = part - 1;
-      if (b >= bands) continue;
+  int total = n + bands * n_above;
+  float s0 = 0.0;
+  int b = 0, i_above = 0;
+  for (int j = 0; j < total; ++j) {
+    float s, length_;
+    bool own = j < n;
+    if (own) {
+      float u1 = float(j + 1) / float(n);
+      float s1 = distance * u1 * u1;
+      s = 0.5 * (s0 + s1);
+      length_ = s1 - s0;
+      s0 = s1;
+    } else {
       float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
-      if (lo < band_top) continue;
-      s_lo = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
+      float s_lo = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
       float s_hi = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
-      ds = (s_hi - s_lo) / float(n_above);
-      steps = n_above;
-    }
-    float s0 = 0.0;
-    for (int i = 0; i < steps; ++i) {
-      float s, length_;
-      if (part == 0) {
-        float u1 = float(i + 1) / float(n);
-        float s1 = distance * u1 * u1;
-        s = 0.5 * (s0 + s1);
-        length_ = s1 - s0;
-        s0 = s1;
-      } else {
-        s = s_lo + (float(i) + 0.5) * ds;
-        length_ = ds;
+      float ds = (s_hi - s_lo) / float(n_above);
+      s = s_lo + (float(i_above) + 0.5) * ds;
+      // A band below the sample's own (or the own one) adds nothing.
+      length_ = lo < band_top ? 0.0 : ds;
+      if (++i_above == n_above) {
+        i_above = 0;
+        ++b;
       }
-      float sigma = CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * length_;
-      if (part == 0) depth += sigma;
-      else depth_above += sigma;
     }
+    float sigma = length_ > 0.0 ? CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * length_ : 0.0;
+    if (own) depth += sigma;
+    else depth_above += sigma;
   }
   return bands > 1 ? depth + depth_above : depth;
 }
 
-// The ambient table at altitude h: x sky above, y ground below.
-vec3 CloudAmbient(float h, float hf) {
+// The ambient table at altitude h: the mean radiance of the sky above
+// (`up`) and of what lies below (`down`).
+void CloudAmbientRows(float h, out vec3 up, out vec3 down) {
   int rows = gpu_clouds.lut.w;
   float y = clamp(h / gpu_clouds.range.y, 0.0, 1.0) * float(rows - 1);
   int y0 = min(int(y), rows - 2);
   float f = y - float(y0);
-  vec3 up = mix(cloud_lut[CloudAmbientIndex(y0, 0)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 0)].xyz, f);
-  vec3 down = mix(cloud_lut[CloudAmbientIndex(y0, 1)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 1)].xyz, f);
-  // Mean incident radiance over the sphere, the sky half occluded towards
-  // the cloud's base and the ground half towards its top (takram's height
-  // factor hf / 2 + 1 / 2).
-  return 0.5 * up * (0.5 + 0.5 * hf) + 0.5 * down * (1.0 - 0.5 * hf);
+  up = mix(cloud_lut[CloudAmbientIndex(y0, 0)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 0)].xyz, f);
+  down = mix(cloud_lut[CloudAmbientIndex(y0, 1)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 1)].xyz, f);
 }
+
+// Mean incident radiance over the sphere at height fraction hf, the sky half
+// occluded towards the cloud's base and the ground half towards its top
+// (takram's height factor hf / 2 + 1 / 2).
+vec3 CloudAmbient(vec3 up, vec3 down, float hf) { return 0.5 * up * (0.5 + 0.5 * hf) + 0.5 * down * (1.0 - 0.5 * hf); }
 
 // ---------------------------------------------------------------- the march
 
@@ -458,6 +461,63 @@ struct CloudMarch {
   float transmittance;  // of the clouds along the whole ray (grey)
 };
 
+// The tables along one segment of the view ray, read at its start, middle
+// and end (nodes 0, 1, 2, at u = 0, 1/2, 1 of the segment) and interpolated
+// per sample (CloudSegmentAir, CloudSegmentAt). Read per sample, the aerial
+// perspective alone was 16 LUT texels (two slices of two bilinear halves)
+// and the ambient 4 more at every view sample: lavapipe runs a sample's
+// whole lighting, masked, whether or not it holds cloud.
+// - The air's optical depth from the viewer, quadratic in u: its
+//   transmittance is exp(-depth), and the depth is nearly linear in distance
+//   where the transmittance is not.
+// - The air's in-scattering: S(t) - S(t0) = the integral of T J over
+//   [t0, t], = g (T(t0) - T(t)) with g = J / extinction where that ratio is
+//   constant along the ray; g is taken linear in u through its values at
+//   nodes 1 and 2 (exact for a uniform medium, where a polynomial in t is
+//   not: S saturates as 1 - exp).
+// - The ambient rows at the ray's altitude there, quadratic in u.
+struct CloudSegmentTables {
+  vec3 air_depth[3];
+  vec3 air_inscatter[3];
+  vec3 up[3];
+  vec3 down[3];
+  vec3 air_start;  // the air's transmittance at node 0
+  vec3 g1, g2;     // g at nodes 1 and 2
+};
+
+void CloudSegmentNode(IN(AtmosphereParameters) atm, vec3 view, IN(CloudApTexel) ap, float t, int k,
+                      inout CloudSegmentTables tables) {
+  float r0 = atm.bottom_radius + atm.observer_altitude;
+  tables.air_depth[k] = -log(max(CloudAerialPerspective(ap, t, 1), vec3(1e-30)));
+  tables.air_inscatter[k] = CloudAerialPerspective(ap, t, 0);
+  CloudAmbientRows(AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t), tables.up[k], tables.down[k]);
+}
+
+// Lagrange weights of the nodes at u = 0, 1/2, 1.
+vec3 CloudSegmentWeights(float u) { return vec3((1.0 - u) * (1.0 - 2.0 * u), 4.0 * u * (1.0 - u), u * (2.0 * u - 1.0)); }
+vec3 CloudSegmentAt(vec3 v[3], vec3 w) { return max(v[0] * w.x + v[1] * w.y + v[2] * w.z, vec3(0.0)); }
+
+// The segment's tables at its three distances.
+CloudSegmentTables CloudSegmentRead(IN(AtmosphereParameters) atm, vec3 view, IN(CloudApTexel) ap, float t0, float t1) {
+  CloudSegmentTables tables;
+  CloudSegmentNode(atm, view, ap, t0, 0, tables);
+  CloudSegmentNode(atm, view, ap, 0.5 * (t0 + t1), 1, tables);
+  CloudSegmentNode(atm, view, ap, t1, 2, tables);
+  tables.air_start = exp(-tables.air_depth[0]);
+  tables.g1 = (tables.air_inscatter[1] - tables.air_inscatter[0]) /
+              max(tables.air_start - exp(-tables.air_depth[1]), vec3(1e-6));
+  tables.g2 = (tables.air_inscatter[2] - tables.air_inscatter[0]) /
+              max(tables.air_start - exp(-tables.air_depth[2]), vec3(1e-6));
+  return tables;
+}
+
+// The air's transmittance and in-scattering from the viewer at u.
+void CloudSegmentAir(IN(CloudSegmentTables) tables, float u, vec3 w, out vec3 transmittance, out vec3 inscatter) {
+  transmittance = exp(-CloudSegmentAt(tables.air_depth, w));
+  vec3 g = max(mix(tables.g1, tables.g2, 2.0 * u - 1.0), vec3(0.0));
+  inscatter = tables.air_inscatter[0] + g * max(tables.air_start - transmittance, vec3(0.0));
+}
+
 // Marches the view ray through the part [t0, t1] of a band of thickness
 // `band_thickness`: steps of a third of view_steps per thickness crossed,
 // at most view_steps (a vertical crossing takes a third of them, a
@@ -472,6 +532,7 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
   float dt = (t1 - t0) / float(n);
   float cos_theta = dot(view, sun);
   int octaves = gpu_clouds.counts.w;
+  CloudSegmentTables tables = CloudSegmentRead(atm, view, ap, t0, t1);
   for (int i = 0; i < n; ++i) {
     float t = t0 + (float(i) + 0.5) * dt;
     float h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
@@ -510,7 +571,9 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
         break;
       }
     }
-    vec3 source = albedo * (scattered + CloudAmbient(h, hf));
+    float u = (float(i) + 0.5) / float(n);
+    vec3 w = CloudSegmentWeights(u);
+    vec3 source = albedo * (scattered + CloudAmbient(CloudSegmentAt(tables.up, w), CloudSegmentAt(tables.down, w), hf));
     // Hillaire 2016 section 5.6.3: the in-scattering integrated over the step
     // with the transmittance inside it, S (1 - exp(-sigma_t dt)) / sigma_t,
     // here with S = sigma_s J = albedo sigma_t J.
@@ -519,7 +582,9 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     // The air between the viewer and the sample: the cloud's light through
     // its transmittance, and the air's own in-scattering in front of the
     // cloud where the cloud hides what lies behind.
-    m.radiance += CloudAerialPerspective(ap, t, 1) * source * absorbed + CloudAerialPerspective(ap, t, 0) * absorbed;
+    vec3 air_transmittance, air_inscatter;
+    CloudSegmentAir(tables, u, w, air_transmittance, air_inscatter);
+    m.radiance += (air_transmittance * source + air_inscatter) * absorbed;
     m.transmittance *= step_transmittance;
     // Early exit: what lies behind would add less than 1e-3 of itself; it
     // is dropped (transmittance 0), so a thick deck hides the sun disc.

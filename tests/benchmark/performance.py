@@ -555,10 +555,12 @@ def print_clouds(results, w1_stage_runs, w3_stage_runs, w3m_stage_runs):
     print(f"| W3 | {w3_render:.3f} s ({w3_render / w1_render:.1f}x W1; target 8x) | {len(w3_stage_runs)} |")
     w3m_render = render(w3m_stage_runs)
     print(f"| W3, every view marched | {w3m_render:.3f} s ({w3m_render / w1_render:.1f}x W1) | {len(w3m_stage_runs)} |")
-    for key in ("w3_half", "w3_marched", "w3_sequence"):
+    for key in ("w1_half", "w3_half", "w3_marched", "w3_sequence"):
         if key in results:
             r = results[key]
-            print(f"| {r['label']}, whole process | {r['wall']:.2f} s, {r['peak_max']:.0f} MiB peak | {len(r['walls'])} |")
+            print(f"| {r['label']}, whole process | {r['wall']:.2f} s wall, {r['cpu']:.2f} s CPU, "
+                  f"{r['peak_max']:.0f} MiB peak, load "
+                  f"{min(r['loads']):.1f}-{max(r['loads']):.1f} | {len(r['walls'])} |")
     print(f"\nW3's cloud passes (GPU, last run, frame and SH views): {cloud_ms:.0f} ms")
     for p in passes:
         if p["name"].startswith("cloud"):
