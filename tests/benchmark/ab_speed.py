@@ -15,25 +15,16 @@ import argparse
 import hashlib
 import os
 import statistics
-import subprocess
 import sys
 import tempfile
-import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from performance import ROOT, run as run_process
 
 
 def run(cmd):
-    """Runs cmd from the project root; returns (wall s, CPU s). Fails loudly."""
-    start = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    out = proc.stdout.read()
-    _, status, usage = os.wait4(proc.pid, 0)
-    wall = time.monotonic() - start
-    if os.waitstatus_to_exitcode(status) != 0:
-        sys.stderr.write(out.decode(errors="replace"))
-        raise SystemExit(f"failed: {' '.join(cmd)}")
-    return wall, usage.ru_utime + usage.ru_stime
+    """Runs cmd from the project root; returns (wall s, CPU s of the process). Fails loudly."""
+    wall, _, cpu = run_process(cmd)
+    return wall, cpu
 
 
 def tree_digest(folder):

@@ -47,9 +47,13 @@
 # in R, weather in G): the spread constants below come from it.
 import argparse
 import math
+import os
 import sys
 
 import bpy
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from blender_scene import cycles_cpu_scene, make_equirectangular, nishita_world  # noqa: E402
 
 parser = argparse.ArgumentParser()
 parser.add_argument("out")
@@ -73,13 +77,8 @@ SHAPE_MEAN, SHAPE_SD = 0.5, 0.0822
 WEATHER_MEAN, WEATHER_SD = 0.5, 0.0982
 STEP_M, MAX_STEPS = LAYER_THICKNESS_M / 16.0, 48
 
-scene = bpy.context.scene
-scene.render.engine = "CYCLES"
-scene.cycles.device = "CPU"
-scene.cycles.samples = args.samples
+scene = cycles_cpu_scene(args.samples)
 scene.cycles.seed = args.seed
-scene.cycles.use_denoising = False
-scene.cycles.use_adaptive_sampling = False
 scene.cycles.volume_max_steps = MAX_STEPS
 scene.render.resolution_x = args.width
 scene.render.resolution_y = args.width // 2
@@ -98,24 +97,10 @@ if args.rows:
     scene.render.border_min_y = (height - args.rows[1]) / height
     scene.render.border_max_y = (height - args.rows[0]) / height
 
-for obj in list(bpy.data.objects):
-    bpy.data.objects.remove(obj, do_unlink=True)
-
-world = bpy.data.worlds.new("sky")
-scene.world = world
-world.use_nodes = True
-wn = world.node_tree.nodes
-wn.clear()
-sky = wn.new("ShaderNodeTexSky")
-sky.sky_type = "NISHITA"
-sky.sun_disc = True
+sky = nishita_world(scene, bpy.data.worlds.new("sky"))
 sky.altitude = 0.0
 sky.sun_elevation = math.radians(args.sun_elevation)
 sky.sun_rotation = math.radians(135.0)
-background = wn.new("ShaderNodeBackground")
-world_out = wn.new("ShaderNodeOutputWorld")
-world.node_tree.links.new(sky.outputs["Color"], background.inputs["Color"])
-world.node_tree.links.new(background.outputs["Background"], world_out.inputs["Surface"])
 
 
 class Graph:
@@ -256,11 +241,7 @@ if args.probe:
     cam_data.ortho_scale = 2.0 * LAYER_HALF_WIDTH_M
     cam_data.clip_end = 1e5
 else:
-    cam_data.type = "PANO"
-    if hasattr(cam_data, "panorama_type"):
-        cam_data.panorama_type = "EQUIRECTANGULAR"
-    else:
-        cam_data.cycles.panorama_type = "EQUIRECTANGULAR"
+    make_equirectangular(cam_data)
     cam_data.clip_end = 1e7
 cam = bpy.data.objects.new("camera", cam_data)
 cam.location = (0.0, 0.0, 10000.0) if args.probe else (0.0, 0.0, 2.0)
