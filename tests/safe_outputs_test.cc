@@ -564,7 +564,7 @@ TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
   CommandRun run = RunSkybake(bake + "--out '" + out + "'");
   EXPECT_EQ(run.exit_code, 7) << run.output;
   EXPECT_NE(run.output.find("the sequence needs an estimated "), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their records and manifest entries), above the "
+  EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their styles and the scene's per-frame data), above the "
                             "budget of 10 MiB: bake it in parts"),
             std::string::npos)
       << run.output;

@@ -143,10 +143,12 @@ void CheckSequenceBudget(const RenderPlan& plan, const BakeOptions& options) {
   if (frame_mib + records_mib <= options.max_memory_mib) return;
   throw BudgetError(fmt::format(
       "the sequence needs an estimated {:.0f} MiB of memory: {:.0f} MiB for its largest frame and {:.0f} MiB for "
-      "what it keeps of its {} frames (their records and manifest entries), above the budget of {:.0f} MiB: bake "
+      "what it keeps of its {} frames ({}), above the budget of {:.0f} MiB: bake "
       "it in parts (--frames A:B or --shard I/N, then merge-manifest), or raise --max-memory-mib (README "
       "\"Limits\")",
-      frame_mib + records_mib, frame_mib, records_mib, baked, options.max_memory_mib));
+      frame_mib + records_mib, frame_mib, records_mib, baked,
+      options.keep_frame_records ? "their records and manifest entries" : "their styles and the scene's per-frame data",
+      options.max_memory_mib));
 }
 
 }  // namespace skybake
