@@ -1,4 +1,5 @@
 #include "skybake/input/astronomy.h"
+#include "skybake/input/ephemeris.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,11 +8,12 @@
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
+#include <libnova/earth.h>
+#include <libnova/julian_day.h>
 #include <libnova/lunar.h>
 #include <libnova/nutation.h>
 #include <libnova/parallax.h>
 #include <libnova/precession.h>
-#include <libnova/julian_day.h>
 #include <libnova/solar.h>
 #include <libnova/transform.h>
 #include <nlohmann/json.hpp>
@@ -34,22 +36,29 @@ double CompassAzimuthFromLibnova(double libnova_azimuth_deg) { return Wrap360(li
 
 namespace {
 
-// libnova caches its nutation (and lunar and solar series) by Julian day
-// and reuses a value for a nearby day, so a result depends on the calls
+// libnova caches its nutation (and the solar series built on it) by Julian
+// day and reuses a value for a nearby day, so a result depends on the calls
 // before it at the 1e-10 level. Computing each at a day far away first
 // makes the next call at `julian_day_ut` compute afresh: a frame's stars
 // and Moon are then the same whichever frames were computed before it (a
-// shard of a sequence gives the unsharded bake's bytes).
+// shard of a sequence gives the unsharded bake's bytes). The lunar series
+// keeps no cache (ln_get_lunar_geo_posn at a day gives the same bits
+// whatever was computed before); its equatorial place reads the nutation.
 void ResetLibnovaCaches(double julian_day_ut) {
   const double far = julian_day_ut + 400.0;
   ln_nutation nutation{};
   ln_get_nutation(far, &nutation);
   ln_equ_posn equatorial{};
-  ln_get_lunar_equ_coords(far, &equatorial);
   ln_get_solar_equ_coords(far, &equatorial);
   ln_lnlat_posn ecliptic{};
-  ln_get_lunar_ecl_coords(far, &ecliptic, 0.0);
   ln_get_solar_ecl_coords(far, &ecliptic);
+}
+
+// Meeus eq. 13.3 and 13.4: equatorial (RA, Dec) from ecliptic (lambda,
+// beta) with the obliquity eps, all in radians; RA in (-pi, pi].
+void EquatorialFromEcliptic(double lambda, double beta, double eps, double& ra, double& dec) {
+  ra = std::atan2(std::sin(lambda) * std::cos(eps) - std::tan(beta) * std::sin(eps), std::cos(lambda));
+  dec = std::asin(std::sin(beta) * std::cos(eps) + std::cos(beta) * std::sin(eps) * std::sin(lambda));
 }
 
 SkyDirection FromLibnovaHorizontal(const ln_hrz_posn& h) {
@@ -191,21 +200,25 @@ glm::dvec3 J2000Axes::ToJ2000(const glm::dvec3& world) const {
   return {glm::dot(world, x), glm::dot(world, y), glm::dot(world, z)};
 }
 
+glm::dvec3 WorldFromJ2000(const J2000Axes& axes, const glm::dvec3& v) { return v.x * axes.x + v.y * axes.y + v.z * axes.z; }
+
 std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,
                                    const GeoLocation& place, double min_elevation_deg) {
+  return PlaceStars(catalogue, magnitude_limit, J2000AxesAt(julian_day_ut, place), min_elevation_deg);
+}
+
+std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, const J2000Axes& axes,
+                                   double min_elevation_deg) {
   // Precession and the horizontal transform are rotations: libnova turns
   // the three J2000 axes (RA 0 and 90 deg on the equator, the pole) into
   // world directions once per frame, and each star's J2000 unit vector is
   // rotated by the matrix they make (the same place as HorizontalFromJ2000
   // per star, to 1e-9; tests/astronomy_test.cc).
-  const J2000Axes axes = J2000AxesAt(julian_day_ut, place);
-  const glm::dvec3 &x = axes.x, &y = axes.y, &z = axes.z;
   const double min_y = std::sin(min_elevation_deg * kDeg);
   std::vector<PlacedStar> placed;
   for (const CatalogueStar& s : catalogue.stars) {
     if (s.v_magnitude > magnitude_limit) continue;
-    const glm::dvec3 v = UnitFromEquatorial(s.ra_j2000_deg, s.dec_j2000_deg);
-    const glm::dvec3 d = v.x * x + v.y * y + v.z * z;
+    const glm::dvec3 d = WorldFromJ2000(axes, UnitFromEquatorial(s.ra_j2000_deg, s.dec_j2000_deg));
     if (d.y <= min_y) continue;
     placed.push_back({d, StarIlluminanceLux(s.v_magnitude), StarColorFromBMinusV(s.b_minus_v)});
   }
@@ -219,17 +232,64 @@ double MoonIlluminanceLux(double phase_angle_deg, double distance_km) {
   return foot_candles * kLuxPerFootCandle * r * r;
 }
 
+LunarEphemeris ComputeLunarEphemeris(double julian_day_ut) {
+  ResetLibnovaCaches(julian_day_ut);
+  LunarEphemeris e;
+  // The one evaluation of ELP 2000-82B: rectangular geocentric, km, the
+  // J2000 mean ecliptic and equinox (precision 0: every term, as
+  // ln_get_lunar_equ_coords sums them).
+  ln_rect_posn moon{};
+  ln_get_lunar_geo_posn(julian_day_ut, &moon, 0.0);
+  const double lambda = std::atan2(moon.Y, moon.X), beta = std::atan2(moon.Z, std::hypot(moon.X, moon.Y));
+  e.ecliptic_longitude_deg = Wrap360(lambda / kDeg);
+  e.ecliptic_latitude_deg = beta / kDeg;
+  e.distance_km = std::sqrt(moon.X * moon.X + moon.Y * moon.Y + moon.Z * moon.Z);
+  // libnova turns ecliptic into equatorial places with the obliquity of
+  // its nutation (ln_get_equ_from_ecl); so does this, to match its places.
+  ln_nutation nutation{};
+  ln_get_nutation(julian_day_ut, &nutation);
+  const double eps = nutation.ecliptic * kDeg;
+  double ra = 0.0, dec = 0.0;
+  EquatorialFromEcliptic(lambda, beta, eps, ra, dec);
+  e.ra_deg = Wrap360(ra / kDeg);
+  e.dec_deg = dec / kDeg;
+  ln_lnlat_posn sun{};
+  ln_get_solar_ecl_coords(julian_day_ut, &sun);
+  const double sun_lambda = sun.lng * kDeg, sun_beta = sun.lat * kDeg;
+  const double sun_km = ln_get_earth_solar_dist(julian_day_ut) * kKmPerAu;
+  double sun_ra = 0.0, sun_dec = 0.0;
+  EquatorialFromEcliptic(sun_lambda, sun_beta, eps, sun_ra, sun_dec);
+  e.sun_ra_deg = Wrap360(sun_ra / kDeg);
+  e.sun_dec_deg = sun_dec / kDeg;
+  // Meeus eq. 48.2: the Moon's geocentric elongation psi from the Sun (the
+  // angle between the two directions, from their cross and dot products so
+  // that it stays exact near 0 and 180 deg), then eq. 48.3: the phase
+  // angle i, tan i = R sin psi / (Delta - R cos psi).
+  const glm::dvec3 to_moon = UnitFromEquatorial(e.ecliptic_longitude_deg, e.ecliptic_latitude_deg);
+  const glm::dvec3 to_sun = UnitFromEquatorial(sun.lng, sun.lat);
+  const double psi = std::atan2(glm::length(glm::cross(to_moon, to_sun)), glm::dot(to_moon, to_sun));
+  const double phase = std::atan2(sun_km * std::sin(psi), e.distance_km - sun_km * std::cos(psi));
+  e.phase_angle_deg = phase / kDeg;
+  e.illuminated_fraction = 0.5 * (1.0 + std::cos(phase));  // eq. 48.1
+  // Eq. 48.5: the position angle of the bright limb's midpoint.
+  const double dra = sun_ra - ra;
+  const double chi = std::atan2(std::cos(sun_dec) * std::sin(dra),
+                                std::sin(sun_dec) * std::cos(dec) - std::cos(sun_dec) * std::sin(dec) * std::cos(dra));
+  e.bright_limb_deg = Wrap360(chi / kDeg);
+  e.ecliptic_elongation_deg = Wrap360(e.ecliptic_longitude_deg - sun.lng);
+  return e;
+}
+
 MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double observer_altitude_m) {
   MoonState m;
-  ResetLibnovaCaches(julian_day_ut);
-  // Geocentric apparent place (ELP 2000-82B). libnova 0.16 refers it to the
-  // J2000 equinox, as its solar coordinates (tests/astronomy_test.cc checks
-  // this against Meeus example 47.a), so it is precessed to the date.
-  ln_equ_posn j2000{};
-  ln_get_lunar_equ_coords(julian_day_ut, &j2000);
+  const LunarEphemeris e = ComputeLunarEphemeris(julian_day_ut);
+  // Geocentric place. libnova 0.16 refers it to the J2000 equinox, as its
+  // solar coordinates (tests/astronomy_test.cc checks this against Meeus
+  // example 47.a), so it is precessed to the date.
+  ln_equ_posn j2000{e.ra_deg, e.dec_deg};
   ln_equ_posn geocentric{};
   ln_get_equ_prec2(&j2000, JD2000, julian_day_ut, &geocentric);
-  const double distance_geocentric_km = ln_get_lunar_earth_dist(julian_day_ut);
+  const double distance_geocentric_km = e.distance_km;
   ln_lnlat_posn observer{place.longitude_deg, place.latitude_deg};
   ln_hrz_posn h{};
   ln_get_hrz_from_equ(&geocentric, &observer, julian_day_ut, &h);
@@ -252,14 +312,11 @@ MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double obs
   m.distance_km = std::sqrt(distance_geocentric_km * distance_geocentric_km + r_km * r_km -
                             2.0 * distance_geocentric_km * r_km * std::sin(m.geocentric_elevation_deg * kDeg));
   m.angular_radius_rad = std::asin(kMoonRadiusKm / m.distance_km);
-  m.phase_angle_deg = ln_get_lunar_phase(julian_day_ut);
-  m.illuminated_fraction = ln_get_lunar_disk(julian_day_ut);
-  m.bright_limb_deg = ln_get_lunar_bright_limb(julian_day_ut);
+  m.phase_angle_deg = e.phase_angle_deg;
+  m.illuminated_fraction = e.illuminated_fraction;
+  m.bright_limb_deg = e.bright_limb_deg;
   m.illuminance_lux = MoonIlluminanceLux(m.phase_angle_deg, m.distance_km);
-  ln_lnlat_posn moon_ecl{}, sun_ecl{};
-  ln_get_lunar_ecl_coords(julian_day_ut, &moon_ecl, 0.0);
-  ln_get_solar_ecl_coords(julian_day_ut, &sun_ecl);
-  m.ecliptic_elongation_deg = Wrap360(moon_ecl.lng - sun_ecl.lng);
+  m.ecliptic_elongation_deg = e.ecliptic_elongation_deg;
   return m;
 }
 
