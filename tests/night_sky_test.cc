@@ -23,6 +23,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include "skybake/input/config.h"
+#include "skybake/input/ephemeris.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/tools/reference_model.h"
@@ -779,6 +780,94 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
   testing::ExpectNoValidationMessages();
 }
 
+// W1's maps (six 512^2 faces, a 512 strip, a 2048 x 1024 latlong) by day
+// with the Moon down. The bound before placement looks at a small texel
+// star by star (WeightedTexelLoad), so where the daylit sky outshines
+// every star no star is placed and nothing is splatted; where a star does
+// reach 2^-13 of a texel (a bright star in a 512 face, any star in the
+// latlong's polar rows or a strip's edge texels, whose solid angles are a
+// fraction of the others') they are placed. Either way the maps are the
+// bytes of the whole splat (every star splatted, every addition tested).
+// The frames: configs/schedules/24h.toml's 23-26 (2024-04-23 11:00-12:30
+// CLT at Cerro Paranal, the Sun 45-53 deg up, the Moon down: W1's day
+// frames of docs/performance.md), and 2024-01-15 04:00 UT with Sirius, the
+// brightest star, 82 deg up and the Sun put at 45 deg.
+TEST(NightSkyGpu, DaylitW1MapsPlaceNoStarWhereNoneShows) {
+  SkyStyle style;
+  style.night.stars = true;
+  style.night.moon = true;
+  style.night.airglow = true;
+  style.effects.night_dimming = true;
+  std::string error;
+  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
+  ASSERT_TRUE(catalogue) << error;
+  const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
+  SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+  NightSkyRenderer deferred(testing::Vulkan()), whole(testing::Vulkan());
+  whole.set_splat_bound(false);
+  const StarGrid grid(*catalogue, style.night.star_magnitude_limit, style.output.units);
+  std::vector<ViewRequest> views;
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, 512, 512, face});
+  views.push_back({MAPPING_CUBE_STRIP, 512, 6 * 512, 0});
+  views.push_back({MAPPING_LATLONG, 2048, 1024, 0});
+  const std::vector<Rgb> airglow =
+      AirglowTable(style.atmosphere, table, 90.0, style.effects.night_sky_luminance_cd_m2, style.output.units);
+  const GeoLocation paranal{-24.6272, -70.4042};
+  struct Case {
+    double julian_day_ut;
+    std::optional<double> sun_elevation;  // none: the real Sun's
+  };
+  std::vector<Case> cases;
+  for (int frame = 23; frame <= 26; ++frame) cases.push_back({2460423.5 + (4.0 + 0.5 * (frame - 1)) / 24.0, std::nullopt});
+  cases.push_back({2460324.5 + 4.0 / 24.0, 45.0});
+  int none_shows = 0, some_show = 0;
+  for (const Case& c : cases) {
+    const LunarEphemeris e = ComputeLunarEphemeris(c.julian_day_ut);
+    const glm::dvec3 sun = c.sun_elevation ? SunDirectionFromElevationAzimuth(*c.sun_elevation, 290.0)
+                                           : HorizontalFromJ2000(e.sun_ra_deg, e.sun_dec_deg, c.julian_day_ut, paranal).direction;
+    const std::string what = fmt::format("jd {:.4f}, sun {:.1f} deg", c.julian_day_ut, std::asin(sun.y) * 180.0 / M_PI);
+    ASSERT_GT(sun.y, std::sin(40.0 * M_PI / 180.0)) << what;
+    const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
+    NightFrame night = ComputeNightFrame(style, &*catalogue, table, c.julian_day_ut, paranal, sun);
+    NightFrame later = ComputeNightFrame(style, &*catalogue, table, c.julian_day_ut, paranal, sun, &grid);
+    night.airglow = airglow;
+    later.airglow = airglow;
+    ASSERT_TRUE(night.moon);
+    ASSERT_LT(night.moon->sky.elevation_deg, 0.0) << what;
+    ASSERT_TRUE(later.pending) << what;
+    std::vector<RgbaImage> a, b;
+    for (size_t i = 0; i < views.size(); ++i) {
+      a.push_back({views[i].width, views[i].height, sky[i], nullptr});
+      b.push_back({views[i].width, views[i].height, sky[i], nullptr});
+    }
+    const size_t cleared_before = deferred.views_cleared_before_placement();
+    deferred.AddToViews(style, later, views, a);
+    whole.AddToViews(style, night, views, b);
+    const size_t cleared = deferred.views_cleared_before_placement() - cleared_before;
+    size_t shown = 0;
+    for (size_t i = 0; i < views.size(); ++i) {
+      ASSERT_EQ(a[i].rgba.size(), b[i].rgba.size());
+      EXPECT_EQ(std::memcmp(a[i].rgba.data(), b[i].rgba.data(), a[i].rgba.size() * sizeof(float)), 0)
+          << what << ", view " << i;
+      shown += b[i].rgba != sky[i];
+    }
+    std::printf("%s: %zu of %zu views show a star; %zu cleared before placement, stars %s\n", what.c_str(), shown,
+                views.size(), cleared, later.pending->placed() ? "placed" : "not placed");
+    if (shown == 0) {
+      EXPECT_EQ(cleared, views.size()) << what;
+      EXPECT_FALSE(later.pending->placed()) << what;
+      ++none_shows;
+    } else {
+      EXPECT_TRUE(later.pending->placed()) << what;
+      EXPECT_LE(cleared, views.size() - shown) << what;
+      ++some_show;
+    }
+  }
+  EXPECT_GT(none_shows, 0);
+  EXPECT_GT(some_show, 0);  // Sirius high in a 512 face
+  testing::ExpectNoValidationMessages();
+}
+
 // The tile bound's smallest solid angle per tile, from its corner texels,
 // is the smallest of its texels' (faces, strips and latlongs, tiles cut by
 // the view's edge or, in a strip, by a face's).
@@ -846,6 +935,17 @@ TEST(NightSky, StarGridBoundsTheStarsInEveryCone) {
       if (glm::dot(v, d) >= cos_r) brute += e;
     const double bound = grid.SumWithin(d, r);
     EXPECT_GE(bound, brute) << "cone " << i << " radius " << r;
+    // StarsWithin gives every star of the cone (and others of its cells),
+    // each with its E and its J2000 vector as PlaceStars forms it.
+    std::vector<StarGrid::Star> near;
+    grid.StarsWithin(d, r, near);
+    double listed = 0.0, listed_in_cone = 0.0;
+    for (const StarGrid::Star& s : near) {
+      listed += s.e;
+      if (glm::dot(s.j2000, d) >= cos_r) listed_in_cone += s.e;
+    }
+    EXPECT_NEAR(listed_in_cone, brute, 1e-12 * total) << "cone " << i;
+    EXPECT_LE(listed, bound) << "cone " << i;
     if (r < 0.01) {
       EXPECT_LT(bound, 0.01 * total) << "cone " << i;
     }
@@ -853,6 +953,55 @@ TEST(NightSky, StarGridBoundsTheStarsInEveryCone) {
     ++cones;
   }
   EXPECT_GT(empty, cones / 20);
+  std::vector<StarGrid::Star> all;
+  grid.StarsWithin(glm::dvec3(0.0, 0.0, 1.0), M_PI, all);
+  EXPECT_EQ(all.size(), stars.size());
+}
+
+// WeightedTexelLoad is at least each texel's addition (largest channel)
+// times its solid angle, and at most SplatBound's load (every weight 1):
+// random sources and texels of faces, strips and latlongs, the texels a
+// source lands on and the latlong's repeated meridian included.
+TEST(NightSky, WeightedTexelLoadBoundsEachAddition) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0), log10(-6.0, -2.0);
+  int checked = 0, below_unweighted = 0;
+  for (const ViewRequest& view : ViewsOfSize(24)) {
+    std::vector<PointSource> sources(60);
+    for (PointSource& p : sources) {
+      p.direction = glm::normalize(glm::dvec3(unit(rng), unit(rng), unit(rng)));
+      if (&p - sources.data() < 6) p.direction = glm::normalize(glm::dvec3(1e-3 * unit(rng), 1.0, 1e-3 * unit(rng)));
+      const double e = std::pow(10.0, log10(rng));
+      p.irradiance = {e, e * 0.7, e * 1.2};
+    }
+    for (const TexelAdd& a : SplatPointSources(view, sources)) {
+      const int x = int(a.texel % view.width), y = int(a.texel / view.width);
+      const double omega = ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG && x == view.width - 1 ? 0 : x, y);
+      const double added = std::max({double(a.rgb[0]), double(a.rgb[1]), double(a.rgb[2])}) * omega;
+      const double load = WeightedTexelLoad(view, sources, x, y);
+      EXPECT_GE(load * (1.0 + 1e-6), added) << view.mapping << " " << x << " " << y;
+      // SplatBound's load: every source that lands on the texel, at weight 1.
+      double unweighted = 0.0;
+      for (const PointSource& p : sources)
+        if (WeightedTexelLoad(view, {p}, x, y) > 0.0) unweighted += std::max({p.irradiance[0], p.irradiance[1], p.irradiance[2]});
+      EXPECT_LE(load, unweighted * (1.0 + 1e-12)) << view.mapping << " " << x << " " << y;
+      below_unweighted += load < 0.9 * unweighted;
+      ++checked;
+    }
+    // A texel no source lands on has no load.
+    int empty = 0;
+    for (int y = 0; y < view.height && empty < 20; y += 3)
+      for (int x = 0; x < view.width && empty < 20; x += 5) {
+        bool reached = false;
+        for (const TexelAdd& a : SplatPointSources(view, sources))
+          reached = reached || a.texel == size_t(y) * view.width + x;
+        if (reached) continue;
+        EXPECT_EQ(WeightedTexelLoad(view, sources, x, y), 0.0) << view.mapping << " " << x << " " << y;
+        ++empty;
+      }
+  }
+  EXPECT_GT(checked, 500);
+  EXPECT_GT(below_unweighted, checked / 4);  // the weights tighten the bound
 }
 
 // A rectangle's cone holds the directions and mu of its texels, its

@@ -14,6 +14,7 @@
 
 #include "skybake/model/aoas.h"
 #include "skybake/input/config.h"
+#include "skybake/input/ephemeris.h"
 #include "skybake/pipeline/gallery.h"
 #include "skybake/pipeline/night_prune.h"
 #include "skybake/pipeline/pass_plan.h"
@@ -370,6 +371,25 @@ std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<Po
   return adds;
 }
 
+double WeightedTexelLoad(const ViewRequest& view, const std::vector<PointSource>& sources, int x, int y) {
+  const int w = view.width;
+  const int own_x = view.mapping == MAPPING_LATLONG && x == w - 1 ? 0 : x;  // the repeated meridian
+  std::vector<SplatTarget> targets;
+  double load = 0.0;
+  for (const PointSource& s : sources) {
+    if (s.irradiance[0] <= 0.0 && s.irradiance[1] <= 0.0 && s.irradiance[2] <= 0.0) continue;  // as TargetsOf
+    SplatTargets(view, glm::normalize(s.direction), targets);
+    double total = 0.0, here = 0.0;
+    for (const SplatTarget& t : targets) {
+      if (ViewTexelSolidAngle(view, t.x, t.y) <= 0.0) continue;  // as SplatFromTargets
+      total += t.weight;
+      if (t.x == own_x && t.y == y) here += t.weight;
+    }
+    if (total > 0.0 && here > 0.0) load += LargestChannel(s.irradiance) * here / total;
+  }
+  return load;
+}
+
 SplatTiles::SplatTiles(const ViewRequest& view, const std::vector<float>& mu) : view_(view) {
   const int w = view.width, h = view.height;
   const bool strip = view.mapping == MAPPING_CUBE_STRIP;
@@ -607,10 +627,15 @@ std::vector<PointSource> MoonDiscSources(const glm::dvec3& moon_direction, doubl
 
 std::vector<PointSource> StarSources(const StarCatalogue& catalogue, double magnitude_limit, OutputUnits units,
                                      const TransmittanceTable& t, double julian_day_ut, const GeoLocation& place) {
+  return StarSources(catalogue, magnitude_limit, units, t, J2000AxesAt(julian_day_ut, place));
+}
+
+std::vector<PointSource> StarSources(const StarCatalogue& catalogue, double magnitude_limit, OutputUnits units,
+                                     const TransmittanceTable& t, const J2000Axes& axes) {
   const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
   const Rgb output = OutputScale(units);
   std::vector<PointSource> sources;
-  for (const PlacedStar& s : PlaceStars(catalogue, magnitude_limit, julian_day_ut, place, kStarMinElevationDeg)) {
+  for (const PlacedStar& s : PlaceStars(catalogue, magnitude_limit, axes, kStarMinElevationDeg)) {
     const Rgb tr = t.At(s.direction.y);
     PointSource p;
     p.direction = s.direction;

@@ -23,6 +23,7 @@
 // nearly every tile takes a star).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -33,6 +34,19 @@
 #include "skybake/pipeline/night_sky.h"
 
 namespace skybake {
+
+// StarSources with the frame's axes given (J2000AxesAt, computed once):
+// PendingStars places its stars with the axes the bound used.
+std::vector<PointSource> StarSources(const StarCatalogue& catalogue, double magnitude_limit, OutputUnits units,
+                                     const TransmittanceTable& t, const J2000Axes& axes);
+
+// The load of one texel (x, y) of `view` with the sources' weights: the
+// sum over `sources` of the largest channel of each one's irradiance times
+// its weight at the texel, renormalized within the view as the splat does
+// (a latlong's last column takes its first's). The texel's addition
+// (largest channel) is at most this over its solid angle; SplatBound's load
+// is the same with every weight taken as 1.
+double WeightedTexelLoad(const ViewRequest& view, const std::vector<PointSource>& sources, int x, int y);
 
 // The catalogue's stars to a magnitude limit in cells of 0.5 deg of
 // declination and right ascension (J2000), each cell the sum of its stars'
@@ -47,10 +61,28 @@ class StarGrid {
   // d +- r and, off the poles, RA +- asin(sin r / cos d)).
   double SumWithin(const glm::dvec3& direction, double radius_rad) const;
   double total() const { return total_; }
+  // A star of the grid: its J2000 unit vector (as PlaceStars forms it), its
+  // irradiance at the top of the atmosphere in `units` (as StarSources forms
+  // it before the transmittance) and E, its largest channel.
+  struct Star {
+    glm::dvec3 j2000{0.0, 0.0, 1.0};
+    Rgb top{0.0, 0.0, 0.0};
+    double e = 0.0;
+  };
+  // Every star within `radius_rad` of `direction` (and others of the same
+  // cells), appended to `out`.
+  void StarsWithin(const glm::dvec3& direction, double radius_rad, std::vector<Star>& out) const;
 
  private:
   static constexpr int kRows = 360, kColumns = 720;
+  // Calls cells(row, a, b) for the columns [a, b] of each row of the cells
+  // that meet the cone's box (a > b: the row wraps, [a, end) and [0, b]);
+  // false when the cone holds a hemisphere or more (every cell).
+  template <typename Cells>
+  bool ForCellsWithin(const glm::dvec3& direction, double radius_rad, Cells cells) const;
   std::vector<double> prefix_;  // per row, kColumns + 1 running sums
+  std::vector<uint32_t> first_;  // the stars of cell k: stars_[first_[k], first_[k + 1])
+  std::vector<Star> stars_;
   double total_ = 0.0;
 };
 
@@ -79,6 +111,11 @@ struct UnplacedLight {
   glm::dvec3 moon_centre{0.0, 1.0, 0.0};
   double moon_radius_rad = 0.0;     // every sample is within it of the centre
   const std::vector<Rgb>* airglow = nullptr;  // null or empty: none
+  // With it (and `stars`), a single texel the bound above does not clear
+  // is looked at star by star: the grid's stars near it placed and
+  // attenuated as StarSources places and attenuates them, with their
+  // weights at the texel (WeightedTexelLoad).
+  const TransmittanceTable* table = nullptr;
 };
 
 // Whether no addition of `light` can reach `min_relative` of a texel of
@@ -113,8 +150,6 @@ class PendingStars {
   const TransmittanceTable& table_;
   double magnitude_limit_;
   OutputUnits units_;
-  double julian_day_ut_;
-  GeoLocation place_;
   J2000Axes axes_;
   std::optional<NightFrame> placed_;
   std::optional<UnplacedLight> light_[2];  // without and with the Moon
