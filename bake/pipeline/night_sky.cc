@@ -774,6 +774,10 @@ const SplatTiles& NightSkyRenderer::TilesOf(const ViewRequest& view, bool with_m
 const NightFrame* NightSkyRenderer::ForView(const ViewRequest& view, const NightFrame& night, const float* rgba,
                                             bool with_moon) {
   if (!night.pending) return &night;
+  // Once a view has placed the frame's stars, the tile bound (which knows
+  // each star's place) is the cheaper look at the views left: they go
+  // through it as in a frame placed at once.
+  if (night.pending->placed()) return &night.pending->Placed(night);
   if (splat_bound_ && tile_bound_) {
     const SplatTiles& tiles = TilesOf(view, false);
     const std::array<int, 4> key = {view.mapping, view.width, view.height, view.face};
