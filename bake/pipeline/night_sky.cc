@@ -906,8 +906,9 @@ void AddNightSkyPlan(const std::vector<SkyStyle>& frames, PassPlan& plan) {
   const std::string pruned =
       day == 0 ? std::string("no frame has the Sun up: every view splatted")
                : fmt::format("in the {} of {} frames with the Sun up each view is first bounded before any star is "
-                             "placed (the catalogue binned by J2000 position against each tile's darkest texel): a "
-                             "frame whose views no star, Moon or glow can change places no star and splats nothing; "
+                             "placed (the catalogue binned by J2000 position against each tile's darkest texel, and "
+                             "star by star at a texel that the bins do not clear): a frame whose views no star, Moon "
+                             "or glow can change places no star and splats nothing; "
                              "a view that may change then goes through the tile bound, skipped where no addition can "
                              "reach 2^-13 of a texel (the daylit sky outshines it)",
                              day, int(frames.size()));
