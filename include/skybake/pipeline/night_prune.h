@@ -11,16 +11,18 @@
 // near its J2000 direction. A tile whose bound is under 2^-13 x its
 // darkest texel x its smallest solid angle cannot take a byte, as in
 // BoundByTiles; one that is not is cut in four, down to single texels
-// (the latlong's polar rows, whose texels are tiny, clear this way unless
-// a star is right at the zenith). The airglow is bounded over each cone's
-// range of mu. The Moon's disc samples, placed already, are bounded by
-// their total over the disc's cone.
+// (the latlong's polar rows, whose texels are tiny). A single texel that
+// does not clear so is looked at star by star (UnplacedLight::table): its
+// nearby stars placed and weighed as the splat would (WeightedTexelLoad).
+// The airglow is bounded over each cone's range of mu. The Moon's disc
+// samples, placed already, are bounded by their total over the disc's cone.
 //
 // When every tile of a view clears, the view is left as it is; when one
 // does not, the frame's stars are placed (PendingStars, once) and that view
-// goes through BoundByTiles and SplatBound as before, so the maps are the
-// same bytes (tests/night_sky_test.cc). Used while the Sun is up (by night
-// nearly every tile takes a star).
+// and the ones after it go through BoundByTiles and SplatBound as in a
+// frame placed at once, so the maps are the same bytes
+// (tests/night_sky_test.cc). Used while the Sun is up (by night nearly
+// every tile takes a star).
 #pragma once
 
 #include <cstdint>
