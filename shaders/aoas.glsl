@@ -267,13 +267,33 @@ vec3 ScaleSaturation(vec3 rgb, Real factor) {
 
 // ---------------------------------------------------------------- the styled sky
 
+// The principles that act on the colour of a texel, in order: the cloud
+// saturation (eq. 7-8 and the shapes), judged in `color_scale` RGB, then the
+// night floor. `radiance` is the physical radiance along texel direction `w`
+// (unit) with the Sun along unit `sun`. The sky pass applies them to its own
+// three wavelengths; the spectral mode's style pass (sky_style.comp) to the
+// colour its wavelength groups combine to.
+vec3 StyleSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) aoas, vec3 radiance, vec3 w, vec3 sun) {
+  if (aoas.cloud_noise || aoas.cloud_shapes) {
+    Real keep = 1.0;
+    // Noise clouds live in the sky half of the dome, above the ground plane.
+    if (aoas.cloud_noise && w.y > 0.0)
+      keep *= 1.0 - aoas.noise_strength * CloudNoiseAmount(aoas, w * aoas.dome_radius);
+    if (aoas.cloud_shapes) keep *= 1.0 - CloudShapeAmount(aoas, w);
+    vec3 color = radiance * aoas.color_scale;
+    radiance = ScaleSaturation(color, keep) / aoas.color_scale;
+  }
+  if (atm.night) radiance = ApplyNightDimming(atm, radiance, w, sun);
+  return radiance;
+}
+
 // Radiance of the styled sky for texel direction `w` (unit; the dome
 // fragment R w seen from the dome centre) with the Sun along unit `sun`,
 // in the units of ComputeSkyRadiance (read from the sky-view LUT with
 // `use_sky_view`, as ComputeSkyRadianceFromSkyView). Applies, in order: the skydome
 // transform (eq. 1-2), the perturbation (eq. 5-6), the physical radiance
 // (the hue principle acts through atm.rayleigh_scattering), then the cloud
-// saturation (eq. 7-8 and the shapes), judged in `color_scale` RGB.
+// saturation and the night floor (StyleSkyRadiance).
 vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) aoas, vec3 w,
                               vec3 sun, bool use_sky_view) {
   AtmosphereParameters earth = atm;
@@ -311,17 +331,7 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
 #endif
   if (use_sky_view && !aoas.skydome && !twilight_march) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
   else radiance = ComputeSkyRadiance(earth, view, sun_local);
-  if (aoas.cloud_noise || aoas.cloud_shapes) {
-    Real keep = 1.0;
-    // Noise clouds live in the sky half of the dome, above the ground plane.
-    if (aoas.cloud_noise && w.y > 0.0)
-      keep *= 1.0 - aoas.noise_strength * CloudNoiseAmount(aoas, fragment);
-    if (aoas.cloud_shapes) keep *= 1.0 - CloudShapeAmount(aoas, w);
-    vec3 color = radiance * aoas.color_scale;
-    radiance = ScaleSaturation(color, keep) / aoas.color_scale;
-  }
-  if (atm.night) radiance = ApplyNightDimming(atm, radiance, w, sun);
-  return radiance;
+  return StyleSkyRadiance(atm, aoas, radiance, w, sun);
 }
 
 #endif  // SKYBAKE_AOAS_GLSL

@@ -142,6 +142,200 @@ TEST(SpectralSkyTest, RendererCombinesItsGroupsWithTheCieWeights) {
   testing::ExpectNoValidationMessages();
 }
 
+// A latlong of the styled sky as a bake renders it (renderer_cache.cc): the
+// hue in the atmosphere, the per-texel principles in the AOAS inputs, whose
+// colour scale is OutputScale(kLuminance); 3 wavelengths or the spectral mode.
+std::vector<float> StyledLatlong(int wavelengths, const AoasSettings& aoas, const EffectSettings& effects,
+                                 const glm::dvec3& sun) {
+  QualitySettings quality;
+  quality.wavelengths = wavelengths;
+  const Rgb scale = OutputScale(OutputUnits::kLuminance);
+  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(AtmosphereParams(), aoas), quality, effects, scale, false,
+                       ToAoasInputs(aoas, scale));
+  return renderer.Render(sun, {{MAPPING_LATLONG, 96, 48, 0}})[0];
+}
+
+// Hue in [0, 1), saturation, value of RGB (the definitions of aoas.glsl's
+// RgbToHsv, in double).
+std::array<double, 3> Hsv(const float* c) {
+  const double v = std::max({double(c[0]), double(c[1]), double(c[2])});
+  const double lo = std::min({double(c[0]), double(c[1]), double(c[2])});
+  const double delta = v - lo;
+  double h = 0.0;
+  if (delta > 0.0) {
+    if (v == c[0]) h = (c[1] - c[2]) / delta;
+    else if (v == c[1]) h = 2.0 + (c[2] - c[0]) / delta;
+    else h = 4.0 + (c[0] - c[1]) / delta;
+    h /= 6.0;
+    if (h < 0.0) h += 1.0;
+  }
+  return {h, v > 0.0 ? delta / v : 0.0, v};
+}
+
+// No texel is NaN, infinite, or negative where the unstyled sky is not.
+void ExpectFiniteAndNoNewNegatives(const std::vector<float>& on, const std::vector<float>& off, const char* what) {
+  int bad = 0;
+  for (size_t i = 0; i < on.size(); ++i)
+    if (!std::isfinite(on[i]) || (on[i] < 0.0f && off[i] >= 0.0f)) ++bad;
+  EXPECT_EQ(bad, 0) << what;
+}
+
+// The saturation principle (clouds or shapes) on against off: the texel's
+// value (HSV V, the largest channel) and hue kept, its saturation scaled
+// by the principle's keep factor. Returns the keep factor of each texel
+// whose unstyled saturation is above 0.05 (-1 elsewhere).
+std::vector<double> KeepFactors(const std::vector<float>& on, const std::vector<float>& off, const char* what) {
+  std::vector<double> keep(on.size() / 4, -1.0);
+  double worst_value = 0.0, worst_hue = 0.0;
+  for (size_t t = 0; t < keep.size(); ++t) {
+    const std::array<double, 3> a = Hsv(&off[4 * t]), b = Hsv(&on[4 * t]);
+    if (a[2] <= 0.0) continue;
+    worst_value = std::max(worst_value, std::abs(b[2] - a[2]) / a[2]);
+    if (a[1] <= 0.05) continue;
+    keep[t] = b[1] / a[1];
+    if (b[1] > 0.01) worst_hue = std::max(worst_hue, std::min(std::abs(b[0] - a[0]), 1.0 - std::abs(b[0] - a[0])));
+  }
+  // Float rounding of a few operations (2^-24 = 6e-8 each) on the value
+  // (seen: 7e-8); on the hue, of channel differences of at least 5% of the
+  // value (seen: 2e-6).
+  EXPECT_LE(worst_value, 1e-6) << what << ": the value (largest channel) changed";
+  EXPECT_LE(worst_hue, 2e-5) << what << ": the hue changed";
+  return keep;
+}
+
+// The saturation principles in the spectral mode do what they do with
+// three wavelengths: the same keep factor at every texel (the principle's
+// noise or shapes are geometry, the same in both), value and hue kept.
+void ExpectSaturationAsWithThreeWavelengths(const AoasSettings& on_style, const std::string& what) {
+  AoasSettings off_style = on_style;
+  off_style.clouds.enabled = false;
+  off_style.shapes.enabled = false;
+  const EffectSettings effects;
+  const glm::dvec3 sun = SunDirectionFromElevationAzimuth(25.0, 150.0);
+  std::map<int, std::vector<double>> keep;
+  for (int n : {3, 8}) {
+    const std::vector<float> on = StyledLatlong(n, on_style, effects, sun);
+    const std::vector<float> off = StyledLatlong(n, off_style, effects, sun);
+    const std::string label = fmt::format("{}, {} wavelengths", what, n);
+    ExpectFiniteAndNoNewNegatives(on, off, label.c_str());
+    keep[n] = KeepFactors(on, off, label.c_str());
+  }
+  int compared = 0, clouded = 0;
+  double worst = 0.0;
+  for (size_t t = 0; t < keep[3].size(); ++t) {
+    if (keep[3][t] < 0.0 || keep[8][t] < 0.0) continue;
+    ++compared;
+    if (keep[3][t] < 0.8) ++clouded;
+    worst = std::max(worst, std::abs(keep[8][t] - keep[3][t]));
+  }
+  // Both keep factors are ratios of saturations of at least 0.05 rounded
+  // to float: a few 2^-24 over 0.05 each, about 1e-6 (seen: 1.2e-6).
+  EXPECT_LE(worst, 1e-5) << what << ": the spectral keep factor differs from the three-wavelength one";
+  EXPECT_GT(compared, 1000) << what;
+  EXPECT_GT(clouded, 50) << what << ": too few texels lose a fifth of their saturation for the test to mean anything";
+  testing::ExpectNoValidationMessages();
+}
+
+TEST(SpectralSkyTest, SaturationCloudsActAsWithThreeWavelengths) {
+  AoasSettings aoas;
+  aoas.clouds.enabled = true;
+  aoas.clouds.strength = 1.0;
+  ExpectSaturationAsWithThreeWavelengths(aoas, "aoas.clouds");
+}
+
+TEST(SpectralSkyTest, CloudShapesActAsWithThreeWavelengths) {
+  AoasSettings aoas;
+  aoas.shapes.enabled = true;
+  CloudShape arc;
+  arc.kind = ShapeKind::kPolyline;
+  arc.points = {{20.0, 60.0}, {45.0, 150.0}, {30.0, 260.0}};
+  arc.radius_deg = 12.0;
+  aoas.shapes.shapes = {arc};
+  ExpectSaturationAsWithThreeWavelengths(aoas, "aoas.shapes");
+}
+
+// The night floor in the spectral mode adds the neutral the three-wavelength
+// path adds: on = (1 - k) off + k L (1, 1, 1) above the horizon, (1 - k) off
+// below it, with k the night weight of the Sun's elevation and L the floor's
+// luminance in cd/m^2; so its luminance adds k L, energy for energy.
+TEST(SpectralSkyTest, NightFloorAddsTheNeutralOfThreeWavelengths) {
+  EffectSettings off;
+  EffectSettings on = off;
+  on.night_dimming = true;
+  on.night_dimming_strength = 0.8;
+  on.night_sky_luminance_cd_m2 = 2e-3;
+  const double elevation = -12.0;
+  const glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 200.0);
+  // 1 - smoothstep(sin(-18 deg), sin(-6 deg), sin(elevation)), as NightDimmingWeight.
+  const double a = std::sin(-18.0 * M_PI / 180.0), b = std::sin(-6.0 * M_PI / 180.0);
+  const double x = std::clamp((std::sin(elevation * M_PI / 180.0) - a) / (b - a), 0.0, 1.0);
+  const double k = on.night_dimming_strength * (1.0 - x * x * (3.0 - 2.0 * x));
+  const double floor = on.night_sky_luminance_cd_m2;
+  const AoasSettings aoas;
+  const ViewRequest view{MAPPING_LATLONG, 96, 48, 0};
+  for (int n : {3, 8}) {
+    const std::vector<float> with = StyledLatlong(n, aoas, on, sun);
+    const std::vector<float> without = StyledLatlong(n, aoas, off, sun);
+    ExpectFiniteAndNoNewNegatives(with, without, "night floor");
+    double worst = 0.0, sky_luminance = 0.0;
+    for (int y = 0; y < view.height; ++y)
+      for (int x = 0; x < view.width; ++x) {
+        const size_t t = size_t(y) * view.width + x;
+        const bool above = ViewTexelDirection(view, x, y).y > 0.0;
+        for (int c = 0; c < 3; ++c) {
+          const double want = (1.0 - k) * without[4 * t + c] + (above ? k * floor : 0.0);
+          // Float rounding of the blend and the colour scale's two steps,
+          // a few 2^-24 (seen: 2.4e-7).
+          worst = std::max(worst, std::abs(with[4 * t + c] - want) /
+                                      ((1.0 - k) * std::abs(without[4 * t + c]) + k * floor));
+        }
+        if (above && y == 0) sky_luminance += without[4 * t + 1] / view.width;
+      }
+    EXPECT_LE(worst, 2e-6) << n << " wavelengths";
+    // Both terms count: the twilight sky and the floor are within a few decades.
+    EXPECT_GT(sky_luminance, 1e-3 * floor) << n << " wavelengths";
+    EXPECT_LT(sky_luminance, 1e3 * floor) << n << " wavelengths";
+  }
+  // The spectral renderer's directions get the floor too.
+  QualitySettings quality;
+  quality.wavelengths = 8;
+  const Rgb scale = OutputScale(OutputUnits::kLuminance);
+  SkyRenderer night(testing::Vulkan(), AtmosphereParams(), quality, on, scale, false, ToAoasInputs(aoas, scale));
+  SkyRenderer day(testing::Vulkan(), AtmosphereParams(), quality, off, scale, false, ToAoasInputs(aoas, scale));
+  const std::vector<glm::dvec3> up = {{0.0, 1.0, 0.0}, {0.0, -1.0, 0.0}};
+  const std::vector<float> lit = night.RenderDirections(sun, up), dark = day.RenderDirections(sun, up);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(lit[c], (1.0 - k) * dark[c] + k * floor, 2e-6 * ((1.0 - k) * std::abs(dark[c]) + k * floor)) << c;
+    EXPECT_NEAR(lit[4 + c], (1.0 - k) * dark[4 + c], 2e-6 * std::abs(dark[4 + c]) + 1e-12) << c;
+  }
+  testing::ExpectNoValidationMessages();
+}
+
+// A drift of the clouds (a sequence's frames) updates the spectral renderer
+// in place and renders what a new renderer renders.
+TEST(SpectralSkyTest, SpectralCloudDriftUpdatesInPlace) {
+  AoasSettings aoas;
+  aoas.clouds.enabled = true;
+  QualitySettings quality;
+  quality.wavelengths = 4;
+  const Rgb scale = OutputScale(OutputUnits::kLuminance);
+  const EffectSettings effects;
+  SkyRenderer kept(testing::Vulkan(), AtmosphereParams(), quality, effects, scale, false, ToAoasInputs(aoas, scale));
+  const glm::dvec3 sun = SunDirectionFromElevationAzimuth(30.0, 100.0);
+  const std::vector<ViewRequest> views = {{MAPPING_LATLONG, 48, 24, 0}};
+  const std::vector<float> before = kept.Render(sun, views)[0];
+  aoas.clouds.drift = {0.7, 0.0, 0.3};
+  ASSERT_TRUE(kept.UpdateAoas(ToAoasInputs(aoas, scale)));
+  const std::vector<float> after = kept.Render(sun, views)[0];
+  SkyRenderer fresh(testing::Vulkan(), AtmosphereParams(), quality, effects, scale, false, ToAoasInputs(aoas, scale));
+  EXPECT_EQ(after, fresh.Render(sun, views)[0]);
+  EXPECT_NE(after, before) << "the drift moved no cloud";
+  // Another set of switches needs another renderer.
+  AoasSettings plain;
+  EXPECT_FALSE(kept.UpdateAoas(ToAoasInputs(plain, scale)));
+  testing::ExpectNoValidationMessages();
+}
+
 // The style's spectral keys: refused before any GPU work, located, with the fix.
 TEST(SpectralSkyTest, BadSpectralSettingsAreRefusedWithTheirPlace) {
   auto errors = [](const std::string& toml, const std::vector<std::string>& overrides = {}) {
@@ -154,10 +348,22 @@ TEST(SpectralSkyTest, BadSpectralSettingsAreRefusedWithTheirPlace) {
   EXPECT_NE(low.errors[0].message.find("[3, 48]"), std::string::npos) << low.errors[0].message;
   EXPECT_EQ(errors("[quality]\nwavelengths = 49\n").errors.size(), 1u);
   EXPECT_EQ(errors("[quality]\nwavelengths = 8.5\n").errors.size(), 1u);
-  ConfigResult night = errors("[quality]\nwavelengths = 8\n[effects]\nnight_dimming = true\n");
-  ASSERT_EQ(night.errors.size(), 1u);
-  EXPECT_EQ(night.errors[0].line, 2);
-  EXPECT_NE(night.errors[0].message.find("effects.night_dimming"), std::string::npos);
+  // The principles that act on RGB colour are the style pass's: accepted, no warning.
+  for (const char* principle : {"[effects]\nnight_dimming = true\n", "[clouds]\nenabled = true\n",
+                                "[shapes]\nenabled = true\n[[shapes.shape]]\npoints = [[30.0, 90.0]]\n"}) {
+    ConfigResult styled = errors(std::string("[quality]\nwavelengths = 8\n") + principle);
+    EXPECT_TRUE(styled.ok()) << principle << (styled.errors.empty() ? "" : styled.errors[0].message);
+    EXPECT_TRUE(styled.warnings.empty()) << principle << styled.warnings[0].message;
+    EXPECT_EQ(styled.style.quality.wavelengths, 8) << principle;
+  }
+  // With cloud layers too, a warning: the style pass comes after the layers.
+  ConfigResult layered = errors(
+      "[quality]\nwavelengths = 8\n[effects]\nnight_dimming = true\n[[cloud_layer]]\ntype = \"cumulus\"\n");
+  EXPECT_TRUE(layered.ok()) << (layered.errors.empty() ? "" : layered.errors[0].message);
+  ASSERT_EQ(layered.warnings.size(), 1u);
+  EXPECT_EQ(layered.warnings[0].key, "quality.wavelengths");
+  EXPECT_EQ(layered.warnings[0].line, 2);
+  EXPECT_NE(layered.warnings[0].message.find("cloud layers"), std::string::npos) << layered.warnings[0].message;
   ConfigResult space = errors("[output]\nunits = \"spectral\"\ncolor_space = \"acescg\"\n");
   ASSERT_EQ(space.errors.size(), 1u);
   EXPECT_EQ(space.errors[0].key, "output.color_space");
@@ -191,9 +397,19 @@ TEST(SpectralSkyTest, CommandLineRefusesOutOfRangeBins) {
   const std::string out = testing::FreshTempDir("spectral_bad");
   const testing::CommandRun bake = testing::RunSkybake(
       "bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
-      " --set quality.wavelengths=8 --set effects.night_dimming=true");
+      " --set quality.wavelengths=2 --set effects.night_dimming=true");
   EXPECT_EQ(bake.exit_code, 3) << bake.output;
   EXPECT_TRUE(testing::FileNames(out).empty()) << "nothing written";
+}
+
+// The night floor and the AOAS saturation clouds bake in the spectral mode.
+TEST(SpectralSkyTest, CommandLineBakesTheColourPrinciplesSpectrally) {
+  const std::string out = testing::FreshTempDir("spectral_styled");
+  const testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
+      " --set quality.wavelengths=4 --set effects.night_dimming=true --set clouds.enabled=true");
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  EXPECT_FALSE(testing::FileNames(out).empty());
 }
 
 // An EXR's chromaticities and RGB as floats.

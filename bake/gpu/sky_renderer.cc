@@ -10,6 +10,7 @@
 #include <cstring>
 #include <exception>
 #include <future>
+#include <stdexcept>
 
 #include <glm/geometric.hpp>
 #include <sys/mman.h>
@@ -19,6 +20,7 @@
 #include "shaders/kCloudResampleSpv.spv.h"
 #include "shaders/kMultiscatteringLutSpv.spv.h"
 #include "shaders/kSkyRenderSpv.spv.h"
+#include "shaders/kSkyStyleSpv.spv.h"
 #include "shaders/kSkyviewLutSpv.spv.h"
 #include "shaders/kTransmittanceLutSpv.spv.h"
 #include "shaders/kMultiscatteringLutAnalyticSpv.spv.h"
@@ -54,21 +56,38 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
                          const QualitySettings& quality, const EffectSettings& effects,
                          const Rgb& output_scale, bool output_directions,
                          const AoasInputs& aoas, const CloudInputs& clouds, const ShaderSwitches& shaders)
+    : SkyRenderer(Role::kSky, context, atmosphere, quality, effects, output_scale, output_directions, aoas, clouds,
+                  shaders) {}
+
+std::unique_ptr<SkyRenderer> SkyRenderer::StylePass(VulkanContext& context, const AtmosphereParams& atmosphere,
+                                                    const QualitySettings& quality, const EffectSettings& effects,
+                                                    const Rgb& output_scale, const AoasInputs& aoas) {
+  QualitySettings three = quality;
+  three.wavelengths = kRgbWavelengths;
+  return std::unique_ptr<SkyRenderer>(new SkyRenderer(Role::kStylePass, context, atmosphere, three, effects,
+                                                      output_scale, false, aoas, CloudInputs(), ShaderSwitches()));
+}
+
+SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmosphereParams& atmosphere,
+                         const QualitySettings& quality, const EffectSettings& effects, const Rgb& output_scale,
+                         bool output_directions, const AoasInputs& aoas, const CloudInputs& clouds,
+                         const ShaderSwitches& shaders)
     : context_(context),
       quality_(quality),
       effects_(effects),
       aoas_switches_(aoas.switches),
-      output_directions_(output_directions) {
-  if (quality.wavelengths > kRgbWavelengths && !output_directions) {
+      output_directions_(output_directions),
+      style_pass_(role == Role::kStylePass) {
+  if (quality.wavelengths > kRgbWavelengths && !output_directions && !style_pass_) {
     spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
     SyncSpectral();
     return;
   }
   gpu_atmosphere_ = ToGpuAtmosphere(atmosphere, quality, effects, output_scale);
-  disc_pass_ = !output_directions && UsesSunDiscPass(quality, effects, aoas.switches, shaders);
+  disc_pass_ = !output_directions && !style_pass_ && UsesSunDiscPass(quality, effects, aoas.switches, shaders);
   // Clouds (clouds.h): a style without layers gets no cloud pipeline, no
   // noise and no cloud pass; its buffers are placeholders.
-  cloud_layers_ = output_directions ? 0 : clouds.layers();
+  cloud_layers_ = output_directions || style_pass_ ? 0 : clouds.layers();
   gpu_clouds_ = clouds.uniform;
   cloud_weather_images_ = clouds.weather_images;
   VkDevice device = context_.device();
@@ -91,31 +110,7 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
   dispatch_buffer_ = CreateBuffer(64 * sizeof(gpu::SkyPush), storage);  // grown by Submit when a submission needs more
 
-  VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
-  for (uint32_t i = 0; i < kBindingCount; ++i) {
-    bindings[i].binding = i;
-    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    bindings[i].descriptorCount = 1;
-    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-  }
-  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(uint32_t));
-  set_layout_ = layouts.set;
-  pipeline_layout_ = layouts.pipeline;
-
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
-  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
-  pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 2;
-  pool_info.pPoolSizes = pool_sizes;
-  VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &descriptor_pool_));
-  VkDescriptorSetAllocateInfo alloc_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
-  alloc_info.descriptorPool = descriptor_pool_;
-  alloc_info.descriptorSetCount = 1;
-  alloc_info.pSetLayouts = &set_layout_;
-  VK_CHECK(vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
-  UpdateDescriptors();
+  CreateDescriptorSet();
 
   // Pipelines are built once per renderer, never per frame, and only those
   // the effects need. Compiling is most of a short bake's start-up on
@@ -141,14 +136,15 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
                    : PipelineJob{pipeline, generic_code, sizeof(generic_code)};
   };
   std::vector<PipelineJob> jobs;
-  if (NeedsTransmittanceLut(quality, effects) || cloud_layers_ > 0)
+  if (style_pass_) jobs.push_back({&style_pipeline_, kSkyStyleSpv, sizeof(kSkyStyleSpv)});
+  else if (NeedsTransmittanceLut(quality, effects) || cloud_layers_ > 0)
     jobs.push_back(job(&transmittance_pipeline_, analytic, kTransmittanceLutAnalyticSpv, kTransmittanceLutSpv));
-  if (effects.multiple_scattering)
+  if (effects.multiple_scattering && !style_pass_)
     jobs.push_back(
         job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
-  if (sky_view) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
-  jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
-  sky_view_variant_ = sources.sky_view_render;
+  if (sky_view && !style_pass_) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
+  if (!style_pass_) jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
+  sky_view_variant_ = sources.sky_view_render && !style_pass_;
   for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
   if (disc_pass_) {
     // The sky pass without the disc, and the disc pass that adds it.
@@ -196,6 +192,35 @@ SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosph
   VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_));
 
   timestamps_supported_ = context_.SupportsTimestamps();
+}
+
+void SkyRenderer::CreateDescriptorSet() {
+  VkDevice device = context_.device();
+  VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
+  for (uint32_t i = 0; i < kBindingCount; ++i) {
+    bindings[i].binding = i;
+    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorCount = 1;
+    bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, kBindingCount, sizeof(uint32_t));
+  set_layout_ = layouts.set;
+  pipeline_layout_ = layouts.pipeline;
+
+  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
+  VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  pool_info.maxSets = 1;
+  pool_info.poolSizeCount = 2;
+  pool_info.pPoolSizes = pool_sizes;
+  VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &descriptor_pool_));
+  VkDescriptorSetAllocateInfo alloc_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  alloc_info.descriptorPool = descriptor_pool_;
+  alloc_info.descriptorSetCount = 1;
+  alloc_info.pSetLayouts = &set_layout_;
+  VK_CHECK(vkAllocateDescriptorSets(device, &alloc_info, &descriptor_set_));
+  UpdateDescriptors();
 }
 
 bool UsesSunDiscPass(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas,
@@ -260,7 +285,8 @@ void SkyRenderer::DestroyAll() {
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
                         &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
-                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_}) {
+                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_,
+                        &style_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -887,6 +913,51 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
   view.width = int(directions.size());
   view.height = 1;
   return Render(sun, {view}, sun_disc)[0];
+}
+
+void SkyRenderer::ApplyStyle(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                             std::vector<std::vector<float>>& images, const std::vector<glm::dvec3>& directions) {
+  if (!style_pass_) throw std::logic_error("SkyRenderer::ApplyStyle: not a style pass (SkyRenderer::StylePass)");
+  size_t total = 0;
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
+  // The directions of a MAPPING_DIRECTIONS view after every view's texels.
+  const VkDeviceSize bytes = VkDeviceSize(std::max<size_t>(total + directions.size(), 1)) * 16;
+  if (bytes > context_.properties().limits.maxStorageBufferRange && views.size() > 1) {
+    // In two halves, as Render splits a frame too large for one buffer.
+    const size_t half = views.size() / 2;
+    std::vector<std::vector<float>> first(images.begin(), images.begin() + half);
+    std::vector<std::vector<float>> second(images.begin() + half, images.end());
+    ApplyStyle(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half), first, directions);
+    std::vector<PassTiming> timings = last_timings();
+    ApplyStyle(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), second, directions);
+    timings.insert(timings.end(), last_timings().begin(), last_timings().end());
+    timings_ = timings;
+    for (size_t i = 0; i < views.size(); ++i) images[i] = std::move(i < half ? first[i] : second[i - half]);
+    return;
+  }
+  EnsureOutputCapacity(bytes);
+  BindOutput(output_buffer_);
+  float* data = static_cast<float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < views.size(); ++i) std::memcpy(data + 4 * offsets[i], images[i].data(), images[i].size() * 4);
+  for (size_t i = 0; i < directions.size(); ++i) {
+    float* d = data + 4 * (total + i);
+    d[0] = float(directions[i].x);
+    d[1] = float(directions[i].y);
+    d[2] = float(directions[i].z);
+    d[3] = 0.0f;
+  }
+  std::vector<Dispatch> dispatches;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewRequest& v = views[i];
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    push.view = {v.mapping, v.width, v.height, v.face};
+    push.offsets = {int32_t(offsets[i]), 0, int32_t(total), 0};
+    dispatches.push_back({"style", style_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
+  }
+  Submit(dispatches, std::vector<bool>(dispatches.size(), false));  // views are disjoint
+  for (size_t i = 0; i < views.size(); ++i) std::memcpy(images[i].data(), data + 4 * offsets[i], images[i].size() * 4);
 }
 
 bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,

@@ -1,6 +1,7 @@
 #include "skybake/gpu/spectral_sky.h"
 
 #include <algorithm>
+#include <stdexcept>
 #include <utility>
 
 namespace skybake {
@@ -9,6 +10,29 @@ namespace {
 QualitySettings GroupQuality(QualitySettings q) {
   q.wavelengths = kRgbWavelengths;
   return q;
+}
+
+// The principles that act on a texel's colour (the AOAS saturation clouds
+// and shapes, the night floor) are the style pass's, on the combined
+// colour: the groups render the physical sky without them.
+bool StylesColour(const AoasInputs& aoas, const EffectSettings& effects) {
+  return aoas.switches.cloud_noise || aoas.switches.cloud_shapes || effects.night_dimming;
+}
+AoasInputs GroupAoas(AoasInputs aoas) {
+  aoas.switches.cloud_noise = false;
+  aoas.switches.cloud_shapes = false;
+  return aoas;
+}
+EffectSettings GroupEffects(EffectSettings effects) {
+  effects.night_dimming = false;
+  return effects;
+}
+// The colour the style pass sees: linear Rec.709 in cd/m^2, which the
+// AOAS colour scale (OutputScale(kLuminance)) maps the three-wavelength
+// radiance to; radiance = colour / scale, as the sky pass sees it.
+Rgb StyleScale(const AoasInputs& aoas) {
+  const gpu::vec4& c = aoas.uniform.color_scale;
+  return {c.x, c.y, c.z};
 }
 
 // Adds a group's three channels, times its matrix, to the RGB of `sum`
@@ -37,11 +61,17 @@ SpectralSky::SpectralSky(VulkanContext& context, const AtmosphereParams& atmosph
 SpectralSky::SpectralSky(VulkanContext& context, SpectralBins bins, std::vector<SpectralGroup> groups,
                          const QualitySettings& quality, const EffectSettings& effects, const AoasInputs& aoas,
                          const CloudInputs& clouds, const ShaderSwitches& shaders)
-    : bins_(std::move(bins)), groups_(std::move(groups)) {
+    : bins_(std::move(bins)), groups_(std::move(groups)), style_aoas_(aoas), style_effects_(effects) {
   // Each group renders radiance (unit output scale); the CIE weights make it cd/m^2.
   for (const SpectralGroup& g : groups_)
-    renderers_.push_back(std::make_unique<SkyRenderer>(context, g.atmosphere, GroupQuality(quality), effects,
-                                                       Rgb{1.0, 1.0, 1.0}, false, aoas, clouds, shaders));
+    renderers_.push_back(std::make_unique<SkyRenderer>(context, g.atmosphere, GroupQuality(quality),
+                                                       GroupEffects(effects), Rgb{1.0, 1.0, 1.0}, false,
+                                                       GroupAoas(aoas), clouds, shaders));
+  if (StylesColour(aoas, effects)) {
+    if (StyleScale(aoas)[0] <= 0.0 || StyleScale(aoas)[1] <= 0.0 || StyleScale(aoas)[2] <= 0.0)
+      throw std::invalid_argument("SpectralSky: the AOAS colour scale must be positive (ToAoasInputs)");
+    style_ = SkyRenderer::StylePass(context, groups_.front().atmosphere, quality, effects, StyleScale(aoas), aoas);
+  }
 }
 
 SpectralSky::~SpectralSky() = default;
@@ -67,6 +97,10 @@ std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const
       Accumulate(rendered.views[i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0,
                  sum[i].data());
   }
+  if (style_) {
+    style_->ApplyStyle(sun, views, sum);
+    timings_.insert(timings_.end(), style_->last_timings().begin(), style_->last_timings().end());
+  }
   return sum;
 }
 
@@ -79,6 +113,17 @@ std::vector<float> SpectralSky::RenderDirections(const glm::dvec3& sun, const st
     timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
     Accumulate(group.data(), directions.size(), groups_[g].to_rgb, g == 0, sum.data());
   }
+  if (style_) {
+    ViewRequest view;
+    view.mapping = MAPPING_DIRECTIONS;
+    view.width = int(directions.size());
+    view.height = 1;
+    std::vector<std::vector<float>> images(1);
+    images[0] = std::move(sum);
+    style_->ApplyStyle(sun, {view}, images, directions);
+    timings_.insert(timings_.end(), style_->last_timings().begin(), style_->last_timings().end());
+    return std::move(images[0]);
+  }
   return sum;
 }
 
@@ -86,16 +131,28 @@ bool SpectralSky::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
                                    const EffectSettings& effects) {
   if (quality.wavelengths != bins_.count()) return false;  // also refuses groups of one's own
   std::vector<SpectralGroup> groups = SpectralGroups(atmosphere, bins_);
+  if (effects.night_dimming != (style_ && style_effects_.night_dimming)) return false;  // a style pass comes or goes
   for (size_t g = 0; g < renderers_.size(); ++g)
-    if (!renderers_[g]->UpdateAtmosphere(groups[g].atmosphere, GroupQuality(quality), effects, Rgb{1.0, 1.0, 1.0}))
+    if (!renderers_[g]->UpdateAtmosphere(groups[g].atmosphere, GroupQuality(quality), GroupEffects(effects),
+                                         Rgb{1.0, 1.0, 1.0}))
       return false;
+  if (style_ && !style_->UpdateAtmosphere(groups.front().atmosphere, GroupQuality(quality), effects,
+                                          StyleScale(style_aoas_)))
+    return false;
+  style_effects_ = effects;
   groups_ = groups;
   return true;
 }
 
 bool SpectralSky::UpdateAoas(const AoasInputs& aoas) {
+  // The style pass's switches are its pipeline's: another set needs a new renderer.
+  const bool clouds_on = aoas.switches.cloud_noise || aoas.switches.cloud_shapes;
+  const bool clouds_were = style_ && (style_aoas_.switches.cloud_noise || style_aoas_.switches.cloud_shapes);
+  if (clouds_on != clouds_were) return false;
   bool ok = true;
-  for (auto& r : renderers_) ok = r->UpdateAoas(aoas) && ok;
+  for (auto& r : renderers_) ok = r->UpdateAoas(GroupAoas(aoas)) && ok;
+  if (style_) ok = style_->UpdateAoas(aoas) && ok;
+  if (ok) style_aoas_ = aoas;
   return ok;
 }
 
@@ -120,6 +177,7 @@ RenderCounters SpectralSky::counters() const {
     sum.cloud_dispatches += c.cloud_dispatches;
     sum.sun_disc_texels += c.sun_disc_texels;
   }
+  if (style_) sum.pipelines += style_->counters().pipelines;
   // A frame is every group's render of it.
   sum.frames = renderers_.empty() ? 0 : renderers_.front()->counters().frames;
   return sum;

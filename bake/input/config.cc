@@ -1229,9 +1229,10 @@ void CheckIbl(const SkyStyle& style, StyleChecks& c) {
 }
 
 // The spectral mode (quality.wavelengths > 3) integrates radiance to colour:
-// radiance output keeps the three named wavelengths, and the per-texel
-// effects that act on RGB colour (saturation, the night floor's neutral
-// grey) have no spectral form yet.
+// radiance output keeps the three named wavelengths. The per-texel effects
+// that act on RGB colour (the AOAS saturation clouds and shapes, the night
+// floor) are applied to the combined colour by the style pass (spectral_sky.h);
+// with cloud layers that is after the layers are composited, not before.
 void CheckSpectral(SkyStyle& style, StyleChecks& c) {
   const bool radiance = style.output.units == OutputUnits::kSpectral;
   if (radiance && style.output.color_space != ColorSpace::kRec709) {
@@ -1251,16 +1252,16 @@ void CheckSpectral(SkyStyle& style, StyleChecks& c) {
     style.quality.wavelengths = kRgbWavelengths;
     return;
   }
-  auto refuse = [&](const char* key, const char* what) {
-    ConfigError e = c.Locate("quality.wavelengths");
-    e.message = fmt::format("the spectral mode ({} bins) cannot render {} ({} is set), which acts on RGB colour: "
-                            "set quality.wavelengths = 3 or turn {} off",
-                            style.quality.wavelengths, what, key, key);
-    c.errors.push_back(e);
-  };
-  if (style.aoas.clouds.enabled) refuse("clouds.enabled", "the AOAS saturation clouds");
-  if (style.aoas.shapes.enabled) refuse("shapes.enabled", "the AOAS cloud shapes");
-  if (style.effects.night_dimming) refuse("effects.night_dimming", "the night-sky floor");
+  const bool styles_colour = style.aoas.clouds.enabled || style.aoas.shapes.enabled || style.effects.night_dimming;
+  if (styles_colour && !ActiveCloudLayers(style.clouds).empty()) {
+    ConfigError w = c.Locate("quality.wavelengths");
+    w.message = fmt::format("the spectral mode ({} bins) applies the AOAS saturation clouds and shapes and the "
+                            "night floor to the sky after the cloud layers are composited over it, so they act on "
+                            "the layers too (the three-wavelength path applies them to the sky behind the layers): "
+                            "set quality.wavelengths = 3 for that order",
+                            style.quality.wavelengths);
+    c.warnings.push_back(w);
+  }
 }
 
 // A preset that every explicit key overrides changes nothing: say so.

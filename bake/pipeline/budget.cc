@@ -55,8 +55,12 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   // The spectral mode (spectral_sky.h): one renderer per group of three
   // bins, each with its LUTs and an output buffer of its own (RGBA float, 16
   // bytes a texel), their sum on the host in place of the one renderer's.
+  // The style pass (the AOAS saturation clouds and shapes, the night floor
+  // on the combined colour) has one more such buffer.
   const double groups = q.wavelengths > kRgbWavelengths ? double((q.wavelengths + 2) / 3) : 1.0;
-  const double spectral_buffers = q.wavelengths > kRgbWavelengths ? 16.0 * groups * texels : 0.0;
+  const bool style_pass = style.aoas.clouds.enabled || style.aoas.shapes.enabled || style.effects.night_dimming;
+  const double spectral_buffers =
+      q.wavelengths > kRgbWavelengths ? 16.0 * (groups + (style_pass ? 1.0 : 0.0)) * texels : 0.0;
   const double luts = groups * 16.0 *
                       (double(q.transmittance_width) * q.transmittance_height +
                        double(q.multiscattering_size) * q.multiscattering_size +

@@ -214,8 +214,10 @@ bool PlansSunDiscPass(const SkyStyle& first, const SkyStyle& pruned, const Shade
   AoasSwitches switches;
   switches.skydome = xp.skydome.enabled;
   switches.ambiguity = xp.ambiguity.enabled;
-  switches.cloud_noise = xp.clouds.enabled;
-  switches.cloud_shapes = xp.shapes.enabled;
+  // The spectral mode's groups leave the saturation to the style pass (spectral_sky.h).
+  const bool spectral = first.quality.wavelengths > kRgbWavelengths;
+  switches.cloud_noise = xp.clouds.enabled && !spectral;
+  switches.cloud_shapes = xp.shapes.enabled && !spectral;
   return UsesSunDiscPass(first.quality, pruned.effects, switches, shaders);
 }
 
@@ -371,6 +373,9 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
                             fmt::format("quality.wavelengths = {}: {} groups of 3 wavelengths, each with its own "
                                         "LUTs and views (the sky passes' runs count them)",
                                         n, groups)});
+    // The principles that act on a texel's colour, once on the combined colour.
+    if (pruned.aoas.clouds.enabled || pruned.aoas.shapes.enabled || pruned.effects.night_dimming)
+      plan.passes.push_back({"style", "every texel", "once per frame", plan.frames, 0.0});
   }
   PlanCloudPasses(first, plan);
   PlanMoonlitPasses(first, pruned, plan);

@@ -85,6 +85,20 @@ class SkyRenderer {
   SkyRenderer(const SkyRenderer&) = delete;
   SkyRenderer& operator=(const SkyRenderer&) = delete;
 
+  // The spectral mode's style pass (SpectralSky): a renderer with no sky of
+  // its own, whose one pipeline (sky_style.comp) applies the principles that
+  // act on a texel's colour (the AOAS saturation clouds and shapes, the
+  // night floor; StyleSkyRadiance of aoas.glsl) to views of colour that
+  // `output_scale` maps radiance to, as the sky pass of the three-wavelength
+  // path applies them to its radiance.
+  static std::unique_ptr<SkyRenderer> StylePass(VulkanContext& context, const AtmosphereParams& atmosphere,
+                                                const QualitySettings& quality, const EffectSettings& effects,
+                                                const Rgb& output_scale, const AoasInputs& aoas);
+  // StylePass only: styles `images` (RGBA texels of `views`) in place. A
+  // MAPPING_DIRECTIONS view takes its texels' unit directions from `directions`.
+  void ApplyStyle(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                  std::vector<std::vector<float>>& images, const std::vector<glm::dvec3>& directions = {});
+
   // Builds the transmittance LUT, then the multiple-scattering LUT (only when
   // multiple scattering is on). Called automatically by the first Render.
   void PrecomputeLuts();
@@ -163,6 +177,12 @@ class SkyRenderer {
     uint32_t groups_x, groups_y;
   };
 
+  enum class Role { kSky, kStylePass };
+  SkyRenderer(Role role, VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+              const EffectSettings& effects, const Rgb& output_scale, bool output_directions, const AoasInputs& aoas,
+              const CloudInputs& clouds, const ShaderSwitches& shaders);
+  void CreateDescriptorSet();  // the layouts, the pool and the set of kBindingCount bindings
+
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
@@ -209,6 +229,7 @@ class SkyRenderer {
   EffectSettings effects_;
   AoasSwitches aoas_switches_;
   bool output_directions_ = false;
+  bool style_pass_ = false;  // StylePass: style_pipeline_ is its only pipeline
   bool disc_pass_ = false;  // UsesSunDiscPass
   bool luts_ready_ = false;
   bool skyview_ready_ = false;
@@ -247,6 +268,7 @@ class SkyRenderer {
   VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
   VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
   VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;  // built on the first frame that marches the twilight band
+  VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
   bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;

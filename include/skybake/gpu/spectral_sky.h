@@ -2,6 +2,9 @@
 // per group of three wavelength bins, each with its group's atmosphere and
 // LUTs, and their views combined into linear Rec.709 (cd/m^2) with the
 // groups' CIE weights. Cost grows with the number of groups, ceil(N / 3).
+// The principles that act on a texel's colour (the AOAS saturation clouds
+// and shapes, the night floor) are applied once, to the combined colour, by
+// a style pass.
 // A SkyRenderer whose quality asks for more than three wavelengths holds one
 // and forwards to it, so every user of the renderer gets the spectral sky.
 #pragma once
@@ -49,6 +52,13 @@ class SpectralSky {
   SpectralBins bins_;
   std::vector<SpectralGroup> groups_;
   std::vector<std::unique_ptr<SkyRenderer>> renderers_;
+  // The style pass (SkyRenderer::StylePass) when the style has principles
+  // that act on a texel's colour (the AOAS saturation clouds and shapes, the
+  // night floor): the groups render without them, and it applies them to the
+  // combined colour, as the three-wavelength sky pass does to its radiance.
+  std::unique_ptr<SkyRenderer> style_;
+  AoasInputs style_aoas_;
+  EffectSettings style_effects_;
   std::vector<PassTiming> timings_;
 };
 
