@@ -344,6 +344,92 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
   return -r0 * mu + branch * sqrt(max(disc, 0.0));
 }
 
+// Nearest-voxel reads of an n^3 volume and of an n^2 map (the texel that
+// holds the point), wrapping: one load where the trilinear read takes 8.
+float SampleVolumeNearest(int first, int n, vec3 uvw) {
+  ivec3 i = min(ivec3(fract(uvw) * float(n)), ivec3(n - 1));
+  return cloud_noise[first + (i.z * n + i.y) * n + i.x];
+}
+float SampleMapNearest(int first, int n, vec2 uv) {
+  ivec2 i = min(ivec2(fract(uv) * float(n)), ivec2(n - 1));
+  return cloud_noise[first + i.y * n + i.x];
+}
+
+// LayerExtinction without the detail erosion (the light march's density),
+// its volumes and weather map read at the nearest voxel: the light march's
+// far samples (CloudOpticalDepthToSun), where a step is about a voxel long
+// or longer, so the sample is a point estimate of the step either way.
+float LayerLightExtinctionNearest(int l, vec2 xz, float h) {
+  GpuCloudLayer layer = gpu_clouds.layers[l];
+  float hf = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
+  float profile = HeightProfile(layer.profile, hf);
+  vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
+  vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
+  float d;
+  if (layer.weather.w > 1.5) {
+    float n = float(gpu_clouds.resolution.x);
+    d = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x,
+                            vec3(weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), weather_uv.y));
+  } else {
+    float weather = SampleMapNearest(layer.noise.z, gpu_clouds.resolution.z, weather_uv);
+    float coverage = clamp(2.0 * layer.weather.x - 1.0 + weather, 0.0, 1.0);
+    float shape = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x,
+                                      vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y);
+    float base = mix(1.0, shape, layer.shape.x) * profile;
+    d = coverage > 0.0 ? clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage : 0.0;
+  }
+  return hf > 0.0 && hf < 1.0 ? d * layer.shell.z : 0.0;
+}
+
+float CloudLightExtinction(vec2 xz, float h, bool nearest) {
+  if (!nearest) return CloudExtinction(xz, h, false);
+  float sigma = 0.0;
+  for (int l = 0; l < kCloudLayers; ++l) sigma += LayerLightExtinctionNearest(l, xz, h);
+  return sigma;
+}
+
+// The light march's place: the next sample's distance `s` along the Sun and
+// its length (0: it adds nothing). Own band first (n samples placed
+// quadratically over `distance`), then n_above uniform samples over each
+// band the Sun's ray crosses above band_top. s0, b, i_above: the march's
+// state from the previous sample.
+struct CloudLightState {
+  float s0;
+  int b, i_above;
+  float depth, depth_above;
+};
+
+void CloudLightStep(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top,
+                    float distance, int n, int n_above, int j, bool nearest, inout CloudLightState st) {
+  float r = atm.bottom_radius + h;
+  float s, length_;
+  bool own = j < n;
+  if (own) {
+    float u1 = float(j + 1) / float(n);
+    float s1 = distance * u1 * u1;
+    s = 0.5 * (st.s0 + s1);
+    length_ = s1 - st.s0;
+    st.s0 = s1;
+  } else {
+    float lo = gpu_clouds.bands[st.b].x, hi = gpu_clouds.bands[st.b].y;
+    float s_lo = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
+    float s_hi = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
+    float ds = (s_hi - s_lo) / float(n_above);
+    s = s_lo + (float(st.i_above) + 0.5) * ds;
+    // A band below the sample's own (or the own one) adds nothing.
+    length_ = lo < band_top ? 0.0 : ds;
+    if (++st.i_above == n_above) {
+      st.i_above = 0;
+      ++st.b;
+    }
+  }
+  float sigma = length_ > 0.0
+                    ? CloudLightExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), nearest) * length_
+                    : 0.0;
+  if (own) st.depth += sigma;
+  else st.depth_above += sigma;
+}
+
 // Optical depth (dimensionless) toward the Sun from a view sample, in two
 // parts. Its own band: light_steps samples placed quadratically (dense near
 // the sample) over the distance to the top of the band along the Sun, at
@@ -351,51 +437,29 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
 // deck above darkens the sunlight of the clouds below it): each band the
 // Sun's ray crosses on its way up, min(light_steps, 4) uniform samples over
 // the crossing (a band above is crossed whole). Both without the detail
-// erosion. One loop over both parts with one density call, its trip count
-// the samples there are: lavapipe inlines every call, never branches over an
-// `if` (a block no lane takes still runs, masked), and runs a loop's body at
-// least once, so a loop per band (the four a one-band style does not have
-// among them) cost four density reads per view sample for nothing.
+// erosion. The first phase.w samples (the nearest the view sample) read the
+// volumes trilinearly, the others the nearest voxel
+// (quality.cloud_light_trilinear_steps). Two loops, each with one density
+// call, their trip counts the samples there are: lavapipe inlines every
+// call, never branches over an `if` (a block no lane takes still runs,
+// masked; a per-sample choice of read would run both), and runs a loop's
+// body at least once, so a loop per band (the four a one-band style does not
+// have among them) cost four density reads per view sample for nothing.
 const float kCloudLightDistanceKm = 8.0;
 float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top) {
   float reach = (band_top - h) / max(mu_s, 0.1);
   float distance = min(max(reach, 0.05), kCloudLightDistanceKm);
   int n = gpu_clouds.counts.z;
-  float r = atm.bottom_radius + h;
-  float depth = 0.0, depth_above = 0.0;
-  // The samples: n in the own band, then n_above in each band b (when above band_top).
   int bands = gpu_clouds.resolution.w > 1 ? gpu_clouds.resolution.w : 0;
   int n_above = min(n, 4);
   int total = n + bands * n_above;
-  float s0 = 0.0;
-  int b = 0, i_above = 0;
-  for (int j = 0; j < total; ++j) {
-    float s, length_;
-    bool own = j < n;
-    if (own) {
-      float u1 = float(j + 1) / float(n);
-      float s1 = distance * u1 * u1;
-      s = 0.5 * (s0 + s1);
-      length_ = s1 - s0;
-      s0 = s1;
-    } else {
-      float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
-      float s_lo = CloudRayToAltitude(atm, r, h, mu_s, lo, 1.0);
-      float s_hi = CloudRayToAltitude(atm, r, h, mu_s, hi, 1.0);
-      float ds = (s_hi - s_lo) / float(n_above);
-      s = s_lo + (float(i_above) + 0.5) * ds;
-      // A band below the sample's own (or the own one) adds nothing.
-      length_ = lo < band_top ? 0.0 : ds;
-      if (++i_above == n_above) {
-        i_above = 0;
-        ++b;
-      }
-    }
-    float sigma = length_ > 0.0 ? CloudExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * length_ : 0.0;
-    if (own) depth += sigma;
-    else depth_above += sigma;
-  }
-  return bands > 1 ? depth + depth_above : depth;
+  int trilinear = min(int(gpu_clouds.phase.w), total);
+  CloudLightState st = CloudLightState(0.0, 0, 0, 0.0, 0.0);
+  for (int j = 0; j < trilinear; ++j)
+    CloudLightStep(atm, xz, h, mu_s, sun, band_top, distance, n, n_above, j, false, st);
+  for (int j = trilinear; j < total; ++j)
+    CloudLightStep(atm, xz, h, mu_s, sun, band_top, distance, n, n_above, j, true, st);
+  return bands > 1 ? st.depth + st.depth_above : st.depth;
 }
 
 // The ambient table at altitude h: the mean radiance of the sky above
@@ -518,6 +582,41 @@ void CloudSegmentAir(IN(CloudSegmentTables) tables, float u, vec3 w, out vec3 tr
   inscatter = tables.air_inscatter[0] + g * max(tables.air_start - transmittance, vec3(0.0));
 }
 
+// The atmosphere's transmittance to the Sun along one segment of the view
+// ray: its optical depth (the transmittance LUT's) at the segment's start,
+// middle and end, quadratic in u between them as the air's tables above
+// (CloudSegmentWeights); the visible fraction of the disc, which falls from
+// 1 to 0 within a sample or two at the Earth's shadow, per sample. Read per
+// sample, the LUT was 4 texels and its parametrisation at every view sample
+// (lavapipe runs it, masked, whether or not the sample holds cloud).
+struct CloudSunSegment {
+  vec3 depth[3];
+};
+
+CloudSunSegment CloudSunSegmentRead(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, float t0, float t1) {
+  CloudSunSegment seg;
+  float r0 = atm.bottom_radius + atm.observer_altitude;
+  for (int k = 0; k < 3; ++k) {
+    float t = mix(t0, t1, 0.5 * float(k));
+    float h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
+    float r = atm.bottom_radius + h;
+    float mu_s = dot(vec3(t * view.x, r0 + t * view.y, t * view.z), sun) / r;
+    seg.depth[k] = -log(max(GetTransmittanceToTopBoundary(atm, r, h, ClampCosine(mu_s)), vec3(1e-30)));
+  }
+  return seg;
+}
+
+// The Sun's light at a sample (weights w of its u): the segment's
+// transmittance times the visible fraction of the disc at (r, h, mu_s), as
+// GetTransmittanceToSun.
+vec3 CloudSunLight(IN(AtmosphereParameters) atm, IN(CloudSunSegment) seg, vec3 w, float r, float h, float mu_s) {
+  float sin_theta_h = atm.bottom_radius / r;
+  float cos_theta_h = -sqrt(max(h * (r + atm.bottom_radius), 0.0)) / r;
+  float visible = smoothstep(-sin_theta_h * atm.sun_angular_radius, sin_theta_h * atm.sun_angular_radius,
+                             mu_s - cos_theta_h);
+  return exp(-CloudSegmentAt(seg.depth, w)) * visible;
+}
+
 // Marches the view ray through the part [t0, t1] of a band of thickness
 // `band_thickness`: steps of a third of view_steps per thickness crossed,
 // at most view_steps (a vertical crossing takes a third of them, a
@@ -533,6 +632,7 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
   float cos_theta = dot(view, sun);
   int octaves = gpu_clouds.counts.w;
   CloudSegmentTables tables = CloudSegmentRead(atm, view, ap, t0, t1);
+  CloudSunSegment sun_segment = CloudSunSegmentRead(atm, view, sun, t0, t1);
   for (int i = 0; i < n; ++i) {
     float t = t0 + (float(i) + 0.5) * dt;
     float h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
@@ -543,7 +643,9 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     vec3 p = vec3(xz.x, r0 + t * view.y, xz.y);
     float mu_s = dot(p, sun) / (atm.bottom_radius + h);
     float r = atm.bottom_radius + h;
-    vec3 sun_light = GetTransmittanceToSun(atm, r, h, ClampCosine(mu_s));
+    float u = (float(i) + 0.5) / float(n);
+    vec3 w = CloudSegmentWeights(u);
+    vec3 sun_light = CloudSunLight(atm, sun_segment, w, r, h, ClampCosine(mu_s));
     vec3 scattered = vec3(0.0);
     if (max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
       float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
@@ -571,8 +673,6 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
         break;
       }
     }
-    float u = (float(i) + 0.5) / float(n);
-    vec3 w = CloudSegmentWeights(u);
     vec3 source = albedo * (scattered + CloudAmbient(CloudSegmentAt(tables.up, w), CloudSegmentAt(tables.down, w), hf));
     // Hillaire 2016 section 5.6.3: the in-scattering integrated over the step
     // with the transmittance inside it, S (1 - exp(-sigma_t dt)) / sigma_t,

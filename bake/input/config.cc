@@ -157,6 +157,9 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   if (v.kReads || !s.clouds.layers.empty()) {
     v.Int("quality.cloud_view_steps", cq.view_steps, 1, kMaxSteps);
     v.Int("quality.cloud_light_steps", cq.light_steps, 1, 256);
+    // Written only when it reads some light samples at the nearest voxel.
+    if (v.kReads || cq.light_trilinear_steps < cq.light_steps)
+      v.Int("quality.cloud_light_trilinear_steps", cq.light_trilinear_steps, 0, 256);
     v.Int("quality.cloud_octaves", cq.octaves, 1, 16);
     v.Int("quality.cloud_shape_resolution", cq.shape_resolution, 8, 256);
     v.Int("quality.cloud_detail_resolution", cq.detail_resolution, 8, 256);

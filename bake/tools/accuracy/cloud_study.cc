@@ -59,14 +59,17 @@ Scene StudyScene() {
 
 CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather, int octaves = 8,
                          double panorama_scale = 0.0) {
-  return {.view_steps = view, .light_steps = light, .octaves = octaves, .shape_resolution = shape,
-          .detail_resolution = detail, .weather_resolution = weather, .panorama_scale = panorama_scale};
+  // Every light sample trilinear, unless a case says otherwise.
+  return {.view_steps = view, .light_steps = light, .light_trilinear_steps = 256, .octaves = octaves,
+          .shape_resolution = shape, .detail_resolution = detail, .weather_resolution = weather,
+          .panorama_scale = panorama_scale};
 }
 
 std::string CaseName(const CloudQuality& q) {
   std::string name = fmt::format("{}/{} vol {}/{}/{}", q.view_steps, q.light_steps, q.shape_resolution,
                                  q.detail_resolution, q.weather_resolution);
   if (q.octaves != 8) name += fmt::format(" oct {}", q.octaves);
+  if (q.light_trilinear_steps < q.light_steps) name += fmt::format(" tri {}", q.light_trilinear_steps);
   return name;
 }
 
@@ -241,6 +244,14 @@ std::vector<CloudQuality> MarchCases(bool quick) {
   cases.push_back(MakeQuality(48, 12, 64, 16, 256));
   cases.push_back(MakeQuality(48, 12, 64, 32, 128));
   for (int octaves : {2, 4}) cases.push_back(MakeQuality(48, 12, 64, 32, 256, octaves));
+  // The light march's far samples at the nearest voxel
+  // (quality.cloud_light_trilinear_steps): the first k trilinear.
+  for (auto [view, light, trilinear] : {std::tuple{48, 24, 4}, {48, 24, 8}, {48, 24, 12}, {24, 12, 3}, {24, 12, 6},
+                                        {32, 16, 4}, {32, 24, 6}, {48, 16, 4}}) {
+    CloudQuality q = MakeQuality(view, light, 64, 32, 256);
+    q.light_trilinear_steps = trilinear;
+    cases.push_back(q);
+  }
   return cases;
 }
 
