@@ -19,8 +19,31 @@ vec4 CloudPanoramaTexel(int first, int width, int index, int y) {
   return cloud_lut[first + index];
 }
 
-// The panorama's texels around `view` (Imf::LatLongMap's grid: row 0 the
-// zenith, columns 0 and width - 1 both the meridian behind -Z), bilinear,
+// The texels row y of a width x height panorama marches: one more than
+// width x cos(latitude), so its texels are no farther apart in longitude
+// than the equator's (a latlong row holds 1 / cos(latitude) times the texels
+// its angular resolution needs); at least CLOUD_PANORAMA_MIN_ROW_WIDTH, at
+// most width (CloudPanoramaRowWidth in cloud_panorama.h). The row keeps
+// its place (texels y x width on) and its first and last texels are the
+// meridian behind -Z, as in a latlong of this width.
+int CloudPanoramaRowWidth(int width, int height, int y) {
+  float cos_latitude = sin(kPi * float(y) / float(height - 1));
+  return clamp(int(ceil(float(width) * cos_latitude)) + 1, min(CLOUD_PANORAMA_MIN_ROW_WIDTH, width), width);
+}
+
+// Row y at `u` in [0, 1] along it (column 0 at 0, its last column at 1),
+// linear between its two nearest texels.
+vec4 CloudPanoramaRowRead(int first, int width, int height, int y, float u) {
+  int w = CloudPanoramaRowWidth(width, height, y);
+  float x = u * float(w - 1);
+  int x0 = min(int(x), w - 2);
+  int row = y * width + x0;
+  return mix(CloudPanoramaTexel(first, width, row, y), CloudPanoramaTexel(first, width, row + 1, y), x - float(x0));
+}
+
+// The panorama's texels around `view` (Imf::LatLongMap's grid, each row
+// with its own width: row 0 the zenith, a row's first and last columns both
+// the meridian behind -Z), bilinear,
 // but never across the horizon: a ray just below it meets the ground and no
 // cloud in front of it (seen from below the clouds), one just above crosses
 // the whole deck edge on, so the clouds' transmittance jumps from 1 to about 0
@@ -30,10 +53,10 @@ vec4 CloudPanoramaTexel(int first, int width, int index, int y) {
 vec4 CloudPanoramaRead(int first, int width, int height, vec3 view) {
   float latitude = asin(clamp(view.y, -1.0, 1.0));
   float longitude = atan(view.x, view.z);
-  float x = clamp((0.5 - longitude / (2.0 * kPi)) * float(width - 1), 0.0, float(width - 1));
+  float u = clamp(0.5 - longitude / (2.0 * kPi), 0.0, 1.0);
   float y = clamp((0.5 - latitude / kPi) * float(height - 1), 0.0, float(height - 1));
-  int x0 = min(int(x), width - 2), y0 = min(int(y), height - 2);
-  float fx = x - float(x0), fy = y - float(y0);
+  int y0 = min(int(y), height - 2);
+  float fy = y - float(y0);
   // The cosine of the horizon's zenith angle seen from the observer.
   float ratio = gpu_atmosphere.radii.x / (gpu_atmosphere.radii.x + gpu_atmosphere.radii.z);
   float mu_horizon = -sqrt(max(1.0 - ratio * ratio, 0.0));
@@ -42,10 +65,7 @@ vec4 CloudPanoramaRead(int first, int width, int height, vec3 view) {
   float mu1 = sin(kPi * (0.5 - float(y0 + 1) / float(height - 1)));
   if ((mu0 < mu_horizon) != below) fy = 1.0;
   if ((mu1 < mu_horizon) != below) fy = 0.0;
-  int row0 = y0 * width + x0, row1 = row0 + width;
-  vec4 a = mix(CloudPanoramaTexel(first, width, row0, y0), CloudPanoramaTexel(first, width, row0 + 1, y0), fx);
-  vec4 b = mix(CloudPanoramaTexel(first, width, row1, y0 + 1), CloudPanoramaTexel(first, width, row1 + 1, y0 + 1), fx);
-  return mix(a, b, fy);
+  return mix(CloudPanoramaRowRead(first, width, height, y0, u), CloudPanoramaRowRead(first, width, height, y0 + 1, u), fy);
 }
 
 #endif  // SKYBAKE_CLOUD_PANORAMA_GLSL

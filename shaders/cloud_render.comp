@@ -23,13 +23,18 @@ vec3 ViewDirection(ivec2 texel) {
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   // The panorama's dispatch covers its marched rows only (cloud_panorama.glsl).
+  // A row marches its own width of texels (CloudPanoramaRowWidth).
+  int row_width = push.view.y;
   if (push.rect.w == CLOUD_MODE_PANORAMA) {
     texel.y += CloudPanoramaFirstRow();
     if (texel.y >= CloudPanoramaEndRow()) return;
+    row_width = CloudPanoramaRowWidth(push.view.y, push.view.z, texel.y);
   }
-  if (texel.x >= push.view.y || texel.y >= push.view.z) return;
+  if (texel.x >= row_width || texel.y >= push.view.z) return;
   AtmosphereParameters atm = AtmosphereFromUniform();
-  vec3 view = ViewDirection(texel);
+  vec3 view = push.rect.w == CLOUD_MODE_PANORAMA
+                  ? DirectionFromLatLongPixel(float(texel.x), float(texel.y), row_width, push.view.z)
+                  : ViewDirection(texel);
   CloudMarch m = MarchClouds(atm, view, push.sun_direction.xyz);
   if (push.rect.w == CLOUD_MODE_PANORAMA) {
     cloud_lut[push.rect.x + texel.y * push.view.y + texel.x] = vec4(m.radiance, m.transmittance);

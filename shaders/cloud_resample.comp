@@ -21,10 +21,17 @@ vec3 ViewDirection(ivec2 texel) {
 void main() {
   ivec2 texel = ivec2(gl_GlobalInvocationID.xy);
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
-  // A latlong of the panorama's own size reads its own texel.
-  vec4 c = push.view.x == MAPPING_LATLONG && push.view.y == push.rect.y && push.view.z == push.rect.z
-               ? CloudPanoramaTexel(push.rect.x, push.rect.y, texel.y * push.rect.y + texel.x, texel.y)
-               : CloudPanoramaRead(push.rect.x, push.rect.y, push.rect.z, ViewDirection(texel));
+  // A latlong of the panorama's own size reads its own row: its own texel
+  // where the row is whole, else along the row.
+  vec4 c;
+  if (push.view.x == MAPPING_LATLONG && push.view.y == push.rect.y && push.view.z == push.rect.z) {
+    bool whole = CloudPanoramaRowWidth(push.rect.y, push.rect.z, texel.y) == push.rect.y;
+    c = whole ? CloudPanoramaTexel(push.rect.x, push.rect.y, texel.y * push.rect.y + texel.x, texel.y)
+              : CloudPanoramaRowRead(push.rect.x, push.rect.y, push.rect.z, texel.y,
+                                     float(texel.x) / float(push.rect.y - 1));
+  } else {
+    c = CloudPanoramaRead(push.rect.x, push.rect.y, push.rect.z, ViewDirection(texel));
+  }
   // The clouds' shadow on the ground below the horizon, per texel (cloud_shadow.glsl; off: 0).
   vec3 ground_loss = GroundCloudShadowLoss(AtmosphereFromUniform(), ViewDirection(texel), push.sun_direction.xyz);
   if (c.w == 1.0 && ground_loss == vec3(0.0)) return;  // the sky as the sky pass wrote it

@@ -633,12 +633,24 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
   int octaves = gpu_clouds.counts.w;
   CloudSegmentTables tables = CloudSegmentRead(atm, view, ap, t0, t1);
   CloudSunSegment sun_segment = CloudSunSegmentRead(atm, view, sun, t0, t1);
-  for (int i = 0; i < n; ++i) {
-    float t = t0 + (float(i) + 0.5) * dt;
-    float h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
-    vec2 xz = t * view.xz;
-    float sigma_t = CloudExtinction(xz, h, true);
-    if (sigma_t <= 0.0) continue;
+  // Two loops: the inner one finds the ray's next sample with cloud (the
+  // density alone), the outer one lights it. lavapipe runs a vector of 8
+  // rays in lockstep and never branches over an `if`, so with one loop every
+  // sample paid for the whole lighting, masked, when it held no cloud; now
+  // the lighting runs once per lit sample of the vector's busiest ray.
+  for (int next = 0; next < n;) {
+    int i = next;
+    float t = 0.0, h = 0.0, sigma_t = 0.0;
+    vec2 xz = vec2(0.0);
+    for (; i < n; ++i) {
+      t = t0 + (float(i) + 0.5) * dt;
+      h = AltitudeAlongRay(atm, r0, atm.observer_altitude, view.y, t);
+      xz = t * view.xz;
+      sigma_t = CloudExtinction(xz, h, true);
+      if (!(sigma_t <= 0.0)) break;
+    }
+    if (i >= n) break;
+    next = i + 1;
     // The sample's local vertical and the Sun's cosine zenith there.
     vec3 p = vec3(xz.x, r0 + t * view.y, xz.y);
     float mu_s = dot(p, sun) / (atm.bottom_radius + h);

@@ -7,6 +7,8 @@
 #include <cstring>
 
 #include <gtest/gtest.h>
+
+#include "skybake/gpu/cloud_panorama.h"
 #include <glm/glm.hpp>
 
 #include "skybake/model/aoas.h"
@@ -295,9 +297,14 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
   const PassPlan plan = PlanPasses({on, on});
   const PlannedPass* panorama = pass(plan, "clouds panorama");
   ASSERT_NE(panorama, nullptr) << FormatPlan(plan, "on");
-  EXPECT_EQ(panorama->size, "256 x 128, rows 0 to 64 marched");
+  // Each row marches width x cos(latitude) + 1 texels (CloudPanoramaRowWidth):
+  // over the sky half about 2 / pi of the whole rows.
+  const size_t texels = CloudPanoramaMarchedTexels({256, 128}, {0, 65});
+  EXPECT_GT(texels, 0.6 * 256 * 65);
+  EXPECT_LT(texels, 0.75 * 256 * 65);
+  EXPECT_EQ(panorama->size, "256 x 128, rows 0 to 64 marched, " + std::to_string(texels) + " texels");
   EXPECT_EQ(panorama->runs, 2);
-  EXPECT_EQ(panorama->samples, 256.0 * 65.0 * cq.view_steps * (1.0 + cq.light_steps));
+  EXPECT_EQ(panorama->samples, double(texels) * cq.view_steps * (1.0 + cq.light_steps));
   const PlannedPass* latlong = pass(plan, "clouds latlong (resampled)");
   ASSERT_NE(latlong, nullptr);
   EXPECT_EQ(latlong->samples, 0.0);
@@ -306,7 +313,8 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
   EXPECT_NE(FormatPlan(plan, "on").find("clouds panorama"), std::string::npos);
   // 2 km up, inside the layer: every row.
   EXPECT_EQ(pass(PlanPasses({style("0.45", "[atmosphere]\nobserver_altitude_m = 2000\n")}), "clouds panorama")->size,
-            "256 x 128, rows 0 to 127 marched");
+            "256 x 128, rows 0 to 127 marched, " + std::to_string(CloudPanoramaMarchedTexels({256, 128}, {0, 128})) +
+                " texels");
   // Off: each view marches its own texels.
   const PassPlan marched = PlanPasses({style("0.45", "[quality]\ncloud_panorama_scale = 0.0\n")});
   EXPECT_EQ(pass(marched, "clouds panorama"), nullptr);

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "skybake/gpu_shared.h"
+
 namespace skybake {
 
 int CloudPanoramaHeightFor(const ViewRequest& view) {
@@ -54,6 +56,19 @@ CloudPanoramaRows CloudPanoramaRowsSeeingBands(const CloudPanorama& panorama, do
     while (rows.begin < panorama.height - 1 && mu(rows.begin) > kCloudPanoramaRowMargin) ++rows.begin;
   }
   return rows;
+}
+
+int CloudPanoramaRowWidth(const CloudPanorama& panorama, int y) {
+  constexpr double kPi = 3.14159265358979323846;
+  const double cos_latitude = std::sin(kPi * double(y) / double(panorama.height - 1));
+  const int w = int(std::ceil(double(panorama.width) * cos_latitude)) + 1;
+  return std::clamp(w, std::min(CLOUD_PANORAMA_MIN_ROW_WIDTH, panorama.width), panorama.width);
+}
+
+size_t CloudPanoramaMarchedTexels(const CloudPanorama& panorama, const CloudPanoramaRows& rows) {
+  size_t texels = 0;
+  for (int y = rows.begin; y < rows.end; ++y) texels += size_t(CloudPanoramaRowWidth(panorama, y));
+  return texels;
 }
 
 }  // namespace skybake

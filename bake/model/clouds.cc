@@ -140,14 +140,15 @@ double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
   const double layers = double(std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers));
   if (layers == 0.0) return 0.0;
   const CloudQuality& q = clouds.quality;
-  // Per view sample: the layer loop; per lit sample also the light march
-  // (each step a layer loop), the octaves and the albedo's layer loop, and
-  // with more than one layer the march through the bands above (a band per
-  // layer at most, min(light_steps, 4) steps each, each a layer loop).
+  // Per view sample: the layer loop; per lit sample also the lighting loop's
+  // own iteration, the light march (each step a layer loop), the octaves and
+  // the albedo's layer loop, and with more than one layer the march through
+  // the bands above (a band per layer at most, min(light_steps, 4) steps
+  // each, each a layer loop).
   const double above = layers > 1.0 ? layers * (1.0 + std::min(q.light_steps, 4) * (1.0 + layers)) : 0.0;
   // The light march is two loops (trilinear, then nearest reads), one of
   // them possibly empty: a loop runs its body at least once.
-  const double per_sample = 1.0 + layers + (q.light_steps + 1) * (1.0 + layers) + q.octaves + layers + above;
+  const double per_sample = 2.0 + layers + (q.light_steps + 1) * (1.0 + layers) + q.octaves + layers + above;
   return layers * q.view_steps * per_sample;
 }
 

@@ -57,10 +57,10 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
   const CloudPanoramaRows rows = CloudPanoramaRowsSeeingBands(
       panorama, first.atmosphere.bottom_radius_km, first.atmosphere.observer_altitude_m * 1e-3, bands);
   plan.passes.push_back({"clouds panorama",
-                         fmt::format("{} x {}, rows {} to {} marched", panorama.width, panorama.height, rows.begin,
-                                     rows.end - 1),
+                         fmt::format("{} x {}, rows {} to {} marched, {} texels", panorama.width, panorama.height,
+                                     rows.begin, rows.end - 1, CloudPanoramaMarchedTexels(panorama, rows)),
                          fmt::format("once per frame (quality.cloud_panorama_scale = {})", cq.panorama_scale), frames,
-                         double(panorama.width) * (rows.end - rows.begin) * per_texel});
+                         double(CloudPanoramaMarchedTexels(panorama, rows)) * per_texel});
   for (const ViewRequest& v : views)
     plan.passes.push_back({view_name(v) + " (resampled)", fmt::format("{} x {}", v.width, v.height),
                            "once per frame", frames, 0.0});

@@ -157,6 +157,8 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 #define CLOUD_MODE_MARCH 0     // march the view's own texels (no panorama)
 #define CLOUD_MODE_PANORAMA 1  // march the panorama's texels into the cloud table buffer
 #define CLOUD_MODE_RESAMPLE 2  // composite the view from the panorama
+// The cloud panorama's narrowest row, texels (cloud_panorama.glsl, cloud_panorama.h).
+#define CLOUD_PANORAMA_MIN_ROW_WIDTH 16
 
 SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo

@@ -6,9 +6,13 @@
 // work; the panorama marches the directions of the finest view once.
 //
 // The panorama's texel grid is the OpenEXR latlong's (Imf::LatLongMap: row 0
-// the zenith, column 0 and column width - 1 the same meridian), so a latlong
-// view of the panorama's size reads its own texels, bit for bit what marching
-// that view gives; the other views read it bilinearly.
+// the zenith, column 0 and column width - 1 the same meridian), but a row
+// marches only width x cos(latitude) + 1 of its texels, spread over the
+// whole circle (CloudPanoramaRowWidth): the same angular resolution as the
+// equator's, about a third fewer texels over a hemisphere. A latlong view of
+// the panorama's size reads its whole rows' texels, bit for bit what marching
+// that view gives, and the narrower rows along the row; the other views read
+// it bilinearly.
 #pragma once
 
 #include <array>
@@ -57,6 +61,12 @@ CloudPanoramaRows CloudPanoramaRowsSeeingBands(const CloudPanorama& panorama, do
 // the ground's tangent by a kilometre or more (float rounding at 6360 km is
 // half a metre), so a row left out is one the march would leave empty too.
 constexpr double kCloudPanoramaRowMargin = 0.02;
+
+// The texels row y of `panorama` marches (cloud_panorama.glsl): one more
+// than width x cos(latitude), at least CLOUD_PANORAMA_MIN_ROW_WIDTH, at most
+// the width; and the texels the rows [begin, end) march in all.
+int CloudPanoramaRowWidth(const CloudPanorama& panorama, int y);
+size_t CloudPanoramaMarchedTexels(const CloudPanorama& panorama, const CloudPanoramaRows& rows);
 
 // 4096 x 2048 texels of RGBA float: 128 MiB.
 constexpr int kMaxCloudPanoramaHeight = 2048;
