@@ -139,18 +139,21 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
 }
 
 // The twilight band's march (quality.twilight_march_band_deg): with the Sun
-// below the band, the texels in it are the per-texel ray march of the band's
-// steps and the texels above it the sky-view LUT's; with the Sun above it the
-// renderer is the one without the band, texel for texel, and builds no
-// pipeline for it.
+// below quality.twilight_sun_below_deg, the texels in the band are the
+// per-texel ray march of the band's steps (a twilight frame's: the sun
+// transmittance read in the logarithm) and the texels above it the sky-view
+// LUT's; with the Sun above it the renderer is the one without the band,
+// texel for texel, and builds no pipeline for it.
 TEST(ConvergedReferenceTest, TwilightBandIsMarchedBelowItsSunAndPrunedAbove) {
   AtmosphereParams a;
   const EffectSettings single = SingleScatteringOnly();
   QualitySettings band = QualityPreset("production");
   band.twilight_march_band_deg = 6.0;
   band.twilight_march_steps = 48;
+  band.twilight_sun_below_deg = 6.0;
   QualitySettings lut = band, march = band;
   lut.twilight_march_band_deg = 0.0;
+  lut.twilight_sun_below_deg = 0.0;
   march.sky_view_lut = false;
   march.view_steps = 48;
   SkyRenderer with_band(testing::Vulkan(), a, band, single, {1, 1, 1});

@@ -143,12 +143,17 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   v.Int("quality.transmittance_lut_height", q.transmittance_height, 2, kMaxLutSize);
   v.Int("quality.multiscattering_lut_size", q.multiscattering_size, 2, kMaxLutSize);
   v.Int("quality.wavelengths", q.wavelengths, kRgbWavelengths, kMaxWavelengthBins);  // spectrum.h
-  // The twilight band's march: written into the resolved style only when
-  // on, so a style without it resolves (and its EXR headers record it) as
-  // before the key existed.
-  if (v.kReads || q.twilight_march_band_deg > 0.0) {
+  // The twilight settings: written into the resolved style only when they
+  // differ from the named preset's (which the record names), so a style
+  // that keeps them resolves (and its EXR headers record it) as before the
+  // keys existed.
+  const QualitySettings preset = QualityPreset(s.quality_preset);
+  if (v.kReads || q.twilight_march_band_deg != preset.twilight_march_band_deg ||
+      q.twilight_march_steps != preset.twilight_march_steps ||
+      q.twilight_sun_below_deg != preset.twilight_sun_below_deg) {
     v.Real("quality.twilight_march_band_deg", q.twilight_march_band_deg, Range{0.0, 90.0, false, false});
     v.Int("quality.twilight_march_steps", q.twilight_march_steps, 0, kMaxSteps);
+    v.Real("quality.twilight_sun_below_deg", q.twilight_sun_below_deg, Range{0.0, 90.0, false, false});
   }
   // The cloud sampling keys: read always; written into the resolved style
   // only when it has cloud layers, so a style without them resolves (and

@@ -46,6 +46,10 @@ Rgb NightSkyRadiance(const EffectSettings& e) {
   return {e.night_sky_luminance_cd_m2 / k[0], e.night_sky_luminance_cd_m2 / k[1], e.night_sky_luminance_cd_m2 / k[2]};
 }
 
+double TwilightSunElevationDeg(const QualitySettings& q) {
+  return q.twilight_sun_below_deg > 0.0 ? q.twilight_sun_below_deg : q.twilight_march_band_deg;
+}
+
 bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
   return q.light_steps <= 0 || e.multiple_scattering || e.ground || e.sun_disc;
 }
@@ -74,7 +78,9 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
   g.night = v4(NightSkyRadiance(effects), effects.night_dimming_strength);
   g.twilight = {float(q.twilight_march_band_deg * M_PI / 180.0),
-                float(q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps), 0.0f, 0.0f};
+                float(q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps),
+                float(TwilightSunElevationDeg(q) > 0.0 ? std::sin(TwilightSunElevationDeg(q) * M_PI / 180.0) : -2.0),
+                0.0f};
   return g;
 }
 
