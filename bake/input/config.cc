@@ -121,6 +121,12 @@ void VisitEffects(SkyStyle& s, Visitor& v) {
   v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
 }
 
+template <class Visitor>
+bool RecordsEveryKey(const Visitor& v) {
+  if constexpr (requires { v.record_every_key; }) return v.record_every_key;
+  return false;
+}
+
 // The sampling: the preset, then the keys that refine it (sky and clouds).
 template <class Visitor>
 void VisitQuality(SkyStyle& s, Visitor& v) {
@@ -148,7 +154,7 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   // that keeps them resolves (and its EXR headers record it) as before the
   // keys existed.
   const QualitySettings preset = QualityPreset(s.quality_preset);
-  if (v.kReads || q.twilight_march_band_deg != preset.twilight_march_band_deg ||
+  if (v.kReads || RecordsEveryKey(v) || q.twilight_march_band_deg != preset.twilight_march_band_deg ||
       q.twilight_march_steps != preset.twilight_march_steps ||
       q.twilight_sun_below_deg != preset.twilight_sun_below_deg) {
     v.Real("quality.twilight_march_band_deg", q.twilight_march_band_deg, Range{0.0, 90.0, false, false});
@@ -752,6 +758,7 @@ class StyleReader : public TomlReader {
 class StyleWriter {
  public:
   static constexpr bool kReads = false;
+  bool record_every_key = false;  // also the keys a resolved style leaves out where they are the preset's
   void Real(const char* path, double& v, const Range&) { Put(path, v); }
   void Triple(const char* path, Rgb& v, const Range&) { Put(path, toml::array{v[0], v[1], v[2]}); }
   void Int(const char* path, int& v, int, int) { Put(path, int64_t(v)); }
@@ -911,6 +918,7 @@ std::vector<std::string> PresetKeys() {
     SkyStyle style;
     style.quality = QualityPreset(name);
     StyleWriter writer;
+    writer.record_every_key = true;  // the twilight keys too, where they are production's
     VisitStyle(style, writer);
     presets.push_back(*writer.table().get_as<toml::table>("quality"));
   }

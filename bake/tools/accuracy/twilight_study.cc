@@ -5,8 +5,9 @@
 // Sun. Single scattering (no multiple scattering, no ground, no disc), upper
 // hemisphere, denser near the horizon than the integrator study (the
 // shadow's edge lies 0..6 deg above it). `--study twilight`; `--only TEXT`
-// keeps the cases whose name contains TEXT; `--observer-altitude-m` moves
-// the observer. Writes twilight.csv.
+// keeps the cases whose name contains TEXT (`--only presets`: the three
+// presets alone); `--observer-altitude-m` moves the observer. Writes
+// twilight.csv.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -167,7 +168,9 @@ std::string RunTwilightStudy(StudyContext& context) {
   const std::vector<double> suns = TwilightSunElevations(options.quick);
   std::vector<TwilightCase> cases = TwilightCases();
   if (options.quick) cases.resize(2);  // draft, production
-  if (!options.only.empty())
+  if (options.only == "presets")
+    std::erase_if(cases, [&](const TwilightCase& c) { return c.name != c.preset; });
+  else if (!options.only.empty())
     std::erase_if(cases, [&](const TwilightCase& c) { return c.name.find(options.only) == std::string::npos; });
 
   context.Say(fmt::format("twilight reference: {} directions x {} sun elevations", dirs.size(), suns.size()));

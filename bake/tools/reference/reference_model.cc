@@ -146,8 +146,15 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
   glsl::AtmosphereParameters atm = impl_->ForSun(sun);
   if (impl_->use_skyview && !glsl::InTwilightMarchBand(atm, view, sun))
     return glsl::ComputeSkyRadianceFromSkyView(atm, view, sun) * impl_->output_scale;
-  if (impl_->use_skyview) atm.view_steps = atm.twilight_march_steps;  // the band's march
-  return glsl::ComputeSkyRadiance(atm, view, sun) * impl_->output_scale;
+  if (!impl_->use_skyview) return glsl::ComputeSkyRadiance(atm, view, sun) * impl_->output_scale;
+  // The band's march, with the disc added as the GPU's sun-disc pass adds it
+  // to a sky-view renderer's texels: through the transmittance LUT.
+  atm.view_steps = atm.twilight_march_steps;
+  glsl::AtmosphereParameters sky = atm;
+  sky.sun_disc = false;
+  glm::dvec3 radiance = glsl::ComputeSkyRadiance(sky, view, sun);
+  if (atm.sun_disc) radiance += glsl::SunDiscThroughAtmosphere(atm, view, sun) * atm.solar_irradiance;
+  return radiance * impl_->output_scale;
 }
 
 glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
