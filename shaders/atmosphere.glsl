@@ -153,6 +153,24 @@ vec3 SampleTransmittanceLut(IN(AtmosphereParameters) atm, vec2 uv) {
   return mix(lower, upper, b.fy);
 }
 
+// The same read with the optical depth -log T interpolated instead of T:
+// along grazing rays near the ground T falls as exp(-tau) with tau up to ~10
+// (blue, the horizon) and changing by ~0.5 per texel of the 256 x 64 LUT,
+// where a linear mix of T overestimates it by up to tau^2 / 8 ~ 3%; tau itself
+// is smooth there (docs/accuracy.md, "Twilight"). A texel at or below 1e-30
+// (float32 denormals) keeps the linear mix.
+vec3 SampleTransmittanceLutLog(IN(AtmosphereParameters) atm, vec2 uv) {
+  LutBilinear b = LutBilinearAt(uv, atm.transmittance_width, atm.transmittance_height);
+  vec3 t00 = TransmittanceLutTexel(b.x0, b.y0), t10 = TransmittanceLutTexel(b.x1, b.y0);
+  vec3 t01 = TransmittanceLutTexel(b.x0, b.y1), t11 = TransmittanceLutTexel(b.x1, b.y1);
+  vec3 linear = mix(mix(t00, t10, b.fx), mix(t01, t11, b.fx), b.fy);
+  vec3 floor_value = vec3(1e-30);
+  vec3 lowest = min(min(t00, t10), min(t01, t11));
+  vec3 logarithmic = exp2(mix(mix(log2(max(t00, floor_value)), log2(max(t10, floor_value)), b.fx),
+                              mix(log2(max(t01, floor_value)), log2(max(t11, floor_value)), b.fx), b.fy));
+  return mix(linear, logarithmic, vec3(greaterThan(lowest, floor_value)));
+}
+
 vec3 SampleMultipleScatteringLut(IN(AtmosphereParameters) atm, vec2 uv) {
   LutBilinear b = LutBilinearAt(uv, atm.multiscattering_width, atm.multiscattering_height);
   vec3 lower = mix(MultipleScatteringLutTexel(b.x0, b.y0), MultipleScatteringLutTexel(b.x1, b.y0), b.fx);
@@ -235,15 +253,19 @@ vec3 GetTransmittanceToTopBoundary(IN(AtmosphereParameters) atm, Real r, Real al
   return SampleTransmittanceLut(atm, TransmittanceUvFromRMu(atm, r, altitude, mu));
 }
 
-// Transmittance to the Sun, times the fraction of the solar disc above the
-// horizon (Bruneton 2017), which keeps the terminator continuous.
-vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atm, Real r, Real altitude,
-                           Real mu_s) {
+// The fraction of the solar disc above the horizon at radius r (Bruneton
+// 2017), which keeps the terminator continuous.
+Real SunVisibleFraction(IN(AtmosphereParameters) atm, Real r, Real altitude, Real mu_s) {
   Real sin_theta_h = atm.bottom_radius / r;
   Real cos_theta_h = -sqrt(max(altitude * (r + atm.bottom_radius), 0.0)) / r;
-  Real visible = smoothstep(-sin_theta_h * atm.sun_angular_radius,
-                            sin_theta_h * atm.sun_angular_radius, mu_s - cos_theta_h);
-  return GetTransmittanceToTopBoundary(atm, r, altitude, mu_s) * visible;
+  return smoothstep(-sin_theta_h * atm.sun_angular_radius, sin_theta_h * atm.sun_angular_radius,
+                    mu_s - cos_theta_h);
+}
+
+// Transmittance to the Sun, times the fraction of the solar disc above the horizon.
+vec3 GetTransmittanceToSun(IN(AtmosphereParameters) atm, Real r, Real altitude,
+                           Real mu_s) {
+  return GetTransmittanceToTopBoundary(atm, r, altitude, mu_s) * SunVisibleFraction(atm, r, altitude, mu_s);
 }
 
 // ---------------------------------------------------------------- phase functions
@@ -389,7 +411,13 @@ Real SunDiscRadiance(IN(AtmosphereParameters) atm, Real theta) {
 // Transmittance from (r_t, mu_s_t) to the Sun, times the visible fraction of
 // the disc: from the LUT, or (light_steps > 0) by a midpoint march of
 // light_steps steps, Galaj 2019's "light samples".
+// In a twilight frame (atm.transmittance_log) the LUT is read in the
+// logarithm (SampleTransmittanceLutLog): the Sun's light there crosses the
+// low air at grazing angles, where T is far from linear between texels.
 vec3 SunTransmittance(IN(AtmosphereParameters) atm, Real r_t, Real h, Real mu_s_t) {
+  if (atm.light_steps <= 0 && atm.transmittance_log)
+    return SampleTransmittanceLutLog(atm, TransmittanceUvFromRMu(atm, r_t, h, mu_s_t)) *
+           SunVisibleFraction(atm, r_t, h, mu_s_t);
   if (atm.light_steps <= 0) return GetTransmittanceToSun(atm, r_t, h, mu_s_t);
   Real sin_theta_h = atm.bottom_radius / r_t;
   Real cos_theta_h = -sqrt(max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
@@ -851,13 +879,13 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
 }
 
 // Whether `view` is ray-marched per texel rather than read from the sky-view
-// LUT: at twilight (the Sun below twilight_march_band of elevation), the sky
+// LUT: at twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
 // from the observer's horizon up to twilight_march_band above it, where the
 // Earth's shadow and the band above it fall by orders of magnitude within
 // the spacing of the LUT's rows (docs/accuracy.md, "Twilight"). Hillaire
 // 2020 section 5.3 suggests the same fall-back for accuracy.
 bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  if (!(atm.twilight_march_band > 0.0) || sun.y >= sin(atm.twilight_march_band)) return false;
+  if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return false;
   Real above_horizon = HorizonZenithAngle(atm) - atan(length(vec2(view.x, view.z)), view.y);
   return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band;
 }

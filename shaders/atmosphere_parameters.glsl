@@ -37,6 +37,8 @@ struct AtmosphereParameters {
   int sky_view_height;          // sky-view LUT texels along the zenith angle
   Real twilight_march_band;     // rad; 0: every texel reads the sky-view LUT
   int twilight_march_steps;     // view steps of the twilight band's march
+  Real twilight_sun_sine;       // sine of the Sun's elevation below which a frame is twilight
+  bool transmittance_log;       // the view samples' sun transmittance read in log (twilight frames)
   bool multiple_scattering;     // add Hillaire's multiple-scattering term
   bool sun_disc;                // add the limb-darkened solar disc
   bool ground;                  // add the sunlit Lambertian ground

@@ -167,7 +167,9 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.transmittance_height = gpu_atmosphere.lut_sizes.y;
   atm.multiscattering_width = gpu_atmosphere.lut_sizes.z;
   atm.multiscattering_height = gpu_atmosphere.lut_sizes.w;
-  atm.view_steps = gpu_atmosphere.samples.x;
+  // A twilight frame's pipeline without the sky-view LUT marches every
+  // texel with the twilight steps (quality.twilight_march_steps).
+  atm.view_steps = kTwilightMarch && !kUseSkyView ? int(gpu_atmosphere.twilight.y) : gpu_atmosphere.samples.x;
   atm.transmittance_steps = gpu_atmosphere.samples.y;
   atm.multiscattering_steps = gpu_atmosphere.samples.z;
   atm.multiscattering_sqrt_dirs = gpu_atmosphere.effects.w;
@@ -178,6 +180,9 @@ AtmosphereParameters AtmosphereFromUniform() {
   atm.sky_view_height = gpu_atmosphere.render.z;
   atm.twilight_march_band = kTwilightMarch ? gpu_atmosphere.twilight.x : 0.0;
   atm.twilight_march_steps = int(gpu_atmosphere.twilight.y);
+  atm.twilight_sun_sine = gpu_atmosphere.twilight.z;
+  // Only a twilight frame's pipeline has kTwilightMarch (SkyRenderer::TwilightSkyPipeline).
+  atm.transmittance_log = kTwilightMarch;
   atm.multiple_scattering = kMultipleScattering;
   atm.sun_disc = kSunDisc;
   atm.ground = kGround;

@@ -183,7 +183,7 @@ TEST(ConfigTest, PresetInTheDefaultTemplateTakesEffect) {
     }
     uncommented += l + "\n";
   }
-  EXPECT_EQ(keys, 24);  // 13 for the clear sky, 2 for the twilight band, 9 for the cloud layers
+  EXPECT_EQ(keys, 25);  // 13 for the clear sky, 3 for twilight, 9 for the cloud layers
   ConfigResult spelled = ParseSkyStyle(original.substr(0, begin) + uncommented + original.substr(end), "spelled.toml");
   ASSERT_TRUE(spelled.ok()) << ::testing::PrintToString(Messages(spelled));
   EXPECT_EQ(spelled.style.resolved_toml, shipped.style.resolved_toml);
@@ -196,7 +196,8 @@ TEST(ConfigTest, PresetOverriddenByEveryKeyWarns) {
   const std::string all_keys =
       "[quality]\npreset = \"reference\"\nintegrator = \"analytic\"\nsky_view_lut = true\n"
       "sky_view_lut_width = 256\nsky_view_lut_height = 144\nview_steps = 32\ntransmittance_steps = 256\n"
-      "transmittance_lut_width = 256\ntransmittance_lut_height = 64\n";
+      "transmittance_lut_width = 256\ntransmittance_lut_height = 64\ntwilight_march_band_deg = 10.0\n"
+      "twilight_march_steps = 64\n";
   ConfigResult r = ParseSkyStyle(all_keys, "q.toml");
   ASSERT_TRUE(r.ok()) << ::testing::PrintToString(Messages(r));
   ASSERT_EQ(r.warnings.size(), 1u);
@@ -204,7 +205,8 @@ TEST(ConfigTest, PresetOverriddenByEveryKeyWarns) {
             "q.toml:2:10: quality.preset: preset 'reference' changes nothing: every key it sets is given "
             "explicitly (quality.integrator, quality.sky_view_lut, quality.sky_view_lut_height, "
             "quality.sky_view_lut_width, quality.transmittance_lut_height, quality.transmittance_lut_width, "
-            "quality.transmittance_steps, quality.view_steps), and explicit keys refine the preset; remove or "
+            "quality.transmittance_steps, quality.twilight_march_band_deg, quality.twilight_march_steps, "
+            "quality.view_steps), and explicit keys refine the preset; remove or "
             "comment out those keys to use it");
   EXPECT_TRUE(r.style.quality.sky_view_lut);  // the explicit keys still win
   EXPECT_EQ(r.style.quality.view_steps, 32);

@@ -65,7 +65,9 @@ TEST_P(HardCaseTest, FiniteNonNegativeAndGpuMatchesDouble) {
   const std::vector<glm::dvec3> suns = {glm::dvec3(0.0, 1.0, 0.0),  // exactly at the zenith
                                         SunDirectionFromElevationAzimuth(30.0, 120.0),
                                         SunDirectionFromElevationAzimuth(2.0, 250.0),
-                                        // twilight: the Earth's shadow over the low sky
+                                        // twilight (the presets' twilight frames, the Sun below
+                                        // 3 deg): the horizon towards the Sun, the Earth's shadow
+                                        SunDirectionFromElevationAzimuth(0.5, 200.0),
                                         SunDirectionFromElevationAzimuth(-3.0, 160.0),
                                         SunDirectionFromElevationAzimuth(-18.0, 300.0)};
   const std::vector<glm::dvec3> dirs = CaseDirections(suns);

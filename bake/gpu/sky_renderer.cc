@@ -454,9 +454,8 @@ void SkyRenderer::BindOutput(const Buffer& target) {
 }
 
 bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
-  const double band = quality_.twilight_march_band_deg * M_PI / 180.0;
-  return quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ && band > 0.0 &&
-         sun.y < std::sin(band);
+  const double below = TwilightSunElevationDeg(quality_) * M_PI / 180.0;
+  return !aoas_switches_.skydome && !output_directions_ && below > 0.0 && sun.y < std::sin(below);
 }
 
 VkPipeline SkyRenderer::TwilightSkyPipeline() {

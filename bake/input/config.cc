@@ -121,6 +121,12 @@ void VisitEffects(SkyStyle& s, Visitor& v) {
   v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
 }
 
+template <class Visitor>
+bool RecordsEveryKey(const Visitor& v) {
+  if constexpr (requires { v.record_every_key; }) return v.record_every_key;
+  return false;
+}
+
 // The sampling: the preset, then the keys that refine it (sky and clouds).
 template <class Visitor>
 void VisitQuality(SkyStyle& s, Visitor& v) {
@@ -143,12 +149,17 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   v.Int("quality.transmittance_lut_height", q.transmittance_height, 2, kMaxLutSize);
   v.Int("quality.multiscattering_lut_size", q.multiscattering_size, 2, kMaxLutSize);
   v.Int("quality.wavelengths", q.wavelengths, kRgbWavelengths, kMaxWavelengthBins);  // spectrum.h
-  // The twilight band's march: written into the resolved style only when
-  // on, so a style without it resolves (and its EXR headers record it) as
-  // before the key existed.
-  if (v.kReads || q.twilight_march_band_deg > 0.0) {
+  // The twilight settings: written into the resolved style only when they
+  // differ from the named preset's (which the record names), so a style
+  // that keeps them resolves (and its EXR headers record it) as before the
+  // keys existed.
+  const QualitySettings preset = QualityPreset(s.quality_preset);
+  if (v.kReads || RecordsEveryKey(v) || q.twilight_march_band_deg != preset.twilight_march_band_deg ||
+      q.twilight_march_steps != preset.twilight_march_steps ||
+      q.twilight_sun_below_deg != preset.twilight_sun_below_deg) {
     v.Real("quality.twilight_march_band_deg", q.twilight_march_band_deg, Range{0.0, 90.0, false, false});
     v.Int("quality.twilight_march_steps", q.twilight_march_steps, 0, kMaxSteps);
+    v.Real("quality.twilight_sun_below_deg", q.twilight_sun_below_deg, Range{0.0, 90.0, false, false});
   }
   // The cloud sampling keys: read always; written into the resolved style
   // only when it has cloud layers, so a style without them resolves (and
@@ -750,6 +761,7 @@ class StyleReader : public TomlReader {
 class StyleWriter {
  public:
   static constexpr bool kReads = false;
+  bool record_every_key = false;  // also the keys a resolved style leaves out where they are the preset's
   void Real(const char* path, double& v, const Range&) { Put(path, v); }
   void Triple(const char* path, Rgb& v, const Range&) { Put(path, toml::array{v[0], v[1], v[2]}); }
   void Int(const char* path, int& v, int, int) { Put(path, int64_t(v)); }
@@ -909,6 +921,7 @@ std::vector<std::string> PresetKeys() {
     SkyStyle style;
     style.quality = QualityPreset(name);
     StyleWriter writer;
+    writer.record_every_key = true;  // the twilight keys too, where they are production's
     VisitStyle(style, writer);
     presets.push_back(*writer.table().get_as<toml::table>("quality"));
   }

@@ -20,12 +20,18 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 //   production  analytic 32 quadratic steps, sky-view LUT 256 x 144   8.59e-3
 //   reference   Simpson 64 quadratic steps per texel, transmittance
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
+// and at twilight (the Sun below 3 deg: the sun transmittance read in the
+// logarithm; docs/accuracy.md "Twilight", sun 5 .. -10 deg):
+//   draft       the sky up to 10 deg marched, 24 steps                2.42e-2
+//   production  the sky up to 10 deg marched, 64 steps                5.31e-3
+//   reference   128 steps per texel                                   7.08e-4
 QualitySettings QualityPreset(const std::string& name) {
   QualitySettings q;  // production
   if (name == "draft") {
     q.sky_view_width = 192;
     q.sky_view_height = 216;
     q.view_steps = 24;
+    q.twilight_march_steps = 24;
   } else if (name == "reference") {
     q.sky_view_lut = false;
     q.view_steps = 64;
@@ -33,6 +39,8 @@ QualitySettings QualityPreset(const std::string& name) {
     q.transmittance_width = 1024;
     q.transmittance_height = 256;
     q.transmittance_steps = 1024;
+    q.twilight_march_band_deg = 0.0;  // no sky-view LUT: every texel is marched
+    q.twilight_march_steps = 128;
   }
   return q;
 }
@@ -44,6 +52,10 @@ Rgb NightSkyRadiance(const EffectSettings& e) {
   // radiance L / K_c gives Rec.709 (L, L, L), neutral of luminance L.
   const Rgb k = {114974.916437, 71305.954816, 65310.548555};
   return {e.night_sky_luminance_cd_m2 / k[0], e.night_sky_luminance_cd_m2 / k[1], e.night_sky_luminance_cd_m2 / k[2]};
+}
+
+double TwilightSunElevationDeg(const QualitySettings& q) {
+  return q.twilight_sun_below_deg > 0.0 ? q.twilight_sun_below_deg : q.twilight_march_band_deg;
 }
 
 bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
@@ -74,7 +86,9 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
   g.night = v4(NightSkyRadiance(effects), effects.night_dimming_strength);
   g.twilight = {float(q.twilight_march_band_deg * M_PI / 180.0),
-                float(q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps), 0.0f, 0.0f};
+                float(q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps),
+                float(TwilightSunElevationDeg(q) > 0.0 ? std::sin(TwilightSunElevationDeg(q) * M_PI / 180.0) : -2.0),
+                0.0f};
   return g;
 }
 

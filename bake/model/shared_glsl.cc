@@ -37,6 +37,8 @@ AtmosphereParameters SharedAtmosphere(const AtmosphereParams& a, const QualitySe
   atm.sky_view_height = q.sky_view_height;
   atm.twilight_march_band = q.twilight_march_band_deg * M_PI / 180.0;
   atm.twilight_march_steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
+  atm.twilight_sun_sine = TwilightSunElevationDeg(q) > 0.0 ? std::sin(TwilightSunElevationDeg(q) * M_PI / 180.0) : -2.0;
+  atm.transmittance_log = false;  // set per frame (ReferenceModel, as the GPU's twilight pipeline)
   atm.multiple_scattering = effects.multiple_scattering;
   atm.sun_disc = effects.sun_disc;
   atm.ground = effects.ground;

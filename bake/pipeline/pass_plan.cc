@@ -190,21 +190,24 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 }
 
 // The twilight band's march (quality.twilight_march_band_deg): in the
-// frames whose Sun is below the band, the texels up to the band above the
+// frames whose Sun is below TwilightSunElevationDeg (listed only when there
+// is one), the texels up to the band above the
 // horizon (a fraction sin(band) / 2 of each view's directions, which it
 // estimates) are ray-marched by a sky pass of their own pipeline.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
                       PassPlan& plan) {
   const QualitySettings& q = first.quality;
   const double band = q.twilight_march_band_deg;
-  if (!(band > 0.0) || !NeedsSkyViewLut(pruned)) return;
+  const double below = TwilightSunElevationDeg(q);
+  if (!(band > 0.0) || !(below > 0.0) || !NeedsSkyViewLut(pruned)) return;
   const int runs = int(std::count_if(frames.begin(), frames.end(),
-                                     [&](const SkyStyle& f) { return f.sun.elevation_deg < band; }));
+                                     [&](const SkyStyle& f) { return f.sun.elevation_deg < below; }));
+  if (runs == 0) return;  // no twilight frame: the pass never runs
   double texels = 0.0;
   for (const ViewRequest& v : PlanViews(first)) texels += double(v.width) * v.height;
   const int steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
   plan.passes.push_back({"twilight band march", fmt::format("0..{:g} deg above the horizon", band),
-                         fmt::format("frames with the Sun below {:g} deg", band), runs,
+                         fmt::format("frames with the Sun below {:g} deg", below), runs,
                          texels * 0.5 * std::sin(band * M_PI / 180.0) * steps * std::max(q.light_steps, 1)});
 }
 

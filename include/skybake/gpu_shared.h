@@ -87,7 +87,8 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   ivec4 render;                // x: light steps (0: transmittance LUT); y,z: sky-view LUT size; w: step distribution
   vec4 strengths;              // x: multiple-scattering strength; y: sun-disc strength; zw: unused
   vec4 night;                  // xyz: night-sky radiance (output units before output_scale); w: strength
-  vec4 twilight;               // x: twilight march band, rad (0: off); y: its view steps; zw: unused
+  vec4 twilight;               // x: twilight march band, rad (0: off); y: its view steps; z: sine of the Sun's
+                               // elevation below which a frame is twilight; w: unused
 };
 
 // Most cloud-shape segments a style can have (GpuAoas.shape_segments). A

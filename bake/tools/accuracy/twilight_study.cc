@@ -5,8 +5,9 @@
 // Sun. Single scattering (no multiple scattering, no ground, no disc), upper
 // hemisphere, denser near the horizon than the integrator study (the
 // shadow's edge lies 0..6 deg above it). `--study twilight`; `--only TEXT`
-// keeps the cases whose name contains TEXT; `--observer-altitude-m` moves
-// the observer. Writes twilight.csv.
+// keeps the cases whose name contains TEXT (`--only presets`: the three
+// presets alone); `--observer-altitude-m` moves the observer. Writes
+// twilight.csv.
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -40,6 +41,7 @@ std::vector<TwilightCase> TwilightCases() {
     // The variant of a preset that already has a twilight band starts without it.
     c.quality.twilight_march_band_deg = 0.0;
     c.quality.twilight_march_steps = 0;
+    c.quality.twilight_sun_below_deg = 0.0;
     change(c.quality);
     cases.push_back(c);
   };
@@ -50,12 +52,43 @@ std::vector<TwilightCase> TwilightCases() {
       q.sky_view_lut = false;
       q.view_steps = steps;
     });
+  // What limits the 64-step march towards a Sun at 0..1 deg: the sun
+  // transmittance's LUT (a finer one, or none: the Sun's path marched), or
+  // the view integral's rule.
+  variant("production", "ray march 64 steps, no LUT, transmittance LUT 1024x256", [&](QualitySettings& q) {
+    q.sky_view_lut = false;
+    q.view_steps = 64;
+    q.transmittance_width = 1024;
+    q.transmittance_height = 256;
+  });
+  variant("production", "ray march 64 steps, no LUT, sun path marched 64 steps", [&](QualitySettings& q) {
+    q.sky_view_lut = false;
+    q.view_steps = 64;
+    q.light_steps = 64;
+  });
+  variant("production", "ray march 64 steps, no LUT, Simpson", [&](QualitySettings& q) {
+    q.sky_view_lut = false;
+    q.view_steps = 64;
+    q.integrator = INTEGRATOR_SIMPSON;
+  });
   for (double band : {6.0, 10.0})
     for (int steps : {32, 64})
       variant("production", fmt::format("band {:g} deg marched, {} steps", band, steps), [&](QualitySettings& q) {
         q.twilight_march_band_deg = band;
         q.twilight_march_steps = steps;
       });
+  // A twilight frame (the Sun below 3 deg) reading the sun transmittance in
+  // the logarithm, with the band marched (the LUT presets) or not.
+  auto twilight = [](double band, int steps) {
+    return [=](QualitySettings& q) {
+      q.twilight_march_band_deg = band;
+      q.twilight_march_steps = steps;
+      q.twilight_sun_below_deg = 3.0;
+    };
+  };
+  for (int steps : {32, 64})
+    variant("production", fmt::format("band 10 deg marched, {} steps, Sun below 3 deg, log T", steps),
+            twilight(10.0, steps));
   for (int rows : {432})
     variant("draft", fmt::format("LUT 192x{}", rows), [&](QualitySettings& q) { q.sky_view_height = rows; });
   for (double band : {6.0, 10.0})
@@ -64,6 +97,12 @@ std::vector<TwilightCase> TwilightCases() {
         q.twilight_march_band_deg = band;
         q.twilight_march_steps = steps;
       });
+  for (int steps : {24, 32})
+    variant("draft", fmt::format("band 10 deg marched, {} steps, Sun below 3 deg, log T", steps),
+            twilight(10.0, steps));
+  variant("reference", "Sun below 3 deg, log T", twilight(0.0, 0));
+  for (int steps : {128})
+    variant("reference", fmt::format("Sun below 3 deg, log T, {} steps", steps), twilight(0.0, steps));
   return cases;
 }
 
@@ -91,7 +130,8 @@ std::vector<glm::dvec3> TwilightDirections(bool quick, std::vector<glm::dvec2>& 
 }
 
 std::vector<double> TwilightSunElevations(bool quick) {
-  return quick ? std::vector<double>{3.0, -1.0, -6.0} : std::vector<double>{3.0, 1.0, 0.0, -1.0, -3.0, -6.0, -10.0};
+  return quick ? std::vector<double>{3.0, -1.0, -6.0}
+               : std::vector<double>{5.0, 3.0, 2.0, 1.0, 0.0, -1.0, -3.0, -6.0, -10.0};
 }
 
 struct TwilightResult {
@@ -128,7 +168,9 @@ std::string RunTwilightStudy(StudyContext& context) {
   const std::vector<double> suns = TwilightSunElevations(options.quick);
   std::vector<TwilightCase> cases = TwilightCases();
   if (options.quick) cases.resize(2);  // draft, production
-  if (!options.only.empty())
+  if (options.only == "presets")
+    std::erase_if(cases, [&](const TwilightCase& c) { return c.name != c.preset; });
+  else if (!options.only.empty())
     std::erase_if(cases, [&](const TwilightCase& c) { return c.name.find(options.only) == std::string::npos; });
 
   context.Say(fmt::format("twilight reference: {} directions x {} sun elevations", dirs.size(), suns.size()));

@@ -23,6 +23,19 @@ struct ReferenceModel::Impl {
   bool skyview_ready = false;
   glm::dvec3 skyview_sun{0.0};
 
+  // The parameters for a frame with this Sun: a twilight frame's
+  // (TwilightSunElevationDeg) reads the sun transmittance in the logarithm
+  // and marches the band (without the sky-view LUT: every texel, with the
+  // twilight steps), as the GPU's twilight pipeline; any other frame's
+  // marches no band, as the GPU's day pipeline.
+  glsl::AtmosphereParameters ForSun(const glm::dvec3& sun) const {
+    glsl::AtmosphereParameters a = atm;
+    a.transmittance_log = sun.y < atm.twilight_sun_sine;
+    if (!a.transmittance_log) a.twilight_march_band = 0.0;
+    if (a.transmittance_log && !use_skyview) a.view_steps = a.twilight_march_steps;  // every texel marched
+    return a;
+  }
+
   // The LUTs and the AOAS block, for the shared code's hooks on this thread.
   void Bind() const {
     glsl::Tables tables;
@@ -130,15 +143,24 @@ void ReferenceModel::PrepareSun(const glm::dvec3& sun) const {
 glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& sun) const {
   PrepareSun(sun);  // the sky-view LUT, as the GPU builds it
   impl_->Bind();
-  if (impl_->use_skyview)
-    return glsl::ComputeSkyRadianceFromSkyView(impl_->atm, view, sun) * impl_->output_scale;
-  return glsl::ComputeSkyRadiance(impl_->atm, view, sun) * impl_->output_scale;
+  glsl::AtmosphereParameters atm = impl_->ForSun(sun);
+  if (impl_->use_skyview && !glsl::InTwilightMarchBand(atm, view, sun))
+    return glsl::ComputeSkyRadianceFromSkyView(atm, view, sun) * impl_->output_scale;
+  if (!impl_->use_skyview) return glsl::ComputeSkyRadiance(atm, view, sun) * impl_->output_scale;
+  // The band's march, with the disc added as the GPU's sun-disc pass adds it
+  // to a sky-view renderer's texels: through the transmittance LUT.
+  atm.view_steps = atm.twilight_march_steps;
+  glsl::AtmosphereParameters sky = atm;
+  sky.sun_disc = false;
+  glm::dvec3 radiance = glsl::ComputeSkyRadiance(sky, view, sun);
+  if (atm.sun_disc) radiance += glsl::SunDiscThroughAtmosphere(atm, view, sun) * atm.solar_irradiance;
+  return radiance * impl_->output_scale;
 }
 
 glm::dvec3 ReferenceModel::StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const {
   PrepareSun(sun);
   impl_->Bind();
-  return glsl::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, w, sun, impl_->use_skyview) *
+  return glsl::ComputeStyledSkyRadiance(impl_->ForSun(sun), impl_->aoas, w, sun, impl_->use_skyview) *
          impl_->output_scale;
 }
 
@@ -146,9 +168,9 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
   PrepareSun(sun);
   std::vector<glm::dvec3> dirs = ViewDirections(view);
   std::vector<double> image(dirs.size() * 4);
+  const glsl::AtmosphereParameters atm = impl_->ForSun(sun);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {
-    glm::dvec3 l = glsl::ComputeStyledSkyRadiance(impl_->atm, impl_->aoas, dirs[i], sun,
-                                                       impl_->use_skyview) *
+    glm::dvec3 l = glsl::ComputeStyledSkyRadiance(atm, impl_->aoas, dirs[i], sun, impl_->use_skyview) *
                    impl_->output_scale;
     image[4 * i + 0] = l.x;
     image[4 * i + 1] = l.y;

@@ -194,8 +194,10 @@ class SkyRenderer {
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
                             bool twilight_march = false);
-  // Whether this Sun's views march the twilight band (quality.twilight_march_band_deg),
-  // and the sky pass that does, built on the first such frame.
+  // Whether this Sun makes the frame twilight (TwilightSunElevationDeg): its
+  // views march the twilight band (quality.twilight_march_band_deg) and read
+  // the sun transmittance in the logarithm, with the sky pass that does,
+  // built on the first such frame.
   bool MarchesTwilightBand(const glm::dvec3& sun) const;
   VkPipeline TwilightSkyPipeline();
   void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one

@@ -76,10 +76,19 @@ struct QualitySettings {
   // elevation above the observer's horizon is ray-marched per texel instead
   // of read from the sky-view LUT: the Earth's shadow crosses it faster than
   // the LUT's rows resolve (docs/accuracy.md, "Twilight"). 0: off.
-  double twilight_march_band_deg = 0.0;
-  // View steps of that march (0: view_steps).
-  int twilight_march_steps = 0;
+  double twilight_march_band_deg = 10.0;
+  // View steps of that march, and of every texel's in a twilight frame
+  // without the sky-view LUT (0: view_steps).
+  int twilight_march_steps = 64;
+  // The Sun's elevation (deg) below which a frame is twilight: its pipeline
+  // marches the band and reads the view samples' sun transmittance from the
+  // LUT in the logarithm (grazing sunlight, docs/accuracy.md "Twilight").
+  // 0: the band's elevation.
+  double twilight_sun_below_deg = 3.0;
 };
+
+// The Sun's elevation (deg) below which `q` renders a frame as twilight (0: never).
+double TwilightSunElevationDeg(const QualitySettings& q);
 
 // The named presets, chosen from the accuracy study (docs/accuracy.md):
 // "draft", "production" (the defaults of QualitySettings), "reference".
