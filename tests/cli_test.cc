@@ -142,7 +142,7 @@ TEST(CliTest, PresetOverriddenByEveryKeyWarns) {
   std::string keys;
   for (const char* k : {"integrator=analytic", "sky_view_lut=true", "sky_view_lut_width=256", "sky_view_lut_height=144",
                         "view_steps=32", "transmittance_steps=256", "transmittance_lut_width=256",
-                        "transmittance_lut_height=64"})
+                        "transmittance_lut_height=64", "twilight_march_band_deg=10", "twilight_march_steps=64"})
     keys += std::string(" --set quality.") + k;
   for (const char* command : {"check", "bake --dry-run"}) {
     CommandRun run = Skybake(std::string(command) + " " + Style() + " --set quality.preset=reference" + keys);
