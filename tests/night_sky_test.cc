@@ -48,6 +48,24 @@ std::vector<ViewRequest> ViewsOfSize(int n) {
   return views;
 }
 
+// A style with the stars, the Moon, the airglow and the night floor on.
+SkyStyle EveryNightFeature() {
+  SkyStyle style;
+  style.night.stars = true;
+  style.night.moon = true;
+  style.night.airglow = true;
+  style.effects.night_dimming = true;
+  return style;
+}
+
+// The shipped star catalogue; a test that cannot load it fails with the reason.
+std::optional<StarCatalogue> DefaultCatalogue() {
+  std::string error;
+  std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
+  EXPECT_TRUE(catalogue) << error;
+  return catalogue;
+}
+
 // Energy (sum of radiance x solid angle) per channel of the additions.
 glm::dvec3 Energy(const ViewRequest& view, const std::vector<TexelAdd>& adds) {
   glm::dvec3 e(0.0);
@@ -635,14 +653,9 @@ TEST(NightSkyGpu, MoonlightIsBelowHalfFloatResolutionWhileTheSunIsUp) {
 // stars begin to show to the night, with the first-quarter Moon up (its disc
 // shows in daylight: the bounds open only the texels around it) and down.
 TEST(NightSkyGpu, SplatBoundChangesNoByte) {
-  SkyStyle style;
-  style.night.stars = true;
-  style.night.moon = true;
-  style.night.airglow = true;
-  style.effects.night_dimming = true;
-  std::string error;
-  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
-  ASSERT_TRUE(catalogue) << error;
+  const SkyStyle style = EveryNightFeature();
+  const std::optional<StarCatalogue> catalogue = DefaultCatalogue();
+  ASSERT_TRUE(catalogue);
   const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
   const Rgb scale = OutputScale(style.output.units);
   SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, scale);
@@ -797,14 +810,9 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
 // frames of docs/performance.md), and 2024-01-15 04:00 UT with Sirius, the
 // brightest star, 82 deg up and the Sun put at 45 deg.
 TEST(NightSkyGpu, DaylitW1MapsPlaceNoStarWhereNoneShows) {
-  SkyStyle style;
-  style.night.stars = true;
-  style.night.moon = true;
-  style.night.airglow = true;
-  style.effects.night_dimming = true;
-  std::string error;
-  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
-  ASSERT_TRUE(catalogue) << error;
+  const SkyStyle style = EveryNightFeature();
+  const std::optional<StarCatalogue> catalogue = DefaultCatalogue();
+  ASSERT_TRUE(catalogue);
   const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
   SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
   NightSkyRenderer deferred(testing::Vulkan()), whole(testing::Vulkan());
@@ -905,9 +913,8 @@ TEST(NightSky, SplatTilesHoldTheirSmallestSolidAngle) {
 // any cone (at least the sum of those within it, by brute force) and holds
 // all of them; a small cone in an empty part of the sky is empty.
 TEST(NightSky, StarGridBoundsTheStarsInEveryCone) {
-  std::string error;
-  const std::optional<StarCatalogue> catalogue = LoadStarCatalogue(DefaultStarCataloguePath(), error);
-  ASSERT_TRUE(catalogue) << error;
+  const std::optional<StarCatalogue> catalogue = DefaultCatalogue();
+  ASSERT_TRUE(catalogue);
   const double limit = NightSettings().star_magnitude_limit;
   const StarGrid grid(*catalogue, limit, OutputUnits::kLuminance);
   // E: in luminance units the largest channel of the luminance-normalized colour, in lux.
