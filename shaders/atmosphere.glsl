@@ -424,7 +424,10 @@ vec3 SunTransmittance(IN(AtmosphereParameters) atm, Real r_t, Real h, Real mu_s_
   Real visible = smoothstep(-sin_theta_h * atm.sun_angular_radius,
                             sin_theta_h * atm.sun_angular_radius, mu_s_t - cos_theta_h);
   if (visible <= 0.0) return vec3(0.0);
-  return exp(-ComputeOpticalDepthToTopBoundary(atm, r_t, h, mu_s_t, atm.light_steps)) * visible;
+  // With the Sun partly set (its centre below the horizon at this point) the
+  // light that reaches it grazes the horizon: march along the horizon ray,
+  // as the transmittance LUT's read clamps to it, not through the ground.
+  return exp(-ComputeOpticalDepthToTopBoundary(atm, r_t, h, max(mu_s_t, cos_theta_h), atm.light_steps)) * visible;
 }
 
 // The view ray of one texel after moving an observer above the atmosphere to
