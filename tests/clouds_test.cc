@@ -622,5 +622,118 @@ TEST(CloudLightNearest, FarLightSamplesAtTheNearestVoxelStayClose) {
   testing::ExpectNoValidationMessages();
 }
 
+// ---------------------------------------------------------------- empty space
+
+// FillCloudSkipMaps (clouds.h): every cell's value is the maximum of the
+// texels a bilinear or trilinear read at any point of the cell touches
+// (brute force over random points and their 8 or 4 texels, wrapping), and
+// no more than the maximum of the cell's reach (it is a maximum, not 1).
+TEST(CloudSkip, CellMaximaBoundEveryReadOfTheirCell) {
+  gpu::GpuClouds g{};
+  g.counts = {2, 8, 4, 8};
+  g.resolution = {9, 4, 10, 1};  // odd sizes: the last cell holds one texel
+  const size_t shape = 9 * 9 * 9, detail = 4 * 4 * 4, weather = 10 * 10;
+  for (int l = 0; l < 2; ++l)
+    g.layers[l].noise = {int(l * (shape + detail + weather)), int(l * (shape + detail + weather) + shape),
+                         int(l * (shape + detail + weather) + shape + detail), 1};
+  std::vector<float> noise(CloudNoiseFloats(g));
+  ASSERT_EQ(noise.size(), CloudSkipFirst(g) + 2 * CloudSkipFloatsPerLayer(g));
+  uint32_t state = 12345u;
+  auto next = [&]() {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / 16777216.0f;
+  };
+  for (size_t i = 0; i < CloudSkipFirst(g); ++i) noise[i] = next();
+  FillCloudSkipMaps(g, noise.data());
+  auto wrap = [](int i, int n) { return ((i % n) + n) % n; };
+  for (int l = 0; l < 2; ++l) {
+    const float* map = noise.data() + CloudSkipFirst(g) + l * CloudSkipFloatsPerLayer(g);
+    const int wc = CloudSkipCells(10), sc = CloudSkipCells(9);
+    ASSERT_EQ(wc, 5);
+    ASSERT_EQ(sc, 5);
+    const float* shape_map = map + wc * wc;
+    const float* volume = noise.data() + g.layers[l].noise.x;
+    const float* wmap = noise.data() + g.layers[l].noise.z;
+    int below_one = 0;
+    for (int k = 0; k < 20000; ++k) {
+      const glm::vec3 u(next(), next(), next());
+      // The shader's cell (CloudSkipCell) and the trilinear read's texels (SampleVolume).
+      const glm::ivec3 cell = glm::min(glm::ivec3(u * 9.0f), glm::ivec3(8)) >> CLOUD_SKIP_CELL_SHIFT;
+      const float bound = shape_map[(cell.z * sc + cell.y) * sc + cell.x];
+      const glm::ivec3 base = glm::ivec3(glm::floor(u * 9.0f - 0.5f));
+      for (int c = 0; c < 8; ++c) {
+        const glm::ivec3 t(wrap(base.x + (c & 1), 9), wrap(base.y + ((c >> 1) & 1), 9), wrap(base.z + (c >> 2), 9));
+        ASSERT_GE(bound, volume[(t.z * 9 + t.y) * 9 + t.x]) << "layer " << l << " point " << k;
+      }
+      const glm::ivec2 wcell = glm::min(glm::ivec2(glm::vec2(u) * 10.0f), glm::ivec2(9)) >> CLOUD_SKIP_CELL_SHIFT;
+      const float wbound = map[wcell.y * wc + wcell.x];
+      const glm::ivec2 wbase = glm::ivec2(glm::floor(glm::vec2(u) * 10.0f - 0.5f));
+      for (int c = 0; c < 4; ++c)
+        ASSERT_GE(wbound, wmap[wrap(wbase.y + (c >> 1), 10) * 10 + wrap(wbase.x + (c & 1), 10)]);
+      below_one += bound < 0.999f;
+    }
+    // Each cell's value is the maximum of its reach (6 texels a side from 2 less than its first).
+    for (int z = 0; z < sc; ++z)
+      for (int y = 0; y < sc; ++y)
+        for (int x = 0; x < sc; ++x) {
+          float m = 0.0f;
+          for (int k = 0; k < 216; ++k)
+            m = std::max(m, volume[(wrap(2 * z - 2 + k / 36, 9) * 9 + wrap(2 * y - 2 + k / 6 % 6, 9)) * 9 +
+                                   wrap(2 * x - 2 + k % 6, 9)]);
+          EXPECT_EQ(shape_map[(z * sc + y) * sc + x], m);
+        }
+    EXPECT_GT(below_one, 0) << "the bounds are maxima, not 1";
+  }
+}
+
+// The view march skips the samples the bounds (CloudMargin) say hold no
+// cloud; their density is 0, so every view, the SH faces and the sun
+// direction keep their bytes with the bounds on and off (GpuClouds.range.w),
+// for W3's cumulus at coverage 0.45 (where the bounds skip most), an
+// overcast deck, two overlapping layers with shear, a thin high layer, and
+// the observer inside and above the layers, at a high, a low and a set sun.
+TEST(CloudSkip, SkippingEmptySpaceKeepsTheBytes) {
+  struct SkipCase {
+    const char* name;
+    std::string toml;
+    double sun;
+  };
+  const std::vector<SkipCase> cases = {
+      {"W3 cumulus", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"), 30.0},
+      {"W3 cumulus, low sun", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45"), 4.0},
+      {"overcast stratus", Layer(800, 600, "type = \"stratus\"\ncoverage = 1.0"), 45.0},
+      {"overlapping, shear", Layer(1500, 1500, "coverage = 0.6\nshear_m_s_per_km = [20.0, 5.0]\nwind_m_s = [10.0, 0.0]") +
+                                 Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4"), 20.0},
+      {"thin cirrus at 10 km", Layer(10000, 300, "type = \"cirrus\"\ncoverage = 0.35"), -3.0},
+      {"observer inside", "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
+      {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
+  };
+  for (const SkipCase& c : cases) {
+    const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
+    auto render = [&](bool skip) {
+      CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
+      clouds.uniform.range.w = skip ? 1.0f : 0.0f;
+      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                    OutputScale(style.output.units), false,
+                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)), clouds);
+      const int n = 24;
+      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+      const glm::dvec3 sun = Sun(c.sun);
+      std::vector<std::vector<float>> images = r.Render(sun, views);
+      images.push_back(r.Render(sun, {views[0]})[0]);  // one latlong: marched, no panorama
+      images.push_back(r.RenderDirections(sun, {sun, glm::dvec3(0.0, 0.2, 0.98)}));
+      return images;
+    };
+    const std::vector<std::vector<float>> off = render(false), on = render(true);
+    ASSERT_EQ(on.size(), off.size());
+    for (size_t i = 0; i < on.size(); ++i) EXPECT_TRUE(on[i] == off[i]) << c.name << ", image " << i;
+    const SkyStyle clear = PrunedStyle(Style(std::string(kFast) + c.toml.substr(0, c.toml.find("[[cloud_layer]]"))));
+    EXPECT_FALSE(StyleRenderer(clear).renderer->Render(Sun(c.sun), {{MAPPING_LATLONG, 96, 48, 0}})[0] == off[8])
+        << c.name << ": the layer shows (the test is not vacuous)";
+  }
+  testing::ExpectNoValidationMessages();
+}
+
 }  // namespace
 }  // namespace skybake

@@ -643,8 +643,15 @@ void SkyRenderer::GenerateCloudNoise() {
   // between them; the submission's end orders them before later reads.
   barriers.assign(dispatches.size(), false);
   Submit(dispatches, barriers);
+  FillCloudSkipMaps();
   cloud_noise_ready_ = true;
   ++counters_.cloud_noise_builds;
+}
+
+void SkyRenderer::FillCloudSkipMaps() {
+  // The noise's writes were made visible to the host by the submission's
+  // last barrier and its fence; the host's writes reach the next submission.
+  if (gpu_clouds_.range.w > 0.5f) skybake::FillCloudSkipMaps(gpu_clouds_, static_cast<float*>(cloud_noise_buffer_.mapped));
 }
 
 void SkyRenderer::CopyCloudWeatherImages() {
@@ -1008,8 +1015,12 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   }
   // The tables depend on the layers' top (the ambient table's range) and distances.
   if (!same(c.range, gpu_clouds_.range)) cloud_tables_ready_ = false;
+  // The empty-space bounds follow the weather images copied in place, and
+  // are filled when the march starts to use them.
+  const bool refill = cloud_noise_ready_ && (!noise_same || c.range.w != gpu_clouds_.range.w);
   gpu_clouds_ = c;
   std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
+  if (refill) FillCloudSkipMaps();
   if (!cloud_noise_ready_ && luts_ready_) GenerateCloudNoise();
   return true;
 }

@@ -1,9 +1,11 @@
 #include "skybake/model/clouds.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 #include <stdexcept>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -148,15 +150,79 @@ double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
   const double above = layers > 1.0 ? layers * (1.0 + std::min(q.light_steps, 4) * (1.0 + layers)) : 0.0;
   // The light march is two loops (trilinear, then nearest reads), one of
   // them possibly empty: a loop runs its body at least once.
-  const double per_sample = 2.0 + layers + (q.light_steps + 1) * (1.0 + layers) + q.octaves + layers + above;
+  // The empty-space loop (clouds.glsl, CloudMargin) adds its own iteration
+  // and its layer loop per view sample.
+  const double per_sample = 3.0 + 2.0 * layers + (q.light_steps + 1) * (1.0 + layers) + q.octaves + layers + above;
   return layers * q.view_steps * per_sample;
 }
 
 size_t CloudNoiseFloats(const gpu::GpuClouds& c) {
+  const size_t layers = size_t(std::max(c.counts.x, 0));
+  return std::max<size_t>(CloudSkipFirst(c) + layers * CloudSkipFloatsPerLayer(c), 4);
+}
+
+int CloudSkipCells(int resolution) { return (resolution + (1 << CLOUD_SKIP_CELL_SHIFT) - 1) >> CLOUD_SKIP_CELL_SHIFT; }
+
+size_t CloudSkipFirst(const gpu::GpuClouds& c) {
   const size_t per_layer = size_t(c.resolution.x) * c.resolution.x * c.resolution.x +
                            size_t(c.resolution.y) * c.resolution.y * c.resolution.y +
                            size_t(c.resolution.z) * c.resolution.z;
-  return std::max<size_t>(per_layer * size_t(std::max(c.counts.x, 0)), 4);
+  return per_layer * size_t(std::max(c.counts.x, 0));
+}
+
+size_t CloudSkipFloatsPerLayer(const gpu::GpuClouds& c) {
+  const size_t wc = size_t(CloudSkipCells(c.resolution.z)), sc = size_t(CloudSkipCells(c.resolution.x));
+  return wc * wc + sc * sc * sc;
+}
+
+namespace {
+
+// The maximum along one axis of a grid (`size` [x, y, z] values, x fastest)
+// over each cell's reach: for cell a, the values at a * 2 - 2 ... a * 2 + 3,
+// wrapped. `axis` 0, 1, 2; the result has CloudSkipCells(size[axis]) along it.
+std::vector<float> CellMaxAlong(const std::vector<float>& v, std::array<int, 3> size, int axis) {
+  const int n = size[axis], cells = CloudSkipCells(n);
+  std::array<int, 3> out = size;
+  out[axis] = cells;
+  std::vector<float> r(size_t(out[0]) * out[1] * out[2]);
+  const int lo = 2, hi = 3;  // the bilinear read's neighbour and one texel for rounding, each side
+  for (int z = 0; z < out[2]; ++z)
+    for (int y = 0; y < out[1]; ++y)
+      for (int x = 0; x < out[0]; ++x) {
+        std::array<int, 3> p = {x, y, z};
+        const int a = p[axis];
+        float m = 0.0f;
+        for (int k = (a << CLOUD_SKIP_CELL_SHIFT) - lo; k <= (a << CLOUD_SKIP_CELL_SHIFT) + hi; ++k) {
+          p[axis] = ((k % n) + n) % n;
+          m = std::max(m, v[(size_t(p[2]) * size[1] + p[1]) * size[0] + p[0]]);
+        }
+        r[(size_t(z) * out[1] + y) * out[0] + x] = m;
+      }
+  return r;
+}
+
+}  // namespace
+
+void FillCloudSkipMaps(const gpu::GpuClouds& c, float* noise) {
+  const int ns = c.resolution.x, nw = c.resolution.z;
+  float* out = noise + CloudSkipFirst(c);
+  for (int l = 0; l < c.counts.x; ++l, out += CloudSkipFloatsPerLayer(c)) {
+    const gpu::GpuCloudLayer& layer = c.layers[l];
+    std::vector<float> weather(noise + layer.noise.z, noise + layer.noise.z + size_t(nw) * nw);
+    weather = CellMaxAlong(CellMaxAlong(weather, {nw, nw, 1}, 0), {CloudSkipCells(nw), nw, 1}, 1);
+    std::copy(weather.begin(), weather.end(), out);
+    float* shape_out = out + weather.size();
+    const int sc = CloudSkipCells(ns);
+    if (layer.weather.w > 1.5f) {
+      std::fill(shape_out, shape_out + size_t(sc) * sc * sc, 1.0f);
+      continue;
+    }
+    std::vector<float> shape(noise + layer.noise.x, noise + layer.noise.x + size_t(ns) * ns * ns);
+    shape = CellMaxAlong(shape, {ns, ns, ns}, 0);
+    shape = CellMaxAlong(shape, {sc, ns, ns}, 1);
+    shape = CellMaxAlong(shape, {sc, sc, ns}, 2);
+    std::copy(shape.begin(), shape.end(), shape_out);
+  }
 }
 
 CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
@@ -216,7 +282,8 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
   }
-  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 0.0f};
+  // range.w: the view march skips empty space (FillCloudSkipMaps).
+  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 1.0f};
   // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
   int bands = 0;
   for (int i = 0; i < count; ++i) {

@@ -160,6 +160,9 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 #define CLOUD_MODE_RESAMPLE 2  // composite the view from the panorama
 // The cloud panorama's narrowest row, texels (cloud_panorama.glsl, cloud_panorama.h).
 #define CLOUD_PANORAMA_MIN_ROW_WIDTH 16
+// The empty-space bounds (clouds.h, FillCloudSkipMaps; clouds.glsl, CloudMargin): one cell per
+// 2 texels along each axis of a weather map and a shape volume (a shift: cell = texel >> 1).
+#define CLOUD_SKIP_CELL_SHIFT 1
 
 SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo
@@ -179,7 +182,8 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   ivec4 lut;         // aerial perspective LUT x: azimuth texels; y: zenith texels; z: distance slices; w: ambient altitudes
   vec4 phase;        // x: forward g; y: backward g; z: forward weight; w: unused
   vec4 octave;       // Wrenninge 2013 x: contribution a; y: attenuation b; z: eccentricity c; w: unused
-  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; z: panorama scale; w: unused
+  vec4 range;        // x: max cloud distance km; y: top altitude of the ambient table km; z: panorama scale;
+                     // w: 1 = the view march skips empty space by the bounds after the noise (FillCloudSkipMaps)
   vec4 ground_shadow;  // the clouds' shadow on the ground the sky shows below the horizon (cloud_shadow.h):
                       // x: strength (0: off); y: samples per band crossing along the sun direction; zw: unused
   // The union of the layers' shells, overlapping layers merged: x, y: bottom

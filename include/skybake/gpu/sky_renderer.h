@@ -217,6 +217,7 @@ class SkyRenderer {
   void AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   void GenerateCloudNoise();
   void CopyCloudWeatherImages();  // the weather images into the noise buffer, the volumes kept
+  void FillCloudSkipMaps();       // the empty-space bounds from the noise (clouds.h), when range.w asks
 
   // The spectral mode's groups (quality.wavelengths > 3), else null; its
   // timings and counters are copied here after each call.

@@ -132,8 +132,27 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
                           double time_s);
 
 // Floats of the noise buffer (shape, detail and weather of every active
-// layer), and where each part of layer i starts.
+// layer, then the empty-space bounds of every layer), and where each part of
+// layer i starts.
 size_t CloudNoiseFloats(const gpu::GpuClouds& clouds);
+
+// The empty-space bounds of the view march (clouds.glsl, CloudMargin), after
+// every layer's noise in the noise buffer: per layer its weather map's
+// maximum over each cell of 2 x 2 texels (CLOUD_SKIP_CELL_SHIFT), then its
+// shape volume's over each cell of 2^3 voxels. A cell's maximum is taken over
+// every texel a bilinear (trilinear) read at a point of the cell can touch
+// and one more on each side for rounding, wrapping as the noise tiles: 6
+// texels along each axis from the cell's first less 2. Where the weather
+// and shape maxima times the height profile stay below Schneider's coverage
+// threshold, LayerExtinction is 0 and the march skips the density.
+int CloudSkipCells(int resolution);
+size_t CloudSkipFirst(const gpu::GpuClouds& clouds);  // the first float of layer 0's bounds
+size_t CloudSkipFloatsPerLayer(const gpu::GpuClouds& clouds);
+// Writes every layer's bounds from its noise (`noise`: CloudNoiseFloats
+// floats, the noise already generated). A formation's density volume (in the
+// shape volume's place) is not bounded: its cells hold 1, and CloudMargin
+// marches such a layer's every sample.
+void FillCloudSkipMaps(const gpu::GpuClouds& clouds, float* noise);
 
 // Reads a weather image's first channel (coverage) resampled to
 // `resolution` x `resolution` (rows from the north edge); throws
