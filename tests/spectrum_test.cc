@@ -120,6 +120,39 @@ TEST(SpectrumTest, BinsCoverTheRangeAndLandOnTheTablesAt48) {
   EXPECT_DOUBLE_EQ(four.centre_nm[1], 535.0);
 }
 
+// The groups' shares of a change of colour (the colour principles under
+// cloud layers, spectral_sky.h) combine back to that change: sum_g to_rgb[g]
+// share[g] is the identity. The padding channel of the last group gets
+// nothing, and a group the eye barely sees (48 bins: 800-830 nm) gets far
+// less than the one at the middle of the spectrum.
+TEST(SpectrumTest, ColourChangeSharesCombineToTheChange) {
+  for (int n : {4, 8, 16, 47, 48}) {
+    const std::vector<SpectralGroup> groups = SpectralGroups(AtmosphereParams(), WavelengthBins(n));
+    const std::vector<Matrix3> shares = ColourChangeShares(groups);
+    ASSERT_EQ(shares.size(), groups.size());
+    Matrix3 sum{};
+    for (size_t g = 0; g < groups.size(); ++g)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          for (int k = 0; k < 3; ++k) sum[i][j] += groups[g].to_rgb[i][k] * shares[g][k][j];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) EXPECT_NEAR(sum[i][j], i == j ? 1.0 : 0.0, 1e-12) << n << " bins, " << i << j;
+    for (size_t g = 0; g < groups.size(); ++g)
+      for (int c = 0; c < 3; ++c) {
+        if (groups[g].bin[c] >= 0) continue;
+        for (int j = 0; j < 3; ++j) EXPECT_EQ(shares[g][c][j], 0.0) << n << " bins, padding of group " << g;
+      }
+  }
+  const std::vector<Matrix3> shares = ColourChangeShares(SpectralGroups(AtmosphereParams(), WavelengthBins(48)));
+  auto norm = [](const Matrix3& m) {
+    double s = 0.0;
+    for (const auto& row : m)
+      for (double x : row) s += x * x;
+    return std::sqrt(s);
+  };
+  EXPECT_LT(norm(shares.back()), 1e-3 * norm(shares[7])) << "800-830 nm against 570-590 nm";
+}
+
 TEST(SpectrumTest, ColourSpaceMatrices) {
   // XYZ -> linear sRGB of IEC 61966-2-1 (the matrix Bruneton 2017 uses).
   const Matrix3 m = XyzToRgb(ColorSpace::kRec709);

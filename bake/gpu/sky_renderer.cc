@@ -788,8 +788,74 @@ bool SkyRenderer::HoldsFrames() const {
   return false;
 }
 
+std::vector<SkyRenderer::Dispatch> SkyRenderer::ViewDispatches(const glm::dvec3& sun,
+                                                               const std::vector<ViewRequest>& views, bool sun_disc,
+                                                               const std::vector<size_t>& offsets,
+                                                               VkPipeline pipeline) const {
+  static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+  std::vector<Dispatch> dispatches;
+  for (size_t i = 0; i < views.size(); ++i) {
+    const ViewRequest& v = views[i];
+    gpu::SkyPush push{};
+    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+    push.view = {v.mapping, v.width, v.height, v.face};
+    // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
+    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
+    std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
+                       : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
+                                                          : "directions";
+    dispatches.push_back({name, pipeline, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+                          GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
+  }
+  return dispatches;
+}
+
+void SkyRenderer::AddSunDisc(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                             const std::vector<Dispatch>& view_dispatches, std::vector<Dispatch>& dispatches,
+                             std::vector<bool>& barriers) {
+  // The disc, added to the texels near the Sun once the sky pass has
+  // written them. Its angular radius with the margin NearSunDisc leaves.
+  const double disc_angle = std::min(2.0 * double(gpu_atmosphere_.solar_irradiance.w), 3.14159265358979);
+  const size_t last_view = dispatches.size() - 1;
+  for (size_t i = 0; i < views.size(); ++i) {
+    for (const TexelRect& r : TexelsNearDirection(views[i], sun, disc_angle)) {
+      gpu::SkyPush push = view_dispatches[i].push;  // the view's own constants
+      push.rect = {r.x0, r.y0, r.x1, r.y1};
+      dispatches.push_back({"sun disc", disc_pipeline_, push, GroupCount(r.x1 - r.x0, SKYBAKE_LOCAL_SIZE_X),
+                            GroupCount(r.y1 - r.y0, SKYBAKE_LOCAL_SIZE_Y)});
+      // Rectangles are disjoint, within and across views.
+      barriers.push_back(false);
+      ++counters_.sun_disc_dispatches;
+      counters_.sun_disc_texels += (long long)(r.x1 - r.x0) * (r.y1 - r.y0);
+    }
+  }
+  // The sky pass's writes before the disc's reads.
+  if (dispatches.size() > last_view + 1) barriers[last_view] = true;
+}
+
+void SkyRenderer::AddCloudComposites(const std::vector<Dispatch>& view_dispatches, const CloudPanorama& panorama,
+                                     int32_t panorama_row_range, std::vector<Dispatch>& dispatches,
+                                     std::vector<bool>& barriers) {
+  // The sky and disc passes' writes before the cloud pass reads them (in a
+  // submission of its own, FramePart::kClouds, the host's writes are).
+  if (!barriers.empty()) barriers.back() = true;
+  for (Dispatch d : view_dispatches) {
+    d.name = "clouds " + d.name;
+    d.pipeline = cloud_pipeline_;
+    if (panorama.width > 0) {
+      d.pipeline = cloud_resample_pipeline_;
+      d.push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_RESAMPLE};
+      d.push.offsets.w = panorama_row_range;
+    }
+    dispatches.push_back(d);
+    barriers.push_back(false);  // views are disjoint
+    ++counters_.cloud_dispatches;
+  }
+}
+
 void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
-                              bool sun_disc, const std::vector<size_t>& offsets) {
+                              bool sun_disc, const std::vector<size_t>& offsets, FramePart part) {
   // The cloud panorama (cloud_panorama.h), after the cloud tables in their
   // buffer; growing it rewrites the descriptors, so before the output's.
   const CloudPanorama panorama = cloud_layers_ > 0 ? ChooseCloudPanorama(views, gpu_clouds_.range.z) : CloudPanorama{};
@@ -806,94 +872,52 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   BindOutput(target);
   // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
   const VkPipeline sky_pipeline = MarchesTwilightBand(sun) ? TwilightSkyPipeline() : sky_pipeline_;
+  // The views' constants, the cloud pass's too.
+  const std::vector<Dispatch> view_dispatches = ViewDispatches(sun, views, sun_disc, offsets, sky_pipeline);
 
-  static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
-  // The skydome moves the observer, so its texels ray-march: no sky-view LUT.
-  if (quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ &&
-      !(skyview_ready_ && skyview_sun_ == sun)) {
-    // The sky-view LUT depends on the sun only: built once per sun position.
-    skyview_ready_ = true;
-    skyview_sun_ = sun;
-    // The sky-view LUT for this Sun, read by every view below.
-    gpu::SkyPush push{};
-    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-    dispatches.push_back({"sky-view LUT", skyview_pipeline_, push,
-                          GroupCount(quality_.sky_view_width, SKYBAKE_LOCAL_SIZE_X),
-                          GroupCount(quality_.sky_view_height, SKYBAKE_LOCAL_SIZE_Y)});
-    barriers.push_back(true);
-    ++counters_.skyview_lut_builds;
-  }
-  if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
-  if (panorama.width > 0) {
-    gpu::SkyPush push{};
-    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-    push.view = {MAPPING_LATLONG, panorama.width, panorama.height, 0};
-    push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
-    push.offsets.w = panorama_row_range;
-    // Read by the cloud passes after the views' barrier below.
-    dispatches.push_back({"clouds panorama", cloud_pipeline_, push, GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
-                          GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y)});
-    barriers.push_back(false);
-    ++counters_.cloud_dispatches;
-  }
-  const size_t first_view = dispatches.size();
-  for (size_t i = 0; i < views.size(); ++i) {
-    const ViewRequest& v = views[i];
-    gpu::SkyPush push{};
-    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-    push.view = {v.mapping, v.width, v.height, v.face};
-    // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
-    push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
-    std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
-                       : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
-                       : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
-                                                          : "directions";
-    dispatches.push_back({name, sky_pipeline, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
-                          GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
-    // Views write disjoint ranges of the output buffer: no barriers between them.
-    barriers.push_back(false);
-  }
-  if (disc_pass_ && sun_disc) {
-    // The disc, added to the texels near the Sun once the sky pass has
-    // written them. Its angular radius with the margin NearSunDisc leaves.
-    const double disc_angle = std::min(2.0 * double(gpu_atmosphere_.solar_irradiance.w), 3.14159265358979);
-    const size_t last_view = dispatches.size() - 1;
-    for (size_t i = 0; i < views.size(); ++i) {
-      for (const TexelRect& r : TexelsNearDirection(views[i], sun, disc_angle)) {
-        gpu::SkyPush push = dispatches[first_view + i].push;  // the view's own constants
-        push.rect = {r.x0, r.y0, r.x1, r.y1};
-        dispatches.push_back({"sun disc", disc_pipeline_, push, GroupCount(r.x1 - r.x0, SKYBAKE_LOCAL_SIZE_X),
-                              GroupCount(r.y1 - r.y0, SKYBAKE_LOCAL_SIZE_Y)});
-        // Rectangles are disjoint, within and across views.
-        barriers.push_back(false);
-        ++counters_.sun_disc_dispatches;
-        counters_.sun_disc_texels += (long long)(r.x1 - r.x0) * (r.y1 - r.y0);
-      }
+  if (part != FramePart::kClouds) {
+    // The skydome moves the observer, so its texels ray-march: no sky-view LUT.
+    if (quality_.sky_view_lut && !aoas_switches_.skydome && !output_directions_ &&
+        !(skyview_ready_ && skyview_sun_ == sun)) {
+      // The sky-view LUT depends on the sun only: built once per sun position.
+      skyview_ready_ = true;
+      skyview_sun_ = sun;
+      // The sky-view LUT for this Sun, read by every view below.
+      gpu::SkyPush push{};
+      push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+      dispatches.push_back({"sky-view LUT", skyview_pipeline_, push,
+                            GroupCount(quality_.sky_view_width, SKYBAKE_LOCAL_SIZE_X),
+                            GroupCount(quality_.sky_view_height, SKYBAKE_LOCAL_SIZE_Y)});
+      barriers.push_back(true);
+      ++counters_.skyview_lut_builds;
     }
-    // The sky pass's writes before the disc's reads.
-    if (dispatches.size() > last_view + 1) barriers[last_view] = true;
-  }
-  if (cloud_layers_ > 0) {
-    // The sky and disc passes' writes before the cloud pass reads them.
-    barriers.back() = true;
-    for (size_t i = 0; i < views.size(); ++i) {
-      Dispatch d = dispatches[first_view + i];
-      d.name = "clouds " + d.name;
-      d.pipeline = cloud_pipeline_;
-      if (panorama.width > 0) {
-        d.pipeline = cloud_resample_pipeline_;
-        d.push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_RESAMPLE};
-        d.push.offsets.w = panorama_row_range;
-      }
-      dispatches.push_back(d);
-      barriers.push_back(false);  // views are disjoint
+    if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
+    if (panorama.width > 0) {
+      gpu::SkyPush push{};
+      push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+      push.view = {MAPPING_LATLONG, panorama.width, panorama.height, 0};
+      push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
+      push.offsets.w = panorama_row_range;
+      // Read by the cloud passes after the views' barrier below.
+      dispatches.push_back({"clouds panorama", cloud_pipeline_, push,
+                            GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
+                            GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y)});
+      barriers.push_back(false);
       ++counters_.cloud_dispatches;
     }
+    for (const Dispatch& d : view_dispatches) {
+      dispatches.push_back(d);
+      // Views write disjoint ranges of the output buffer: no barriers between them.
+      barriers.push_back(false);
+    }
+    if (disc_pass_ && sun_disc) AddSunDisc(sun, views, view_dispatches, dispatches, barriers);
   }
+  if (cloud_layers_ > 0 && part != FramePart::kClearSky)
+    AddCloudComposites(view_dispatches, panorama, panorama_row_range, dispatches, barriers);
   Submit(dispatches, barriers);
-  ++counters_.frames;
+  if (part != FramePart::kClouds) ++counters_.frames;
 }
 
 std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
@@ -919,6 +943,46 @@ std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
   view.width = int(directions.size());
   view.height = 1;
   return Render(sun, {view}, sun_disc)[0];
+}
+
+std::vector<float*> SkyRenderer::RenderClearSky(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                                bool sun_disc, const std::vector<glm::dvec3>& directions) {
+  if (spectral_ || style_pass_ || output_directions_)
+    throw std::logic_error("SkyRenderer::RenderClearSky: a three-wavelength sky renderer only");
+  if (!luts_ready_) PrecomputeLuts();
+  size_t total = 0;
+  const std::vector<size_t> offsets = TexelOffsets(views, total);
+  // A MAPPING_DIRECTIONS view's directions after its texels, as RenderDirections places them.
+  const VkDeviceSize bytes = VkDeviceSize(std::max<size_t>(total + directions.size(), 1)) * 16;
+  if (bytes > context_.properties().limits.maxStorageBufferRange)
+    throw VulkanError(fmt::format("{} texels need {} MiB in one storage buffer; {} allows {} MiB "
+                                  "(maxStorageBufferRange): lower render.cube_size or render.latlong_height",
+                                  total, bytes >> 20, context_.device_info().name,
+                                  context_.properties().limits.maxStorageBufferRange >> 20),
+                      VK_ERROR_OUT_OF_DEVICE_MEMORY);
+  EnsureOutputCapacity(bytes);
+  float* data = static_cast<float*>(output_buffer_.mapped);
+  for (size_t i = 0; i < directions.size(); ++i) {
+    float* d = data + 4 * (total + i);
+    d[0] = float(directions[i].x);
+    d[1] = float(directions[i].y);
+    d[2] = float(directions[i].z);
+    d[3] = 0.0f;
+  }
+  SubmitViews(output_buffer_, sun, views, sun_disc, offsets, FramePart::kClearSky);
+  clear_sky_ = std::make_unique<ClearSkyFrame>(ClearSkyFrame{sun, views, sun_disc, offsets});
+  std::vector<float*> texels;
+  for (size_t offset : offsets) texels.push_back(data + 4 * offset);
+  return texels;
+}
+
+void SkyRenderer::CompositeClouds() {
+  if (!clear_sky_) throw std::logic_error("SkyRenderer::CompositeClouds: no RenderClearSky before it");
+  const ClearSkyFrame frame = *clear_sky_;
+  clear_sky_.reset();
+  timings_.clear();
+  if (cloud_layers_ == 0) return;  // the clear sky is the frame
+  SubmitViews(output_buffer_, frame.sun, frame.views, frame.sun_disc, frame.offsets, FramePart::kClouds);
 }
 
 void SkyRenderer::ApplyStyle(const glm::dvec3& sun, const std::vector<ViewRequest>& views,

@@ -49,6 +49,19 @@ void Accumulate(const float* group, size_t texels, const Matrix3& to_rgb, bool f
   }
 }
 
+// Adds share * (the RGB of `change`) to the three channels of each texel of
+// `group` (RGBA texels); alpha is kept.
+void AddShare(const float* change, size_t texels, const Matrix3& share, float* group) {
+  float m[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) m[i][j] = float(share[i][j]);
+  for (size_t t = 0; t < texels; ++t) {
+    const float* in = change + 4 * t;
+    float* out = group + 4 * t;
+    for (int i = 0; i < 3; ++i) out[i] += m[i][0] * in[0] + m[i][1] * in[1] + m[i][2] * in[2];
+  }
+}
+
 }  // namespace
 
 SpectralSky::SpectralSky(VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
@@ -61,7 +74,12 @@ SpectralSky::SpectralSky(VulkanContext& context, const AtmosphereParams& atmosph
 SpectralSky::SpectralSky(VulkanContext& context, SpectralBins bins, std::vector<SpectralGroup> groups,
                          const QualitySettings& quality, const EffectSettings& effects, const AoasInputs& aoas,
                          const CloudInputs& clouds, const ShaderSwitches& shaders)
-    : bins_(std::move(bins)), groups_(std::move(groups)), style_aoas_(aoas), style_effects_(effects) {
+    : bins_(std::move(bins)),
+      groups_(std::move(groups)),
+      style_aoas_(aoas),
+      style_effects_(effects),
+      context_(context),
+      cloud_layers_(clouds.layers()) {
   // Each group renders radiance (unit output scale); the CIE weights make it cd/m^2.
   for (const SpectralGroup& g : groups_)
     renderers_.push_back(std::make_unique<SkyRenderer>(context, g.atmosphere, GroupQuality(quality),
@@ -71,6 +89,7 @@ SpectralSky::SpectralSky(VulkanContext& context, SpectralBins bins, std::vector<
     if (StyleScale(aoas)[0] <= 0.0 || StyleScale(aoas)[1] <= 0.0 || StyleScale(aoas)[2] <= 0.0)
       throw std::invalid_argument("SpectralSky: the AOAS colour scale must be positive (ToAoasInputs)");
     style_ = SkyRenderer::StylePass(context, groups_.front().atmosphere, quality, effects, StyleScale(aoas), aoas);
+    if (cloud_layers_ > 0) shares_ = ColourChangeShares(groups_);
   }
 }
 
@@ -86,6 +105,7 @@ void SpectralSky::PrecomputeLuts() {
 
 std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                                                     bool sun_disc) {
+  if (style_ && cloud_layers_ > 0) return RenderStyledUnderClouds(sun, views, sun_disc, {});
   std::vector<std::vector<float>> sum;
   for (const ViewRequest& v : views) sum.emplace_back(size_t(v.width) * v.height * 4, 0.0f);
   timings_.clear();
@@ -106,6 +126,13 @@ std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const
 
 std::vector<float> SpectralSky::RenderDirections(const glm::dvec3& sun, const std::vector<glm::dvec3>& directions,
                                                  bool sun_disc) {
+  if (style_ && cloud_layers_ > 0) {
+    ViewRequest view;
+    view.mapping = MAPPING_DIRECTIONS;
+    view.width = int(directions.size());
+    view.height = 1;
+    return std::move(RenderStyledUnderClouds(sun, {view}, sun_disc, directions)[0]);
+  }
   std::vector<float> sum(directions.size() * 4, 0.0f);
   timings_.clear();
   for (size_t g = 0; g < renderers_.size(); ++g) {
@@ -127,6 +154,61 @@ std::vector<float> SpectralSky::RenderDirections(const glm::dvec3& sun, const st
   return sum;
 }
 
+std::vector<std::vector<float>> SpectralSky::RenderStyledUnderClouds(const glm::dvec3& sun,
+                                                                     const std::vector<ViewRequest>& views,
+                                                                     bool sun_disc,
+                                                                     const std::vector<glm::dvec3>& directions) {
+  size_t total = directions.size();
+  for (const ViewRequest& v : views) total += size_t(v.width) * v.height;
+  if (VkDeviceSize(total) * 16 > context_.properties().limits.maxStorageBufferRange && views.size() > 1) {
+    // In two halves, as SkyRenderer::Render splits a frame too large for one buffer.
+    const size_t half = views.size() / 2;
+    std::vector<std::vector<float>> images =
+        RenderStyledUnderClouds(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half), sun_disc, {});
+    std::vector<PassTiming> timings = timings_;
+    for (std::vector<float>& image :
+         RenderStyledUnderClouds(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), sun_disc, {}))
+      images.push_back(std::move(image));
+    timings.insert(timings.end(), timings_.begin(), timings_.end());
+    timings_ = timings;
+    return images;
+  }
+  timings_.clear();
+  auto record = [this](const SkyRenderer& r) {
+    timings_.insert(timings_.end(), r.last_timings().begin(), r.last_timings().end());
+  };
+  // Every group's clear sky (and Sun), combined; each stays in its
+  // renderer's memory until its layers are composited over it.
+  std::vector<std::vector<float>> sum;
+  for (const ViewRequest& v : views) sum.emplace_back(size_t(v.width) * v.height * 4, 0.0f);
+  std::vector<std::vector<float*>> skies;
+  for (size_t g = 0; g < renderers_.size(); ++g) {
+    skies.push_back(renderers_[g]->RenderClearSky(sun, views, sun_disc, directions));
+    record(*renderers_[g]);
+    for (size_t i = 0; i < views.size(); ++i)
+      Accumulate(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
+  }
+  // The style's change of the combined sky, R = Style(sky) - sky.
+  std::vector<std::vector<float>> change = sum;
+  style_->ApplyStyle(sun, views, change, directions);
+  record(*style_);
+  for (size_t i = 0; i < views.size(); ++i) {
+    for (size_t k = 0; k < change[i].size(); ++k) change[i][k] = k % 4 == 3 ? 0.0f : change[i][k] - sum[i][k];
+    std::fill(sum[i].begin(), sum[i].end(), 0.0f);
+  }
+  // Each group's share of R added to its sky, its layers composited over
+  // that (their light plus their transmittance times the texel), combined again.
+  for (size_t g = 0; g < renderers_.size(); ++g) {
+    for (size_t i = 0; i < views.size(); ++i)
+      AddShare(change[i].data(), size_t(views[i].width) * views[i].height, shares_[g], skies[g][i]);
+    renderers_[g]->CompositeClouds();
+    record(*renderers_[g]);
+    for (size_t i = 0; i < views.size(); ++i)
+      Accumulate(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
+  }
+  return sum;
+}
+
 bool SpectralSky::UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                                    const EffectSettings& effects) {
   if (quality.wavelengths != bins_.count()) return false;  // also refuses groups of one's own
@@ -141,6 +223,7 @@ bool SpectralSky::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
     return false;
   style_effects_ = effects;
   groups_ = groups;
+  if (!shares_.empty()) shares_ = ColourChangeShares(groups_);
   return true;
 }
 

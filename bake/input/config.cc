@@ -1245,10 +1245,10 @@ void CheckIbl(const SkyStyle& style, StyleChecks& c) {
 }
 
 // The spectral mode (quality.wavelengths > 3) integrates radiance to colour:
-// radiance output keeps the three named wavelengths. The per-texel effects
-// that act on RGB colour (the AOAS saturation clouds and shapes, the night
-// floor) are applied to the combined colour by the style pass (spectral_sky.h);
-// with cloud layers that is after the layers are composited, not before.
+// radiance output keeps the three named wavelengths. (The per-texel effects
+// that act on RGB colour, the AOAS saturation clouds and shapes and the night
+// floor, are applied to the combined colour by the style pass, spectral_sky.h:
+// with cloud layers to the sky behind them, as with three wavelengths.)
 void CheckSpectral(SkyStyle& style, StyleChecks& c) {
   const bool radiance = style.output.units == OutputUnits::kSpectral;
   if (radiance && style.output.color_space != ColorSpace::kRec709) {
@@ -1266,17 +1266,6 @@ void CheckSpectral(SkyStyle& style, StyleChecks& c) {
                             style.quality.wavelengths);
     c.warnings.push_back(w);
     style.quality.wavelengths = kRgbWavelengths;
-    return;
-  }
-  const bool styles_colour = style.aoas.clouds.enabled || style.aoas.shapes.enabled || style.effects.night_dimming;
-  if (styles_colour && !ActiveCloudLayers(style.clouds).empty()) {
-    ConfigError w = c.Locate("quality.wavelengths");
-    w.message = fmt::format("the spectral mode ({} bins) applies the AOAS saturation clouds and shapes and the "
-                            "night floor to the sky after the cloud layers are composited over it, so they act on "
-                            "the layers too (the three-wavelength path applies them to the sky behind the layers): "
-                            "set quality.wavelengths = 3 for that order",
-                            style.quality.wavelengths);
-    c.warnings.push_back(w);
   }
 }
 

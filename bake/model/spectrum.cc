@@ -224,6 +224,25 @@ std::vector<SpectralGroup> SpectralGroups(const AtmosphereParams& style, const S
   return groups;
 }
 
+std::vector<Matrix3> ColourChangeShares(const std::vector<SpectralGroup>& groups) {
+  auto transpose = [](const Matrix3& m) {
+    Matrix3 t{};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) t[i][j] = m[j][i];
+    return t;
+  };
+  Matrix3 gram{};
+  for (const SpectralGroup& g : groups) {
+    const Matrix3 p = Multiply(g.to_rgb, transpose(g.to_rgb));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) gram[i][j] += p[i][j];
+  }
+  const Matrix3 inverse = Inverse(gram);
+  std::vector<Matrix3> shares;
+  for (const SpectralGroup& g : groups) shares.push_back(Multiply(transpose(g.to_rgb), inverse));
+  return shares;
+}
+
 double Rec709Luminance(const std::array<double, 3>& rgb) {
   const Matrix3 m = RgbToXyz(ColorSpace::kRec709);
   return m[1][0] * rgb[0] + m[1][1] * rgb[1] + m[1][2] * rgb[2];

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 
+#include "skybake/model/clouds.h"
 #include "skybake/model/spectrum.h"
 #include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
@@ -56,11 +57,12 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   // bins, each with its LUTs and an output buffer of its own (RGBA float, 16
   // bytes a texel), their sum on the host in place of the one renderer's.
   // The style pass (the AOAS saturation clouds and shapes, the night floor
-  // on the combined colour) has one more such buffer.
+  // on the combined colour) has one more such buffer; with cloud layers, the
+  // style's change of the colour is one more on the host.
   const double groups = q.wavelengths > kRgbWavelengths ? double((q.wavelengths + 2) / 3) : 1.0;
   const bool style_pass = style.aoas.clouds.enabled || style.aoas.shapes.enabled || style.effects.night_dimming;
-  const double spectral_buffers =
-      q.wavelengths > kRgbWavelengths ? 16.0 * (groups + (style_pass ? 1.0 : 0.0)) * texels : 0.0;
+  const double style_buffers = style_pass ? (ActiveCloudLayers(style.clouds).empty() ? 1.0 : 2.0) : 0.0;
+  const double spectral_buffers = q.wavelengths > kRgbWavelengths ? 16.0 * (groups + style_buffers) * texels : 0.0;
   const double luts = groups * 16.0 *
                       (double(q.transmittance_width) * q.transmittance_height +
                        double(q.multiscattering_size) * q.multiscattering_size +

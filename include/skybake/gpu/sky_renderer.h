@@ -20,7 +20,8 @@
 
 namespace skybake {
 
-class SpectralSky;  // spectral_sky.h
+class SpectralSky;      // spectral_sky.h
+struct CloudPanorama;   // cloud_panorama.h
 
 // Texels [x0, x1) x [y0, y1) of a view.
 struct TexelRect {
@@ -118,6 +119,20 @@ class SkyRenderer {
   RenderedViews RenderInPlace(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
                               bool sun_disc = true);
 
+  // A frame in two steps, for the spectral mode's style pass (SpectralSky)
+  // to act on the sky behind the cloud layers as the three-wavelength sky
+  // pass does: RenderClearSky renders the views (or one MAPPING_DIRECTIONS
+  // view of `directions`) without their cloud pass, into the renderer's
+  // output buffer, and returns where each view's RGBA texels are there,
+  // writable; CompositeClouds then runs the cloud pass of those views over
+  // what the texels hold by then, as Render runs it over the sky pass's
+  // (the clouds' light plus their transmittance times the texel). The
+  // texels stay until the renderer's next call. Without cloud layers,
+  // CompositeClouds leaves them as they are.
+  std::vector<float*> RenderClearSky(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                                     bool sun_disc, const std::vector<glm::dvec3>& directions = {});
+  void CompositeClouds();
+
   // True while the texels of a RenderInPlace are held.
   bool HoldsFrames() const;
 
@@ -177,6 +192,15 @@ class SkyRenderer {
     uint32_t groups_x, groups_y;
   };
 
+  // What SubmitViews submits: the whole frame, or the frame without its
+  // cloud pass and then that pass alone (RenderClearSky, CompositeClouds).
+  enum class FramePart { kWhole, kClearSky, kClouds };
+  struct ClearSkyFrame {
+    glm::dvec3 sun;
+    std::vector<ViewRequest> views;
+    bool sun_disc;
+    std::vector<size_t> offsets;
+  };
   enum class Role { kSky, kStylePass };
   SkyRenderer(Role role, VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
               const EffectSettings& effects, const Rgb& output_scale, bool output_directions, const AoasInputs& aoas,
@@ -210,7 +234,17 @@ class SkyRenderer {
   // The sky-view LUT when the Sun moved, the views at `offsets` (texels) of
   // `target`, the sun-disc pass; submitted and waited for.
   void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
-                   bool sun_disc, const std::vector<size_t>& offsets);
+                   bool sun_disc, const std::vector<size_t>& offsets, FramePart part = FramePart::kWhole);
+  // Its parts: the views' sky-pass dispatches (whose constants the cloud
+  // pass's reuse), the sun-disc pass over them, the cloud pass over them.
+  std::vector<Dispatch> ViewDispatches(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
+                                       const std::vector<size_t>& offsets, VkPipeline pipeline) const;
+  void AddSunDisc(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                  const std::vector<Dispatch>& view_dispatches, std::vector<Dispatch>& dispatches,
+                  std::vector<bool>& barriers);
+  void AddCloudComposites(const std::vector<Dispatch>& view_dispatches, const CloudPanorama& panorama,
+                          int32_t panorama_row_range, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
+  std::unique_ptr<ClearSkyFrame> clear_sky_;  // RenderClearSky's frame, until CompositeClouds
 
   // The cloud passes' dispatches of a frame: noise (when not yet built) and
   // tables (when the sun moved) before the views; the cloud pass after them.

@@ -4,7 +4,8 @@
 // groups' CIE weights. Cost grows with the number of groups, ceil(N / 3).
 // The principles that act on a texel's colour (the AOAS saturation clouds
 // and shapes, the night floor) are applied once, to the combined colour, by
-// a style pass.
+// a style pass; with cloud layers, to the sky behind them, as with three
+// wavelengths (Render).
 // A SkyRenderer whose quality asks for more than three wavelengths holds one
 // and forwards to it, so every user of the renderer gets the spectral sky.
 #pragma once
@@ -35,6 +36,13 @@ class SpectralSky {
 
   void PrecomputeLuts();
   // Every group's views, combined: linear Rec.709 in cd/m^2, alpha of the first group.
+  // With the style pass and cloud layers, each group's frame is split around
+  // the style pass (SkyRenderer::RenderClearSky, CompositeClouds): the
+  // groups' clear skies are combined, styled, and the style's change R of
+  // the combined colour is handed back to the groups (ColourChangeShares)
+  // before each composites its layers, so the result is the clouds' light
+  // plus their transmittance times the styled sky, the three-wavelength
+  // path's order.
   std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
                                          bool sun_disc);
   std::vector<float> RenderDirections(const glm::dvec3& sun_direction, const std::vector<glm::dvec3>& directions,
@@ -60,6 +68,13 @@ class SpectralSky {
   AoasInputs style_aoas_;
   EffectSettings style_effects_;
   std::vector<PassTiming> timings_;
+  VulkanContext& context_;
+  int cloud_layers_ = 0;
+  std::vector<Matrix3> shares_;  // ColourChangeShares of groups_, with the style pass and cloud layers
+  // The frame split around the style pass (Render, RenderDirections with
+  // the style pass and cloud layers); `directions` for one MAPPING_DIRECTIONS view.
+  std::vector<std::vector<float>> RenderStyledUnderClouds(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                                          bool sun_disc, const std::vector<glm::dvec3>& directions);
 };
 
 }  // namespace skybake

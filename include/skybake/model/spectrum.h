@@ -90,6 +90,17 @@ struct SpectralGroup {
 };
 std::vector<SpectralGroup> SpectralGroups(const AtmosphereParams& style, const SpectralBins& bins);
 
+// How the spectral mode hands a change of the combined colour back to the
+// groups (SpectralSky, the colour principles under cloud layers): a change
+// R of linear Rec.709 (cd/m^2) becomes the change share[g] * R of group g's
+// radiance, and sum_g to_rgb[g] * share[g] is the identity, so the groups'
+// changes combine to R. The split is the least-squares one (the smallest
+// sum of squared radiance changes): share[g] = to_rgb[g]^T (sum_h to_rgb[h]
+// to_rgb[h]^T)^-1, which gives little to the groups whose bins the eye
+// barely sees (a group's own to_rgb, near singular there, is never inverted)
+// and nothing to a group's padding channel.
+std::vector<Matrix3> ColourChangeShares(const std::vector<SpectralGroup>& groups);
+
 // Rec.709 luminance (cd/m^2) of linear Rec.709.
 double Rec709Luminance(const std::array<double, 3>& rgb);
 
