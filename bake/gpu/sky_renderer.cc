@@ -50,6 +50,15 @@ uint32_t GroupCount(int texels, int local_size) {
   return uint32_t((texels + local_size - 1) / local_size);
 }
 
+// The push constants of a dispatch over one view: the Sun and the view's
+// mapping, size and face (the offsets are the caller's).
+gpu::SkyPush ViewPush(const glm::dvec3& sun, const ViewRequest& v) {
+  gpu::SkyPush push{};
+  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+  push.view = {v.mapping, v.width, v.height, v.face};
+  return push;
+}
+
 }  // namespace
 
 SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
@@ -796,9 +805,7 @@ std::vector<SkyRenderer::Dispatch> SkyRenderer::ViewDispatches(const glm::dvec3&
   std::vector<Dispatch> dispatches;
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
-    gpu::SkyPush push{};
-    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-    push.view = {v.mapping, v.width, v.height, v.face};
+    gpu::SkyPush push = ViewPush(sun, v);
     // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
     push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
     std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
@@ -1019,9 +1026,7 @@ void SkyRenderer::ApplyStyle(const glm::dvec3& sun, const std::vector<ViewReques
   std::vector<Dispatch> dispatches;
   for (size_t i = 0; i < views.size(); ++i) {
     const ViewRequest& v = views[i];
-    gpu::SkyPush push{};
-    push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-    push.view = {v.mapping, v.width, v.height, v.face};
+    gpu::SkyPush push = ViewPush(sun, v);
     push.offsets = {int32_t(offsets[i]), 0, int32_t(total), 0};
     dispatches.push_back({"style", style_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});

@@ -35,31 +35,29 @@ Rgb StyleScale(const AoasInputs& aoas) {
   return {c.x, c.y, c.z};
 }
 
-// Adds a group's three channels, times its matrix, to the RGB of `sum`
-// (RGBA texels); the first group also sets alpha.
-void Accumulate(const float* group, size_t texels, const Matrix3& to_rgb, bool first, float* sum) {
-  float m[3][3];
+// Adds m * (the RGB of `in`) to the three channels of each texel of `out`
+// (RGBA texels); with copy_alpha, out's alpha becomes in's.
+void AddTransformed(const float* in, size_t texels, const Matrix3& m, bool copy_alpha, float* out) {
+  float f[3][3];
   for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m[i][j] = float(to_rgb[i][j]);
+    for (int j = 0; j < 3; ++j) f[i][j] = float(m[i][j]);
   for (size_t t = 0; t < texels; ++t) {
-    const float* in = group + 4 * t;
-    float* out = sum + 4 * t;
-    for (int i = 0; i < 3; ++i) out[i] += m[i][0] * in[0] + m[i][1] * in[1] + m[i][2] * in[2];
-    if (first) out[3] = in[3];
+    const float* a = in + 4 * t;
+    float* b = out + 4 * t;
+    for (int i = 0; i < 3; ++i) b[i] += f[i][0] * a[0] + f[i][1] * a[1] + f[i][2] * a[2];
+    if (copy_alpha) b[3] = a[3];
   }
 }
 
-// Adds share * (the RGB of `change`) to the three channels of each texel of
-// `group` (RGBA texels); alpha is kept.
+// Adds a group's three channels, times its matrix, to the RGB of `sum`; the
+// first group also sets alpha.
+void Accumulate(const float* group, size_t texels, const Matrix3& to_rgb, bool first, float* sum) {
+  AddTransformed(group, texels, to_rgb, first, sum);
+}
+
+// Adds share * (the RGB of `change`) to `group`; alpha is kept.
 void AddShare(const float* change, size_t texels, const Matrix3& share, float* group) {
-  float m[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) m[i][j] = float(share[i][j]);
-  for (size_t t = 0; t < texels; ++t) {
-    const float* in = change + 4 * t;
-    float* out = group + 4 * t;
-    for (int i = 0; i < 3; ++i) out[i] += m[i][0] * in[0] + m[i][1] * in[1] + m[i][2] * in[2];
-  }
+  AddTransformed(change, texels, share, false, group);
 }
 
 }  // namespace
