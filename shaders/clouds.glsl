@@ -22,6 +22,13 @@ layout(std430, set = 0, binding = BINDING_CLOUD_LUT) buffer CloudLutBuffer {
 // Active layers: the loops over layers have this bound, so a style's layer
 // count is compiled in (the cloud pipelines exist only when it is > 0).
 layout(constant_id = SPEC_CLOUD_LAYERS) const int kCloudLayers = 1;
+// Whether the Sun lights the clouds. Off for a frame whose every band is in
+// the Earth's shadow (CloudEarthShadowElevationDeg, clouds.h): the disc's
+// visible fraction is exactly 0 at every sample the march can take, so the
+// sunlight, and with it the light march, is 0 there; compiled out, since
+// lavapipe runs an `if` masked and every lit sample paid for the light march.
+// The ambient light of the sky and the ground is the same either way.
+layout(constant_id = SPEC_CLOUD_SUN_LIGHT) const bool kCloudSunLight = true;
 
 // ---------------------------------------------------------------- hashing and tiling noise
 
@@ -714,9 +721,9 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     float r = atm.bottom_radius + h;
     float u = (float(i) + 0.5) / float(n);
     vec3 w = CloudSegmentWeights(u);
-    vec3 sun_light = CloudSunLight(atm, sun_segment, w, r, h, ClampCosine(mu_s));
+    vec3 sun_light = kCloudSunLight ? CloudSunLight(atm, sun_segment, w, r, h, ClampCosine(mu_s)) : vec3(0.0);
     vec3 scattered = vec3(0.0);
-    if (max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
+    if (kCloudSunLight && max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
       float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
       // Wrenninge 2013: octave o scatters a^o of the light, sees b^o of the
       // optical depth and a phase of eccentricity c^o.

@@ -735,5 +735,72 @@ TEST(CloudSkip, SkippingEmptySpaceKeepsTheBytes) {
   testing::ExpectNoValidationMessages();
 }
 
+// A frame whose every band is in the Earth's shadow (the Sun below
+// CloudEarthShadowElevationDeg) marches its clouds without the Sun's light
+// march (SPEC_CLOUD_SUN_LIGHT off): the same bytes as the full march
+// (SKYBAKE_SHADOWED_CLOUDS=0, ShaderSwitches::shadowed_clouds off) in every
+// view, the panorama's and the marched latlong's and explicit directions, and
+// the variant counted per frame; with the Sun 0.05 deg above the bound the
+// full march runs. The night clouds still show (their ambient light and their
+// transmittance over the sky): the test is not vacuous.
+TEST(CloudEarthShadow, ShadowedFramesSkipTheLightMarchWithTheSameBytes) {
+  struct ShadowCase {
+    const char* name;
+    std::string toml;
+  };
+  const std::vector<ShadowCase> cases = {
+      {"W3 cumulus", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]")},
+      {"overlapping, two bands", Layer(1500, 1500, "coverage = 0.6") +
+                                     Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4") +
+                                     Layer(8000, 500, "type = \"cirrus\"\ncoverage = 0.5")},
+      {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45")},
+  };
+  for (const ShadowCase& c : cases) {
+    const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
+    double top_km = 0.0;
+    for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
+      top_km = std::max(top_km, (l.altitude_m + l.thickness_m) * 1e-3);
+    const double below = CloudEarthShadowElevationDeg(
+        style.atmosphere.bottom_radius_km, style.atmosphere.observer_altitude_m * 1e-3, top_km,
+        style.clouds.quality.max_distance_km, style.atmosphere.sun_angular_radius_rad);
+    auto render = [&](bool variant, double elevation_deg, int* shadowed_frames) {
+      ShaderSwitches shaders;
+      shaders.shadowed_clouds = variant;
+      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                    OutputScale(style.output.units), false,
+                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                    ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0), shaders);
+      const int n = 24;
+      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+      const glm::dvec3 sun = Sun(elevation_deg);
+      std::vector<std::vector<float>> images = r.Render(sun, views);  // the panorama
+      images.push_back(r.Render(sun, {views[0]})[0]);                 // one latlong: marched
+      images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, 0.05, -0.8)}));
+      *shadowed_frames = r.counters().shadowed_cloud_frames;
+      return images;
+    };
+    for (double elevation : {below - 0.05, below - 6.0}) {
+      int on_frames = 0, off_frames = 0;
+      const std::vector<std::vector<float>> on = render(true, elevation, &on_frames);
+      const std::vector<std::vector<float>> off = render(false, elevation, &off_frames);
+      EXPECT_EQ(on_frames, 3) << c.name << " at " << elevation << " deg: the variant runs";
+      EXPECT_EQ(off_frames, 0) << c.name;
+      ASSERT_EQ(on.size(), off.size());
+      for (size_t i = 0; i < on.size(); ++i)
+        EXPECT_TRUE(on[i] == off[i]) << c.name << " at " << elevation << " deg, image " << i;
+      const SkyStyle clear = PrunedStyle(Style(std::string(kFast) + c.toml.substr(0, c.toml.find("[[cloud_layer]]"))));
+      EXPECT_FALSE(StyleRenderer(clear).renderer->Render(Sun(elevation), {{MAPPING_LATLONG, 96, 48, 0}})[0] == on[8])
+          << c.name << " at " << elevation << " deg: the night clouds show";
+    }
+    int above_frames = -1;
+    render(true, below + 0.05, &above_frames);
+    EXPECT_EQ(above_frames, 0) << c.name << ": 0.05 deg above the bound the Sun's light is marched";
+  }
+  // W3's layer (top 3 km, 300 km) from the ground: the bound of the header's comment.
+  EXPECT_NEAR(CloudEarthShadowElevationDeg(6360.0, 0.0, 3.0, 300.0, 0.004675), -3.80, 0.005);
+  testing::ExpectNoValidationMessages();
+}
+
 }  // namespace
 }  // namespace skybake

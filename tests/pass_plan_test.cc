@@ -330,6 +330,53 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
   }
 }
 
+// The frames whose every cloud band is in the Earth's shadow (the Sun below
+// CloudEarthShadowElevationDeg: -3.80 deg for a 3 km top from the ground)
+// are listed in the effect "clouds in the Earth's shadow" with the bound, and
+// the panorama pass again for them without the light march's samples; off
+// with SKYBAKE_SHADOWED_CLOUDS=0 (ShaderSwitches::shadowed_clouds) or when no
+// frame is that dark. `skybake plan` prints the same.
+TEST(PassPlanTest, CloudFramesInTheEarthsShadowAreListed) {
+  const std::string layer = "[render]\ncube_size = 64\nlatlong_height = 128\n"
+                            "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = 0.45\n";
+  auto at = [&](double elevation_deg) { return Style(layer, {"sun.elevation_deg=" + std::to_string(elevation_deg)}); };
+  auto pass = [](const PassPlan& p, const std::string& name) -> const PlannedPass* {
+    for (const PlannedPass& x : p.passes)
+      if (x.name == name) return &x;
+    return nullptr;
+  };
+  const std::vector<SkyStyle> frames = {at(10.0), at(-3.7), at(-3.9), at(-12.0), at(-3.75)};
+  const PassPlan plan = PlanPasses(frames);
+  const EffectDecision& effect = Effect(plan, "clouds in the Earth's shadow");
+  EXPECT_TRUE(effect.on) << FormatPlan(plan, "frames");
+  EXPECT_NE(effect.reason.find("2 of 5 frames (plan order 2-3) with the Sun below -3.80 deg"), std::string::npos)
+      << effect.reason;
+  const PlannedPass* lit = pass(plan, "clouds panorama");
+  const PlannedPass* dark = pass(plan, "clouds panorama in the Earth's shadow");
+  ASSERT_NE(lit, nullptr);
+  ASSERT_NE(dark, nullptr) << FormatPlan(plan, "frames");
+  EXPECT_EQ(lit->runs, 3);
+  EXPECT_EQ(dark->runs, 2);
+  const CloudQuality& cq = frames[0].clouds.quality;
+  EXPECT_EQ(dark->samples * (1.0 + cq.light_steps), lit->samples);
+  EXPECT_EQ(dark->size, lit->size);
+  EXPECT_NE(FormatPlan(plan, "frames").find("clouds panorama in the Earth's shadow"), std::string::npos);
+  // Switched off: every frame marches the Sun's light.
+  ShaderSwitches off;
+  off.shadowed_clouds = false;
+  const PassPlan full = PlanPasses(frames, off);
+  EXPECT_FALSE(Effect(full, "clouds in the Earth's shadow").on);
+  EXPECT_EQ(pass(full, "clouds panorama in the Earth's shadow"), nullptr);
+  EXPECT_EQ(pass(full, "clouds panorama")->runs, 5);
+  EXPECT_GT(full.total_samples, plan.total_samples);
+  // No frame below the bound.
+  const PassPlan day = PlanPasses({at(10.0), at(-3.7)});
+  EXPECT_FALSE(Effect(day, "clouds in the Earth's shadow").on);
+  EXPECT_NE(Effect(day, "clouds in the Earth's shadow").reason.find("no frame with the Sun below -3.80 deg"),
+            std::string::npos);
+  EXPECT_EQ(pass(day, "clouds panorama in the Earth's shadow"), nullptr);
+}
+
 // The cloud formation's CPU step and the cloud shadow map's pass are listed
 // with their cost: the formation simulates from step 0 to the last planned
 // frame's step (warm-up 5 + 10 per hour x 1.25 h = 17.5: 18 steps) of

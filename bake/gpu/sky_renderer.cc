@@ -86,7 +86,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       effects_(effects),
       aoas_switches_(aoas.switches),
       output_directions_(output_directions),
-      style_pass_(role == Role::kStylePass) {
+      style_pass_(role == Role::kStylePass),
+      shadowed_clouds_(shaders.shadowed_clouds) {
   if (quality.wavelengths > kRgbWavelengths && !output_directions && !style_pass_) {
     spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
     SyncSpectral();
@@ -294,7 +295,7 @@ void SkyRenderer::DestroyAll() {
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
                         &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
-                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_,
+                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_, &shadowed_cloud_pipeline_,
                         &style_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
@@ -481,8 +482,28 @@ VkPipeline SkyRenderer::TwilightSkyPipeline() {
   return twilight_sky_pipeline_;
 }
 
+bool SkyRenderer::CloudsInEarthShadow(const glm::dvec3& sun) const {
+  if (cloud_layers_ == 0 || !shadowed_clouds_) return false;
+  // The GPU's own values: the bands' tops, the distance bound, the radii (km).
+  double top = 0.0;
+  for (int b = 0; b < gpu_clouds_.resolution.w; ++b) top = std::max(top, double(gpu_clouds_.bands[b].y));
+  const double below = CloudEarthShadowElevationDeg(gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.z, top,
+                                                    gpu_clouds_.range.x, gpu_atmosphere_.solar_irradiance.w);
+  return sun.y < std::sin(below * M_PI / 180.0);
+}
+
+VkPipeline SkyRenderer::ShadowedCloudPipeline() {
+  if (!shadowed_cloud_pipeline_) {
+    // cloud_pipeline_ with the Sun's light (and its light march) compiled out.
+    shadowed_cloud_pipeline_ =
+        CreatePipeline(kCloudRenderSpv, sizeof(kCloudRenderSpv), false, false, false, false);
+    ++counters_.pipelines;
+  }
+  return shadowed_cloud_pipeline_;
+}
+
 VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
-                                       bool twilight_march) {
+                                       bool twilight_march, bool cloud_sun_light) {
   // Specialization constants (SPEC_* of gpu_shared.h). Every pipeline gets
   // them all; a shader that does not use one ignores it.
   struct {
@@ -491,21 +512,21 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
-    VkBool32 twilight_march;
+    VkBool32 twilight_march, cloud_sun_light;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
-              twilight_march};
-  const VkSpecializationMapEntry entries[16] = {
+              twilight_march,               cloud_sun_light};
+  const VkSpecializationMapEntry entries[17] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
-      {SPEC_TWILIGHT_MARCH, 60, 4}};
-  VkSpecializationInfo specialization{16, entries, sizeof(values), &values};
+      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}};
+  VkSpecializationInfo specialization{17, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
@@ -842,14 +863,14 @@ void SkyRenderer::AddSunDisc(const glm::dvec3& sun, const std::vector<ViewReques
 }
 
 void SkyRenderer::AddCloudComposites(const std::vector<Dispatch>& view_dispatches, const CloudPanorama& panorama,
-                                     int32_t panorama_row_range, std::vector<Dispatch>& dispatches,
-                                     std::vector<bool>& barriers) {
+                                     int32_t panorama_row_range, VkPipeline cloud_pipeline,
+                                     std::vector<Dispatch>& dispatches, std::vector<bool>& barriers) {
   // The sky and disc passes' writes before the cloud pass reads them (in a
   // submission of its own, FramePart::kClouds, the host's writes are).
   if (!barriers.empty()) barriers.back() = true;
   for (Dispatch d : view_dispatches) {
     d.name = "clouds " + d.name;
-    d.pipeline = cloud_pipeline_;
+    d.pipeline = cloud_pipeline;
     if (panorama.width > 0) {
       d.pipeline = cloud_resample_pipeline_;
       d.push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_RESAMPLE};
@@ -879,6 +900,10 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   BindOutput(target);
   // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
   const VkPipeline sky_pipeline = MarchesTwilightBand(sun) ? TwilightSkyPipeline() : sky_pipeline_;
+  // With every cloud band in the Earth's shadow the clouds march without the Sun's light.
+  const bool shadowed_clouds = CloudsInEarthShadow(sun);
+  const VkPipeline cloud_pipeline = shadowed_clouds ? ShadowedCloudPipeline() : cloud_pipeline_;
+  if (shadowed_clouds && part != FramePart::kClouds) ++counters_.shadowed_cloud_frames;
   // The views' constants, the cloud pass's too.
   const std::vector<Dispatch> view_dispatches = ViewDispatches(sun, views, sun_disc, offsets, sky_pipeline);
 
@@ -908,7 +933,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
       push.offsets.w = panorama_row_range;
       // Read by the cloud passes after the views' barrier below.
-      dispatches.push_back({"clouds panorama", cloud_pipeline_, push,
+      dispatches.push_back({"clouds panorama", cloud_pipeline, push,
                             GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
                             GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y)});
       barriers.push_back(false);
@@ -922,7 +947,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     if (disc_pass_ && sun_disc) AddSunDisc(sun, views, view_dispatches, dispatches, barriers);
   }
   if (cloud_layers_ > 0 && part != FramePart::kClearSky)
-    AddCloudComposites(view_dispatches, panorama, panorama_row_range, dispatches, barriers);
+    AddCloudComposites(view_dispatches, panorama, panorama_row_range, cloud_pipeline, dispatches, barriers);
   Submit(dispatches, barriers);
   if (part != FramePart::kClouds) ++counters_.frames;
 }

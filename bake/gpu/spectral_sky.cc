@@ -261,6 +261,7 @@ RenderCounters SpectralSky::counters() const {
   if (style_) sum.pipelines += style_->counters().pipelines;
   // A frame is every group's render of it.
   sum.frames = renderers_.empty() ? 0 : renderers_.front()->counters().frames;
+  sum.shadowed_cloud_frames = renderers_.empty() ? 0 : renderers_.front()->counters().shadowed_cloud_frames;
   return sum;
 }
 

@@ -138,6 +138,21 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
   return problems;
 }
 
+double CloudEarthShadowElevationDeg(double bottom_radius_km, double observer_altitude_km, double highest_top_km,
+                                    double max_distance_km, double sun_angular_radius_rad) {
+  const double R = bottom_radius_km;
+  const double r0 = R + std::max(observer_altitude_km, 0.0);
+  const double r_top = R + std::max(highest_top_km, 0.0) + 0.01;
+  // The disc's visibility is 0 where mu_s <= this, at every radius up to r_top.
+  const double x = R / r_top;
+  const double mu_shadow = -std::sqrt(1.0 - x * x) - x * sun_angular_radius_rad - 1e-4;
+  // The farthest sample, and the largest angle between its zenith and the observer's.
+  const double t_max = std::min(max_distance_km, std::sqrt(r0 * r0 - R * R) + std::sqrt(r_top * r_top - R * R));
+  const double gamma = 2.0 * std::asin(std::min(t_max / (2.0 * R), 1.0));
+  // theta_s - gamma >= acos(mu_shadow): the elevation pi / 2 - theta_s.
+  return (M_PI / 2.0 - gamma - std::acos(mu_shadow)) * 180.0 / M_PI;
+}
+
 double CloudLoopIterationsPerTexel(const CloudSettings& clouds) {
   const double layers = double(std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers));
   if (layers == 0.0) return 0.0;

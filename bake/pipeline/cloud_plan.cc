@@ -36,9 +36,18 @@ int CloudBands(const std::vector<CloudLayer>& layers) {
 }  // namespace
 
 void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<ViewRequest>& views, int frames,
-                       PassPlan& plan) {
+                       int shadowed, double shadow_below_deg, PassPlan& plan) {
   const CloudQuality& cq = first.clouds.quality;
   const double per_texel = double(cq.view_steps) * layers * (1.0 + cq.light_steps);
+  const double per_texel_shadowed = double(cq.view_steps) * layers;
+  // A marching pass: its sunlit frames, then its frames in the Earth's shadow.
+  auto march = [&](const std::string& name, const std::string& size, const std::string& frequency, double texels) {
+    if (frames > shadowed) plan.passes.push_back({name, size, frequency, frames - shadowed, texels * per_texel});
+    if (shadowed > 0)
+      plan.passes.push_back({name + " in the Earth's shadow", size,
+                             fmt::format("frames with the Sun below {:.2f} deg (no light march)", shadow_below_deg),
+                             shadowed, texels * per_texel_shadowed});
+  };
   auto view_name = [](const ViewRequest& v) {
     return v.mapping == MAPPING_LATLONG      ? std::string("clouds latlong")
            : v.mapping == MAPPING_CUBE_STRIP ? std::string("clouds cube strip")
@@ -47,8 +56,8 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
   const CloudPanorama panorama = ChooseCloudPanorama(views, cq.panorama_scale);
   if (panorama.width == 0) {
     for (const ViewRequest& v : views)
-      plan.passes.push_back({view_name(v), fmt::format("{} x {}", v.width, v.height), "once per frame (at most)",
-                             frames, double(v.width) * v.height * per_texel});
+      march(view_name(v), fmt::format("{} x {}", v.width, v.height), "once per frame (at most)",
+            double(v.width) * v.height);
     return;
   }
   std::vector<std::array<double, 2>> bands;
@@ -56,11 +65,11 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
     bands.push_back({l.altitude_m * 1e-3, (l.altitude_m + l.thickness_m) * 1e-3});
   const CloudPanoramaRows rows = CloudPanoramaRowsSeeingBands(
       panorama, first.atmosphere.bottom_radius_km, first.atmosphere.observer_altitude_m * 1e-3, bands);
-  plan.passes.push_back({"clouds panorama",
-                         fmt::format("{} x {}, rows {} to {} marched, {} texels", panorama.width, panorama.height,
-                                     rows.begin, rows.end - 1, CloudPanoramaMarchedTexels(panorama, rows)),
-                         fmt::format("once per frame (quality.cloud_panorama_scale = {})", cq.panorama_scale), frames,
-                         double(CloudPanoramaMarchedTexels(panorama, rows)) * per_texel});
+  march("clouds panorama",
+        fmt::format("{} x {}, rows {} to {} marched, {} texels", panorama.width, panorama.height, rows.begin,
+                    rows.end - 1, CloudPanoramaMarchedTexels(panorama, rows)),
+        fmt::format("once per frame (quality.cloud_panorama_scale = {})", cq.panorama_scale),
+        double(CloudPanoramaMarchedTexels(panorama, rows)));
   for (const ViewRequest& v : views)
     plan.passes.push_back({view_name(v) + " (resampled)", fmt::format("{} x {}", v.width, v.height),
                            "once per frame", frames, 0.0});

@@ -21,9 +21,12 @@ void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan);
 // band, and their medium samples) and one "clouds <view> (resampled)" per
 // view, no medium samples; else each view marches its own texels. Medium
 // samples: at most view_steps per layer crossing, each lit sample
-// light_steps more.
+// light_steps more. Of the `frames`, the `shadowed` ones (every band in the
+// Earth's shadow: CloudEarthShadowElevationDeg, below `shadow_below_deg`)
+// march without the Sun's light march: the marching passes are listed again
+// for them ("... in the Earth's shadow"), view_steps per layer crossing.
 void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<ViewRequest>& views, int frames,
-                       PassPlan& plan);
+                       int shadowed, double shadow_below_deg, PassPlan& plan);
 
 // Effect "cloud formation" and its CPU step per active layer with a
 // formation: cells per step, and the steps simulated to reach the planned

@@ -224,11 +224,57 @@ bool PlansSunDiscPass(const SkyStyle& first, const SkyStyle& pruned, const Shade
   return UsesSunDiscPass(first.quality, pruned.effects, switches, shaders);
 }
 
-// Volumetric cloud layers: the noise volumes, the tables, every view.
-void PlanCloudPasses(const SkyStyle& first, PassPlan& plan) {
+// Frame numbers (plan order) as runs: "0-17, 80-95".
+std::string FrameRanges(const std::vector<int>& frames) {
+  std::string out;
+  for (size_t i = 0; i < frames.size();) {
+    size_t j = i;
+    while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+    out += (out.empty() ? "" : ", ") +
+           (j == i ? std::to_string(frames[i]) : fmt::format("{}-{}", frames[i], frames[j]));
+    i = j + 1;
+  }
+  return out;
+}
+
+// The Sun's elevation, deg, below which every band of the style's active
+// cloud layers is in the Earth's shadow (CloudEarthShadowElevationDeg), and
+// their highest top, km.
+double CloudShadowBelowDeg(const SkyStyle& style, double* top_km) {
+  *top_km = 0.0;
+  for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
+    *top_km = std::max(*top_km, (l.altitude_m + l.thickness_m) * 1e-3);
+  const AtmosphereParams& a = style.atmosphere;
+  return CloudEarthShadowElevationDeg(a.bottom_radius_km, a.observer_altitude_m * 1e-3, *top_km,
+                                      style.clouds.quality.max_distance_km, a.sun_angular_radius_rad);
+}
+
+// Volumetric cloud layers: the noise volumes, the tables, every view; the
+// effect "clouds in the Earth's shadow": the frames whose cloud march runs
+// without the Sun's light march (SkyRenderer::CloudsInEarthShadow).
+void PlanCloudPasses(const std::vector<SkyStyle>& frames, const SkyStyle& first, const ShaderSwitches& shaders,
+                     PassPlan& plan) {
   const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
   const CloudQuality& cq = first.clouds.quality;
   if (!cloud_layers.empty()) {
+    double top_km = 0.0;
+    const double below = CloudShadowBelowDeg(first, &top_km);
+    std::vector<int> shadowed;
+    for (size_t i = 0; i < frames.size(); ++i)
+      if (frames[i].sun.elevation_deg < below) shadowed.push_back(int(i));
+    const std::string geometry = fmt::format("the Sun below {:.2f} deg: every band (top {:g} km, within {:g} km) in "
+                                             "the Earth's shadow",
+                                             below, top_km, cq.max_distance_km);
+    const bool on = shaders.shadowed_clouds && !shadowed.empty();
+    plan.effects.push_back(
+        {"clouds in the Earth's shadow", true, on,
+         !shaders.shadowed_clouds
+             ? "SKYBAKE_SHADOWED_CLOUDS=0: every frame's clouds march the Sun's light"
+         : on ? fmt::format("{} of {} frames (plan order {}) with {}: their cloud march runs without the Sun's "
+                            "light march (constant 21 off), the same bytes",
+                            shadowed.size(), frames.size(), FrameRanges(shadowed), geometry)
+              : fmt::format("no frame with {}", geometry)});
+    if (!shaders.shadowed_clouds) shadowed.clear();
     const int layers = int(cloud_layers.size());
     const double shape = double(cq.shape_resolution) * cq.shape_resolution * cq.shape_resolution;
     const double detail = double(cq.detail_resolution) * cq.detail_resolution * cq.detail_resolution;
@@ -241,7 +287,8 @@ void PlanCloudPasses(const SkyStyle& first, PassPlan& plan) {
     // ambient 16 altitudes x 64 directions x 16 steps.
     plan.passes.push_back({"cloud tables", "AP 32 x 64 x 32, ambient 16", "once per frame", plan.frames,
                            32.0 * 64 * 32 * 4 + 16.0 * 64 * 16});
-    AddCloudMarchPlan(first, layers, PlanViews(first), plan.frames, plan);  // cloud_plan.h: panorama or views
+    AddCloudMarchPlan(first, layers, PlanViews(first), plan.frames, int(shadowed.size()), below,
+                      plan);  // cloud_plan.h: panorama or views
   }
 }
 
@@ -310,6 +357,7 @@ std::string DescribeVariant(const SkyStyle& first, const SkyStyle& pruned, bool 
   const QualitySettings& q = first.quality;
   const bool sky_view = NeedsSkyViewLut(pruned);
   const std::vector<CloudLayer> cloud_layers = ActiveCloudLayers(first.clouds);
+  double top_km = 0.0;
   const CloudQuality& cq = first.clouds.quality;
   std::string variant;
   static const char* kIntegrators[] = {"analytic", "midpoint", "trapezoid", "simpson"};
@@ -331,8 +379,13 @@ std::string DescribeVariant(const SkyStyle& first, const SkyStyle& pruned, bool 
     variant += fmt::format(
         "\n  clouds: cloud_render with {} layer(s) compiled in (constant 20), after the sky and sun-disc passes; "
         "per texel at most {} view steps per layer crossing (a third of them for a vertical crossing), {} light "
-        "steps per lit sample, {} scattering octaves, no cloud beyond {} km",
-        cloud_layers.size(), cq.view_steps, cq.light_steps, cq.octaves, cq.max_distance_km);
+        "steps per lit sample, {} scattering octaves, no cloud beyond {} km; {}",
+        cloud_layers.size(), cq.view_steps, cq.light_steps, cq.octaves, cq.max_distance_km,
+        shaders.shadowed_clouds
+            ? fmt::format("a frame with the Sun below {:.2f} deg (every band in the Earth's shadow) runs it with "
+                          "constant 21 off: no Sun's light, no light march",
+                          CloudShadowBelowDeg(first, &top_km))
+            : "every frame with the Sun's light march (SKYBAKE_SHADOWED_CLOUDS=0)");
   else
     variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
   return variant;
@@ -380,7 +433,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
     if (pruned.aoas.clouds.enabled || pruned.aoas.shapes.enabled || pruned.effects.night_dimming)
       plan.passes.push_back({"style", "every texel", "once per frame", plan.frames, 0.0});
   }
-  PlanCloudPasses(first, plan);
+  PlanCloudPasses(frames, first, shaders, plan);
   PlanMoonlitPasses(first, pruned, plan);
   AddNightSkyPlan(frames, plan);  // night_sky.h: the host's splat and glow, and what prunes them
   AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h

@@ -37,6 +37,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_SUN_DISC_PASS 15       // bool: sky_render as the sun-disc pass
 #define SPEC_TWILIGHT_MARCH 16      // bool: the twilight band is ray-marched (quality.twilight_march_band_deg)
 #define SPEC_CLOUD_LAYERS 20        // int: the active volumetric cloud layers
+#define SPEC_CLOUD_SUN_LIGHT 21     // bool: the Sun lights the clouds (off: every band in the Earth's shadow)
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere

@@ -24,6 +24,7 @@ struct RenderCounters {
   int cloud_noise_builds = 0;   // noise volumes generated (once per renderer unless seeds change)
   int cloud_table_builds = 0;   // aerial-perspective LUT and ambient table (once per sun position)
   int cloud_dispatches = 0;     // dispatches of the cloud pass
+  int shadowed_cloud_frames = 0;  // frames whose cloud march ran without the Sun's light (every band in the shadow)
   long long sun_disc_texels = 0;  // texels they covered
 };
 

@@ -40,6 +40,9 @@ std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::d
 struct ShaderSwitches {
   bool generic = false;       // SKYBAKE_GENERIC_SHADERS=1: every pipeline from the generic shaders, no variant
   bool sun_disc_pass = true;  // SKYBAKE_SUN_DISC_PASS=0: the disc tested by every texel, no pass of its own
+  // SKYBAKE_SHADOWED_CLOUDS=0: no cloud pass without the Sun's light march, even with every band in the
+  // Earth's shadow (CloudEarthShadowElevationDeg)
+  bool shadowed_clouds = true;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
@@ -217,13 +220,19 @@ class SkyRenderer {
   void WriteStorageBinding(uint32_t binding, VkBuffer buffer);
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
-                            bool twilight_march = false);
+                            bool twilight_march = false, bool cloud_sun_light = true);
   // Whether this Sun makes the frame twilight (TwilightSunElevationDeg): its
   // views march the twilight band (quality.twilight_march_band_deg) and read
   // the sun transmittance in the logarithm, with the sky pass that does,
   // built on the first such frame.
   bool MarchesTwilightBand(const glm::dvec3& sun) const;
   VkPipeline TwilightSkyPipeline();
+  // Whether this Sun leaves every cloud band in the Earth's shadow
+  // (CloudEarthShadowElevationDeg, shaders.shadowed_clouds): the frame's
+  // cloud march runs without the Sun's light march (specialization constant
+  // 21), the same bytes, with the pipeline built on the first such frame.
+  bool CloudsInEarthShadow(const glm::dvec3& sun) const;
+  VkPipeline ShadowedCloudPipeline();
   void DestroyAll();  // every Vulkan object of the renderer; safe on a partly built one
   // Records the dispatches into one command buffer, submits, waits, and
   // records per-dispatch timings. A barrier follows every dispatch that a
@@ -243,7 +252,8 @@ class SkyRenderer {
                   const std::vector<Dispatch>& view_dispatches, std::vector<Dispatch>& dispatches,
                   std::vector<bool>& barriers);
   void AddCloudComposites(const std::vector<Dispatch>& view_dispatches, const CloudPanorama& panorama,
-                          int32_t panorama_row_range, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
+                          int32_t panorama_row_range, VkPipeline cloud_pipeline, std::vector<Dispatch>& dispatches,
+                          std::vector<bool>& barriers);
   std::unique_ptr<ClearSkyFrame> clear_sky_;  // RenderClearSky's frame, until CompositeClouds
 
   // The cloud passes' dispatches of a frame: noise (when not yet built) and
@@ -305,6 +315,8 @@ class SkyRenderer {
   VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
   VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
   VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;  // built on the first frame that marches the twilight band
+  VkPipeline shadowed_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the Sun's light (CloudsInEarthShadow)
+  bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
   VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
   bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant
   VkCommandPool command_pool_ = VK_NULL_HANDLE;

@@ -118,6 +118,28 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
 double CloudLoopIterationsPerTexel(const CloudSettings& clouds);
 constexpr double kMaxCloudLoopIterations = 60000.0;
 
+// The Sun's elevation, deg, below which every sample the cloud march can
+// take lies in the Earth's shadow (the cloud pass then runs without the
+// Sun's light march: SPEC_CLOUD_SUN_LIGHT, clouds.glsl). Frame: the
+// planet's centre at the origin, the observer `observer_altitude_km` above
+// `bottom_radius_km`; every band's top at most `highest_top_km`, no sample
+// beyond `max_distance_km` (quality.cloud_max_distance_km). The shader's
+// disc visibility (CloudSunLight, as GetTransmittanceToSun) is exactly 0
+// where mu_s <= cos_theta_h - sin_theta_h alpha at the sample's radius r
+// (sin_theta_h = R / r, cos_theta_h = -sqrt(1 - (R / r)^2), alpha the Sun's
+// angular radius): the whole disc below the sample's horizon. That bound
+// falls with r (for r < R sqrt(1 + alpha^2) / alpha), so it is taken at the
+// highest top. A sample's zenith is at most gamma from the observer's,
+// 2 asin(t / 2R) for a sample t from the observer (the chord between the two
+// radii is at least 2 R sin(gamma / 2)), and t is at most the distance along
+// a ray that grazes the ground to the highest top, sqrt(r0^2 - R^2) +
+// sqrt(r_top^2 - R^2), or max_distance_km. So mu_s <= cos(theta_s - gamma),
+// theta_s the Sun's zenith angle at the observer. Conservative: 10 m on the
+// top and 1e-4 on the cosine (about 0.006 deg) for the shader's float
+// rounding. W3 (a 3 km top, 300 km): -3.80 deg.
+double CloudEarthShadowElevationDeg(double bottom_radius_km, double observer_altitude_km, double highest_top_km,
+                                    double max_distance_km, double sun_angular_radius_rad);
+
 // What the renderer needs: the uniform block, the weather images (R channel,
 // resampled to the procedural map's resolution), and the sizes of the noise
 // volumes. Empty `uniform.counts.x` (0 layers) means no cloud pass at all.
