@@ -20,6 +20,19 @@
 namespace skybake {
 namespace {
 
+// The converged reference's radiance along each of `dirs`, on two threads.
+std::vector<glm::dvec3> ReferenceRadiances(const ConvergedReference& ref, const std::vector<glm::dvec3>& dirs,
+                                           const glm::dvec3& sun) {
+  std::vector<glm::dvec3> expected(dirs.size());
+  std::vector<std::thread> pool;
+  for (size_t t = 0; t < 2; ++t)
+    pool.emplace_back([&, t] {
+      for (size_t i = t; i < dirs.size(); i += 2) expected[i] = ref.Radiance(dirs[i], sun);
+    });
+  for (std::thread& th : pool) th.join();
+  return expected;
+}
+
 TEST(GaussLegendreTest, EightPointsIntegrateDegree15Exactly) {
   std::vector<double> x, w;
   GaussLegendre(8, x, w);
@@ -161,13 +174,7 @@ TEST(ConvergedReferenceTest, SunPathMarchFollowsTheHorizonWhenTheSunIsPartlySet)
       dirs.push_back(glm::dvec3(glm::vec3(SunDirectionFromElevationAzimuth(elevation, azimuth))));
   for (double sun_elevation : {0.0, -0.5, -1.0}) {
     const glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 180.0);
-    std::vector<glm::dvec3> expected(dirs.size());
-    std::vector<std::thread> pool;
-    for (size_t t = 0; t < 2; ++t)
-      pool.emplace_back([&, t] {
-        for (size_t i = t; i < dirs.size(); i += 2) expected[i] = ref.Radiance(dirs[i], sun);
-      });
-    for (std::thread& th : pool) th.join();
+    const std::vector<glm::dvec3> expected = ReferenceRadiances(ref, dirs, sun);
     std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
     double worst = 0.0, max_value = 0.0;
     for (const glm::dvec3& l : expected) max_value = std::max({max_value, l.x, l.y, l.z});
@@ -266,15 +273,7 @@ TEST(ConvergedReferenceTest, PresetsAgainstTheirBudgetsAtTwilight) {
         std::make_unique<SkyRenderer>(testing::Vulkan(), a, QualityPreset(b.preset), single, Rgb{1, 1, 1}));
   for (double sun_elevation : {-10.0, -6.0, -3.0, -1.0, 0.0, 1.0, 2.0}) {
     const glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 180.0);
-    std::vector<glm::dvec3> expected(dirs.size());
-    {
-      std::vector<std::thread> pool;
-      for (size_t t = 0; t < 2; ++t)
-        pool.emplace_back([&, t] {
-          for (size_t i = t; i < dirs.size(); i += 2) expected[i] = ref.Radiance(dirs[i], sun);
-        });
-      for (std::thread& th : pool) th.join();
-    }
+    const std::vector<glm::dvec3> expected = ReferenceRadiances(ref, dirs, sun);
     double max_value = 0.0;
     for (const glm::dvec3& l : expected) max_value = std::max({max_value, l.x, l.y, l.z});
     for (size_t p = 0; p < renderers.size(); ++p) {
