@@ -886,11 +886,15 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
 // from the observer's horizon up to twilight_march_band above it, where the
 // Earth's shadow and the band above it fall by orders of magnitude within
 // the spacing of the LUT's rows (docs/accuracy.md, "Twilight"). Hillaire
-// 2020 section 5.3 suggests the same fall-back for accuracy.
+// 2020 section 5.3 suggests the same fall-back for accuracy. The band's top
+// is raised by the horizon's dip (HorizonZenithAngle - pi/2: 0 at sea level,
+// 2.9 deg at 8 km): from altitude the horizon drops below the horizontal
+// while the shadow's edge above it stands that much higher.
 bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return false;
-  Real above_horizon = HorizonZenithAngle(atm) - atan(length(vec2(view.x, view.z)), view.y);
-  return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band;
+  Real horizon = HorizonZenithAngle(atm);
+  Real above_horizon = horizon - atan(length(vec2(view.x, view.z)), view.y);
+  return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi);
 }
 
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus

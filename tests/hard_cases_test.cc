@@ -168,6 +168,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         HardCase{"Earth, observer at 0 m", [](AtmosphereParams&) {}, EffectSettings{}},
         HardCase{"observer at 1 mm", [](AtmosphereParams& a) { a.observer_altitude_m = 1e-3; }, EffectSettings{}},
+        // The twilight band (its suns -3 and 0.5 deg) raised by the horizon's dip.
+        HardCase{"observer at 8 km", [](AtmosphereParams& a) { a.observer_altitude_m = 8000.0; }, EffectSettings{}},
         HardCase{"observer at the top of the atmosphere",
                  [](AtmosphereParams& a) { a.observer_altitude_m = 1e3 * (a.top_radius_km - a.bottom_radius_km); },
                  EffectSettings{}},
@@ -216,6 +218,45 @@ INSTANTIATE_TEST_SUITE_P(
       for (char c : info.param.name) name += std::isalnum(static_cast<unsigned char>(c)) ? c : '_';
       return name;
     });
+
+// The top of the twilight band from 8 km (quality.twilight_march_band_deg
+// plus the horizon's dip, InTwilightMarchBand): the marched texels just
+// below it and the sky-view LUT's just above it, sun -6 deg, production.
+// No seam: across the top the sky changes by no more than the production
+// budget (1%), and every value is finite and positive.
+TEST(HardCaseExtraTest, TwilightBandTopFrom8KmHasNoSeam) {
+  AtmosphereParams a;
+  a.observer_altitude_m = 8000.0;
+  const QualitySettings q = QualityPreset("production");
+  const double r = a.bottom_radius_km + 1e-3 * a.observer_altitude_m;
+  const double dip_deg =
+      std::asin(std::sqrt(1e-3 * a.observer_altitude_m * (r + a.bottom_radius_km)) / r) * 180.0 / M_PI;
+  const double top_deg = q.twilight_march_band_deg + dip_deg;  // above the horizon, which is dip_deg below 0
+  EffectSettings effects;
+  effects.sun_disc = false;
+  SkyRenderer renderer(testing::Vulkan(), a, q, effects, {1, 1, 1});
+  const glm::dvec3 sun = SunDirectionFromElevationAzimuth(-6.0, 180.0);
+  std::vector<glm::dvec3> dirs;
+  const double offsets[] = {-0.2, -0.02, 0.02, 0.2};  // deg from the top: two below, two above
+  for (double azimuth = 0.0; azimuth <= 180.0; azimuth += 15.0)
+    for (double d : offsets) dirs.push_back(SunDirectionFromElevationAzimuth(top_deg - dip_deg + d, azimuth));
+  const std::vector<float> out = renderer.RenderDirections(sun, dirs);
+  double worst_jump = 0.0, worst_beside = 0.0;
+  for (size_t k = 0; k < dirs.size(); k += 4)
+    for (int c = 0; c < 3; ++c) {
+      for (size_t j = 0; j < 4; ++j)
+        ASSERT_TRUE(std::isfinite(out[4 * (k + j) + c]) && out[4 * (k + j) + c] > 0.0f) << "dir " << k + j;
+      auto rel = [&](size_t i, size_t j) {
+        return std::abs(double(out[4 * i + c]) - out[4 * j + c]) / out[4 * j + c];
+      };
+      worst_jump = std::max(worst_jump, rel(k + 2, k + 1));                      // across the top
+      worst_beside = std::max({worst_beside, rel(k + 1, k), rel(k + 3, k + 2)});  // within each side
+    }
+  std::printf("8 km, sun -6 deg, band top %.2f deg above the horizon: across it %.2e, 0.18 deg beside it %.2e\n",
+              top_deg, worst_jump, worst_beside);
+  EXPECT_LT(worst_jump, 1e-2);
+  testing::ExpectNoValidationMessages();
+}
 
 TEST(HardCaseExtraTest, DenserAtmosphereNeverBrightensTransmittance) {
   AtmosphereParams dense;

@@ -115,7 +115,7 @@ double Budget(const std::string& preset) {
 // directions of accuracy_test's PresetsAgainstTheirBudgetsAtTwilight.
 std::vector<glm::dvec3> TwilightDirections(bool quick, std::vector<glm::dvec2>& elevation_azimuth) {
   const std::vector<double> elevations = quick ? std::vector<double>{0.0, 1.0, 3.0, 6.0, 30.0}
-                                               : std::vector<double>{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 30.0};
+                                               : std::vector<double>{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 15.0, 20.0, 30.0};
   const std::vector<double> azimuths = quick ? std::vector<double>{0.0, 90.0, 180.0}
                                              : std::vector<double>{0.0, 30.0, 60.0, 75.0, 90.0, 120.0, 150.0, 180.0};
   std::vector<glm::dvec3> dirs;
