@@ -15,23 +15,13 @@
 #include "skybake/tools/accuracy.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "reference_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
 namespace {
 
-// The converged reference's radiance along each of `dirs`, on two threads.
-std::vector<glm::dvec3> ReferenceRadiances(const ConvergedReference& ref, const std::vector<glm::dvec3>& dirs,
-                                           const glm::dvec3& sun) {
-  std::vector<glm::dvec3> expected(dirs.size());
-  std::vector<std::thread> pool;
-  for (size_t t = 0; t < 2; ++t)
-    pool.emplace_back([&, t] {
-      for (size_t i = t; i < dirs.size(); i += 2) expected[i] = ref.Radiance(dirs[i], sun);
-    });
-  for (std::thread& th : pool) th.join();
-  return expected;
-}
+using testing::ReferenceRadiances;
 
 TEST(GaussLegendreTest, EightPointsIntegrateDegree15Exactly) {
   std::vector<double> x, w;

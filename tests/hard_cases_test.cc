@@ -19,6 +19,7 @@
 #include "skybake/tools/reference_model.h"
 #include "skybake/gpu/sky_renderer.h"
 #include "skybake/pipeline/night_sky.h"
+#include "reference_fixtures.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -251,13 +252,7 @@ TEST(HardCaseExtraTest, DISABLED_TwilightBandTopFrom8KmHasNoSeam) {
   std::vector<glm::dvec3> dirs;
   for (double azimuth = 0.0; azimuth <= 180.0; azimuth += 15.0)
     for (double d : offsets) dirs.push_back(glm::dvec3(glm::vec3(SunDirectionFromElevationAzimuth(top + d, azimuth))));
-  std::vector<glm::dvec3> expected(dirs.size());
-  std::vector<std::thread> pool;
-  for (size_t t = 0; t < 2; ++t)
-    pool.emplace_back([&, t] {
-      for (size_t i = t; i < dirs.size(); i += 2) expected[i] = reference.Radiance(dirs[i], sun);
-    });
-  for (std::thread& th : pool) th.join();
+  const std::vector<glm::dvec3> expected = testing::ReferenceRadiances(reference, dirs, sun);
   const std::vector<float> out = renderer.RenderDirections(sun, dirs);
   // Over the values above 1e-4 of the maximum (the accuracy study's
   // criterion: opposite the Sun these directions lie in the Earth's shadow,
