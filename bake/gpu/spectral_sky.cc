@@ -36,7 +36,9 @@ Rgb StyleScale(const AoasInputs& aoas) {
 }
 
 // Adds m * (the RGB of `in`) to the three channels of each texel of `out`
-// (RGBA texels); with copy_alpha, out's alpha becomes in's.
+// (RGBA texels); with copy_alpha, out's alpha becomes in's. Sums the groups
+// into RGB (to_rgb; the first group sets alpha) and adds a change's share to
+// a group (shares_, alpha kept).
 void AddTransformed(const float* in, size_t texels, const Matrix3& m, bool copy_alpha, float* out) {
   float f[3][3];
   for (int i = 0; i < 3; ++i)
@@ -47,17 +49,6 @@ void AddTransformed(const float* in, size_t texels, const Matrix3& m, bool copy_
     for (int i = 0; i < 3; ++i) b[i] += f[i][0] * a[0] + f[i][1] * a[1] + f[i][2] * a[2];
     if (copy_alpha) b[3] = a[3];
   }
-}
-
-// Adds a group's three channels, times its matrix, to the RGB of `sum`; the
-// first group also sets alpha.
-void Accumulate(const float* group, size_t texels, const Matrix3& to_rgb, bool first, float* sum) {
-  AddTransformed(group, texels, to_rgb, first, sum);
-}
-
-// Adds share * (the RGB of `change`) to `group`; alpha is kept.
-void AddShare(const float* change, size_t texels, const Matrix3& share, float* group) {
-  AddTransformed(change, texels, share, false, group);
 }
 
 }  // namespace
@@ -112,7 +103,7 @@ std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const
     const RenderedViews rendered = renderers_[g]->RenderInPlace(sun, views, sun_disc);
     timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
     for (size_t i = 0; i < views.size(); ++i)
-      Accumulate(rendered.views[i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0,
+      AddTransformed(rendered.views[i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0,
                  sum[i].data());
   }
   if (style_) {
@@ -136,7 +127,7 @@ std::vector<float> SpectralSky::RenderDirections(const glm::dvec3& sun, const st
   for (size_t g = 0; g < renderers_.size(); ++g) {
     const std::vector<float> group = renderers_[g]->RenderDirections(sun, directions, sun_disc);
     timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
-    Accumulate(group.data(), directions.size(), groups_[g].to_rgb, g == 0, sum.data());
+    AddTransformed(group.data(), directions.size(), groups_[g].to_rgb, g == 0, sum.data());
   }
   if (style_) {
     ViewRequest view;
@@ -184,7 +175,7 @@ std::vector<std::vector<float>> SpectralSky::RenderStyledUnderClouds(const glm::
     skies.push_back(renderers_[g]->RenderClearSky(sun, views, sun_disc, directions));
     record(*renderers_[g]);
     for (size_t i = 0; i < views.size(); ++i)
-      Accumulate(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
+      AddTransformed(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
   }
   // The style's change of the combined sky, R = Style(sky) - sky.
   std::vector<std::vector<float>> change = sum;
@@ -198,11 +189,11 @@ std::vector<std::vector<float>> SpectralSky::RenderStyledUnderClouds(const glm::
   // that (their light plus their transmittance times the texel), combined again.
   for (size_t g = 0; g < renderers_.size(); ++g) {
     for (size_t i = 0; i < views.size(); ++i)
-      AddShare(change[i].data(), size_t(views[i].width) * views[i].height, shares_[g], skies[g][i]);
+      AddTransformed(change[i].data(), size_t(views[i].width) * views[i].height, shares_[g], false, skies[g][i]);
     renderers_[g]->CompositeClouds();
     record(*renderers_[g]);
     for (size_t i = 0; i < views.size(); ++i)
-      Accumulate(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
+      AddTransformed(skies[g][i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0, sum[i].data());
   }
   return sum;
 }
