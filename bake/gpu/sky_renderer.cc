@@ -485,10 +485,7 @@ VkPipeline SkyRenderer::TwilightSkyPipeline() {
 bool SkyRenderer::CloudsInEarthShadow(const glm::dvec3& sun) const {
   if (cloud_layers_ == 0 || !shadowed_clouds_) return false;
   // The GPU's own values: the bands' tops, the distance bound, the radii (km).
-  double top = 0.0;
-  for (int b = 0; b < gpu_clouds_.resolution.w; ++b) top = std::max(top, double(gpu_clouds_.bands[b].y));
-  const double below = CloudEarthShadowElevationDeg(gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.z, top,
-                                                    gpu_clouds_.range.x, gpu_atmosphere_.solar_irradiance.w);
+  const double below = CloudEarthShadowElevationDeg(gpu_clouds_, gpu_atmosphere_);
   return sun.y < std::sin(below * M_PI / 180.0);
 }
 

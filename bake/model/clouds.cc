@@ -240,12 +240,10 @@ void FillCloudSkipMaps(const gpu::GpuClouds& c, float* noise) {
   }
 }
 
-CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
-                          double time_s) {
-  CloudInputs in;
-  gpu::GpuClouds& g = in.uniform;
+gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds) {
+  gpu::GpuClouds g{};
   const std::vector<CloudLayer> layers = ActiveCloudLayers(clouds);
-  if (layers.empty()) return in;
+  if (layers.empty()) return g;
   const CloudQuality& q = clouds.quality;
   const int count = std::min<int>(int(layers.size()), kMaxCloudLayers);
   g.counts = {count, q.view_steps, q.light_steps, q.octaves};
@@ -262,9 +260,6 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
   g.phase = {0.7f, -0.2f, 0.5f, float(trilinear)};
   g.octave = {0.5f, 0.5f, 0.5f, 0.0f};
   double top_km = 0.0;
-  const size_t shape = size_t(q.shape_resolution) * q.shape_resolution * q.shape_resolution;
-  const size_t detail = size_t(q.detail_resolution) * q.detail_resolution * q.detail_resolution;
-  const size_t weather = size_t(q.weather_resolution) * q.weather_resolution;
   for (int i = 0; i < count; ++i) {
     const CloudLayer& l = layers[i];
     gpu::GpuCloudLayer& o = g.layers[i];
@@ -274,6 +269,45 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.profile = {float(l.profile[0]), float(l.profile[1]), float(l.profile[2]), float(l.profile[3])};
     o.shape = {float(l.shape_amount), float(1e3 / l.shape_size_m), float(l.detail_amount),
                float(1e3 / l.detail_size_m)};
+  }
+  // range.w: the view march skips empty space (FillCloudSkipMaps).
+  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 1.0f};
+  // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
+  int bands = 0;
+  for (int i = 0; i < count; ++i) {
+    const float lo = g.layers[i].shell.x, hi = g.layers[i].shell.y;
+    if (bands > 0 && lo <= g.bands[bands - 1].y) {
+      g.bands[bands - 1].y = std::max(g.bands[bands - 1].y, hi);
+    } else {
+      g.bands[bands++] = {lo, hi, 0.0f, 0.0f};
+    }
+  }
+  g.resolution.w = bands;
+  return g;
+}
+
+double CloudEarthShadowElevationDeg(const gpu::GpuClouds& clouds, const gpu::GpuAtmosphere& atmosphere) {
+  double top = 0.0;
+  for (int b = 0; b < clouds.resolution.w; ++b) top = std::max(top, double(clouds.bands[b].y));
+  return CloudEarthShadowElevationDeg(atmosphere.radii.x, atmosphere.radii.z, top, clouds.range.x,
+                                      atmosphere.solar_irradiance.w);
+}
+
+CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
+                          double time_s) {
+  CloudInputs in;
+  gpu::GpuClouds& g = in.uniform;
+  g = CloudGeometryUniform(clouds);
+  const int count = g.counts.x;
+  if (count == 0) return in;
+  const std::vector<CloudLayer> layers = ActiveCloudLayers(clouds);
+  const CloudQuality& q = clouds.quality;
+  const size_t shape = size_t(q.shape_resolution) * q.shape_resolution * q.shape_resolution;
+  const size_t detail = size_t(q.detail_resolution) * q.detail_resolution * q.detail_resolution;
+  const size_t weather = size_t(q.weather_resolution) * q.weather_resolution;
+  for (int i = 0; i < count; ++i) {
+    const CloudLayer& l = layers[i];
+    gpu::GpuCloudLayer& o = g.layers[i];
     // World x = east, z = -north.
     const double seconds = time_s;
     o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
@@ -297,19 +331,6 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
   }
-  // range.w: the view march skips empty space (FillCloudSkipMaps).
-  g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 1.0f};
-  // Bands: the layers' shells, overlapping ones merged (layers are sorted by bottom).
-  int bands = 0;
-  for (int i = 0; i < count; ++i) {
-    const float lo = g.layers[i].shell.x, hi = g.layers[i].shell.y;
-    if (bands > 0 && lo <= g.bands[bands - 1].y) {
-      g.bands[bands - 1].y = std::max(g.bands[bands - 1].y, hi);
-    } else {
-      g.bands[bands++] = {lo, hi, 0.0f, 0.0f};
-    }
-  }
-  g.resolution.w = bands;
   return in;
 }
 

@@ -13,27 +13,6 @@
 #include "skybake/model/clouds.h"
 
 namespace skybake {
-namespace {
-
-// The shells of the layers merged where they overlap (ToCloudInputs' bands).
-int CloudBands(const std::vector<CloudLayer>& layers) {
-  std::vector<std::pair<double, double>> shells;
-  for (const CloudLayer& l : layers) shells.push_back({l.altitude_m, l.altitude_m + l.thickness_m});
-  std::sort(shells.begin(), shells.end());
-  int bands = 0;
-  double top = 0.0;
-  for (const auto& [lo, hi] : shells) {
-    if (bands == 0 || lo > top) {
-      ++bands;
-      top = hi;
-    } else {
-      top = std::max(top, hi);
-    }
-  }
-  return bands;
-}
-
-}  // namespace
 
 void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<ViewRequest>& views, int frames,
                        int shadowed, double shadow_below_deg, PassPlan& plan) {
@@ -93,7 +72,7 @@ void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan) {
        : ground  ? (runs ? "the sky shows no ground (effects.ground off or ground_albedo 0)" : why_off)
                  : "switched off in the style"});
   if (!runs) return;
-  const int bands = CloudBands(layers);
+  const int bands = CloudGeometryUniform(first.clouds).resolution.w;  // the shells merged where they overlap
   plan.passes.push_back({"cloud shadow map", fmt::format("{} x {}", s.resolution, s.resolution),
                          "once per frame with the Sun up", frames,
                          double(s.resolution) * s.resolution * s.steps * bands});

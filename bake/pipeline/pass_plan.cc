@@ -238,15 +238,18 @@ std::string FrameRanges(const std::vector<int>& frames) {
 }
 
 // The Sun's elevation, deg, below which every band of the style's active
-// cloud layers is in the Earth's shadow (CloudEarthShadowElevationDeg), and
-// their highest top, km.
+// cloud layers is in the Earth's shadow, and their highest top, km: from the
+// values the renderer is given (the pruned style's cloud and atmosphere
+// uniforms, as RendererCache::Update builds them), so the plan lists exactly
+// the frames SkyRenderer::CloudsInEarthShadow marches without the light march.
 double CloudShadowBelowDeg(const SkyStyle& style, double* top_km) {
+  const SkyStyle pruned = PrunedStyle(style);
+  const gpu::GpuClouds clouds = CloudGeometryUniform(pruned.clouds);
   *top_km = 0.0;
-  for (const CloudLayer& l : ActiveCloudLayers(style.clouds))
-    *top_km = std::max(*top_km, (l.altitude_m + l.thickness_m) * 1e-3);
-  const AtmosphereParams& a = style.atmosphere;
-  return CloudEarthShadowElevationDeg(a.bottom_radius_km, a.observer_altitude_m * 1e-3, *top_km,
-                                      style.clouds.quality.max_distance_km, a.sun_angular_radius_rad);
+  for (int b = 0; b < clouds.resolution.w; ++b) *top_km = std::max(*top_km, double(clouds.bands[b].y));
+  return CloudEarthShadowElevationDeg(clouds, ToGpuAtmosphere(StyledAtmosphere(pruned.atmosphere, pruned.aoas),
+                                                              pruned.quality, pruned.effects,
+                                                              OutputScale(pruned.output.units)));
 }
 
 // Volumetric cloud layers: the noise volumes, the tables, every view; the

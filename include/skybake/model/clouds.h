@@ -140,6 +140,21 @@ constexpr double kMaxCloudLoopIterations = 60000.0;
 double CloudEarthShadowElevationDeg(double bottom_radius_km, double observer_altitude_km, double highest_top_km,
                                     double max_distance_km, double sun_angular_radius_rad);
 
+// The part of the cloud uniform block that depends on the layers' geometry
+// alone: the counts and resolutions, each active layer's shell (bottom, top,
+// extinction, albedo), profile and noise sizes, the distance range and the
+// bands (the shells merged where they overlap). ToCloudInputs starts from it
+// and adds each layer's wind, weather and noise offsets; the pass plan reads
+// it without building the weather maps.
+gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds);
+
+// CloudEarthShadowElevationDeg for the values the GPU is given: the highest
+// band top of `clouds`, its distance bound (range.x), and the radii and the
+// Sun's angular radius of `atmosphere`. The renderer (which frames run
+// without the light march) and the pass plan (which frames it lists) both
+// ask this, so they agree to the frame.
+double CloudEarthShadowElevationDeg(const gpu::GpuClouds& clouds, const gpu::GpuAtmosphere& atmosphere);
+
 // What the renderer needs: the uniform block, the weather images (R channel,
 // resampled to the procedural map's resolution), and the sizes of the noise
 // volumes. Empty `uniform.counts.x` (0 layers) means no cloud pass at all.
