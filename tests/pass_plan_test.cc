@@ -377,6 +377,29 @@ TEST(PassPlanTest, CloudFramesInTheEarthsShadowAreListed) {
   EXPECT_EQ(pass(day, "clouds panorama in the Earth's shadow"), nullptr);
 }
 
+// The twilight band's march (PlanTwilightBand) in a twilight frame: from
+// the ground it covers 0..10 deg, a fraction sin(10 deg) / 2 of the
+// directions; from 8 km the band reaches from the horizon, acos(R / r) =
+// 2.87 deg below the horizontal, to 10 deg above it (InTwilightMarchBand),
+// so the estimate grows by sin(2.87 deg) / sin(10 deg): 1.289 times.
+TEST(PassPlanTest, TwilightBandEstimateReachesTheHorizonFromAltitude) {
+  auto band = [](const PassPlan& p) -> const PlannedPass* {
+    for (const PlannedPass& x : p.passes)
+      if (x.name == "twilight band march") return &x;
+    return nullptr;
+  };
+  const PassPlan ground = PlanPasses({Style("[sun]\nelevation_deg = -3.0\n")});
+  const PassPlan high = PlanPasses({Style("[sun]\nelevation_deg = -3.0\n[atmosphere]\nobserver_altitude_m = 8000.0\n")});
+  const PassPlan day = PlanPasses({Style("[sun]\nelevation_deg = 20.0\n")});
+  ASSERT_NE(band(ground), nullptr) << FormatPlan(ground, "frames");
+  ASSERT_NE(band(high), nullptr) << FormatPlan(high, "frames");
+  EXPECT_EQ(band(day), nullptr) << FormatPlan(day, "frames");
+  EXPECT_EQ(band(ground)->size, "0..10 deg above the horizon");
+  EXPECT_EQ(band(high)->size, "the horizon (2.87 deg below the horizontal) to 10 deg above the horizontal");
+  const double dip = std::acos(6360.0 / 6368.0);
+  EXPECT_NEAR(band(high)->samples / band(ground)->samples, 1.0 + std::sin(dip) / std::sin(10.0 * M_PI / 180.0), 1e-9);
+}
+
 // The cloud formation's CPU step and the cloud shadow map's pass are listed
 // with their cost: the formation simulates from step 0 to the last planned
 // frame's step (warm-up 5 + 10 per hour x 1.25 h = 17.5: 18 steps) of

@@ -191,9 +191,11 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 
 // The twilight band's march (quality.twilight_march_band_deg): in the
 // frames whose Sun is below TwilightSunElevationDeg (listed only when there
-// is one), the texels up to the band above the
-// horizon (a fraction sin(band) / 2 of each view's directions, which it
-// estimates) are ray-marched by a sky pass of their own pipeline.
+// is one), the texels from the observer's horizon (the dip below the
+// horizontal: acos(R / r), 0 at the ground) up to the band above the
+// horizontal (InTwilightMarchBand) are ray-marched by a sky pass of their
+// own pipeline: a fraction (sin(band) + sin(dip)) / 2 of each view's
+// directions, which it estimates.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
                       PassPlan& plan) {
   const QualitySettings& q = first.quality;
@@ -206,9 +208,14 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   double texels = 0.0;
   for (const ViewRequest& v : PlanViews(first)) texels += double(v.width) * v.height;
   const int steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
-  plan.passes.push_back({"twilight band march", fmt::format("0..{:g} deg above the horizon", band),
-                         fmt::format("frames with the Sun below {:g} deg", below), runs,
-                         texels * 0.5 * std::sin(band * M_PI / 180.0) * steps * std::max(q.light_steps, 1)});
+  const AtmosphereParams& a = first.atmosphere;
+  const double ratio = a.bottom_radius_km / (a.bottom_radius_km + std::max(a.observer_altitude_m, 0.0) * 1e-3);
+  const double dip_deg = std::acos(std::min(ratio, 1.0)) * 180.0 / M_PI;
+  const std::string extent = dip_deg > 0.0 ? fmt::format("the horizon ({:.2f} deg below the horizontal) to {:g} deg above the horizontal", dip_deg, band)
+                                           : fmt::format("0..{:g} deg above the horizon", band);
+  const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
+  plan.passes.push_back({"twilight band march", extent, fmt::format("frames with the Sun below {:g} deg", below), runs,
+                         texels * fraction * steps * std::max(q.light_steps, 1)});
 }
 
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).
