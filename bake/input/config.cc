@@ -177,6 +177,12 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
     v.Int("quality.cloud_weather_resolution", cq.weather_resolution, 8, 2048);
     v.Real("quality.cloud_max_distance_km", cq.max_distance_km, kCloudDistance);
     v.Real("quality.cloud_panorama_scale", cq.panorama_scale, kCloudPanoramaScale);
+    // Written only when on, so the reference's resolved style is as before.
+    if (v.kReads || cq.light_volume_columns > 0) {
+      v.Int("quality.cloud_light_volume_columns", cq.light_volume_columns, 0, 1024);
+      v.Int("quality.cloud_light_volume_slices", cq.light_volume_slices, 2, 64);
+      v.Int("quality.cloud_light_volume_near_steps", cq.light_volume_near_steps, 0, 16);
+    }
   }
 }
 
