@@ -528,11 +528,16 @@ float CloudLightColumnDistance(IN(AtmosphereParameters) atm, float rb, float bot
 }
 
 // Column (i, j) of the light volume (CLOUD_PASS_LIGHT_VOLUME): the cloud's
-// optical depth (without the detail erosion, trilinear reads) from the
-// column's foot up to each slice, kCloudLightVolumeSubsteps samples per
-// slice interval; then, in place, each slice's depth over the light march's
+// optical depth (without the detail erosion, nearest-voxel reads as the
+// exact march's far samples: a slice interval is about a voxel long) from the
+// column's foot up to each slice, light_volume_grid.z samples per slice
+// interval; then, in place, each slice's depth over the light march's
 // distance from it (CloudLightDistance), to the band's top at most: the
 // cumulative depth there less the slice's own, linear between slices.
+// The samples whose bound says no cloud (CloudMargin) are skipped as the
+// view march skips them (their density is 0): an inner loop finds the next
+// sample with cloud, since lavapipe runs an `if` masked, so each interval's
+// depth is summed in its slice first and the slices made cumulative after.
 void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 sun) {
   int n = CloudLightVolumeSlices();
   int first = gpu_clouds.light_volume.w + (j * CloudLightVolumeColumns() + i) * n;
@@ -541,20 +546,33 @@ void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 su
   float rb = atm.bottom_radius + bottom;
   float y = sqrt(max(rb * rb - dot(foot, foot), 0.0));
   float mu = dot(vec3(foot.x, y, foot.y), sun) / rb;
-  const int kSubsteps = 2;  // kCloudLightVolumeSubsteps (clouds.h)
-  float depth = 0.0, s_prev = 0.0;
-  cloud_noise[first] = 0.0;
-  for (int k = 1; k < n; ++k) {
-    float s_k = CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k) / float(n - 1)));
-    float ds = (s_k - s_prev) / float(kSubsteps);
-    for (int m = 0; m < kSubsteps; ++m) {
-      float s = s_prev + (float(m) + 0.5) * ds;
-      depth += CloudLightExtinction(foot + s * sun.xz, AltitudeAlongRay(atm, rb, bottom, mu, s), false) * ds;
+  int substeps = int(gpu_clouds.light_volume_grid.z);  // kCloudLightVolumeSubsteps (clouds.h)
+  for (int k = 0; k < n; ++k) cloud_noise[first + k] = 0.0;
+  int total = (n - 1) * substeps;
+  for (int next = 0; next < total;) {
+    int m = next;
+    vec2 xz = vec2(0.0);
+    float h = 0.0, ds = 0.0;
+    for (; m < total; ++m) {
+      int k = m / substeps;  // the interval from slice k to k + 1
+      float s0 = k == 0 ? 0.0 : CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k) / float(n - 1)));
+      float s1 = CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k + 1) / float(n - 1)));
+      ds = (s1 - s0) / float(substeps);
+      float s = s0 + (float(m - k * substeps) + 0.5) * ds;
+      xz = foot + s * sun.xz;
+      h = AltitudeAlongRay(atm, rb, bottom, mu, s);
+      if (CloudMargin(xz, h) > 0.0) break;
     }
-    s_prev = s_k;
+    if (m >= total) break;
+    next = m + 1;
+    cloud_noise[first + 1 + m / substeps] += CloudLightExtinction(xz, h, true) * ds;
+  }
+  float depth = 0.0;
+  for (int k = 1; k < n; ++k) {
+    depth += cloud_noise[first + k];
     cloud_noise[first + k] = depth;
   }
-  float s_top = s_prev;
+  float s_top = CloudLightColumnDistance(atm, rb, bottom, mu, top);
   // The slice interval [k2, k2 + 1] that holds slice k's end; the ends do
   // not decrease with k, and no slice below k2 is read again.
   int k2 = 0;

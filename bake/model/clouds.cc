@@ -329,7 +329,7 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     for (int b = 0; b < bands; ++b) thickness_km = std::max(thickness_km, double(g.bands[b].y - g.bands[b].x));
     const double extent_km = 1.1 * q.max_distance_km + thickness_km / std::tan(2.0 * M_PI / 180.0);
     g.light_volume_grid = {float(kCloudLightVolumeWarpKm), float(std::asinh(extent_km / kCloudLightVolumeWarpKm)),
-                           0.0f, 0.0f};
+                           float(kCloudLightVolumeSubsteps), 0.0f};
   }
   return in;
 }

@@ -202,7 +202,7 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   // float of the volume in the noise buffer.
   ivec4 light_volume;
   // x: L, km, and y: U of the columns' warped grid, world x = L sinh(u) for u
-  // over [-U, U]; zw: unused.
+  // over [-U, U]; z: the column march's samples per slice interval; w: unused.
   vec4 light_volume_grid;
 };
 

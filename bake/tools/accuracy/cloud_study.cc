@@ -257,8 +257,9 @@ std::vector<CloudQuality> MarchCases(bool quick) {
   // The light volume (quality.cloud_light_volume_*): columns / slices / exact
   // near steps, at production's and draft's steps.
   for (auto [view, light, trilinear, columns, slices, near] :
-       {std::tuple{48, 24, 8, 512, 32, 2}, {48, 24, 8, 256, 16, 1}, {48, 24, 8, 512, 32, 0}, {48, 24, 8, 1024, 32, 2},
-        {48, 24, 8, 512, 64, 2}, {24, 12, 3, 256, 16, 1}, {24, 12, 3, 512, 32, 2}}) {
+       {std::tuple{48, 24, 8, 512, 32, 2}, {48, 24, 8, 512, 16, 2}, {48, 24, 8, 384, 16, 2}, {48, 24, 8, 256, 32, 2},
+        {48, 24, 8, 256, 16, 2}, {48, 24, 8, 256, 16, 1}, {48, 24, 8, 512, 32, 0}, {48, 24, 8, 1024, 32, 2},
+        {24, 12, 3, 256, 16, 1}, {24, 12, 3, 512, 32, 2}}) {
     CloudQuality q = MakeQuality(view, light, 64, 32, 256);
     q.light_trilinear_steps = trilinear;
     q.light_volume_columns = columns;
