@@ -634,10 +634,11 @@ TEST(CloudLightNearest, FarLightSamplesAtTheNearestVoxelStayClose) {
   testing::ExpectNoValidationMessages();
 }
 
-// The light volume (quality.cloud_light_volume_*, clouds.h): production's
-// 512 x 32 volume with 2 exact near steps against every light sample
-// marched, at a low Sun and a high one: within 3% (green, upper hemisphere,
-// 96 x 48), not equal (the volume is read), finite and non-negative. Off
+// The light volume (quality.cloud_light_volume_*, clouds.h): a 512 x 32
+// volume with 2 exact near steps against every light sample marched, at a
+// low Sun and a high one: within 3% (green, upper hemisphere, 96 x 48), not
+// equal (the volume is read), finite and non-negative; production's 256
+// columns within 6%. Off
 // where it cannot serve, with the exact march's bytes: a Sun below
 // kCloudLightVolumeMinElevationDeg, and a style of two bands.
 TEST(CloudLightVolume, StaysCloseToTheExactMarchAndOffKeepsTheBytes) {

@@ -51,9 +51,10 @@ CloudQuality CloudQualityPreset(const std::string& name) {
   // light_trilinear_steps): production 3.42e-2 -> 3.50e-2 with 8 of 24
   // trilinear, draft 8.77e-2 -> 8.95e-2 with 3 of 12 (2026-12-02 run); the
   // reference keeps every light sample trilinear.
-  // The light volume (CloudLightVolume in clouds.h): production 512 columns
-  // x 32 slices, 2 exact near steps; draft 256 x 16, 1; the reference
-  // marches every light sample.
+  // The light volume (CloudLightVolume in clouds.h): production 256 columns
+  // x 32 slices, 2 exact near steps (3.50e-2 -> 4.26e-2; 512 columns 3.56e-2
+  // for 4 times the volume's cost, 16 slices 5.7e-2); draft 256 x 16, 1;
+  // the reference marches every light sample.
   CloudQuality q;  // production: 48 / 24 steps, volumes 64 / 32 / 256, 3.5e-2
   q.light_trilinear_steps = 8;
   if (name == "draft") {

@@ -86,7 +86,7 @@ struct CloudQuality {
   // The light volume (CloudLightVolume below): columns along each horizontal
   // axis (0: off, every light sample marched), altitude slices, and the
   // light steps nearest the view sample that stay exact.
-  int light_volume_columns = 512;
+  int light_volume_columns = 256;
   int light_volume_slices = 32;
   int light_volume_near_steps = 2;
 };
