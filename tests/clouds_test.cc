@@ -137,6 +137,12 @@ TEST(CloudStyle, PresetsSetTheCloudSampling) {
     EXPECT_NE(errors[0].find("clouds_test.toml:2:"), std::string::npos) << errors[0];
     EXPECT_NE(errors[0].find("quality.cloud_light_volume_"), std::string::npos) << errors[0];
   }
+  // Too large for its buffer (at most 64 MiB), with a layer to use it.
+  std::vector<std::string> big = Errors(std::string(kCumulus) + "[quality]\ncloud_light_volume_columns = 1024\n");
+  ASSERT_EQ(big.size(), 1u);
+  EXPECT_NE(big[0].find("clouds_test.toml:8:30: quality.cloud_light_volume_columns: 1024 x 1024 columns x 32 slices"),
+            std::string::npos)
+      << big[0];
   std::vector<std::string> e = Errors("[quality]\ncloud_light_trilinear_steps = 300\n");
   ASSERT_EQ(e.size(), 1u);
   EXPECT_NE(e[0].find("clouds_test.toml:2:31: quality.cloud_light_trilinear_steps"), std::string::npos) << e[0];

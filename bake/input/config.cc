@@ -1153,6 +1153,14 @@ void CheckCloudLayers(const SkyStyle& style, StyleChecks& c) {
   const std::string style_dir = std::filesystem::path(c.name).parent_path().string();
   for (const CloudProblem& p : ValidateClouds(style.clouds, a, style_dir)) {
     std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
+    if (p.layer == -3) {  // the light volume's size
+      ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_volume_columns").node()
+                                   ? "quality.cloud_light_volume_columns"
+                                   : "quality.cloud_light_volume_slices");
+      e.message = p.message;
+      c.errors.push_back(e);
+      continue;
+    }
     if (p.layer == -2) {  // the sampling settings
       ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
                                                                               : "quality.cloud_view_steps");

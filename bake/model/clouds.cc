@@ -112,6 +112,16 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
                                     std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers),
                                     clouds.quality.view_steps, clouds.quality.light_steps, loops,
                                     kMaxCloudLoopIterations)});
+  // The light volume shares the noise buffer (one storage buffer: lavapipe
+  // binds at most 128 MiB): at most 64 MiB of it.
+  const CloudQuality& q = clouds.quality;
+  const double volume_mib = double(q.light_volume_columns) * q.light_volume_columns * q.light_volume_slices * 4.0 /
+                            (1024.0 * 1024.0);
+  if (!ActiveCloudLayers(clouds).empty() && q.light_volume_columns > 0 && volume_mib > 64.0)
+    problems.push_back({-3, "",
+                        fmt::format("{0} x {0} columns x {1} slices make a light volume of {2:.0f} MiB, above 64 MiB: "
+                                    "lower quality.cloud_light_volume_columns or quality.cloud_light_volume_slices",
+                                    q.light_volume_columns, q.light_volume_slices, volume_mib)});
   const double atmosphere_m = (atmosphere.top_radius_km - atmosphere.bottom_radius_km) * 1000.0;
   for (size_t i = 0; i < clouds.layers.size(); ++i) {
     const CloudLayer& l = clouds.layers[i];
