@@ -3,7 +3,8 @@
 // The cloud passes' tables, one kind per dispatch (CLOUD_PASS_* in
 // SkyPush.view.x): the noise volumes and weather map of layer view.w (once
 // per renderer, from the seed alone), and the aerial-perspective LUT and the
-// ambient table (once per sun position).
+// ambient table (once per sun position), and the light volume (once per
+// frame: the Sun and the wind).
 #include "common.glsl"
 #include "clouds.glsl"
 
@@ -18,6 +19,11 @@ void main() {
   if (pass == CLOUD_PASS_AMBIENT) {
     if (id.x >= gpu_clouds.lut.w || id.y > 0) return;
     ComputeCloudAmbientRow(AtmosphereFromUniform(), id.x, push.sun_direction.xyz);
+    return;
+  }
+  if (pass == CLOUD_PASS_LIGHT_VOLUME) {
+    if (id.x >= CloudLightVolumeColumns() || id.y >= CloudLightVolumeColumns()) return;
+    ComputeCloudLightColumn(AtmosphereFromUniform(), id.x, id.y, push.sun_direction.xyz);
     return;
   }
   GpuCloudLayer layer = gpu_clouds.layers[push.view.w];

@@ -29,6 +29,10 @@ layout(constant_id = SPEC_CLOUD_LAYERS) const int kCloudLayers = 1;
 // lavapipe runs an `if` masked and every lit sample paid for the light march.
 // The ambient light of the sky and the ground is the same either way.
 layout(constant_id = SPEC_CLOUD_SUN_LIGHT) const bool kCloudSunLight = true;
+// Whether the light march reads its far part from the frame's light volume
+// (GpuClouds.light_volume, CloudLightVolumeDepth); off: every light sample
+// marched (the reference, a style of two or more bands, a low Sun).
+layout(constant_id = SPEC_CLOUD_LIGHT_VOLUME) const bool kCloudLightVolume = false;
 
 // ---------------------------------------------------------------- hashing and tiling noise
 
@@ -487,6 +491,141 @@ void CloudLightStep(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, 
   else st.depth_above += sigma;
 }
 
+// ---------------------------------------------------------------- the light volume
+
+// The light volume (clouds.h, CloudLightVolume): columns i, j along world x
+// and z of the band's bottom, each holding `slices` floats in the noise
+// buffer, slice k at the altitude k / (slices - 1) through the band.
+int CloudLightVolumeColumns() { return gpu_clouds.light_volume.x; }
+int CloudLightVolumeSlices() { return gpu_clouds.light_volume.y; }
+
+// Column i's world coordinate (km) along its axis: L sinh(u), u uniform
+// over [-U, U] with the first and last columns on the ends.
+float CloudLightVolumeCoordinate(int i) {
+  float last = float(max(CloudLightVolumeColumns() - 1, 1));
+  return gpu_clouds.light_volume_grid.x * sinh(gpu_clouds.light_volume_grid.y * (2.0 * float(i) / last - 1.0));
+}
+
+// The continuous column index of world coordinate x (clamped to the grid).
+float CloudLightVolumeIndex(float x) {
+  float last = float(max(CloudLightVolumeColumns() - 1, 1));
+  float u = asinh(x / gpu_clouds.light_volume_grid.x) / gpu_clouds.light_volume_grid.y;
+  return clamp(0.5 * (u + 1.0) * last, 0.0, last);
+}
+
+// The light march's own distance toward the Sun from altitude h in a band of
+// top `band_top`, mu_s the Sun's cosine zenith there (CloudOpticalDepthToSun).
+const float kCloudLightDistanceKm = 8.0;
+float CloudLightDistance(float h, float mu_s, float band_top) {
+  float reach = (band_top - h) / max(mu_s, 0.1);
+  return min(max(reach, 0.05), kCloudLightDistanceKm);
+}
+
+// Distance along the column of foot radius rb (altitude `bottom`, the Sun's
+// cosine zenith mu there) to altitude H, ascending.
+float CloudLightColumnDistance(IN(AtmosphereParameters) atm, float rb, float bottom, float mu, float H) {
+  return CloudRayToAltitude(atm, rb, bottom, mu, H, 1.0);
+}
+
+// Column (i, j) of the light volume (CLOUD_PASS_LIGHT_VOLUME): the cloud's
+// optical depth (without the detail erosion, nearest-voxel reads as the
+// exact march's far samples: a slice interval is about a voxel long) from the
+// column's foot up to each slice, light_volume_grid.z samples per slice
+// interval; then, in place, each slice's depth over the light march's
+// distance from it (CloudLightDistance), to the band's top at most: the
+// cumulative depth there less the slice's own, linear between slices.
+// The samples whose bound says no cloud (CloudMargin) are skipped as the
+// view march skips them (their density is 0): an inner loop finds the next
+// sample with cloud, since lavapipe runs an `if` masked, so each interval's
+// depth is summed in its slice first and the slices made cumulative after.
+void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 sun) {
+  int n = CloudLightVolumeSlices();
+  int first = gpu_clouds.light_volume.w + (j * CloudLightVolumeColumns() + i) * n;
+  float bottom = gpu_clouds.bands[0].x, top = gpu_clouds.bands[0].y;
+  vec2 foot = vec2(CloudLightVolumeCoordinate(i), CloudLightVolumeCoordinate(j));
+  float rb = atm.bottom_radius + bottom;
+  float y = sqrt(max(rb * rb - dot(foot, foot), 0.0));
+  float mu = dot(vec3(foot.x, y, foot.y), sun) / rb;
+  int substeps = int(gpu_clouds.light_volume_grid.z);  // kCloudLightVolumeSubsteps (clouds.h)
+  for (int k = 0; k < n; ++k) cloud_noise[first + k] = 0.0;
+  int total = (n - 1) * substeps;
+  for (int next = 0; next < total;) {
+    int m = next;
+    vec2 xz = vec2(0.0);
+    float h = 0.0, ds = 0.0;
+    for (; m < total; ++m) {
+      int k = m / substeps;  // the interval from slice k to k + 1
+      float s0 = k == 0 ? 0.0 : CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k) / float(n - 1)));
+      float s1 = CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k + 1) / float(n - 1)));
+      ds = (s1 - s0) / float(substeps);
+      float s = s0 + (float(m - k * substeps) + 0.5) * ds;
+      xz = foot + s * sun.xz;
+      h = AltitudeAlongRay(atm, rb, bottom, mu, s);
+      if (CloudMargin(xz, h) > 0.0) break;
+    }
+    if (m >= total) break;
+    next = m + 1;
+    cloud_noise[first + 1 + m / substeps] += CloudLightExtinction(xz, h, true) * ds;
+  }
+  float depth = 0.0;
+  for (int k = 1; k < n; ++k) {
+    depth += cloud_noise[first + k];
+    cloud_noise[first + k] = depth;
+  }
+  float s_top = CloudLightColumnDistance(atm, rb, bottom, mu, top);
+  // The slice interval [k2, k2 + 1] that holds slice k's end; the ends do
+  // not decrease with k, and no slice below k2 is read again.
+  int k2 = 0;
+  float s_lo = 0.0, s_hi = CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, 1.0 / float(n - 1)));
+  for (int k = 0; k < n; ++k) {
+    float h_k = mix(bottom, top, float(k) / float(n - 1));
+    float s_k = k == 0 ? 0.0 : CloudLightColumnDistance(atm, rb, bottom, mu, h_k);
+    float mu_k = (rb * mu + s_k) / (atm.bottom_radius + h_k);
+    float end = min(s_k + CloudLightDistance(h_k, mu_k, top), s_top);
+    while (k2 < n - 2 && end > s_hi) {
+      ++k2;
+      s_lo = s_hi;
+      s_hi = CloudLightColumnDistance(atm, rb, bottom, mu, mix(bottom, top, float(k2 + 1) / float(n - 1)));
+    }
+    float f = clamp((end - s_lo) / max(s_hi - s_lo, 1e-9), 0.0, 1.0);
+    float d_end = mix(cloud_noise[first + k2], cloud_noise[first + k2 + 1], f);
+    cloud_noise[first + k] = max(d_end - cloud_noise[first + k], 0.0);
+  }
+}
+
+float CloudLightVolumeAt(int i, int j, int k) {
+  return cloud_noise[gpu_clouds.light_volume.w + (j * CloudLightVolumeColumns() + i) * CloudLightVolumeSlices() + k];
+}
+
+// The optical depth toward the Sun from the point `s` along it from a view
+// sample at (xz, h), mu_s the Sun's cosine zenith at the sample: the light
+// volume read trilinearly at that point's column (traced back along the
+// Sun to the band's bottom) and altitude.
+float CloudLightVolumeDepth(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float s) {
+  float r = atm.bottom_radius + h;
+  float hq = AltitudeAlongRay(atm, r, h, mu_s, s);
+  float rq = atm.bottom_radius + hq;
+  float b = rq * ((r * mu_s + s) / rq);  // rq times the Sun's cosine zenith there
+  float bottom = gpu_clouds.bands[0].x, top = gpu_clouds.bands[0].y;
+  // Back along the Sun to the bottom: the smaller root of
+  // back^2 - 2 b back + (rq^2 - rb^2) = 0, in the product form.
+  float c = (hq - bottom) * (2.0 * atm.bottom_radius + hq + bottom);
+  float back = c / max(b + sqrt(max(b * b - c, 0.0)), 1e-6);
+  vec2 foot = xz + (s - back) * sun.xz;
+  float x = CloudLightVolumeIndex(foot.x), z = CloudLightVolumeIndex(foot.y);
+  int n = CloudLightVolumeSlices();
+  float y = clamp((hq - bottom) / (top - bottom), 0.0, 1.0) * float(n - 1);
+  int last = max(CloudLightVolumeColumns() - 2, 0);
+  int x0 = min(int(x), last), z0 = min(int(z), last), y0 = min(int(y), n - 2);
+  int x1 = min(x0 + 1, CloudLightVolumeColumns() - 1), z1 = min(z0 + 1, CloudLightVolumeColumns() - 1);
+  float fx = x - float(x0), fz = z - float(z0), fy = y - float(y0);
+  float a = mix(mix(CloudLightVolumeAt(x0, z0, y0), CloudLightVolumeAt(x1, z0, y0), fx),
+                mix(CloudLightVolumeAt(x0, z1, y0), CloudLightVolumeAt(x1, z1, y0), fx), fz);
+  float d = mix(mix(CloudLightVolumeAt(x0, z0, y0 + 1), CloudLightVolumeAt(x1, z0, y0 + 1), fx),
+                mix(CloudLightVolumeAt(x0, z1, y0 + 1), CloudLightVolumeAt(x1, z1, y0 + 1), fx), fz);
+  return max(mix(a, d, fy), 0.0);
+}
+
 // Optical depth (dimensionless) toward the Sun from a view sample, in two
 // parts. Its own band: light_steps samples placed quadratically (dense near
 // the sample) over the distance to the top of the band along the Sun, at
@@ -502,10 +641,23 @@ void CloudLightStep(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, 
 // masked; a per-sample choice of read would run both), and runs a loop's
 // body at least once, so a loop per band (the four a one-band style does not
 // have among them) cost four density reads per view sample for nothing.
-const float kCloudLightDistanceKm = 8.0;
+// With the light volume (kCloudLightVolume, one band): the first
+// light_volume.z samples, kCloudLightVolumeNearStepKm each (midpoints,
+// trilinear), within `distance`, then the volume from where they end.
 float CloudOpticalDepthToSun(IN(AtmosphereParameters) atm, vec2 xz, float h, float mu_s, vec3 sun, float band_top) {
-  float reach = (band_top - h) / max(mu_s, 0.1);
-  float distance = min(max(reach, 0.05), kCloudLightDistanceKm);
+  float distance = CloudLightDistance(h, mu_s, band_top);
+  if (kCloudLightVolume) {
+    int near_steps = gpu_clouds.light_volume.z;
+    float near = min(distance, 0.1 * float(near_steps));  // kCloudLightVolumeNearStepKm
+    float ds = near / float(max(near_steps, 1));
+    float r = atm.bottom_radius + h;
+    float depth = 0.0;
+    for (int j = 0; j < near_steps; ++j) {
+      float s = (float(j) + 0.5) * ds;
+      depth += CloudLightExtinction(xz + s * sun.xz, AltitudeAlongRay(atm, r, h, mu_s, s), false) * ds;
+    }
+    return depth + CloudLightVolumeDepth(atm, xz, h, mu_s, sun, near);
+  }
   int n = gpu_clouds.counts.z;
   int bands = gpu_clouds.resolution.w > 1 ? gpu_clouds.resolution.w : 0;
   int n_above = min(n, 4);

@@ -183,7 +183,7 @@ TEST(ConfigTest, PresetInTheDefaultTemplateTakesEffect) {
     }
     uncommented += l + "\n";
   }
-  EXPECT_EQ(keys, 25);  // 13 for the clear sky, 3 for twilight, 9 for the cloud layers
+  EXPECT_EQ(keys, 28);  // 13 for the clear sky, 3 for twilight, 12 for the cloud layers
   ConfigResult spelled = ParseSkyStyle(original.substr(0, begin) + uncommented + original.substr(end), "spelled.toml");
   ASSERT_TRUE(spelled.ok()) << ::testing::PrintToString(Messages(spelled));
   EXPECT_EQ(spelled.style.resolved_toml, shipped.style.resolved_toml);

@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "skybake/model/aoas.h"
+#include "skybake/model/clouds.h"
 #include "skybake/pipeline/engine_files.h"
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/pipeline.h"
@@ -311,6 +312,13 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
   EXPECT_NE(pass(plan, "clouds face 5 (resampled)"), nullptr);
   EXPECT_EQ(pass(plan, "clouds latlong"), nullptr);
   EXPECT_NE(FormatPlan(plan, "on").find("clouds panorama"), std::string::npos);
+  // The light volume, once per frame (clouds.h, CloudLightVolume).
+  const PlannedPass* volume = pass(plan, "cloud light volume");
+  ASSERT_NE(volume, nullptr) << FormatPlan(plan, "on");
+  EXPECT_EQ(volume->samples, double(cq.light_volume_columns) * cq.light_volume_columns * (cq.light_volume_slices - 1) *
+                                 kCloudLightVolumeSubsteps);
+  EXPECT_EQ(pass(PlanPasses({style("0.45", "[quality]\ncloud_light_volume_columns = 0\n")}), "cloud light volume"),
+            nullptr);
   // 2 km up, inside the layer: every row.
   EXPECT_EQ(pass(PlanPasses({style("0.45", "[atmosphere]\nobserver_altitude_m = 2000\n")}), "clouds panorama")->size,
             "256 x 128, rows 0 to 127 marched, " + std::to_string(CloudPanoramaMarchedTexels({256, 128}, {0, 128})) +

@@ -116,7 +116,13 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 8 : 16, storage);
   clouds_buffer_ = CreateBuffer(sizeof(gpu::GpuClouds), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
-  cloud_noise_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_)) * 4 : 16, storage);
+  // The light volume (clouds.h, CloudLightVolume) after the noise.
+  cloud_light_volume_ = cloud_layers_ > 0 && CloudLightVolumeOn(gpu_clouds_);
+  cloud_noise_buffer_ = CreateBuffer(
+      cloud_layers_ > 0
+          ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_) + (cloud_light_volume_ ? CloudLightVolumeFloats(gpu_clouds_) : 0)) * 4
+          : 16,
+      storage);
   cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
   dispatch_buffer_ = CreateBuffer(64 * sizeof(gpu::SkyPush), storage);  // grown by Submit when a submission needs more
 
@@ -132,6 +138,7 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
     size_t bytes;
     bool sun_disc = false;
     bool sun_disc_pass = false;
+    bool cloud_light_volume = false;
   };
   // The variants built with the presets' settings fixed (CMakeLists.txt)
   // compile 10-20 times faster; they compute the same values to float
@@ -168,12 +175,13 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
     // use the analytic step whatever the style's integrator.
     jobs.push_back(job(&cloud_lut_pipeline_, true, kCloudLutSpv, kCloudLutSpv));
     jobs.push_back(job(&cloud_pipeline_, true, kCloudRenderSpv, kCloudRenderSpv));
+    jobs.back().cloud_light_volume = cloud_light_volume_;
     jobs.push_back(job(&cloud_resample_pipeline_, true, kCloudResampleSpv, kCloudResampleSpv));
   }
   std::vector<std::future<VkPipeline>> compiled;
   for (const PipelineJob& job : jobs)
     compiled.push_back(std::async(std::launch::async, [this, job] {
-      return CreatePipeline(job.code, job.bytes, job.sun_disc, job.sun_disc_pass);
+      return CreatePipeline(job.code, job.bytes, job.sun_disc, job.sun_disc_pass, false, true, job.cloud_light_volume);
     }));
   std::exception_ptr failure;
   for (size_t i = 0; i < jobs.size(); ++i) {
@@ -296,6 +304,7 @@ void SkyRenderer::DestroyAll() {
   for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
                         &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
                         &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_, &shadowed_cloud_pipeline_,
+                        &marched_light_cloud_pipeline_,
                         &style_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
@@ -499,8 +508,32 @@ VkPipeline SkyRenderer::ShadowedCloudPipeline() {
   return shadowed_cloud_pipeline_;
 }
 
+VkPipeline SkyRenderer::MarchedLightCloudPipeline() {
+  if (!marched_light_cloud_pipeline_) {
+    // cloud_pipeline_ with every light sample marched (no light volume).
+    marched_light_cloud_pipeline_ = CreatePipeline(kCloudRenderSpv, sizeof(kCloudRenderSpv), false, false, false, true);
+    ++counters_.pipelines;
+  }
+  return marched_light_cloud_pipeline_;
+}
+
+void SkyRenderer::AddCloudLightVolume(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
+                                      std::vector<bool>& barriers) {
+  if (cloud_light_volume_ready_ && cloud_light_volume_sun_ == sun) return;
+  cloud_light_volume_ready_ = true;
+  cloud_light_volume_sun_ = sun;
+  gpu::SkyPush push{};
+  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+  push.view = {CLOUD_PASS_LIGHT_VOLUME, 0, 0, 0};
+  const int columns = gpu_clouds_.light_volume.x;
+  dispatches.push_back({"cloud light volume", cloud_lut_pipeline_, push, GroupCount(columns, SKYBAKE_LOCAL_SIZE_X),
+                        GroupCount(columns, SKYBAKE_LOCAL_SIZE_Y)});
+  // Its writes before the cloud pass reads them.
+  barriers.push_back(true);
+}
+
 VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
-                                       bool twilight_march, bool cloud_sun_light) {
+                                       bool twilight_march, bool cloud_sun_light, bool cloud_light_volume) {
   // Specialization constants (SPEC_* of gpu_shared.h). Every pipeline gets
   // them all; a shader that does not use one ignores it.
   struct {
@@ -509,21 +542,21 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
-    VkBool32 twilight_march, cloud_sun_light;
+    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
-              twilight_march,               cloud_sun_light};
-  const VkSpecializationMapEntry entries[17] = {
+              twilight_march,               cloud_sun_light, cloud_light_volume};
+  const VkSpecializationMapEntry entries[18] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
-      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}};
-  VkSpecializationInfo specialization{17, entries, sizeof(values), &values};
+      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4}};
+  VkSpecializationInfo specialization{18, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
@@ -641,6 +674,7 @@ void SkyRenderer::PrecomputeLuts() {
 }
 
 void SkyRenderer::GenerateCloudNoise() {
+  cloud_light_volume_ready_ = false;  // read from the noise
   // The weather images first (host writes to the mapped buffer; the
   // submission below makes them visible to the device), then the volumes
   // and procedural maps, from the seeds alone.
@@ -899,7 +933,11 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   const VkPipeline sky_pipeline = MarchesTwilightBand(sun) ? TwilightSkyPipeline() : sky_pipeline_;
   // With every cloud band in the Earth's shadow the clouds march without the Sun's light.
   const bool shadowed_clouds = CloudsInEarthShadow(sun);
-  const VkPipeline cloud_pipeline = shadowed_clouds ? ShadowedCloudPipeline() : cloud_pipeline_;
+  // A Sun too low for the light volume (CloudLightVolumeForSun): every light sample marched.
+  const bool light_volume = cloud_light_volume_ && !shadowed_clouds && CloudLightVolumeForSun(gpu_clouds_, sun.y);
+  const VkPipeline cloud_pipeline = shadowed_clouds ? ShadowedCloudPipeline()
+                                    : cloud_light_volume_ && !light_volume ? MarchedLightCloudPipeline()
+                                                                           : cloud_pipeline_;
   if (shadowed_clouds && part != FramePart::kClouds) ++counters_.shadowed_cloud_frames;
   // The views' constants, the cloud pass's too.
   const std::vector<Dispatch> view_dispatches = ViewDispatches(sun, views, sun_disc, offsets, sky_pipeline);
@@ -923,6 +961,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       ++counters_.skyview_lut_builds;
     }
     if (cloud_layers_ > 0) AddCloudTables(sun, dispatches, barriers);
+    if (light_volume) AddCloudLightVolume(sun, dispatches, barriers);
     if (panorama.width > 0) {
       gpu::SkyPush push{};
       push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
@@ -1078,6 +1117,7 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
   luts_ready_ = false;
   skyview_ready_ = false;
   cloud_tables_ready_ = false;
+  cloud_light_volume_ready_ = false;
   return true;
 }
 
@@ -1086,7 +1126,8 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   const gpu::GpuClouds& c = clouds.uniform;
   auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
-      !same(c.lut, gpu_clouds_.lut))
+      !same(c.lut, gpu_clouds_.lut) || !same(c.light_volume, gpu_clouds_.light_volume) ||
+      (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_))
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.
   const bool images_same = clouds.weather_images == cloud_weather_images_;
@@ -1096,6 +1137,8 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
                   c.layers[l].weather.w == gpu_clouds_.layers[l].weather.w;
   const bool noise_same = images_same && layout_same;
   if (same(c, gpu_clouds_) && noise_same) return true;
+  // The light volume follows every cloud setting (the wind's offsets too).
+  cloud_light_volume_ready_ = false;
   // Every submission waits for its fence, so no dispatch reads the buffers now.
   if (!noise_same) {
     cloud_weather_images_ = clouds.weather_images;

@@ -177,6 +177,12 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
     v.Int("quality.cloud_weather_resolution", cq.weather_resolution, 8, 2048);
     v.Real("quality.cloud_max_distance_km", cq.max_distance_km, kCloudDistance);
     v.Real("quality.cloud_panorama_scale", cq.panorama_scale, kCloudPanoramaScale);
+    // Written only when on, so the reference's resolved style is as before.
+    if (v.kReads || cq.light_volume_columns > 0) {
+      v.Int("quality.cloud_light_volume_columns", cq.light_volume_columns, 0, 1024);
+      v.Int("quality.cloud_light_volume_slices", cq.light_volume_slices, 2, 64);
+      v.Int("quality.cloud_light_volume_near_steps", cq.light_volume_near_steps, 0, 16);
+    }
   }
 }
 
@@ -1147,6 +1153,14 @@ void CheckCloudLayers(const SkyStyle& style, StyleChecks& c) {
   const std::string style_dir = std::filesystem::path(c.name).parent_path().string();
   for (const CloudProblem& p : ValidateClouds(style.clouds, a, style_dir)) {
     std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
+    if (p.layer == -3) {  // the light volume's size
+      ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_volume_columns").node()
+                                   ? "quality.cloud_light_volume_columns"
+                                   : "quality.cloud_light_volume_slices");
+      e.message = p.message;
+      c.errors.push_back(e);
+      continue;
+    }
     if (p.layer == -2) {  // the sampling settings
       ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
                                                                               : "quality.cloud_view_steps");

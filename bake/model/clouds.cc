@@ -51,13 +51,21 @@ CloudQuality CloudQualityPreset(const std::string& name) {
   // light_trilinear_steps): production 3.42e-2 -> 3.50e-2 with 8 of 24
   // trilinear, draft 8.77e-2 -> 8.95e-2 with 3 of 12 (2026-12-02 run); the
   // reference keeps every light sample trilinear.
-  CloudQuality q;  // production: 48 / 24 steps, volumes 64 / 32 / 256, 3.5e-2
+  // The light volume (CloudLightVolume in clouds.h): production 256 columns
+  // x 32 slices, 2 exact near steps (3.50e-2 -> 4.26e-2; 512 columns 3.56e-2
+  // for 4 times the volume's cost, 16 slices 5.7e-2); draft 256 x 16, 1
+  // (8.95e-2 -> 9.29e-2); the reference marches every light sample.
+  CloudQuality q;  // production: 48 / 24 steps, volumes 64 / 32 / 256, 4.3e-2
   q.light_trilinear_steps = 8;
   if (name == "draft") {
     q.view_steps = 24;  // 9.0e-2, 0.60 x production's CPU time
     q.light_steps = 12;
     q.light_trilinear_steps = 3;
+    q.light_volume_columns = 256;
+    q.light_volume_slices = 16;
+    q.light_volume_near_steps = 1;
   } else if (name == "reference") {
+    q.light_volume_columns = 0;
     q.light_trilinear_steps = 256;
     q.view_steps = 128;  // 8.4e-3, 3.2 x production's CPU time
     q.light_steps = 32;
@@ -104,6 +112,16 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
                                     std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers),
                                     clouds.quality.view_steps, clouds.quality.light_steps, loops,
                                     kMaxCloudLoopIterations)});
+  // The light volume shares the noise buffer (one storage buffer: lavapipe
+  // binds at most 128 MiB): at most 64 MiB of it.
+  const CloudQuality& q = clouds.quality;
+  const double volume_mib = double(q.light_volume_columns) * q.light_volume_columns * q.light_volume_slices * 4.0 /
+                            (1024.0 * 1024.0);
+  if (!ActiveCloudLayers(clouds).empty() && q.light_volume_columns > 0 && volume_mib > 64.0)
+    problems.push_back({-3, "",
+                        fmt::format("{0} x {0} columns x {1} slices make a light volume of {2:.0f} MiB, above 64 MiB: "
+                                    "lower quality.cloud_light_volume_columns or quality.cloud_light_volume_slices",
+                                    q.light_volume_columns, q.light_volume_slices, volume_mib)});
   const double atmosphere_m = (atmosphere.top_radius_km - atmosphere.bottom_radius_km) * 1000.0;
   for (size_t i = 0; i < clouds.layers.size(); ++i) {
     const CloudLayer& l = clouds.layers[i];
@@ -331,7 +349,34 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
   }
+  // The light volume after the noise and its bounds (CloudNoiseFloats).
+  if (q.light_volume_columns > 0) {
+    g.light_volume = {q.light_volume_columns, q.light_volume_slices, q.light_volume_near_steps,
+                      int32_t(CloudNoiseFloats(g))};
+    // The columns' feet reach past the farthest sample by the band's
+    // thickness over the tangent of the Sun's lowest elevation there
+    // (kCloudLightVolumeMinElevationDeg less the curvature's tilt at that
+    // distance, taken as 4 deg at most): a generous 2 deg here.
+    double thickness_km = 0.0;
+    for (int b = 0; b < g.resolution.w; ++b) thickness_km = std::max(thickness_km, double(g.bands[b].y - g.bands[b].x));
+    const double extent_km = 1.1 * q.max_distance_km + thickness_km / std::tan(2.0 * M_PI / 180.0);
+    g.light_volume_grid = {float(kCloudLightVolumeWarpKm), float(std::asinh(extent_km / kCloudLightVolumeWarpKm)),
+                           float(kCloudLightVolumeSubsteps), 0.0f};
+  }
   return in;
+}
+
+size_t CloudLightVolumeFloats(const gpu::GpuClouds& c) {
+  if (c.light_volume.x <= 0) return 0;
+  return size_t(c.light_volume.x) * size_t(c.light_volume.x) * size_t(c.light_volume.y);
+}
+
+bool CloudLightVolumeOn(const gpu::GpuClouds& c) {
+  return c.counts.x > 0 && c.light_volume.x > 0 && c.resolution.w == 1;
+}
+
+bool CloudLightVolumeForSun(const gpu::GpuClouds& c, double sun_y) {
+  return CloudLightVolumeOn(c) && sun_y >= std::sin(kCloudLightVolumeMinElevationDeg * M_PI / 180.0);
 }
 
 }  // namespace skybake

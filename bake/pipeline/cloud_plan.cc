@@ -32,6 +32,19 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
            : v.mapping == MAPPING_CUBE_STRIP ? std::string("clouds cube strip")
                                              : fmt::format("clouds face {}", v.face);
   };
+  // The light volume (clouds.h, CloudLightVolume): one band only; a frame
+  // with the Sun below kCloudLightVolumeMinElevationDeg does without it.
+  const std::vector<CloudLayer> active = ActiveCloudLayers(first.clouds);
+  if (cq.light_volume_columns > 0 && CloudBands(active) == 1 && frames > shadowed)
+    plan.passes.push_back(
+        {"cloud light volume",
+         fmt::format("{0} x {0} columns x {1} slices, {2} exact near steps", cq.light_volume_columns,
+                     cq.light_volume_slices, cq.light_volume_near_steps),
+         fmt::format("once per frame with the Sun above {:.0f} deg (quality.cloud_light_volume_columns)",
+                     kCloudLightVolumeMinElevationDeg),
+         frames - shadowed,
+         double(cq.light_volume_columns) * cq.light_volume_columns * (cq.light_volume_slices - 1) *
+             kCloudLightVolumeSubsteps});
   const CloudPanorama panorama = ChooseCloudPanorama(views, cq.panorama_scale);
   if (panorama.width == 0) {
     for (const ViewRequest& v : views)

@@ -38,6 +38,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_TWILIGHT_MARCH 16      // bool: the twilight band is ray-marched (quality.twilight_march_band_deg)
 #define SPEC_CLOUD_LAYERS 20        // int: the active volumetric cloud layers
 #define SPEC_CLOUD_SUN_LIGHT 21     // bool: the Sun lights the clouds (off: every band in the Earth's shadow)
+#define SPEC_CLOUD_LIGHT_VOLUME 22  // bool: the light march's far part read from the frame's light volume (clouds.h)
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere
@@ -155,6 +156,7 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 #define CLOUD_PASS_SHAPE 2    // shape noise volume of layer SkyPush.view.w, once per renderer
 #define CLOUD_PASS_DETAIL 3   // detail noise volume of layer SkyPush.view.w
 #define CLOUD_PASS_WEATHER 4  // procedural weather map of layer SkyPush.view.w
+#define CLOUD_PASS_LIGHT_VOLUME 5  // the light volume's columns (GpuClouds.light_volume), once per frame
 // Modes of the cloud pass (SkyPush.rect.w; cloud_panorama.glsl, cloud_panorama.h).
 #define CLOUD_MODE_MARCH 0     // march the view's own texels (no panorama)
 #define CLOUD_MODE_PANORAMA 1  // march the panorama's texels into the cloud table buffer
@@ -192,6 +194,16 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   // marched through each band it crosses, in order along the ray.
   vec4 bands[CLOUD_MAX_LAYERS];
   GpuCloudLayer layers[CLOUD_MAX_LAYERS];
+  // The light volume (clouds.h, CloudLightVolume; clouds.glsl): the optical
+  // depth toward the Sun of points of the band, per frame, on columns along
+  // the Sun. x: columns along each of world x and z (0: off, the exact
+  // march); y: altitude slices through the band; z: the exact light steps
+  // nearest the view sample (kCloudLightVolumeNearStepKm each); w: the first
+  // float of the volume in the noise buffer.
+  ivec4 light_volume;
+  // x: L, km, and y: U of the columns' warped grid, world x = L sinh(u) for u
+  // over [-U, U]; z: the column march's samples per slice interval; w: unused.
+  vec4 light_volume_grid;
 };
 
 
@@ -221,7 +233,7 @@ SKYBAKE_GPU_STRUCT(IblPush) {
 
 #ifdef __cplusplus
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
-static_assert(sizeof(GpuClouds) == (7 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
+static_assert(sizeof(GpuClouds) == (9 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(IblPush) == 7 * 16, "IblPush must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 15 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");

@@ -62,7 +62,7 @@ CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather
   // Every light sample trilinear, unless a case says otherwise.
   return {.view_steps = view, .light_steps = light, .light_trilinear_steps = 256, .octaves = octaves,
           .shape_resolution = shape, .detail_resolution = detail, .weather_resolution = weather,
-          .panorama_scale = panorama_scale};
+          .panorama_scale = panorama_scale, .light_volume_columns = 0};
 }
 
 std::string CaseName(const CloudQuality& q) {
@@ -70,6 +70,8 @@ std::string CaseName(const CloudQuality& q) {
                                  q.detail_resolution, q.weather_resolution);
   if (q.octaves != 8) name += fmt::format(" oct {}", q.octaves);
   if (q.light_trilinear_steps < q.light_steps) name += fmt::format(" tri {}", q.light_trilinear_steps);
+  if (q.light_volume_columns > 0)
+    name += fmt::format(" lv {}/{}/{}", q.light_volume_columns, q.light_volume_slices, q.light_volume_near_steps);
   return name;
 }
 
@@ -250,6 +252,19 @@ std::vector<CloudQuality> MarchCases(bool quick) {
                                         {32, 16, 4}, {32, 24, 6}, {48, 16, 4}}) {
     CloudQuality q = MakeQuality(view, light, 64, 32, 256);
     q.light_trilinear_steps = trilinear;
+    cases.push_back(q);
+  }
+  // The light volume (quality.cloud_light_volume_*): columns / slices / exact
+  // near steps, at production's and draft's steps.
+  for (auto [view, light, trilinear, columns, slices, near] :
+       {std::tuple{48, 24, 8, 512, 32, 2}, {48, 24, 8, 512, 16, 2}, {48, 24, 8, 384, 16, 2}, {48, 24, 8, 256, 32, 2},
+        {48, 24, 8, 256, 16, 2}, {48, 24, 8, 256, 16, 1}, {48, 24, 8, 512, 32, 0}, {48, 24, 8, 1024, 32, 2},
+        {24, 12, 3, 256, 16, 1}, {24, 12, 3, 512, 32, 2}}) {
+    CloudQuality q = MakeQuality(view, light, 64, 32, 256);
+    q.light_trilinear_steps = trilinear;
+    q.light_volume_columns = columns;
+    q.light_volume_slices = slices;
+    q.light_volume_near_steps = near;
     cases.push_back(q);
   }
   return cases;

@@ -220,7 +220,13 @@ class SkyRenderer {
   void WriteStorageBinding(uint32_t binding, VkBuffer buffer);
   // `sun_disc`, `sun_disc_pass`: specialization constants 1 and 15.
   VkPipeline CreatePipeline(const uint32_t* code, size_t bytes, bool sun_disc, bool sun_disc_pass,
-                            bool twilight_march = false, bool cloud_sun_light = true);
+                            bool twilight_march = false, bool cloud_sun_light = true, bool cloud_light_volume = false);
+  // The cloud pass with every light sample marched, for a frame whose Sun is
+  // too low for the light volume (CloudLightVolumeForSun); built on first use.
+  VkPipeline MarchedLightCloudPipeline();
+  // The frame's light volume (CLOUD_PASS_LIGHT_VOLUME), unless it holds this Sun
+  // and these clouds already.
+  void AddCloudLightVolume(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   // Whether this Sun makes the frame twilight (TwilightSunElevationDeg): its
   // views march the twilight band (quality.twilight_march_band_deg) and read
   // the sun transmittance in the logarithm, with the sky pass that does,
@@ -286,6 +292,9 @@ class SkyRenderer {
   bool cloud_noise_ready_ = false;
   bool cloud_tables_ready_ = false;
   glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
+  bool cloud_light_volume_ = false;  // cloud_pipeline_ reads the light volume (CloudLightVolumeOn)
+  bool cloud_light_volume_ready_ = false;
+  glm::dvec3 cloud_light_volume_sun_{0.0};  // the sun the light volume holds
   std::vector<float> cloud_weather_images_;
 
   Buffer atmosphere_buffer_;
@@ -316,6 +325,7 @@ class SkyRenderer {
   VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
   VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;  // built on the first frame that marches the twilight band
   VkPipeline shadowed_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the Sun's light (CloudsInEarthShadow)
+  VkPipeline marched_light_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the light volume
   bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
   VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
   bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant

@@ -83,6 +83,12 @@ struct CloudQuality {
   // Cloud panorama height over the finest view's (cloud_panorama.h); 0: every
   // view marches its own texels.
   double panorama_scale = 1.0;
+  // The light volume (CloudLightVolume below): columns along each horizontal
+  // axis (0: off, every light sample marched), altitude slices, and the
+  // light steps nearest the view sample that stay exact.
+  int light_volume_columns = 256;
+  int light_volume_slices = 32;
+  int light_volume_near_steps = 2;
 };
 CloudQuality CloudQualityPreset(const std::string& name);
 
@@ -154,6 +160,31 @@ gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds);
 // without the light march) and the pass plan (which frames it lists) both
 // ask this, so they agree to the frame.
 double CloudEarthShadowElevationDeg(const gpu::GpuClouds& clouds, const gpu::GpuAtmosphere& atmosphere);
+
+// The light volume (quality.cloud_light_volume_*, clouds.glsl): per frame,
+// the clouds' optical depth toward the Sun from points of the band, over the
+// light march's own distance (CloudOpticalDepthToSun), on columns that
+// follow the Sun's rays up through the band: a column starts at world (x, z)
+// on the band's bottom, x and z each on a warped grid x = L sinh(u)
+// (kCloudLightVolumeWarpKm: fine near the viewer, coarse far away, where a
+// texel covers more cloud), and holds the depth at `slices` altitudes
+// through the band. A lit view sample marches its first `near_steps` light
+// steps (kCloudLightVolumeNearStepKm each) exactly and reads the rest from
+// the volume, trilinearly, at the point the near steps reach. One band only
+// (a style whose layers make two or more keeps the exact march), and only a
+// Sun at least kCloudLightVolumeMinElevationDeg above the horizon: every
+// column then rises through the band within the march's distance bound.
+constexpr double kCloudLightVolumeWarpKm = 1.0;
+constexpr double kCloudLightVolumeNearStepKm = 0.1;
+constexpr double kCloudLightVolumeMinElevationDeg = 6.0;
+// Samples of the column's march per slice interval.
+constexpr int kCloudLightVolumeSubsteps = 1;
+// Floats of the light volume (0 when off).
+size_t CloudLightVolumeFloats(const gpu::GpuClouds& clouds);
+// Whether a frame with the Sun at `sun_y` (the sine of its elevation) reads
+// the light volume: on, one band, the Sun high enough.
+bool CloudLightVolumeOn(const gpu::GpuClouds& clouds);
+bool CloudLightVolumeForSun(const gpu::GpuClouds& clouds, double sun_y);
 
 // What the renderer needs: the uniform block, the weather images (R channel,
 // resampled to the procedural map's resolution), and the sizes of the noise
