@@ -881,6 +881,44 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
   return disc;
 }
 
+// Where the view ray leaves the planet's umbra, as an altitude (km): the
+// top of the atmosphere where it never leaves it, the ray's start where it
+// starts outside it.
+Real UmbraExitAltitude(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  if (!ray.in_atmosphere || UmbraValue(atm, ray, 0.0) >= 0.0) return ray.altitude;
+  if (UmbraValue(atm, ray, ray.t_max) < 0.0) return atm.top_radius - atm.bottom_radius;
+  return AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, UmbraExitDistance(atm, ray));
+}
+
+// `view` turned in its vertical plane to `elevation` (rad) above the horizontal.
+vec3 ViewAtElevation(vec3 view, Real elevation) {
+  vec2 horizontal = vec2(view.x, view.z);
+  Real horizontal_length = length(horizontal);
+  horizontal = horizontal_length > 0.0 ? horizontal / horizontal_length : vec2(1.0, 0.0);
+  return vec3(horizontal.x * cos(elevation), sin(elevation), horizontal.y * cos(elevation));
+}
+
+// Above the band, the texels where the Earth's shadow's edge bends between
+// the LUT's rows: the second difference of the umbra's exit altitude over
+// kTwilightEdgeStep either side of the view, in km. Single scattering there
+// goes as exp(-altitude / scale height), so a bend of the exit altitude is a
+// bend of the logarithm that SampleSkyViewLut mixes linearly; next to the
+// rays that never leave the umbra (the top of the shadow seen from below) it
+// reaches tens of km. kTwilightEdgeBend is the accuracy study's choice
+// (docs/accuracy.md, "The Earth's shadow's edge above the band"): 0.07 km
+// keeps production's 144 rows within 1% at sun -1 .. -10 deg from 0 to 8 km.
+const Real kTwilightEdgeStep = 1.0 * kPi / 180.0;
+const Real kTwilightEdgeBend = 0.07;
+
+bool ShadowEdgeBendsAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  Real elevation = 0.5 * kPi - atan(length(vec2(view.x, view.z)), view.y);
+  Real below = UmbraExitAltitude(atm, ViewAtElevation(view, elevation - kTwilightEdgeStep), sun);
+  Real centre = UmbraExitAltitude(atm, view, sun);
+  Real above = UmbraExitAltitude(atm, ViewAtElevation(view, elevation + kTwilightEdgeStep), sun);
+  return abs(above - 2.0 * centre + below) > kTwilightEdgeBend;
+}
+
 // Whether `view` is ray-marched per texel rather than read from the sky-view
 // LUT: at twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
 // from the observer's horizon up to twilight_march_band above it, where the
@@ -889,12 +927,17 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
 // 2020 section 5.3 suggests the same fall-back for accuracy. The band's top
 // is raised by the horizon's dip (HorizonZenithAngle - pi/2: 0 at sea level,
 // 2.9 deg at 8 km): from altitude the horizon drops below the horizontal
-// while the shadow's edge above it stands that much higher.
+// while the shadow's edge above it stands that much higher. Above the band,
+// the texels where the upper edge of the Earth's shadow bends between the
+// LUT's rows (ShadowEdgeBendsAcrossLutRows: up to 21 deg elevation at sun
+// -7 deg) are marched too.
 bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return false;
   Real horizon = HorizonZenithAngle(atm);
   Real above_horizon = horizon - atan(length(vec2(view.x, view.z)), view.y);
-  return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi);
+  if (!(above_horizon >= 0.0)) return false;
+  if (above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi)) return true;
+  return ShadowEdgeBendsAcrossLutRows(atm, view, sun);
 }
 
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
