@@ -321,16 +321,23 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
   }
   // The sky-view LUT is built for the configured observer and Sun; the
   // skydome moves the observer and turns the Sun, so it ray-marches instead,
-  // as does the low sky at twilight (InTwilightMarchBand) with its own steps.
+  // as does the low sky at twilight (TwilightMarchWeight) with its own steps.
   vec3 radiance;
 #ifdef SKYBAKE_NO_TWILIGHT_MARCH
   const bool twilight_march = false;  // the sky-view variant: no ray march in its SPIR-V
 #else
-  bool twilight_march = use_sky_view && !aoas.skydome && InTwilightMarchBand(earth, view, sun_local);
-  if (twilight_march) earth.view_steps = earth.twilight_march_steps;
+  Real twilight_weight = use_sky_view && !aoas.skydome ? TwilightMarchWeight(earth, view, sun_local) : 0.0;
+  bool twilight_march = twilight_weight >= 1.0;
+  if (twilight_weight > 0.0) earth.view_steps = earth.twilight_march_steps;
 #endif
   if (use_sky_view && !aoas.skydome && !twilight_march) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
   else radiance = ComputeSkyRadiance(earth, view, sun_local);
+#ifndef SKYBAKE_NO_TWILIGHT_MARCH
+  // At the edge of the marched texels above the twilight band, the LUT's
+  // value mixed with the march's: no seam where the march stops.
+  if (twilight_weight > 0.0 && twilight_weight < 1.0)
+    radiance = mix(radiance, ComputeSkyRadiance(earth, view, sun_local), twilight_weight);
+#endif
   return StyleSkyRadiance(atm, aoas, radiance, w, sun);
 }
 

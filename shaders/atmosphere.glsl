@@ -901,26 +901,28 @@ vec3 ViewAtElevation(vec3 view, Real elevation) {
 
 // Above the band, the texels where the Earth's shadow's edge bends between
 // the LUT's rows: the second difference of the umbra's exit altitude over
-// kTwilightEdgeStep either side of the view, in km. Single scattering there
+// kTwilightEdgeStep either side of the view (km). Single scattering there
 // goes as exp(-altitude / scale height), so a bend of the exit altitude is a
 // bend of the logarithm that SampleSkyViewLut mixes linearly; next to the
 // rays that never leave the umbra (the top of the shadow seen from below) it
-// reaches tens of km. kTwilightEdgeBend is the accuracy study's choice
-// (docs/accuracy.md, "The Earth's shadow's edge above the band"): 0.07 km
-// keeps production's 144 rows within 1% at sun -1 .. -10 deg from 0 to 8 km.
+// reaches tens of km. kTwilightEdgeBend is chosen from the accuracy study
+// (docs/accuracy.md, "The Earth's shadow's edge above the band"): marching
+// the texels whose bend exceeds 0.07 km keeps production's 144 rows within
+// 1% at sun -1 .. -10 deg from 0 to 8 km.
 const Real kTwilightEdgeStep = 1.0 * kPi / 180.0;
 const Real kTwilightEdgeBend = 0.07;
 
-bool ShadowEdgeBendsAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+Real ShadowEdgeBendAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   Real elevation = 0.5 * kPi - atan(length(vec2(view.x, view.z)), view.y);
   Real below = UmbraExitAltitude(atm, ViewAtElevation(view, elevation - kTwilightEdgeStep), sun);
   Real centre = UmbraExitAltitude(atm, view, sun);
   Real above = UmbraExitAltitude(atm, ViewAtElevation(view, elevation + kTwilightEdgeStep), sun);
-  return abs(above - 2.0 * centre + below) > kTwilightEdgeBend;
+  return abs(above - 2.0 * centre + below);
 }
 
-// Whether `view` is ray-marched per texel rather than read from the sky-view
-// LUT: at twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
+// How much of `view`'s radiance is ray-marched per texel rather than read
+// from the sky-view LUT (1: marched, 0: read, between: both, mixed): at
+// twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
 // from the observer's horizon up to twilight_march_band above it, where the
 // Earth's shadow and the band above it fall by orders of magnitude within
 // the spacing of the LUT's rows (docs/accuracy.md, "Twilight"). Hillaire
@@ -929,15 +931,16 @@ bool ShadowEdgeBendsAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 
 // 2.9 deg at 8 km): from altitude the horizon drops below the horizontal
 // while the shadow's edge above it stands that much higher. Above the band,
 // the texels where the upper edge of the Earth's shadow bends between the
-// LUT's rows (ShadowEdgeBendsAcrossLutRows: up to 21 deg elevation at sun
-// -7 deg) are marched too.
-bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return false;
+// LUT's rows (up to 21 deg elevation at sun -7 deg) are marched too, mixed
+// with the LUT's value where the bend is between half kTwilightEdgeBend and
+// kTwilightEdgeBend, so that no seam shows where the march stops.
+Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return 0.0;
   Real horizon = HorizonZenithAngle(atm);
   Real above_horizon = horizon - atan(length(vec2(view.x, view.z)), view.y);
-  if (!(above_horizon >= 0.0)) return false;
-  if (above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi)) return true;
-  return ShadowEdgeBendsAcrossLutRows(atm, view, sun);
+  if (!(above_horizon >= 0.0)) return 0.0;
+  if (above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi)) return 1.0;
+  return smoothstep(0.5 * kTwilightEdgeBend, kTwilightEdgeBend, ShadowEdgeBendAcrossLutRows(atm, view, sun));
 }
 
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus

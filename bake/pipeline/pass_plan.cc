@@ -193,11 +193,14 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 // frames whose Sun is below TwilightSunElevationDeg (listed only when there
 // is one), the texels up to the band above the
 // horizon (a fraction sin(band) / 2 of each view's directions, which it
-// estimates) are ray-marched by a sky pass of their own pipeline.
+// estimates) and, above it, the texels on the Earth's shadow's edge
+// (TwilightMarchWeight: at most about 2.5% of the directions, sun
+// -6 deg, docs/accuracy.md) are ray-marched by a sky pass of their own pipeline.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
                       PassPlan& plan) {
   const QualitySettings& q = first.quality;
   const double band = q.twilight_march_band_deg;
+  const double kShadowEdgeFraction = 0.025;
   const double below = TwilightSunElevationDeg(q);
   if (!(band > 0.0) || !(below > 0.0) || !NeedsSkyViewLut(pruned)) return;
   const int runs = int(std::count_if(frames.begin(), frames.end(),
@@ -208,7 +211,7 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   const int steps = q.twilight_march_steps > 0 ? q.twilight_march_steps : q.view_steps;
   plan.passes.push_back({"twilight band march", fmt::format("0..{:g} deg above the horizon", band),
                          fmt::format("frames with the Sun below {:g} deg", below), runs,
-                         texels * 0.5 * std::sin(band * M_PI / 180.0) * steps * std::max(q.light_steps, 1)});
+                         texels * (0.5 * std::sin(band * M_PI / 180.0) + kShadowEdgeFraction) * steps * std::max(q.light_steps, 1)});
 }
 
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).
