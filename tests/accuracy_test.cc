@@ -296,7 +296,7 @@ TEST(ConvergedReferenceTest, PresetsAgainstTheirBudgetsAtTwilightFrom8Km) {
 
 // The sky-view path across the Earth's shadow's edge, run by hand (about
 // 2 minutes; --gtest_also_run_disabled_tests): every 0.25 deg of view
-// elevation from the horizon to 30 deg, every 15 deg of azimuth, observers at
+// elevation from the horizon to 45 deg, every 15 deg of azimuth, observers at
 // 0, 2, 4, 8 and 12 km, the Sun at -1 .. -10 deg every degree, single
 // scattering. Denser than the study's directions (the shadow's edge lies
 // between them), so against a GPU march of 512 steps per texel (the
@@ -340,7 +340,7 @@ TEST(ConvergedReferenceTest, DISABLED_TwilightSweepAcrossTheShadowEdge) {
     SkyRenderer truth(testing::Vulkan(), a, TwilightSweepTruth(), single, Rgb{1, 1, 1});
     const double dip = std::acos(a.bottom_radius_km / (a.bottom_radius_km + altitude_m * 1e-3)) * 180.0 / M_PI;
     std::vector<double> elevations;
-    for (double e = -dip + 0.05; e <= 30.0; e += 0.25) elevations.push_back(e);
+    for (double e = -dip + 0.05; e <= 45.0; e += 0.25) elevations.push_back(e);
     std::vector<glm::dvec3> dirs;
     for (double e : elevations)
       for (double azimuth = 0.0; azimuth <= 180.0; azimuth += 15.0)
