@@ -883,12 +883,28 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
 
 // Where the view ray leaves the planet's umbra, as an altitude (km): the
 // top of the atmosphere where it never leaves it, the ray's start where it
-// starts outside it.
+// starts outside it. In closed form (no bisection: it runs three times per
+// texel above the twilight band): the umbra of UmbraValue to first order in
+// the Sun's angular radius alpha, the cylinder around the anti-solar axis
+// narrowing as a cone, rho^2 < R_b^2 (1 + alpha^2) - 2 R_b alpha x (rho
+// from the axis, x = -p.sun along it), a quadratic in the ray's distance;
+// its constant term as h (r + R_b) - (r mu_s)^2, without r^2 - R_b^2's
+// cancellation in float32.
 Real UmbraExitAltitude(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   SkyRay ray = SetUpSkyRay(atm, view, sun);
-  if (!ray.in_atmosphere || UmbraValue(atm, ray, 0.0) >= 0.0) return ray.altitude;
-  if (UmbraValue(atm, ray, ray.t_max) < 0.0) return atm.top_radius - atm.bottom_radius;
-  return AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, UmbraExitDistance(atm, ray));
+  if (!ray.in_atmosphere) return ray.altitude;
+  Real rb = atm.bottom_radius;
+  Real alpha = atm.sun_angular_radius;
+  Real r_mu_s = ray.r * ray.mu_s;
+  Real a = max(1.0 - ray.nu * ray.nu, 0.0);
+  Real b = 2.0 * (ray.r * ray.mu - r_mu_s * ray.nu) - 2.0 * rb * alpha * ray.nu;
+  Real c = ray.altitude * (ray.r + rb) - r_mu_s * r_mu_s - 2.0 * rb * alpha * r_mu_s - rb * rb * alpha * alpha;
+  if (!(c < 0.0) || !(ray.mu_s < 0.0)) return ray.altitude;  // starts outside the umbra
+  Real root = sqrt(max(b * b - 4.0 * a * c, 0.0));
+  // The larger root, in the form that keeps its digits.
+  Real t_exit = b < 0.0 ? (a > 0.0 ? 0.5 * (root - b) / a : ray.t_max + 1.0) : c / (-0.5 * (b + root));
+  if (!(t_exit < ray.t_max)) return atm.top_radius - atm.bottom_radius;
+  return AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, t_exit);
 }
 
 // `view` turned in its vertical plane to `elevation` (rad) above the horizontal.
