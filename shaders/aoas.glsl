@@ -321,16 +321,30 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
   }
   // The sky-view LUT is built for the configured observer and Sun; the
   // skydome moves the observer and turns the Sun, so it ray-marches instead,
-  // as does the low sky at twilight (InTwilightMarchBand) with its own steps.
+  // as does the low sky at twilight (TwilightMarchWeight) with its own steps.
   vec3 radiance;
 #ifdef SKYBAKE_NO_TWILIGHT_MARCH
   const bool twilight_march = false;  // the sky-view variant: no ray march in its SPIR-V
 #else
-  bool twilight_march = use_sky_view && !aoas.skydome && InTwilightMarchBand(earth, view, sun_local);
-  if (twilight_march) earth.view_steps = earth.twilight_march_steps;
+  Real twilight_weight = use_sky_view && !aoas.skydome ? TwilightMarchWeight(earth, view, sun_local) : 0.0;
+  bool twilight_march = twilight_weight >= 1.0;
+  if (twilight_weight > 0.0) earth.view_steps = earth.twilight_march_steps;
 #endif
+#ifdef SKYBAKE_NO_TWILIGHT_MARCH
   if (use_sky_view && !aoas.skydome && !twilight_march) radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
   else radiance = ComputeSkyRadiance(earth, view, sun_local);
+#else
+  // At the edge of the marched texels above the twilight band, the LUT's
+  // value mixed with the march's: no seam where the march stops. One call
+  // of each, so that the shader holds one ray march.
+  bool read_lut = use_sky_view && !aoas.skydome && !twilight_march;
+  bool march = !read_lut || twilight_weight > 0.0;
+  vec3 lut_radiance = vec3(0.0);
+  if (read_lut) lut_radiance = ComputeSkyRadianceFromSkyView(earth, view, sun_local);
+  radiance = lut_radiance;
+  if (march) radiance = ComputeSkyRadiance(earth, view, sun_local);
+  if (read_lut && march) radiance = mix(lut_radiance, radiance, twilight_weight);
+#endif
   return StyleSkyRadiance(atm, aoas, radiance, w, sun);
 }
 

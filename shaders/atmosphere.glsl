@@ -881,20 +881,89 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
   return disc;
 }
 
-// Whether `view` is ray-marched per texel rather than read from the sky-view
-// LUT: at twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
+// Where the view ray leaves the planet's umbra, as an altitude (km): the
+// top of the atmosphere where it never leaves it, the ray's start where it
+// starts outside it. In closed form (no bisection: it runs three times per
+// texel above the twilight band): the umbra of UmbraValue to first order in
+// the Sun's angular radius alpha, the cylinder around the anti-solar axis
+// narrowing as a cone, rho^2 < R_b^2 (1 + alpha^2) - 2 R_b alpha x (rho
+// from the axis, x = -p.sun along it), a quadratic in the ray's distance;
+// its constant term as h (r + R_b) - (r mu_s)^2, without r^2 - R_b^2's
+// cancellation in float32.
+Real UmbraExitAltitude(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  if (!ray.in_atmosphere) return ray.altitude;
+  Real rb = atm.bottom_radius;
+  Real alpha = atm.sun_angular_radius;
+  Real r_mu_s = ray.r * ray.mu_s;
+  Real a = max(1.0 - ray.nu * ray.nu, 0.0);
+  Real b = 2.0 * (ray.r * ray.mu - r_mu_s * ray.nu) - 2.0 * rb * alpha * ray.nu;
+  Real c = ray.altitude * (ray.r + rb) - r_mu_s * r_mu_s - 2.0 * rb * alpha * r_mu_s - rb * rb * alpha * alpha;
+  if (!(c < 0.0) || !(ray.mu_s < 0.0)) return ray.altitude;  // starts outside the umbra
+  Real root = sqrt(max(b * b - 4.0 * a * c, 0.0));
+  // The larger root, in the form that keeps its digits.
+  Real t_exit = b < 0.0 ? (a > 0.0 ? 0.5 * (root - b) / a : ray.t_max + 1.0) : c / (-0.5 * (b + root));
+  if (!(t_exit < ray.t_max)) return atm.top_radius - atm.bottom_radius;
+  return AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, t_exit);
+}
+
+// `view` turned in its vertical plane to `elevation` (rad) above the horizontal.
+vec3 ViewAtElevation(vec3 view, Real elevation) {
+  vec2 horizontal = vec2(view.x, view.z);
+  Real horizontal_length = length(horizontal);
+  horizontal = horizontal_length > 0.0 ? horizontal / horizontal_length : vec2(1.0, 0.0);
+  return vec3(horizontal.x * cos(elevation), sin(elevation), horizontal.y * cos(elevation));
+}
+
+// Above the band, the texels where the Earth's shadow's edge bends between
+// the LUT's rows: the second difference of the umbra's exit altitude over
+// kTwilightEdgeStep either side of the view (km). Single scattering there
+// goes as exp(-altitude / scale height), so a bend of the exit altitude is a
+// bend of the logarithm that SampleSkyViewLut mixes linearly; next to the
+// rays that never leave the umbra (the top of the shadow seen from below) it
+// reaches tens of km. kTwilightEdgeBend is chosen from the accuracy study
+// (docs/accuracy.md, "The Earth's shadow's edge above the band"): marching
+// the texels whose bend exceeds 0.07 km keeps production's 144 rows within
+// 1% at sun -1 .. -10 deg from 0 to 8 km.
+// The test costs three bisections per texel, so it runs only where the
+// sweep found the LUT's misses: up to kTwilightEdgeReach above the band's
+// top (the worst was at 21.3 deg elevation, sun -7 deg; none above it up
+// to 45 deg).
+const Real kTwilightEdgeStep = 1.0 * kPi / 180.0;
+const Real kTwilightEdgeBend = 0.07;
+const Real kTwilightEdgeReach = 20.0 * kPi / 180.0;
+
+Real ShadowEdgeBendAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  Real centre = UmbraExitAltitude(atm, view, sun);
+  Real elevation = 0.5 * kPi - atan(length(vec2(view.x, view.z)), view.y);
+  Real below = UmbraExitAltitude(atm, ViewAtElevation(view, elevation - kTwilightEdgeStep), sun);
+  Real above = UmbraExitAltitude(atm, ViewAtElevation(view, elevation + kTwilightEdgeStep), sun);
+  return abs(above - 2.0 * centre + below);
+}
+
+// How much of `view`'s radiance is ray-marched per texel rather than read
+// from the sky-view LUT (1: marched, 0: read, between: both, mixed): at
+// twilight (the Sun below the elevation of atm.twilight_sun_sine), the sky
 // from the observer's horizon up to twilight_march_band above it, where the
 // Earth's shadow and the band above it fall by orders of magnitude within
 // the spacing of the LUT's rows (docs/accuracy.md, "Twilight"). Hillaire
 // 2020 section 5.3 suggests the same fall-back for accuracy. The band's top
 // is raised by the horizon's dip (HorizonZenithAngle - pi/2: 0 at sea level,
 // 2.9 deg at 8 km): from altitude the horizon drops below the horizontal
-// while the shadow's edge above it stands that much higher.
-bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return false;
+// while the shadow's edge above it stands that much higher. Above the band,
+// the texels where the upper edge of the Earth's shadow bends between the
+// LUT's rows (up to 21 deg elevation at sun -7 deg) are marched too, mixed
+// with the LUT's value where the bend is between half kTwilightEdgeBend and
+// kTwilightEdgeBend, so that no seam shows where the march stops.
+Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return 0.0;
   Real horizon = HorizonZenithAngle(atm);
   Real above_horizon = horizon - atan(length(vec2(view.x, view.z)), view.y);
-  return above_horizon >= 0.0 && above_horizon < atm.twilight_march_band + (horizon - 0.5 * kPi);
+  if (!(above_horizon >= 0.0)) return 0.0;
+  Real top = atm.twilight_march_band + (horizon - 0.5 * kPi);
+  if (above_horizon < top) return 1.0;
+  if (above_horizon >= top + kTwilightEdgeReach) return 0.0;
+  return smoothstep(0.5 * kTwilightEdgeBend, kTwilightEdgeBend, ShadowEdgeBendAcrossLutRows(atm, view, sun));
 }
 
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus

@@ -34,8 +34,7 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
   };
   // The light volume (clouds.h, CloudLightVolume): one band only; a frame
   // with the Sun below kCloudLightVolumeMinElevationDeg does without it.
-  const std::vector<CloudLayer> active = ActiveCloudLayers(first.clouds);
-  if (cq.light_volume_columns > 0 && CloudBands(active) == 1 && frames > shadowed)
+  if (cq.light_volume_columns > 0 && CloudGeometryUniform(first.clouds).resolution.w == 1 && frames > shadowed)
     plan.passes.push_back(
         {"cloud light volume",
          fmt::format("{0} x {0} columns x {1} slices, {2} exact near steps", cq.light_volume_columns,

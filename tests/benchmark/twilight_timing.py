@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Time two skybake binaries on the same bakes, interleaved: the default style
-at a twilight sun (-3 deg) and a daylight sun (35 deg), whole process and the
-sky-view LUT pass (from timings.json). Prints medians and after/before ratios.
+at a twilight sun (-3 deg) and a daylight sun (35 deg), whole process, the
+sky-view LUT pass and every GPU pass of the frame together (from
+timings.json). Prints medians and after/before ratios.
 
   python3 tests/benchmark/twilight_timing.py --before OLD/skybake --after build/skybake --runs 5
 """
@@ -38,16 +39,18 @@ def main():
                     with open(os.path.join(out, "timings.json")) as f:
                         passes = json.load(f)["frames"][0]["gpu_passes"]
                     lut_ms = sum(p["gpu_ms"] for p in passes if p["name"] == "sky-view LUT")
-                    res.setdefault((name, sun), []).append((seconds, lut_ms))
+                    gpu_ms = sum(p["gpu_ms"] for p in passes)
+                    res.setdefault((name, sun), []).append((seconds, lut_ms, gpu_ms))
     for sun in suns:
         med = {n: statistics.median(x[0] for x in res[(n, sun)]) for n in bins}
         lut = {n: statistics.median(x[1] for x in res[(n, sun)]) for n in bins}
+        gpu = {n: statistics.median(x[2] for x in res[(n, sun)]) for n in bins}
         for n in bins:
             runs = [x[0] for x in res[(n, sun)]]
             print(f"sun {sun:+.0f} deg {n:6s}: whole bake median {med[n]:.3f} s ({min(runs):.3f}-{max(runs):.3f}), "
-                  f"sky-view LUT pass median {lut[n]:.1f} ms")
+                  f"sky-view LUT pass median {lut[n]:.1f} ms, every GPU pass {gpu[n]:.1f} ms")
         print(f"sun {sun:+.0f} deg after/before: whole bake {med['after'] / med['before']:.3f}, "
-              f"sky-view LUT pass {lut['after'] / lut['before']:.3f}")
+              f"sky-view LUT pass {lut['after'] / lut['before']:.3f}, every GPU pass {gpu['after'] / gpu['before']:.3f}")
     print(os.popen("uptime").read().strip())
 
 

@@ -144,7 +144,8 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
   PrepareSun(sun);  // the sky-view LUT, as the GPU builds it
   impl_->Bind();
   glsl::AtmosphereParameters atm = impl_->ForSun(sun);
-  if (impl_->use_skyview && !glsl::InTwilightMarchBand(atm, view, sun))
+  const double twilight_weight = impl_->use_skyview ? glsl::TwilightMarchWeight(atm, view, sun) : 0.0;
+  if (impl_->use_skyview && !(twilight_weight > 0.0))
     return glsl::ComputeSkyRadianceFromSkyView(atm, view, sun) * impl_->output_scale;
   if (!impl_->use_skyview) return glsl::ComputeSkyRadiance(atm, view, sun) * impl_->output_scale;
   // The band's march, with the disc added as the GPU's sun-disc pass adds it
@@ -154,6 +155,9 @@ glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& su
   sky.sun_disc = false;
   glm::dvec3 radiance = glsl::ComputeSkyRadiance(sky, view, sun);
   if (atm.sun_disc) radiance += glsl::SunDiscThroughAtmosphere(atm, view, sun) * atm.solar_irradiance;
+  // At the edge of the marched texels above the band, mixed with the LUT's (TwilightMarchWeight).
+  if (twilight_weight < 1.0)
+    radiance = glm::mix(glsl::ComputeSkyRadianceFromSkyView(atm, view, sun), radiance, twilight_weight);
   return radiance * impl_->output_scale;
 }
 

@@ -62,7 +62,7 @@ vec3 ComputeMultipleScatteringLutTexel(IN(AtmosphereParameters) atm, int x, int 
 vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_s);
 vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
-bool InTwilightMarchBand(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
+Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 // aoas.glsl: the styled sky.
 vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) aoas, vec3 w, vec3 sun,
