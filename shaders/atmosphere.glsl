@@ -925,7 +925,8 @@ vec3 ViewAtElevation(vec3 view, Real elevation) {
 // (docs/accuracy.md, "The Earth's shadow's edge above the band"): marching
 // the texels whose bend exceeds 0.07 km keeps production's 144 rows within
 // 1% at sun -1 .. -10 deg from 0 to 8 km.
-// The test costs three bisections per texel, so it runs only where the
+// The test solves three quadratics per texel (UmbraExitAltitude at the
+// texel's elevation and 1 deg either side), so it runs only where the
 // sweep found the LUT's misses: up to kTwilightEdgeReach above the band's
 // top (the worst was at 21.3 deg elevation, sun -7 deg; none above it up
 // to 45 deg).
