@@ -517,17 +517,23 @@ VkPipeline SkyRenderer::MarchedLightCloudPipeline() {
   return marched_light_cloud_pipeline_;
 }
 
+void SkyRenderer::AddCloudLutDispatch(const char* name, int32_t pass, const glm::dvec3& sun, int width, int height,
+                                      std::vector<Dispatch>& dispatches) {
+  gpu::SkyPush push{};
+  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
+  push.view = {pass, 0, 0, 0};
+  // A height of 0 is a one-dimensional grid.
+  dispatches.push_back({name, cloud_lut_pipeline_, push, GroupCount(width, SKYBAKE_LOCAL_SIZE_X),
+                        height > 0 ? GroupCount(height, SKYBAKE_LOCAL_SIZE_Y) : 1u});
+}
+
 void SkyRenderer::AddCloudLightVolume(const glm::dvec3& sun, std::vector<Dispatch>& dispatches,
                                       std::vector<bool>& barriers) {
   if (cloud_light_volume_ready_ && cloud_light_volume_sun_ == sun) return;
   cloud_light_volume_ready_ = true;
   cloud_light_volume_sun_ = sun;
-  gpu::SkyPush push{};
-  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-  push.view = {CLOUD_PASS_LIGHT_VOLUME, 0, 0, 0};
   const int columns = gpu_clouds_.light_volume.x;
-  dispatches.push_back({"cloud light volume", cloud_lut_pipeline_, push, GroupCount(columns, SKYBAKE_LOCAL_SIZE_X),
-                        GroupCount(columns, SKYBAKE_LOCAL_SIZE_Y)});
+  AddCloudLutDispatch("cloud light volume", CLOUD_PASS_LIGHT_VOLUME, sun, columns, columns, dispatches);
   // Its writes before the cloud pass reads them.
   barriers.push_back(true);
 }
@@ -739,15 +745,10 @@ void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& d
   if (cloud_tables_ready_ && cloud_sun_ == sun) return;
   cloud_tables_ready_ = true;
   cloud_sun_ = sun;
-  gpu::SkyPush push{};
-  push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-  push.view = {CLOUD_PASS_AERIAL, 0, 0, 0};
-  dispatches.push_back({"cloud aerial perspective", cloud_lut_pipeline_, push,
-                        GroupCount(gpu_clouds_.lut.x, SKYBAKE_LOCAL_SIZE_X),
-                        GroupCount(gpu_clouds_.lut.y, SKYBAKE_LOCAL_SIZE_Y)});
+  AddCloudLutDispatch("cloud aerial perspective", CLOUD_PASS_AERIAL, sun, gpu_clouds_.lut.x, gpu_clouds_.lut.y,
+                      dispatches);
   barriers.push_back(false);  // the two tables are disjoint ranges of one buffer
-  push.view.x = CLOUD_PASS_AMBIENT;
-  dispatches.push_back({"cloud ambient", cloud_lut_pipeline_, push, GroupCount(gpu_clouds_.lut.w, SKYBAKE_LOCAL_SIZE_X), 1});
+  AddCloudLutDispatch("cloud ambient", CLOUD_PASS_AMBIENT, sun, gpu_clouds_.lut.w, 0, dispatches);
   // The tables' writes before the cloud pass reads them.
   barriers.push_back(true);
   ++counters_.cloud_table_builds;

@@ -226,6 +226,10 @@ class SkyRenderer {
   VkPipeline MarchedLightCloudPipeline();
   // The frame's light volume (CLOUD_PASS_LIGHT_VOLUME), unless it holds this Sun
   // and these clouds already.
+  // One dispatch of the cloud table pipeline (CLOUD_PASS_*) over a width x
+  // height grid of texels.
+  void AddCloudLutDispatch(const char* name, int32_t pass, const glm::dvec3& sun, int width, int height,
+                           std::vector<Dispatch>& dispatches);
   void AddCloudLightVolume(const glm::dvec3& sun, std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   // Whether this Sun makes the frame twilight (TwilightSunElevationDeg): its
   // views march the twilight band (quality.twilight_march_band_deg) and read
