@@ -301,6 +301,20 @@ gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds) {
     }
   }
   g.resolution.w = bands;
+  // The light volume after the noise and its bounds (CloudNoiseFloats).
+  if (q.light_volume_columns > 0) {
+    g.light_volume = {q.light_volume_columns, q.light_volume_slices, q.light_volume_near_steps,
+                      int32_t(CloudNoiseFloats(g))};
+    // The columns' feet reach past the farthest sample by the band's
+    // thickness over the tangent of the Sun's lowest elevation there
+    // (kCloudLightVolumeMinElevationDeg less the curvature's tilt at that
+    // distance, taken as 4 deg at most): a generous 2 deg here.
+    double thickness_km = 0.0;
+    for (int b = 0; b < g.resolution.w; ++b) thickness_km = std::max(thickness_km, double(g.bands[b].y - g.bands[b].x));
+    const double extent_km = 1.1 * q.max_distance_km + thickness_km / std::tan(2.0 * M_PI / 180.0);
+    g.light_volume_grid = {float(kCloudLightVolumeWarpKm), float(std::asinh(extent_km / kCloudLightVolumeWarpKm)),
+                           float(kCloudLightVolumeSubsteps), 0.0f};
+  }
   return g;
 }
 
@@ -348,20 +362,6 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
     const size_t first = size_t(i) * (shape + detail + weather);
     o.noise = {int32_t(first), int32_t(first + shape), int32_t(first + shape + detail),
                int32_t(l.seed.value_or(aoas_seed))};
-  }
-  // The light volume after the noise and its bounds (CloudNoiseFloats).
-  if (q.light_volume_columns > 0) {
-    g.light_volume = {q.light_volume_columns, q.light_volume_slices, q.light_volume_near_steps,
-                      int32_t(CloudNoiseFloats(g))};
-    // The columns' feet reach past the farthest sample by the band's
-    // thickness over the tangent of the Sun's lowest elevation there
-    // (kCloudLightVolumeMinElevationDeg less the curvature's tilt at that
-    // distance, taken as 4 deg at most): a generous 2 deg here.
-    double thickness_km = 0.0;
-    for (int b = 0; b < g.resolution.w; ++b) thickness_km = std::max(thickness_km, double(g.bands[b].y - g.bands[b].x));
-    const double extent_km = 1.1 * q.max_distance_km + thickness_km / std::tan(2.0 * M_PI / 180.0);
-    g.light_volume_grid = {float(kCloudLightVolumeWarpKm), float(std::asinh(extent_km / kCloudLightVolumeWarpKm)),
-                           float(kCloudLightVolumeSubsteps), 0.0f};
   }
   return in;
 }

@@ -32,9 +32,10 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
            : v.mapping == MAPPING_CUBE_STRIP ? std::string("clouds cube strip")
                                              : fmt::format("clouds face {}", v.face);
   };
-  // The light volume (clouds.h, CloudLightVolume): one band only; a frame
-  // with the Sun below kCloudLightVolumeMinElevationDeg does without it.
-  if (cq.light_volume_columns > 0 && CloudGeometryUniform(first.clouds).resolution.w == 1 && frames > shadowed)
+  // The light volume (clouds.h, CloudLightVolume), where the renderer uses it
+  // (CloudLightVolumeOn); a frame with the Sun below
+  // kCloudLightVolumeMinElevationDeg does without it.
+  if (CloudLightVolumeOn(CloudGeometryUniform(first.clouds)) && frames > shadowed)
     plan.passes.push_back(
         {"cloud light volume",
          fmt::format("{0} x {0} columns x {1} slices, {2} exact near steps", cq.light_volume_columns,
