@@ -319,6 +319,12 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
                                  kCloudLightVolumeSubsteps);
   EXPECT_EQ(pass(PlanPasses({style("0.45", "[quality]\ncloud_light_volume_columns = 0\n")}), "cloud light volume"),
             nullptr);
+  // Two bands: the renderer keeps the exact march (CloudLightVolumeOn), and
+  // the plan lists no volume.
+  const SkyStyle two_bands = style("0.45", "[[cloud_layer]]\naltitude_m = 6000\nthickness_m = 300\n");
+  EXPECT_FALSE(CloudLightVolumeOn(CloudGeometryUniform(two_bands.clouds)));
+  EXPECT_TRUE(CloudLightVolumeOn(CloudGeometryUniform(on.clouds)));
+  EXPECT_EQ(pass(PlanPasses({two_bands}), "cloud light volume"), nullptr) << FormatPlan(PlanPasses({two_bands}), "two");
   // 2 km up, inside the layer: every row.
   EXPECT_EQ(pass(PlanPasses({style("0.45", "[atmosphere]\nobserver_altitude_m = 2000\n")}), "clouds panorama")->size,
             "256 x 128, rows 0 to 127 marched, " + std::to_string(CloudPanoramaMarchedTexels({256, 128}, {0, 128})) +
