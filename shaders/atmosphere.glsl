@@ -821,6 +821,13 @@ vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_
   return ComputeSkyRadianceWithoutSun(atm, view, SunInSkyViewFrame(mu_s)).radiance;
 }
 
+// The sky half's row coordinate of `zenith_angle` in the sky-view LUT (0 at
+// the zenith, half its height - 1 at the horizon), rows closer near the horizon.
+Real SkyViewLutSkyRow(IN(AtmosphereParameters) atm, Real zenith_angle) {
+  Real s = sqrt(max(1.0 - clamp(zenith_angle / HorizonZenithAngle(atm), 0.0, 1.0), 0.0));
+  return (1.0 - s) * Real(atm.sky_view_height / 2 - 1);
+}
+
 // Bilinear read of the sky-view LUT, by hand, never across the horizon: the
 // grid is exact at texel centres, which SkyViewDirectionFromTexel places on
 // the zenith, the horizon (from either side) and the nadir.
@@ -833,8 +840,7 @@ vec3 SampleSkyViewLut(IN(AtmosphereParameters) atm, Real zenith_angle, Real azim
   int y0 = 0;
   int y_last = 0;
   if (!ground) {
-    Real s = sqrt(max(1.0 - clamp(zenith_angle / horizon, 0.0, 1.0), 0.0));
-    Real y = (1.0 - s) * Real(half_height - 1);
+    Real y = SkyViewLutSkyRow(atm, zenith_angle);
     y0 = int(min(floor(y), Real(half_height - 2)));
     fy = y - Real(y0);
     y_last = half_height - 1;
@@ -881,65 +887,52 @@ vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun)
   return disc;
 }
 
-// Where the view ray leaves the planet's umbra, as an altitude (km): the
-// top of the atmosphere where it never leaves it, the ray's start where it
-// starts outside it. In closed form (no bisection: it runs three times per
-// texel above the twilight band): the umbra of UmbraValue to first order in
-// the Sun's angular radius alpha, the cylinder around the anti-solar axis
-// narrowing as a cone, rho^2 < R_b^2 (1 + alpha^2) - 2 R_b alpha x (rho
-// from the axis, x = -p.sun along it), a quadratic in the ray's distance;
-// its constant term as h (r + R_b) - (r mu_s)^2, without r^2 - R_b^2's
-// cancellation in float32.
-Real UmbraExitAltitude(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  SkyRay ray = SetUpSkyRay(atm, view, sun);
-  if (!ray.in_atmosphere) return ray.altitude;
-  Real rb = atm.bottom_radius;
-  Real alpha = atm.sun_angular_radius;
-  Real r_mu_s = ray.r * ray.mu_s;
-  Real a = max(1.0 - ray.nu * ray.nu, 0.0);
-  Real b = 2.0 * (ray.r * ray.mu - r_mu_s * ray.nu) - 2.0 * rb * alpha * ray.nu;
-  Real c = ray.altitude * (ray.r + rb) - r_mu_s * r_mu_s - 2.0 * rb * alpha * r_mu_s - rb * rb * alpha * alpha;
-  if (!(c < 0.0) || !(ray.mu_s < 0.0)) return ray.altitude;  // starts outside the umbra
-  Real root = sqrt(max(b * b - 4.0 * a * c, 0.0));
-  // The larger root, in the form that keeps its digits.
-  Real t_exit = b < 0.0 ? (a > 0.0 ? 0.5 * (root - b) / a : ray.t_max + 1.0) : c / (-0.5 * (b + root));
-  if (!(t_exit < ray.t_max)) return atm.top_radius - atm.bottom_radius;
-  return AltitudeAlongRay(atm, ray.r, ray.altitude, ray.mu, t_exit);
+// The azimuth between the horizontal projections of view and sun (rad, 0 to
+// pi): the sky-view LUT's column coordinate.
+Real SkyViewAzimuth(vec3 view, vec3 sun) {
+  Real cos_part = view.x * sun.x + view.z * sun.z;
+  Real sin_part = abs(view.x * sun.z - view.z * sun.x);
+  Real azimuth = 0.0;
+  if (sin_part > 0.0 || cos_part != 0.0) azimuth = atan(sin_part, cos_part);
+  return azimuth;
 }
 
-// `view` turned in its vertical plane to `elevation` (rad) above the horizontal.
-vec3 ViewAtElevation(vec3 view, Real elevation) {
-  vec2 horizontal = vec2(view.x, view.z);
-  Real horizontal_length = length(horizontal);
-  horizontal = horizontal_length > 0.0 ? horizontal / horizontal_length : vec2(1.0, 0.0);
-  return vec3(horizontal.x * cos(elevation), sin(elevation), horizontal.y * cos(elevation));
-}
-
-// Above the band, the texels where the Earth's shadow's edge bends between
-// the LUT's rows: the second difference of the umbra's exit altitude over
-// kTwilightEdgeStep either side of the view (km). Single scattering there
-// goes as exp(-altitude / scale height), so a bend of the exit altitude is a
-// bend of the logarithm that SampleSkyViewLut mixes linearly; next to the
-// rays that never leave the umbra (the top of the shadow seen from below) it
-// reaches tens of km. kTwilightEdgeBend is chosen from the accuracy study
-// (docs/accuracy.md, "The Earth's shadow's edge above the band"): marching
-// the texels whose bend exceeds 0.07 km keeps production's 144 rows within
-// 1% at sun -1 .. -10 deg from 0 to 8 km.
-// The test solves three quadratics per texel (UmbraExitAltitude at the
-// texel's elevation and 1 deg either side), so it runs only where the
-// sweep found the LUT's misses: up to kTwilightEdgeReach above the band's
-// top (the worst was at 21.3 deg elevation, sun -7 deg; none above it up
-// to 45 deg).
-const Real kTwilightEdgeStep = 1.0 * kPi / 180.0;
-const Real kTwilightEdgeBend = 0.07;
+// The sky-view LUT's own estimate of its error along `view` (above the
+// horizon): the second difference of log2 radiance down its columns at the
+// two rows SampleSkyViewLut mixes, the larger, over both columns it reads
+// and every channel. The read mixes the logarithm linearly, so where the
+// logarithm is quadratic over a row spacing its error midway between the
+// rows is an eighth of that second difference (in ln: times ln 2). Above the
+// twilight band this is where the Earth's shadow's upper edge, and the
+// grazing sunlight just outside it, bend the sky's logarithm between rows.
+// kTwilightLutCurvature (log2) is chosen from the dense twilight sweep
+// (docs/accuracy.md, "The Earth's shadow's edge above the band"): 0.03 keeps
+// production within 1% and draft within 5% at sun -0.5 .. -10 deg from 0 to
+// 12 km; 0.05 missed 1% at 0 m, sun -10 deg (1.08e-2). It runs up to
+// kTwilightEdgeReach above the band's top, where the sweep found the LUT's
+// misses (none above 21.3 deg elevation up to 45 deg).
+const Real kTwilightLutCurvature = 0.03;
 const Real kTwilightEdgeReach = 20.0 * kPi / 180.0;
 
-Real ShadowEdgeBendAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  Real centre = UmbraExitAltitude(atm, view, sun);
-  Real elevation = 0.5 * kPi - atan(length(vec2(view.x, view.z)), view.y);
-  Real below = UmbraExitAltitude(atm, ViewAtElevation(view, elevation - kTwilightEdgeStep), sun);
-  Real above = UmbraExitAltitude(atm, ViewAtElevation(view, elevation + kTwilightEdgeStep), sun);
-  return abs(above - 2.0 * centre + below);
+Real SkyViewLutLogCurvature(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  int last_row = atm.sky_view_height / 2 - 1;
+  Real y = SkyViewLutSkyRow(atm, atan(length(vec2(view.x, view.z)), view.y));
+  int y0 = int(min(floor(y), Real(last_row - 1)));
+  int below = max(y0 - 1, 0);
+  int above = min(y0 + 2, last_row);
+  Real x = clamp(SkyViewAzimuth(view, sun) / kPi, 0.0, 1.0) * Real(atm.sky_view_width - 1);
+  int x0 = int(min(floor(x), Real(atm.sky_view_width - 2)));
+  vec3 floor_value = vec3(1e-30);
+  vec3 curvature = vec3(0.0);
+  for (int column = x0; column <= x0 + 1; ++column) {
+    vec3 l0 = log2(max(SkyViewLutTexel(column, below), floor_value));
+    vec3 l1 = log2(max(SkyViewLutTexel(column, y0), floor_value));
+    vec3 l2 = log2(max(SkyViewLutTexel(column, y0 + 1), floor_value));
+    vec3 l3 = log2(max(SkyViewLutTexel(column, above), floor_value));
+    if (y0 > 0) curvature = max(curvature, abs(l0 - 2.0 * l1 + l2));
+    if (y0 + 2 <= last_row) curvature = max(curvature, abs(l1 - 2.0 * l2 + l3));
+  }
+  return max(curvature.x, max(curvature.y, curvature.z));
 }
 
 // How much of `view`'s radiance is ray-marched per texel rather than read
@@ -952,10 +945,10 @@ Real ShadowEdgeBendAcrossLutRows(IN(AtmosphereParameters) atm, vec3 view, vec3 s
 // is raised by the horizon's dip (HorizonZenithAngle - pi/2: 0 at sea level,
 // 2.9 deg at 8 km): from altitude the horizon drops below the horizontal
 // while the shadow's edge above it stands that much higher. Above the band,
-// the texels where the upper edge of the Earth's shadow bends between the
-// LUT's rows (up to 21 deg elevation at sun -7 deg) are marched too, mixed
-// with the LUT's value where the bend is between half kTwilightEdgeBend and
-// kTwilightEdgeBend, so that no seam shows where the march stops.
+// the texels where the LUT's logarithm bends between its rows
+// (SkyViewLutLogCurvature) are marched too, mixed with the LUT's value where
+// the bend is between half kTwilightLutCurvature and kTwilightLutCurvature,
+// so that no seam shows where the march stops.
 Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return 0.0;
   Real horizon = HorizonZenithAngle(atm);
@@ -964,7 +957,7 @@ Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   Real top = atm.twilight_march_band + (horizon - 0.5 * kPi);
   if (above_horizon < top) return 1.0;
   if (above_horizon >= top + kTwilightEdgeReach) return 0.0;
-  return smoothstep(0.5 * kTwilightEdgeBend, kTwilightEdgeBend, ShadowEdgeBendAcrossLutRows(atm, view, sun));
+  return smoothstep(0.5 * kTwilightLutCurvature, kTwilightLutCurvature, SkyViewLutLogCurvature(atm, view, sun));
 }
 
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
@@ -974,11 +967,7 @@ vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3
   // near 0 and pi (at the zenith, and next to the sun's vertical plane).
   Real horizontal = length(vec2(view.x, view.z));
   Real zenith_angle = atan(horizontal, view.y);
-  // Azimuth between the horizontal projections of view and sun.
-  Real cos_part = view.x * sun.x + view.z * sun.z;
-  Real sin_part = abs(view.x * sun.z - view.z * sun.x);
-  Real azimuth = 0.0;
-  if (sin_part > 0.0 || cos_part != 0.0) azimuth = atan(sin_part, cos_part);
+  Real azimuth = SkyViewAzimuth(view, sun);
   // Whether the ray hits the ground: the test of SetUpSkyRay, which for an
   // observer inside the atmosphere (every texel takes the same branch) needs
   // none of the ray's distances.

@@ -15,6 +15,7 @@
 #include "skybake/tools/accuracy.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/gpu/sky_renderer.h"
+#include "skybake/pipeline/pass_plan.h"
 #include "reference_fixtures.h"
 #include "test_support.h"
 
@@ -295,10 +296,54 @@ TEST(ConvergedReferenceTest, PresetsAgainstTheirBudgetsAtTwilightFrom8Km) {
   ExpectPresetsWithinTheirBudgetsAtTwilight(8000.0);
 }
 
+// The texels above the twilight band that TwilightMarchWeight marches
+// (where the sky-view LUT's logarithm bends between its rows), as a share
+// of the sphere's solid angle, on the double-precision model's own LUT:
+// production and draft, observers at 0, 8 and 12 km, the Sun from -1 to
+// -10 deg. The pass plan counts kTwilightAboveBandShare of each view for
+// them; the share must stay within it, or the plan's cost is too low.
+TEST(ConvergedReferenceTest, TwilightMarchAboveTheBandStaysWithinThePlansShare) {
+  const EffectSettings single = SingleScatteringOnly();
+  double largest = 0.0;
+  for (const std::string& preset : {std::string("production"), std::string("draft")})
+    for (double altitude_m : {0.0, 8000.0, 12000.0}) {
+      AtmosphereParams a;
+      a.observer_altitude_m = altitude_m;
+      const QualitySettings q = QualityPreset(preset);
+      ReferenceModel model(a, q, single, Rgb{1, 1, 1});
+      model.PrecomputeLuts();
+      const double dip = std::acos(a.bottom_radius_km / (a.bottom_radius_km + altitude_m * 1e-3)) * 180.0 / M_PI;
+      std::printf("%-10s %5.0f m:", preset.c_str(), altitude_m);
+      for (double sun_elevation : {-1.0, -2.0, -3.0, -4.0, -5.0, -6.0, -7.0, -8.0, -10.0}) {
+        const glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 180.0);
+        // Cells of 0.25 deg of elevation and 2 deg of azimuth over the half
+        // sphere the LUT holds (the other half is its mirror image).
+        double marched = 0.0, band_and_above = 0.0;
+        for (double e = -dip + 0.125; e < 90.0; e += 0.25) {
+          const double cell = std::cos(e * M_PI / 180.0);
+          for (double azimuth = 1.0; azimuth < 180.0; azimuth += 2.0) {
+            const double w = model.TwilightMarchWeight(SunDirectionFromElevationAzimuth(e, azimuth), sun);
+            if (e > q.twilight_march_band_deg && w > 0.0) marched += cell;
+            band_and_above += cell;
+          }
+        }
+        // Over the whole sphere: band_and_above is the part above the horizon.
+        const double above_horizon = 0.5 * (1.0 + std::sin(dip * M_PI / 180.0));
+        const double share = marched / band_and_above * above_horizon;
+        largest = std::max(largest, share);
+        std::printf(" %.0f:%.2f%%", sun_elevation, 100.0 * share);
+        EXPECT_LE(share, kTwilightAboveBandShare) << preset << " " << altitude_m << " m, sun " << sun_elevation;
+      }
+      std::printf("\n");
+    }
+  std::printf("largest share marched above the band: %.2f%% (the plan counts %.1f%%)\n", 100.0 * largest,
+              100.0 * kTwilightAboveBandShare);
+}
+
 // The sky-view path across the Earth's shadow's edge, run by hand (about
-// 2 minutes; --gtest_also_run_disabled_tests): every 0.25 deg of view
+// 1 minute; --gtest_also_run_disabled_tests): every 0.1 deg of view
 // elevation from the horizon to 45 deg, every 15 deg of azimuth, observers at
-// 0, 2, 4, 8 and 12 km, the Sun at -1 .. -10 deg every degree, single
+// 0, 2, 4, 8 and 12 km, the Sun at -0.5 .. -10 deg every 0.5 deg, single
 // scattering. Denser than the study's directions (the shadow's edge lies
 // between them), so against a GPU march of 512 steps per texel (the
 // reference preset's twilight form with 512 steps, within 1e-4 of
@@ -341,13 +386,13 @@ TEST(ConvergedReferenceTest, DISABLED_TwilightSweepAcrossTheShadowEdge) {
     SkyRenderer truth(testing::Vulkan(), a, TwilightSweepTruth(), single, Rgb{1, 1, 1});
     const double dip = std::acos(a.bottom_radius_km / (a.bottom_radius_km + altitude_m * 1e-3)) * 180.0 / M_PI;
     std::vector<double> elevations;
-    for (double e = -dip + 0.05; e <= 45.0; e += 0.25) elevations.push_back(e);
+    for (double e = -dip + 0.05; e <= 45.0; e += 0.1) elevations.push_back(e);
     std::vector<glm::dvec3> dirs;
     for (double e : elevations)
       for (double azimuth = 0.0; azimuth <= 180.0; azimuth += 15.0)
         dirs.push_back(glm::dvec3(glm::vec3(SunDirectionFromElevationAzimuth(e, azimuth))));
     const size_t per_row = dirs.size() / elevations.size();
-    for (double sun_elevation = -1.0; sun_elevation >= -10.0; sun_elevation -= 1.0) {
+    for (double sun_elevation = -0.5; sun_elevation >= -10.0; sun_elevation -= 0.5) {
       const glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 180.0);
       const std::vector<float> expected = truth.RenderDirections(sun, dirs, false);
       double max_value = 0.0;

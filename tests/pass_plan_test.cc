@@ -395,8 +395,8 @@ TEST(PassPlanTest, CloudFramesInTheEarthsShadowAreListed) {
 // the ground it covers 0..10 deg, a fraction sin(10 deg) / 2 of the
 // directions; from 8 km the band reaches from the horizon, acos(R / r) =
 // 2.87 deg below the horizontal, to 10 deg above it (InTwilightMarchBand),
-// so the band's fraction grows by sin(2.87 deg) / 2; both add the 2.5% of
-// the directions on the Earth's shadow's edge above the band.
+// so the band's fraction grows by sin(2.87 deg) / 2; both add the
+// kTwilightAboveBandShare of the directions marched above the band.
 TEST(PassPlanTest, TwilightBandEstimateReachesTheHorizonFromAltitude) {
   auto band = [](const PassPlan& p) -> const PlannedPass* {
     for (const PlannedPass& x : p.passes)
@@ -412,7 +412,7 @@ TEST(PassPlanTest, TwilightBandEstimateReachesTheHorizonFromAltitude) {
   EXPECT_EQ(band(ground)->size, "0..10 deg above the horizon");
   EXPECT_EQ(band(high)->size, "the horizon (2.87 deg below the horizontal) to 10 deg above the horizontal");
   const double dip = std::acos(6360.0 / 6368.0);
-  const double ground_fraction = 0.5 * std::sin(10.0 * M_PI / 180.0) + 0.025;
+  const double ground_fraction = 0.5 * std::sin(10.0 * M_PI / 180.0) + kTwilightAboveBandShare;
   EXPECT_NEAR(band(high)->samples / band(ground)->samples, 1.0 + 0.5 * std::sin(dip) / ground_fraction, 1e-9);
 }
 

@@ -31,7 +31,7 @@ QualitySettings QualityPreset(const std::string& name) {
     q.sky_view_width = 192;
     q.sky_view_height = 216;
     q.view_steps = 24;
-    q.twilight_march_steps = 24;
+    q.twilight_march_steps = 32;
   } else if (name == "reference") {
     q.sky_view_lut = false;
     q.view_steps = 64;

@@ -195,13 +195,13 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 // horizontal: acos(R / r), 0 at the ground) up to the band above the
 // horizontal (InTwilightMarchBand), a fraction (sin(band) + sin(dip)) / 2 of
 // each view's directions, and, above it, the texels on the Earth's shadow's
-// edge (TwilightMarchWeight: at most about 2.5% of the directions, sun -6
-// deg, docs/accuracy.md) are ray-marched by a sky pass of their own pipeline.
+// edge (TwilightMarchWeight: at most kTwilightAboveBandShare of the
+// directions, docs/accuracy.md) are ray-marched by a sky pass of their own
+// pipeline.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
                       PassPlan& plan) {
   const QualitySettings& q = first.quality;
   const double band = q.twilight_march_band_deg;
-  const double kShadowEdgeFraction = 0.025;
   const double below = TwilightSunElevationDeg(q);
   if (!(band > 0.0) || !(below > 0.0) || !NeedsSkyViewLut(pruned)) return;
   const int runs = int(std::count_if(frames.begin(), frames.end(),
@@ -217,7 +217,7 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
                                            : fmt::format("0..{:g} deg above the horizon", band);
   const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
   plan.passes.push_back({"twilight band march", extent, fmt::format("frames with the Sun below {:g} deg", below), runs,
-                         texels * (fraction + kShadowEdgeFraction) * steps * std::max(q.light_steps, 1)});
+                         texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
 }
 
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).

@@ -140,6 +140,13 @@ void ReferenceModel::PrepareSun(const glm::dvec3& sun) const {
   });
 }
 
+double ReferenceModel::TwilightMarchWeight(const glm::dvec3& view, const glm::dvec3& sun) const {
+  if (!impl_->use_skyview) return 0.0;
+  PrepareSun(sun);
+  impl_->Bind();
+  return glsl::TwilightMarchWeight(impl_->ForSun(sun), view, sun);
+}
+
 glm::dvec3 ReferenceModel::Radiance(const glm::dvec3& view, const glm::dvec3& sun) const {
   PrepareSun(sun);  // the sky-view LUT, as the GPU builds it
   impl_->Bind();

@@ -79,7 +79,7 @@ struct QualitySettings {
   double twilight_march_band_deg = 10.0;
   // View steps of that march, and of every texel's in a twilight frame
   // without the sky-view LUT (0: view_steps).
-  int twilight_march_steps = 64;
+  int twilight_march_steps = 80;
   // The Sun's elevation (deg) below which a frame is twilight: its pipeline
   // marches the band and reads the view samples' sun transmittance from the
   // LUT in the logarithm (grazing sunlight, docs/accuracy.md "Twilight").

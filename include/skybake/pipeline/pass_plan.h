@@ -63,6 +63,13 @@ bool WritesLatlongPng(const SkyStyle& style);
 // device-limit check and the renderer all read this list.
 std::vector<ViewRequest> PlanViews(const SkyStyle& style);
 
+// The share of a view's directions above the twilight band that the plan
+// counts as marched at twilight (TwilightMarchWeight's texels where the
+// sky-view LUT's logarithm bends between its rows): above the largest share
+// the accuracy tests measure (6.65% of the sphere, production at 0 m, sun
+// -7 deg: ConvergedReferenceTest.TwilightMarchAboveTheBandStaysWithinThePlansShare).
+constexpr double kTwilightAboveBandShare = 0.07;
+
 // `shaders`: the CLI's diagnostic switches, as the bake would get them.
 // `hours_from_start`: each frame's clock time since the sequence's first
 // (Schedule frames; empty: 0 h), for the cloud formation's step count.

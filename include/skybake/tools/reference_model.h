@@ -35,6 +35,11 @@ class ReferenceModel {
   // Radiance times output_scale along unit `view` with the Sun along unit `sun`.
   glm::dvec3 Radiance(const glm::dvec3& view, const glm::dvec3& sun) const;
 
+  // How much of `view` is ray-marched rather than read from the sky-view LUT
+  // at twilight (TwilightMarchWeight, on the LUT built for this Sun): 0 to 1,
+  // 0 without the LUT.
+  double TwilightMarchWeight(const glm::dvec3& view, const glm::dvec3& sun) const;
+
   // The styled sky (ComputeStyledSkyRadiance) times output_scale for texel
   // direction `w`.
   glm::dvec3 StyledRadiance(const glm::dvec3& w, const glm::dvec3& sun) const;
