@@ -22,8 +22,8 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 //               LUT 1024 x 256 (1024 points)                          1.77e-4
 // and at twilight (the Sun below 3 deg: the sun transmittance read in the
 // logarithm; docs/accuracy.md "Twilight", sun 5 .. -10 deg):
-//   draft       the sky up to 10 deg marched, 24 steps                2.42e-2
-//   production  the sky up to 10 deg marched, 64 steps                5.31e-3
+//   draft       the sky up to 10 deg marched, 32 steps                1.24e-2
+//   production  the sky up to 10 deg marched, 80 steps                5.31e-3
 //   reference   128 steps per texel                                   7.08e-4
 QualitySettings QualityPreset(const std::string& name) {
   QualitySettings q;  // production
