@@ -261,16 +261,26 @@ float CloudExtinction(vec2 xz, float h, bool detail) {
 // ---------------------------------------------------------------- empty space
 
 // The empty-space bounds after every layer's noise (FillCloudSkipMaps,
-// clouds.h): per layer the maximum of its weather map over each cell of 2 x 2
-// texels' reach, then of its shape volume over each cell of 2^3 voxels'.
-int CloudSkipCells(int n) { return (n + (1 << CLOUD_SKIP_CELL_SHIFT) - 1) >> CLOUD_SKIP_CELL_SHIFT; }
+// clouds.h): per layer the maximum of its weather map over each cell between
+// 2 x 2 texel centres, then of its shape volume over each cell between 2^3
+// voxel centres (one cell per texel).
+int CloudSkipCells(int n) { return n; }
 int CloudSkipFirst(int l) {
   int ns = gpu_clouds.resolution.x, nd = gpu_clouds.resolution.y, nw = gpu_clouds.resolution.z;
   int wc = CloudSkipCells(nw), sc = CloudSkipCells(ns);
   return gpu_clouds.counts.x * (ns * ns * ns + nd * nd * nd + nw * nw) + l * (wc * wc + sc * sc * sc);
 }
-// The cell that holds coordinate u (wrapped) of an n-texel axis.
-int CloudSkipCell(float u, int n) { return min(int(fract(u) * float(n)), n - 1) >> CLOUD_SKIP_CELL_SHIFT; }
+// The cells that hold coordinates u (wrapped) of n-texel axes: the read's
+// first texels, as SampleVolume and SampleMap find them; `edge` is set where
+// a point lies within CLOUD_SKIP_EDGE of its cell's edge along any axis
+// (rounding could put the read in the next cell: such a point is not bounded).
+ivec3 CloudSkipCell(vec3 u, int n, inout bool edge) {
+  vec3 p = fract(u) * float(n) - 0.5;
+  vec3 base = floor(p);
+  vec3 f = p - base;
+  edge = edge || any(lessThan(f, vec3(CLOUD_SKIP_EDGE))) || any(greaterThan(f, vec3(1.0 - CLOUD_SKIP_EDGE)));
+  return WrapLow(base, n);
+}
 
 // Above 0 where layer l may hold cloud at (xz, h); at most 0 where
 // LayerExtinction is 0 there. LayerExtinction's density is 0 where the
@@ -288,14 +298,15 @@ float LayerCloudMargin(int l, vec2 xz, float h) {
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
   vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
   int first = CloudSkipFirst(l);
-  int nw = gpu_clouds.resolution.z, wc = CloudSkipCells(nw);
-  int ns = gpu_clouds.resolution.x, sc = CloudSkipCells(ns);
-  float weather = cloud_noise[first + CloudSkipCell(weather_uv.y, nw) * wc + CloudSkipCell(weather_uv.x, nw)];
+  int nw = gpu_clouds.resolution.z, ns = gpu_clouds.resolution.x;
+  bool edge = false;
+  ivec2 wcell = CloudSkipCell(vec3(weather_uv, 0.0), nw, edge).xy;  // z: mid-cell, never an edge
+  float weather = cloud_noise[first + wcell.y * nw + wcell.x];
   float coverage = clamp(2.0 * layer.weather.x - 1.0 + weather, 0.0, 1.0);
-  vec3 uvw = vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y;
-  float shape = cloud_noise[first + wc * wc +
-                            (CloudSkipCell(uvw.z, ns) * sc + CloudSkipCell(uvw.y, ns)) * sc + CloudSkipCell(uvw.x, ns)];
+  ivec3 cell = CloudSkipCell(vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y, ns, edge);
+  float shape = cloud_noise[first + nw * nw + (cell.z * ns + cell.y) * ns + cell.x];
   float base = mix(1.0, shape, layer.shape.x) * profile;
+  if (edge) return inside ? 1.0 : -1.0;
   return inside && coverage > 0.0 ? base - (1.0 - coverage) + 1e-4 : -1.0;
 }
 

@@ -679,12 +679,13 @@ TEST(CloudLightVolume, StaysCloseToTheExactMarchAndOffKeepsTheBytes) {
 
 // FillCloudSkipMaps (clouds.h): every cell's value is the maximum of the
 // texels a bilinear or trilinear read at any point of the cell touches
-// (brute force over random points and their 8 or 4 texels, wrapping), and
-// no more than the maximum of the cell's reach (it is a maximum, not 1).
+// (brute force over random points and their 8 or 4 texels, wrapping, the
+// cell found as the shader finds it), and exactly the maximum of the cell's
+// own 2 texels a side (it is the tightest bound, not 1).
 TEST(CloudSkip, CellMaximaBoundEveryReadOfTheirCell) {
   gpu::GpuClouds g{};
   g.counts = {2, 8, 4, 8};
-  g.resolution = {9, 4, 10, 1};  // odd sizes: the last cell holds one texel
+  g.resolution = {9, 4, 10, 1};  // odd sizes: the last cell wraps to texel 0
   const size_t shape = 9 * 9 * 9, detail = 4 * 4 * 4, weather = 10 * 10;
   for (int l = 0; l < 2; ++l)
     g.layers[l].noise = {int(l * (shape + detail + weather)), int(l * (shape + detail + weather) + shape),
@@ -702,37 +703,36 @@ TEST(CloudSkip, CellMaximaBoundEveryReadOfTheirCell) {
   for (int l = 0; l < 2; ++l) {
     const float* map = noise.data() + CloudSkipFirst(g) + l * CloudSkipFloatsPerLayer(g);
     const int wc = CloudSkipCells(10), sc = CloudSkipCells(9);
-    ASSERT_EQ(wc, 5);
-    ASSERT_EQ(sc, 5);
+    ASSERT_EQ(wc, 10);
+    ASSERT_EQ(sc, 9);
     const float* shape_map = map + wc * wc;
     const float* volume = noise.data() + g.layers[l].noise.x;
     const float* wmap = noise.data() + g.layers[l].noise.z;
     int below_one = 0;
     for (int k = 0; k < 20000; ++k) {
       const glm::vec3 u(next(), next(), next());
-      // The shader's cell (CloudSkipCell) and the trilinear read's texels (SampleVolume).
-      const glm::ivec3 cell = glm::min(glm::ivec3(u * 9.0f), glm::ivec3(8)) >> CLOUD_SKIP_CELL_SHIFT;
-      const float bound = shape_map[(cell.z * sc + cell.y) * sc + cell.x];
+      // The shader's cell (CloudSkipCell: the read's first texel, wrapped) and
+      // the trilinear read's texels (SampleVolume).
       const glm::ivec3 base = glm::ivec3(glm::floor(u * 9.0f - 0.5f));
+      const glm::ivec3 cell(wrap(base.x, 9), wrap(base.y, 9), wrap(base.z, 9));
+      const float bound = shape_map[(cell.z * sc + cell.y) * sc + cell.x];
       for (int c = 0; c < 8; ++c) {
         const glm::ivec3 t(wrap(base.x + (c & 1), 9), wrap(base.y + ((c >> 1) & 1), 9), wrap(base.z + (c >> 2), 9));
         ASSERT_GE(bound, volume[(t.z * 9 + t.y) * 9 + t.x]) << "layer " << l << " point " << k;
       }
-      const glm::ivec2 wcell = glm::min(glm::ivec2(glm::vec2(u) * 10.0f), glm::ivec2(9)) >> CLOUD_SKIP_CELL_SHIFT;
-      const float wbound = map[wcell.y * wc + wcell.x];
       const glm::ivec2 wbase = glm::ivec2(glm::floor(glm::vec2(u) * 10.0f - 0.5f));
+      const float wbound = map[wrap(wbase.y, 10) * wc + wrap(wbase.x, 10)];
       for (int c = 0; c < 4; ++c)
         ASSERT_GE(wbound, wmap[wrap(wbase.y + (c >> 1), 10) * 10 + wrap(wbase.x + (c & 1), 10)]);
       below_one += bound < 0.999f;
     }
-    // Each cell's value is the maximum of its reach (6 texels a side from 2 less than its first).
+    // Each cell's value is the maximum of its own texels (2 a side: i and i + 1, wrapped).
     for (int z = 0; z < sc; ++z)
       for (int y = 0; y < sc; ++y)
         for (int x = 0; x < sc; ++x) {
           float m = 0.0f;
-          for (int k = 0; k < 216; ++k)
-            m = std::max(m, volume[(wrap(2 * z - 2 + k / 36, 9) * 9 + wrap(2 * y - 2 + k / 6 % 6, 9)) * 9 +
-                                   wrap(2 * x - 2 + k % 6, 9)]);
+          for (int k = 0; k < 8; ++k)
+            m = std::max(m, volume[(wrap(z + (k >> 2), 9) * 9 + wrap(y + ((k >> 1) & 1), 9)) * 9 + wrap(x + (k & 1), 9)]);
           EXPECT_EQ(shape_map[(z * sc + y) * sc + x], m);
         }
     EXPECT_GT(below_one, 0) << "the bounds are maxima, not 1";

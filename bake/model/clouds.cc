@@ -194,7 +194,7 @@ size_t CloudNoiseFloats(const gpu::GpuClouds& c) {
   return std::max<size_t>(CloudSkipFirst(c) + layers * CloudSkipFloatsPerLayer(c), 4);
 }
 
-int CloudSkipCells(int resolution) { return (resolution + (1 << CLOUD_SKIP_CELL_SHIFT) - 1) >> CLOUD_SKIP_CELL_SHIFT; }
+int CloudSkipCells(int resolution) { return resolution; }
 
 size_t CloudSkipFirst(const gpu::GpuClouds& c) {
   const size_t per_layer = size_t(c.resolution.x) * c.resolution.x * c.resolution.x +
@@ -211,25 +211,19 @@ size_t CloudSkipFloatsPerLayer(const gpu::GpuClouds& c) {
 namespace {
 
 // The maximum along one axis of a grid (`size` [x, y, z] values, x fastest)
-// over each cell's reach: for cell a, the values at a * 2 - 2 ... a * 2 + 3,
-// wrapped. `axis` 0, 1, 2; the result has CloudSkipCells(size[axis]) along it.
+// over each cell's two texels: for cell a, the values at a and a + 1,
+// wrapped. `axis` 0, 1, 2; the result has the same size.
 std::vector<float> CellMaxAlong(const std::vector<float>& v, std::array<int, 3> size, int axis) {
-  const int n = size[axis], cells = CloudSkipCells(n);
-  std::array<int, 3> out = size;
-  out[axis] = cells;
-  std::vector<float> r(size_t(out[0]) * out[1] * out[2]);
-  const int lo = 2, hi = 3;  // the bilinear read's neighbour and one texel for rounding, each side
-  for (int z = 0; z < out[2]; ++z)
-    for (int y = 0; y < out[1]; ++y)
-      for (int x = 0; x < out[0]; ++x) {
-        std::array<int, 3> p = {x, y, z};
-        const int a = p[axis];
-        float m = 0.0f;
-        for (int k = (a << CLOUD_SKIP_CELL_SHIFT) - lo; k <= (a << CLOUD_SKIP_CELL_SHIFT) + hi; ++k) {
-          p[axis] = ((k % n) + n) % n;
-          m = std::max(m, v[(size_t(p[2]) * size[1] + p[1]) * size[0] + p[0]]);
-        }
-        r[(size_t(z) * out[1] + y) * out[0] + x] = m;
+  const int n = size[axis];
+  const size_t stride = axis == 0 ? 1 : axis == 1 ? size_t(size[0]) : size_t(size[0]) * size[1];
+  std::vector<float> r(v.size());
+  for (int z = 0; z < size[2]; ++z)
+    for (int y = 0; y < size[1]; ++y)
+      for (int x = 0; x < size[0]; ++x) {
+        const std::array<int, 3> p = {x, y, z};
+        const size_t i = (size_t(z) * size[1] + y) * size[0] + x;
+        const size_t next = p[axis] + 1 < n ? i + stride : i - size_t(n - 1) * stride;
+        r[i] = std::max(v[i], v[next]);
       }
   return r;
 }
@@ -242,7 +236,7 @@ void FillCloudSkipMaps(const gpu::GpuClouds& c, float* noise) {
   for (int l = 0; l < c.counts.x; ++l, out += CloudSkipFloatsPerLayer(c)) {
     const gpu::GpuCloudLayer& layer = c.layers[l];
     std::vector<float> weather(noise + layer.noise.z, noise + layer.noise.z + size_t(nw) * nw);
-    weather = CellMaxAlong(CellMaxAlong(weather, {nw, nw, 1}, 0), {CloudSkipCells(nw), nw, 1}, 1);
+    weather = CellMaxAlong(CellMaxAlong(weather, {nw, nw, 1}, 0), {nw, nw, 1}, 1);
     std::copy(weather.begin(), weather.end(), out);
     float* shape_out = out + weather.size();
     const int sc = CloudSkipCells(ns);
@@ -251,9 +245,7 @@ void FillCloudSkipMaps(const gpu::GpuClouds& c, float* noise) {
       continue;
     }
     std::vector<float> shape(noise + layer.noise.x, noise + layer.noise.x + size_t(ns) * ns * ns);
-    shape = CellMaxAlong(shape, {ns, ns, ns}, 0);
-    shape = CellMaxAlong(shape, {sc, ns, ns}, 1);
-    shape = CellMaxAlong(shape, {sc, sc, ns}, 2);
+    for (int axis = 0; axis < 3; ++axis) shape = CellMaxAlong(shape, {ns, ns, ns}, axis);
     std::copy(shape.begin(), shape.end(), shape_out);
   }
 }

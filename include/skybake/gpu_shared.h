@@ -164,8 +164,10 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 // The cloud panorama's narrowest row, texels (cloud_panorama.glsl, cloud_panorama.h).
 #define CLOUD_PANORAMA_MIN_ROW_WIDTH 16
 // The empty-space bounds (clouds.h, FillCloudSkipMaps; clouds.glsl, CloudMargin): one cell per
-// 2 texels along each axis of a weather map and a shape volume (a shift: cell = texel >> 1).
-#define CLOUD_SKIP_CELL_SHIFT 1
+// texel interval of a weather map and a shape volume (the cell between texel centres i and i + 1,
+// which a bilinear or trilinear read at any point of it touches alone). A point within this
+// fraction of a cell of its edge is not bounded (rounding could put the read in the next cell).
+#define CLOUD_SKIP_EDGE 1e-3
 
 SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo
