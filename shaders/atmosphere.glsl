@@ -949,11 +949,19 @@ Real SkyViewLutLogCurvature(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
 // (SkyViewLutLogCurvature) are marched too, mixed with the LUT's value where
 // the bend is between half kTwilightLutCurvature and kTwilightLutCurvature,
 // so that no seam shows where the march stops.
+// A ray that lies wholly in the planet's umbra (UmbraValue below 0 at both
+// its ends; the umbra is convex, so then at every point between) sees no
+// sunlit air: its light is multiple scattering alone, which varies slowly
+// and which the LUT holds, so it reads the LUT. That is the sky away from the
+// Sun once it is some 10 deg down, and the whole sky at night (from sea level,
+// the Sun more than about 20 deg down).
 Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   if (!(atm.twilight_march_band > 0.0) || sun.y >= atm.twilight_sun_sine) return 0.0;
   Real horizon = HorizonZenithAngle(atm);
   Real above_horizon = horizon - atan(length(vec2(view.x, view.z)), view.y);
   if (!(above_horizon >= 0.0)) return 0.0;
+  SkyRay ray = SetUpSkyRay(atm, view, sun);
+  if (!ray.in_atmosphere || (UmbraValue(atm, ray, 0.0) < 0.0 && UmbraValue(atm, ray, ray.t_max) < 0.0)) return 0.0;
   Real top = atm.twilight_march_band + (horizon - 0.5 * kPi);
   if (above_horizon < top) return 1.0;
   if (above_horizon >= top + kTwilightEdgeReach) return 0.0;

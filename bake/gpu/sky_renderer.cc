@@ -474,7 +474,15 @@ void SkyRenderer::BindOutput(const Buffer& target) {
 
 bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
   const double below = TwilightSunElevationDeg(quality_) * M_PI / 180.0;
-  return !aoas_switches_.skydome && !output_directions_ && below > 0.0 && sun.y < std::sin(below);
+  if (aoas_switches_.skydome || output_directions_ || !(below > 0.0) || !(sun.y < std::sin(below))) return false;
+  // Texels that read the sky-view LUT march only along rays that see sunlit
+  // air (TwilightMarchWeight); with the Sun too low for any, none does, and
+  // the day pipeline gives the same values without the march's cost (on
+  // lavapipe every branch of a shader runs, masked).
+  if (!quality_.sky_view_lut) return true;
+  const double night = SunlitAirDepressionDeg(gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.y,
+                                              gpu_atmosphere_.radii.z, gpu_atmosphere_.solar_irradiance.w);
+  return sun.y > -std::sin(night * M_PI / 180.0);
 }
 
 VkPipeline SkyRenderer::TwilightSkyPipeline() {

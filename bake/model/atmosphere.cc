@@ -1,5 +1,6 @@
 #include "skybake/model/atmosphere.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace skybake {
@@ -56,6 +57,15 @@ Rgb NightSkyRadiance(const EffectSettings& e) {
 
 double TwilightSunElevationDeg(const QualitySettings& q) {
   return q.twilight_sun_below_deg > 0.0 ? q.twilight_sun_below_deg : q.twilight_march_band_deg;
+}
+
+double SunlitAirDepressionDeg(double bottom_radius_km, double top_radius_km, double observer_altitude_km,
+                              double sun_angular_radius_rad) {
+  const double r = bottom_radius_km + std::max(observer_altitude_km, 0.0);
+  if (r >= top_radius_km) return 180.0;
+  const double dip = std::acos(std::min(bottom_radius_km / r, 1.0));
+  const double beyond = std::acos(std::min(bottom_radius_km / top_radius_km, 1.0));
+  return (dip + 2.0 * beyond + sun_angular_radius_rad) * 180.0 / M_PI + 0.5;
 }
 
 bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {

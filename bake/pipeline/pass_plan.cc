@@ -197,15 +197,23 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 // each view's directions, and, above it, the texels on the Earth's shadow's
 // edge (TwilightMarchWeight: at most kTwilightAboveBandShare of the
 // directions, docs/accuracy.md) are ray-marched by a sky pass of their own
-// pipeline.
+// pipeline, unless the Sun is too low for any sunlit air to be in view.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
                       PassPlan& plan) {
   const QualitySettings& q = first.quality;
   const double band = q.twilight_march_band_deg;
   const double below = TwilightSunElevationDeg(q);
   if (!(band > 0.0) || !(below > 0.0) || !NeedsSkyViewLut(pruned)) return;
-  const int runs = int(std::count_if(frames.begin(), frames.end(),
-                                     [&](const SkyStyle& f) { return f.sun.elevation_deg < below; }));
+  // A Sun past SunlitAirDepressionDeg leaves no sunlit air in view: the frame
+  // reads the LUT alone (SkyRenderer::MarchesTwilightBand).
+  auto night = [](const SkyStyle& f) {
+    const AtmosphereParams& a = f.atmosphere;
+    return SunlitAirDepressionDeg(a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
+                                  a.sun_angular_radius_rad);
+  };
+  const int runs = int(std::count_if(frames.begin(), frames.end(), [&](const SkyStyle& f) {
+    return f.sun.elevation_deg < below && f.sun.elevation_deg > -night(f);
+  }));
   if (runs == 0) return;  // no twilight frame: the pass never runs
   double texels = 0.0;
   for (const ViewRequest& v : PlanViews(first)) texels += double(v.width) * v.height;
@@ -216,7 +224,8 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   const std::string extent = dip_deg > 0.0 ? fmt::format("the horizon ({:.2f} deg below the horizontal) to {:g} deg above the horizontal", dip_deg, band)
                                            : fmt::format("0..{:g} deg above the horizon", band);
   const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
-  plan.passes.push_back({"twilight band march", extent, fmt::format("frames with the Sun below {:g} deg", below), runs,
+  plan.passes.push_back({"twilight band march", extent,
+                         fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg", below, night(first)), runs,
                          texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
 }
 

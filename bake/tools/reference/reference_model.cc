@@ -31,6 +31,12 @@ struct ReferenceModel::Impl {
   glsl::AtmosphereParameters ForSun(const glm::dvec3& sun) const {
     glsl::AtmosphereParameters a = atm;
     a.transmittance_log = sun.y < atm.twilight_sun_sine;
+    // No sunlit air in view: the day pipeline (SkyRenderer::MarchesTwilightBand).
+    if (a.transmittance_log && use_skyview &&
+        sun.y <= -std::sin(SunlitAirDepressionDeg(atm.bottom_radius, atm.top_radius, atm.observer_altitude,
+                                                  atm.sun_angular_radius) *
+                           M_PI / 180.0))
+      a.transmittance_log = false;
     if (!a.transmittance_log) a.twilight_march_band = 0.0;
     if (a.transmittance_log && !use_skyview) a.view_steps = a.twilight_march_steps;  // every texel marched
     return a;

@@ -90,6 +90,19 @@ struct QualitySettings {
 // The Sun's elevation (deg) below which `q` renders a frame as twilight (0: never).
 double TwilightSunElevationDeg(const QualitySettings& q);
 
+// The Sun's depression below the horizontal (deg) beyond which an observer
+// inside the atmosphere sees no sunlit air (radii in km, the observer's
+// altitude above the bottom in km, the Sun's angular radius in rad): the
+// view ray that reaches furthest towards the Sun grazes the horizon (the dip
+// acos(R_b / r) below the horizontal) and leaves the top acos(R_b / R_t)
+// beyond the point it grazes, where the horizon lies acos(R_b / R_t) below
+// that point's horizontal; the Sun's disc sets there a radius later. Plus a
+// margin of 0.5 deg, so that a frame past it has no view ray outside the
+// umbra (TwilightMarchWeight's test, shaders/atmosphere.glsl) at float
+// rounding either. From space (an observer above the top): 180 deg.
+double SunlitAirDepressionDeg(double bottom_radius_km, double top_radius_km, double observer_altitude_km,
+                              double sun_angular_radius_rad);
+
 // The named presets, chosen from the accuracy study (docs/accuracy.md):
 // "draft", "production" (the defaults of QualitySettings), "reference".
 QualitySettings QualityPreset(const std::string& name);
