@@ -968,6 +968,15 @@ Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   return smoothstep(0.5 * kTwilightLutCurvature, kTwilightLutCurvature, SkyViewLutLogCurvature(atm, view, sun));
 }
 
+// The elevations (rad above the horizontal) between which
+// TwilightMarchWeight can be above 0: from the horizon (the dip below the
+// horizontal) up to the band's top plus kTwilightEdgeReach, which the dip
+// raises as much as it lowers the horizon. The host renders the rows of a
+// view outside them with the day pipeline (SkyRenderer::TwilightRows).
+vec2 TwilightMarchElevations(IN(AtmosphereParameters) atm) {
+  return vec2(0.5 * kPi - HorizonZenithAngle(atm), atm.twilight_march_band + kTwilightEdgeReach);
+}
+
 // Radiance along `view` read from the sky-view LUT (built for this Sun), plus
 // the solar disc seen through the transmittance LUT.
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {

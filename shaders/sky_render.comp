@@ -19,6 +19,10 @@ void main() {
   if (kSunDiscPass) {
     texel += push.rect.xy;
     if (texel.x >= push.rect.z || texel.y >= push.rect.w) return;
+  } else if (push.rect.w > 0) {
+    // One run of the view's rows, [rect.y, rect.w) (SkyRenderer::AddSkyRows).
+    texel.y += push.rect.y;
+    if (texel.y >= push.rect.w) return;
   }
   if (texel.x >= push.view.y || texel.y >= push.view.z) return;
   vec3 view = ViewDirection(texel);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -371,6 +372,101 @@ TEST(SkyRendererTest, TexelsNearDirectionHoldEveryTexelWithinTheAngle) {
       }
     }
   }
+}
+
+// RowsReachingElevations holds every row with a texel whose elevation lies in
+// the range (every texel checked), and for a narrow range near the horizon
+// leaves most rows of the views out (the test is not vacuous).
+TEST(SkyRendererTest, RowsReachingElevationsHoldEveryRowWithATexelInRange) {
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 256, 128, 0}, {MAPPING_CUBE_STRIP, 64, 384, 0},
+                                    {MAPPING_CUBE_STRIP, 1000, 6000, 0}, {MAPPING_VULKAN_FACE, 7, 7, 4}};
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, 300, 300, face});
+  const double deg = M_PI / 180.0;
+  for (const auto& [low, high] : std::vector<std::pair<double, double>>{
+           {-0.1 * deg, 30.0 * deg}, {-3.0 * deg, 50.0 * deg}, {40.0 * deg, 40.01 * deg}, {-90 * deg, -89 * deg}}) {
+    long long rows = 0, kept = 0;
+    for (const ViewRequest& v : views) {
+      const std::vector<RowRange> runs = RowsReachingElevations(v, low, high);
+      for (size_t i = 0; i < runs.size(); ++i) {
+        EXPECT_LT(runs[i].begin, runs[i].end);
+        if (i > 0) {
+          EXPECT_LT(runs[i - 1].end, runs[i].begin) << "runs in order, apart";
+        }
+        kept += runs[i].end - runs[i].begin;
+      }
+      rows += v.height;
+      for (int y = 0; y < v.height; ++y) {
+        bool needed = false;
+        for (int x = 0; x < v.width && !needed; ++x) {
+          const glm::dvec3 d = ViewTexelDirection(v, x, y);
+          const double e = std::atan2(d.y, std::hypot(d.x, d.z));
+          needed = e >= low && e <= high;
+        }
+        bool held = false;
+        for (const RowRange& r : runs) held = held || (y >= r.begin && y < r.end);
+        if (needed) {
+          ASSERT_TRUE(held) << "mapping " << v.mapping << " face " << v.face << " row " << y;
+        }
+      }
+    }
+    if (high - low < 35.0 * deg) {
+      EXPECT_LT(kept, rows / 2) << low / deg << " .. " << high / deg << " deg";
+    }
+  }
+}
+
+// A twilight frame renders with the twilight pipeline only the rows that can
+// hold a marched texel (SkyRenderer::TwilightRows) and the others with the
+// day pipeline: the same bytes as the twilight pipeline over every row
+// (SKYBAKE_TWILIGHT_ROWS=0, ShaderSwitches::twilight_rows off) in every
+// view, at Suns from just below the twilight threshold to past the last
+// sunlit air, from the ground, from 8 km and from space, with the default
+// band and a wide one (whose rows reach into the +Y face). Most texels
+// take the day pipeline, and the band's march shows (against band 0) from
+// inside the atmosphere, so the test is not vacuous.
+TEST(SkyRendererTest, TwilightRowsKeepTheBytesOfTheWholeTwilightPass) {
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 128, 64, 0}, {MAPPING_CUBE_STRIP, 40, 240, 0}};
+  for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, 40, 40, face});
+  for (double altitude_m : {0.0, 8000.0, 120000.0}) {
+    for (double band : {10.0, 40.0}) {
+      AtmosphereParams atmosphere;
+      atmosphere.observer_altitude_m = altitude_m;
+      QualitySettings quality = QualityPreset("production");
+      quality.twilight_march_band_deg = band;
+      QualitySettings no_band = quality;
+      no_band.twilight_march_band_deg = 0.0;
+      auto renderer = [&](const QualitySettings& q, bool rows) {
+        ShaderSwitches shaders;
+        shaders.twilight_rows = rows;
+        return std::make_unique<SkyRenderer>(testing::Vulkan(), atmosphere, q, EffectSettings(), Rgb{1, 1, 1},
+                                             false, AoasInputs(), CloudInputs(), shaders);
+      };
+      std::unique_ptr<SkyRenderer> split = renderer(quality, true), whole = renderer(quality, false);
+      std::unique_ptr<SkyRenderer> lut = renderer(no_band, true);
+      bool marched = false;
+      for (double elevation : {2.9, -0.5, -4.0, -9.0, -15.0, -20.0}) {
+        const glm::dvec3 sun = SunDirectionFromElevationAzimuth(elevation, 100.0);
+        const std::vector<std::vector<float>> a = split->Render(sun, views), b = whole->Render(sun, views);
+        const std::vector<std::vector<float>> c = lut->Render(sun, views);
+        for (size_t v = 0; v < views.size(); ++v) {
+          EXPECT_TRUE(a[v] == b[v]) << altitude_m << " m, band " << band << " deg, Sun " << elevation
+                                    << " deg, view " << v;
+          marched = marched || a[v] != c[v];
+        }
+      }
+      // From space the band lies above the limb, where rays miss the air: nothing to march.
+      EXPECT_EQ(marched, altitude_m < 1e5) << altitude_m << " m, band " << band << ": the band's march shows";
+      const RenderCounters& on = split->counters();
+      const RenderCounters& off = whole->counters();
+      EXPECT_EQ(off.twilight_texels, off.sky_texels) << "every texel with the twilight pipeline";
+      EXPECT_EQ(on.sky_texels, off.sky_texels);
+      EXPECT_GT(on.twilight_texels, 0);
+      if (band < 20.0 && altitude_m < 1e5) {
+        EXPECT_LT(on.twilight_texels, on.sky_texels * 6 / 10) << altitude_m << " m: most rows by day";
+      }
+    }
+  }
+  testing::ExpectNoValidationMessages();
 }
 
 // The sun disc added by its own pass over the texels near the Sun equals the

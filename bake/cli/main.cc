@@ -566,6 +566,7 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.generic = EnvIs("SKYBAKE_GENERIC_SHADERS", "1");
   args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");
   args.shaders.shadowed_clouds = !EnvIs("SKYBAKE_SHADOWED_CLOUDS", "0");
+  args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
 }
 
 int RunCommand(Cli& cli) {

@@ -31,6 +31,7 @@
 #include "shaders/kTransmittanceLutAnalyticSpv.spv.h"
 #include "skybake/gpu/cloud_panorama.h"
 #include "skybake/gpu/spectral_sky.h"
+#include "skybake/model/shared_glsl.h"
 
 namespace skybake {
 namespace {
@@ -87,7 +88,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       aoas_switches_(aoas.switches),
       output_directions_(output_directions),
       style_pass_(role == Role::kStylePass),
-      shadowed_clouds_(shaders.shadowed_clouds) {
+      shadowed_clouds_(shaders.shadowed_clouds),
+      twilight_rows_(shaders.twilight_rows) {
   if (quality.wavelengths > kRgbWavelengths && !output_directions && !style_pass_) {
     spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
     SyncSpectral();
@@ -480,9 +482,69 @@ bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
   // the day pipeline gives the same values without the march's cost (on
   // lavapipe every branch of a shader runs, masked).
   if (!quality_.sky_view_lut) return true;
-  const double night = SunlitAirDepressionDeg(gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.y,
-                                              gpu_atmosphere_.radii.z, gpu_atmosphere_.solar_irradiance.w);
-  return sun.y > -std::sin(night * M_PI / 180.0);
+  return SunlitAirInView(std::asin(std::clamp(sun.y, -1.0, 1.0)) * 180.0 / M_PI, gpu_atmosphere_.radii.x,
+                         gpu_atmosphere_.radii.y, gpu_atmosphere_.radii.z, gpu_atmosphere_.solar_irradiance.w);
+}
+
+const std::vector<RowRange>& SkyRenderer::TwilightRows(const ViewRequest& view) {
+  for (const auto& [shape, runs] : twilight_row_runs_)
+    if (shape.mapping == view.mapping && shape.width == view.width && shape.height == view.height &&
+        shape.face == view.face)
+      return runs;
+  // The bounds in the shared code's double, from the uniform block's values.
+  glsl::AtmosphereParameters atm{};
+  atm.bottom_radius = gpu_atmosphere_.radii.x;
+  atm.top_radius = gpu_atmosphere_.radii.y;
+  atm.observer_altitude = gpu_atmosphere_.radii.z;
+  atm.twilight_march_band = gpu_atmosphere_.twilight.x;
+  const glm::dvec2 elevations = glsl::TwilightMarchElevations(atm);
+  constexpr double kFloatMargin = 1e-3;  // rad; float32's angles err by about 1e-7 rad
+  std::vector<RowRange> runs;
+  for (RowRange r : RowsReachingElevations(view, elevations.x - kFloatMargin, elevations.y + kFloatMargin)) {
+    r.begin -= r.begin % SKYBAKE_LOCAL_SIZE_Y;
+    r.end = std::min(view.height, r.end + (SKYBAKE_LOCAL_SIZE_Y - r.end % SKYBAKE_LOCAL_SIZE_Y) % SKYBAKE_LOCAL_SIZE_Y);
+    if (!runs.empty() && runs.back().end >= r.begin)
+      runs.back().end = std::max(runs.back().end, r.end);
+    else
+      runs.push_back(r);
+  }
+  twilight_row_runs_.push_back({view, std::move(runs)});
+  return twilight_row_runs_.back().second;
+}
+
+void SkyRenderer::AddSkyRows(const ViewRequest& view, const Dispatch& view_dispatch, bool twilight,
+                             std::vector<Dispatch>& dispatches, std::vector<bool>& barriers) {
+  // Views write disjoint ranges of the output buffer, and runs of rows
+  // disjoint parts of a view: no barriers between them.
+  const long long texels = (long long)view.width * view.height;
+  counters_.sky_texels += texels;
+  if (!twilight || !twilight_rows_ || !quality_.sky_view_lut) {
+    dispatches.push_back(view_dispatch);
+    if (twilight) dispatches.back().pipeline = TwilightSkyPipeline();
+    if (twilight) counters_.twilight_texels += texels;
+    barriers.push_back(false);
+    return;
+  }
+  bool first = true;
+  auto add = [&](int begin, int end, VkPipeline pipeline) {
+    if (end <= begin) return;
+    Dispatch d = view_dispatch;
+    d.pipeline = pipeline;
+    d.push.rect = {0, begin, view.width, end};
+    d.groups_y = GroupCount(end - begin, SKYBAKE_LOCAL_SIZE_Y);
+    d.continues = !first;
+    first = false;
+    dispatches.push_back(d);
+    barriers.push_back(false);
+  };
+  int row = 0;
+  for (const RowRange& r : TwilightRows(view)) {
+    add(row, r.begin, sky_pipeline_);
+    add(r.begin, r.end, TwilightSkyPipeline());
+    counters_.twilight_texels += (long long)view.width * (r.end - r.begin);
+    row = r.end;
+  }
+  add(row, view.height, sky_pipeline_);
 }
 
 VkPipeline SkyRenderer::TwilightSkyPipeline() {
@@ -648,7 +710,10 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
     PassTiming t;
     t.name = dispatches[i].name;
     if (timestamps_supported_) t.gpu_ms = double(stamps[2 * i + 1] - stamps[2 * i]) * period_ns * 1e-6;
-    timings_.push_back(t);
+    if (dispatches[i].continues && !timings_.empty())
+      timings_.back().gpu_ms += t.gpu_ms;
+    else
+      timings_.push_back(t);
   }
 }
 
@@ -860,8 +925,7 @@ bool SkyRenderer::HoldsFrames() const {
 
 std::vector<SkyRenderer::Dispatch> SkyRenderer::ViewDispatches(const glm::dvec3& sun,
                                                                const std::vector<ViewRequest>& views, bool sun_disc,
-                                                               const std::vector<size_t>& offsets,
-                                                               VkPipeline pipeline) const {
+                                                               const std::vector<size_t>& offsets) const {
   static const char* kFaceNames[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
   std::vector<Dispatch> dispatches;
   for (size_t i = 0; i < views.size(); ++i) {
@@ -873,7 +937,7 @@ std::vector<SkyRenderer::Dispatch> SkyRenderer::ViewDispatches(const glm::dvec3&
                        : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
                        : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
                                                           : "directions";
-    dispatches.push_back({name, pipeline, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
+    dispatches.push_back({name, sky_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
                           GroupCount(v.height, SKYBAKE_LOCAL_SIZE_Y)});
   }
   return dispatches;
@@ -939,7 +1003,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
   BindOutput(target);
   // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
-  const VkPipeline sky_pipeline = MarchesTwilightBand(sun) ? TwilightSkyPipeline() : sky_pipeline_;
+  const bool twilight = MarchesTwilightBand(sun);
   // With every cloud band in the Earth's shadow the clouds march without the Sun's light.
   const bool shadowed_clouds = CloudsInEarthShadow(sun);
   // A Sun too low for the light volume (CloudLightVolumeForSun): every light sample marched.
@@ -949,7 +1013,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
                                                                            : cloud_pipeline_;
   if (shadowed_clouds && part != FramePart::kClouds) ++counters_.shadowed_cloud_frames;
   // The views' constants, the cloud pass's too.
-  const std::vector<Dispatch> view_dispatches = ViewDispatches(sun, views, sun_disc, offsets, sky_pipeline);
+  const std::vector<Dispatch> view_dispatches = ViewDispatches(sun, views, sun_disc, offsets);
 
   std::vector<Dispatch> dispatches;
   std::vector<bool> barriers;
@@ -984,11 +1048,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       barriers.push_back(false);
       ++counters_.cloud_dispatches;
     }
-    for (const Dispatch& d : view_dispatches) {
-      dispatches.push_back(d);
-      // Views write disjoint ranges of the output buffer: no barriers between them.
-      barriers.push_back(false);
-    }
+    for (size_t i = 0; i < views.size(); ++i) AddSkyRows(views[i], view_dispatches[i], twilight, dispatches, barriers);
     if (disc_pass_ && sun_disc) AddSunDisc(sun, views, view_dispatches, dispatches, barriers);
   }
   if (cloud_layers_ > 0 && part != FramePart::kClearSky)

@@ -248,6 +248,8 @@ RenderCounters SpectralSky::counters() const {
     sum.cloud_table_builds += c.cloud_table_builds;
     sum.cloud_dispatches += c.cloud_dispatches;
     sum.sun_disc_texels += c.sun_disc_texels;
+    sum.twilight_texels += c.twilight_texels;
+    sum.sky_texels += c.sky_texels;
   }
   if (style_) sum.pipelines += style_->counters().pipelines;
   // A frame is every group's render of it.

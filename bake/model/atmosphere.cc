@@ -68,6 +68,12 @@ double SunlitAirDepressionDeg(double bottom_radius_km, double top_radius_km, dou
   return (dip + 2.0 * beyond + sun_angular_radius_rad) * 180.0 / M_PI + 0.5;
 }
 
+bool SunlitAirInView(double sun_elevation_deg, double bottom_radius_km, double top_radius_km,
+                     double observer_altitude_km, double sun_angular_radius_rad) {
+  return sun_elevation_deg >
+         -SunlitAirDepressionDeg(bottom_radius_km, top_radius_km, observer_altitude_km, sun_angular_radius_rad);
+}
+
 bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
   return q.light_steps <= 0 || e.multiple_scattering || e.ground || e.sun_disc;
 }

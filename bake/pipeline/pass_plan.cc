@@ -206,13 +206,10 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   if (!(band > 0.0) || !(below > 0.0) || !NeedsSkyViewLut(pruned)) return;
   // A Sun past SunlitAirDepressionDeg leaves no sunlit air in view: the frame
   // reads the LUT alone (SkyRenderer::MarchesTwilightBand).
-  auto night = [](const SkyStyle& f) {
-    const AtmosphereParams& a = f.atmosphere;
-    return SunlitAirDepressionDeg(a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
-                                  a.sun_angular_radius_rad);
-  };
   const int runs = int(std::count_if(frames.begin(), frames.end(), [&](const SkyStyle& f) {
-    return f.sun.elevation_deg < below && f.sun.elevation_deg > -night(f);
+    const AtmosphereParams& a = f.atmosphere;
+    return f.sun.elevation_deg < below && SunlitAirInView(f.sun.elevation_deg, a.bottom_radius_km, a.top_radius_km,
+                                                          a.observer_altitude_m * 1e-3, a.sun_angular_radius_rad);
   }));
   if (runs == 0) return;  // no twilight frame: the pass never runs
   double texels = 0.0;
@@ -224,8 +221,13 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   const std::string extent = dip_deg > 0.0 ? fmt::format("the horizon ({:.2f} deg below the horizontal) to {:g} deg above the horizontal", dip_deg, band)
                                            : fmt::format("0..{:g} deg above the horizon", band);
   const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
+  const double night_deg = SunlitAirDepressionDeg(a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
+                                                  a.sun_angular_radius_rad);
   plan.passes.push_back({"twilight band march", extent,
-                         fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg", below, night(first)), runs,
+                         night_deg >= 180.0
+                             ? fmt::format("frames with the Sun below {:g} deg (sunlit air in view from space)", below)
+                             : fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg", below, night_deg),
+                         runs,
                          texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
 }
 

@@ -33,9 +33,8 @@ struct ReferenceModel::Impl {
     a.transmittance_log = sun.y < atm.twilight_sun_sine;
     // No sunlit air in view: the day pipeline (SkyRenderer::MarchesTwilightBand).
     if (a.transmittance_log && use_skyview &&
-        sun.y <= -std::sin(SunlitAirDepressionDeg(atm.bottom_radius, atm.top_radius, atm.observer_altitude,
-                                                  atm.sun_angular_radius) *
-                           M_PI / 180.0))
+        !SunlitAirInView(std::asin(std::clamp(sun.y, -1.0, 1.0)) * 180.0 / M_PI, atm.bottom_radius, atm.top_radius,
+                         atm.observer_altitude, atm.sun_angular_radius))
       a.transmittance_log = false;
     if (!a.transmittance_log) a.twilight_march_band = 0.0;
     if (a.transmittance_log && !use_skyview) a.view_steps = a.twilight_march_steps;  // every texel marched

@@ -26,6 +26,8 @@ struct RenderCounters {
   int cloud_dispatches = 0;     // dispatches of the cloud pass
   int shadowed_cloud_frames = 0;  // frames whose cloud march ran without the Sun's light (every band in the shadow)
   long long sun_disc_texels = 0;  // texels they covered
+  long long twilight_texels = 0;  // texels of the views' sky pass rendered by the twilight pipeline
+  long long sky_texels = 0;       // texels of the views' sky pass, with either pipeline
 };
 
 }  // namespace skybake

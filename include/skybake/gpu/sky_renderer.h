@@ -43,6 +43,9 @@ struct ShaderSwitches {
   // SKYBAKE_SHADOWED_CLOUDS=0: no cloud pass without the Sun's light march, even with every band in the
   // Earth's shadow (CloudEarthShadowElevationDeg)
   bool shadowed_clouds = true;
+  // SKYBAKE_TWILIGHT_ROWS=0: a twilight frame's views wholly with the twilight pipeline, not only the rows
+  // that can hold a marched texel (SkyRenderer::TwilightRows)
+  bool twilight_rows = true;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
@@ -193,6 +196,7 @@ class SkyRenderer {
     VkPipeline pipeline;
     gpu::SkyPush push;
     uint32_t groups_x, groups_y;
+    bool continues = false;  // more of the previous dispatch's pass: timed together with it
   };
 
   // What SubmitViews submits: the whole frame, or the frame without its
@@ -237,6 +241,18 @@ class SkyRenderer {
   // built on the first such frame.
   bool MarchesTwilightBand(const glm::dvec3& sun) const;
   VkPipeline TwilightSkyPipeline();
+  // The runs of `view`'s rows that a twilight frame renders with the twilight
+  // pipeline: those that may hold a texel with TwilightMarchWeight above 0
+  // (between TwilightMarchElevations, widened by 1e-3 rad for float32's
+  // rounding), grown to whole workgroups. The day pipeline gives the other
+  // rows the same bytes without the march's masked cost. Computed once per
+  // view shape.
+  const std::vector<RowRange>& TwilightRows(const ViewRequest& view);
+  // The sky pass over one view (`view_dispatch`, ViewDispatches): one
+  // dispatch, or at twilight runs of rows alternating between the day and
+  // the twilight pipelines.
+  void AddSkyRows(const ViewRequest& view, const Dispatch& view_dispatch, bool twilight,
+                  std::vector<Dispatch>& dispatches, std::vector<bool>& barriers);
   // Whether this Sun leaves every cloud band in the Earth's shadow
   // (CloudEarthShadowElevationDeg, shaders.shadowed_clouds): the frame's
   // cloud march runs without the Sun's light march (specialization constant
@@ -254,10 +270,11 @@ class SkyRenderer {
   // `target`, the sun-disc pass; submitted and waited for.
   void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                    bool sun_disc, const std::vector<size_t>& offsets, FramePart part = FramePart::kWhole);
-  // Its parts: the views' sky-pass dispatches (whose constants the cloud
-  // pass's reuse), the sun-disc pass over them, the cloud pass over them.
+  // Its parts: the views' sky-pass dispatches with the day pipeline (whose
+  // constants the cloud pass's reuse; AddSkyRows submits them), the sun-disc
+  // pass over them, the cloud pass over them.
   std::vector<Dispatch> ViewDispatches(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
-                                       const std::vector<size_t>& offsets, VkPipeline pipeline) const;
+                                       const std::vector<size_t>& offsets) const;
   void AddSunDisc(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
                   const std::vector<Dispatch>& view_dispatches, std::vector<Dispatch>& dispatches,
                   std::vector<bool>& barriers);
@@ -331,6 +348,9 @@ class SkyRenderer {
   VkPipeline shadowed_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the Sun's light (CloudsInEarthShadow)
   VkPipeline marched_light_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the light volume
   bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
+  bool twilight_rows_ = true;                            // ShaderSwitches::twilight_rows
+  // TwilightRows per view shape (mapping, width, height, face).
+  std::vector<std::pair<ViewRequest, std::vector<RowRange>>> twilight_row_runs_;
   VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
   bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant
   VkCommandPool command_pool_ = VK_NULL_HANDLE;

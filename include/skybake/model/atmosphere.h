@@ -103,6 +103,13 @@ double TwilightSunElevationDeg(const QualitySettings& q);
 double SunlitAirDepressionDeg(double bottom_radius_km, double top_radius_km, double observer_altitude_km,
                               double sun_angular_radius_rad);
 
+// Whether a Sun at `sun_elevation_deg` leaves sunlit air in the observer's
+// view: above -SunlitAirDepressionDeg (always from space). A frame without
+// renders with the day pipeline (SkyRenderer::MarchesTwilightBand, the
+// reference model and the pass plan agree through this test).
+bool SunlitAirInView(double sun_elevation_deg, double bottom_radius_km, double top_radius_km,
+                     double observer_altitude_km, double sun_angular_radius_rad);
+
 // The named presets, chosen from the accuracy study (docs/accuracy.md):
 // "draft", "production" (the defaults of QualitySettings), "reference".
 QualitySettings QualityPreset(const std::string& name);

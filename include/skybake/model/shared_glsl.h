@@ -63,6 +63,7 @@ vec3 ComputeSkyViewLutTexel(IN(AtmosphereParameters) atm, int x, int y, Real mu_
 vec3 ComputeSkyRadiance(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 vec3 ComputeSkyRadianceFromSkyView(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 Real TwilightMarchWeight(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
+vec2 TwilightMarchElevations(IN(AtmosphereParameters) atm);
 vec3 SunDiscThroughAtmosphere(IN(AtmosphereParameters) atm, vec3 view, vec3 sun);
 // aoas.glsl: the styled sky.
 vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) aoas, vec3 w, vec3 sun,
