@@ -39,7 +39,12 @@ float CloudShadowOpticalDepth(vec2 xz, float h0, vec3 sun, int steps) {
 // ground is on and the Sun's centre is above the horizon. T_air, the air's
 // transmittance from the viewer to the ground, from the transmittance LUT
 // (the ratio of the two rays to the top, Bruneton 2008).
+// The pipelines of a style without it have it compiled out
+// (kGroundCloudShadow): on lavapipe a branch not taken still runs, masked.
+layout(constant_id = SPEC_GROUND_CLOUD_SHADOW) const bool kGroundCloudShadow = true;
+
 vec3 GroundCloudShadowLoss(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
+  if (!kGroundCloudShadow) return vec3(0.0);
   if (gpu_clouds.ground_shadow.x <= 0.0 || !atm.ground || sun.y <= 0.0) return vec3(0.0);
   SkyRay ray = SetUpSkyRay(atm, view, sun);
   if (!ray.in_atmosphere || !ray.hits_ground || ray.altitude != atm.observer_altitude) return vec3(0.0);

@@ -618,21 +618,23 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
-    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume;
+    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
-              twilight_march,               cloud_sun_light, cloud_light_volume};
-  const VkSpecializationMapEntry entries[18] = {
+              twilight_march,               cloud_sun_light, cloud_light_volume,
+              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f};
+  const VkSpecializationMapEntry entries[19] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
-      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4}};
-  VkSpecializationInfo specialization{18, entries, sizeof(values), &values};
+      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
+      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}};
+  VkSpecializationInfo specialization{19, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
@@ -1196,7 +1198,8 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   auto same = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof a) == 0; };
   if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
       !same(c.lut, gpu_clouds_.lut) || !same(c.light_volume, gpu_clouds_.light_volume) ||
-      (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_))
+      (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_) ||
+      (c.ground_shadow.x > 0.0f) != (gpu_clouds_.ground_shadow.x > 0.0f))  // kGroundCloudShadow's pipelines
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.
   const bool images_same = clouds.weather_images == cloud_weather_images_;

@@ -39,6 +39,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_CLOUD_LAYERS 20        // int: the active volumetric cloud layers
 #define SPEC_CLOUD_SUN_LIGHT 21     // bool: the Sun lights the clouds (off: every band in the Earth's shadow)
 #define SPEC_CLOUD_LIGHT_VOLUME 22  // bool: the light march's far part read from the frame's light volume (clouds.h)
+#define SPEC_GROUND_CLOUD_SHADOW 23  // bool: the clouds' shadow on the ground below the horizon (GpuClouds.ground_shadow.x > 0)
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere
