@@ -17,7 +17,7 @@
 float CloudShadowOpticalDepth(vec2 xz, float h0, vec3 sun, int steps) {
   float tau = 0.0;
   int bands = gpu_clouds.resolution.w;
-  for (int b = 0; b < CLOUD_MAX_LAYERS; ++b) {
+  for (int b = 0; b < kCloudLayers; ++b) {
     if (b >= bands) continue;
     float lo = max(gpu_clouds.bands[b].x, h0), hi = gpu_clouds.bands[b].y;
     if (hi <= lo) continue;

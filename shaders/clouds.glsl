@@ -949,7 +949,7 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   float t_far = gpu_clouds.range.x;
   int bands = gpu_clouds.resolution.w;
   // Segments in order along the ray: x, y the distances; z the band's top, w its thickness.
-  vec4 segments[2 * CLOUD_MAX_LAYERS];
+  vec4 segments[2 * kCloudLayers];
   int count = 0;
   // The descending branch (mu < 0): altitude falls to the perigee, or to
   // the ground.
@@ -961,7 +961,7 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
     h_perigee = AltitudeAlongRay(atm, r0, h0, mu, t_perigee);
     ground = h_perigee <= 0.0;
     float t_end = ground ? CloudRayToAltitude(atm, r0, h0, mu, 0.0, -1.0) : t_perigee;
-    for (int b = CLOUD_MAX_LAYERS - 1; b >= 0; --b) {
+    for (int b = kCloudLayers - 1; b >= 0; --b) {
       if (b >= bands) continue;
       float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
       if (h0 <= lo || h_perigee >= hi) continue;
@@ -973,7 +973,7 @@ CloudMarch MarchClouds(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   if (!ground) {
     // The ascending branch, from the perigee (or the viewer) up.
     float t_start = max(t_perigee, 0.0);
-    for (int b = 0; b < CLOUD_MAX_LAYERS; ++b) {
+    for (int b = 0; b < kCloudLayers; ++b) {
       if (b >= bands) continue;
       float lo = gpu_clouds.bands[b].x, hi = gpu_clouds.bands[b].y;
       if (hi <= h_perigee) continue;
