@@ -19,6 +19,13 @@ layout(std430, set = 0, binding = BINDING_CLOUD_NOISE) buffer CloudNoiseBuffer {
 layout(std430, set = 0, binding = BINDING_CLOUD_LUT) buffer CloudLutBuffer {
   vec4 cloud_lut[];
 };
+// The noise and the tables read through their texel views (common.glsl,
+// kTexelViews); the writes, and the light volume's reads of what its own
+// dispatch wrote, stay on the storage buffers.
+layout(set = 0, binding = BINDING_CLOUD_NOISE_TEXELS) uniform samplerBuffer cloud_noise_view;
+layout(set = 0, binding = BINDING_CLOUD_TABLE_TEXELS) uniform samplerBuffer cloud_table_view;
+float CloudNoise(int i) { return kTexelViews ? texelFetch(cloud_noise_view, i).x : cloud_noise[i]; }
+vec3 CloudTable(int i) { return kTexelViews ? texelFetch(cloud_table_view, i).xyz : cloud_lut[i].xyz; }
 // Active layers: the loops over layers have this bound, so a style's layer
 // count is compiled in (the cloud pipelines exist only when it is > 0).
 layout(constant_id = SPEC_CLOUD_LAYERS) const int kCloudLayers = 1;
@@ -179,10 +186,10 @@ float SampleVolume(int first, int n, vec3 uvw) {
   ivec3 i1 = WrapHigh(i0, n);
   int row0 = first + (i0.z * n + i0.y) * n, row1 = first + (i0.z * n + i1.y) * n;
   int row2 = first + (i1.z * n + i0.y) * n, row3 = first + (i1.z * n + i1.y) * n;
-  float a = mix(cloud_noise[row0 + i0.x], cloud_noise[row0 + i1.x], f.x);
-  float b = mix(cloud_noise[row1 + i0.x], cloud_noise[row1 + i1.x], f.x);
-  float c = mix(cloud_noise[row2 + i0.x], cloud_noise[row2 + i1.x], f.x);
-  float d = mix(cloud_noise[row3 + i0.x], cloud_noise[row3 + i1.x], f.x);
+  float a = mix(CloudNoise(row0 + i0.x), CloudNoise(row0 + i1.x), f.x);
+  float b = mix(CloudNoise(row1 + i0.x), CloudNoise(row1 + i1.x), f.x);
+  float c = mix(CloudNoise(row2 + i0.x), CloudNoise(row2 + i1.x), f.x);
+  float d = mix(CloudNoise(row3 + i0.x), CloudNoise(row3 + i1.x), f.x);
   return mix(mix(a, b, f.y), mix(c, d, f.y), f.z);
 }
 
@@ -193,8 +200,8 @@ float SampleMap(int first, int n, vec2 uv) {
   vec2 f = p - base;
   ivec2 i0 = WrapLow(vec3(base, 0.0), n).xy;
   ivec2 i1 = WrapHigh(ivec3(i0, 0), n).xy;
-  float a = mix(cloud_noise[first + i0.y * n + i0.x], cloud_noise[first + i0.y * n + i1.x], f.x);
-  float b = mix(cloud_noise[first + i1.y * n + i0.x], cloud_noise[first + i1.y * n + i1.x], f.x);
+  float a = mix(CloudNoise(first + i0.y * n + i0.x), CloudNoise(first + i0.y * n + i1.x), f.x);
+  float b = mix(CloudNoise(first + i1.y * n + i0.x), CloudNoise(first + i1.y * n + i1.x), f.x);
   return mix(a, b, f.y);
 }
 
@@ -301,10 +308,10 @@ float LayerCloudMargin(int l, vec2 xz, float h) {
   int nw = gpu_clouds.resolution.z, ns = gpu_clouds.resolution.x;
   bool edge = false;
   ivec2 wcell = CloudSkipCell(vec3(weather_uv, 0.0), nw, edge).xy;  // z: mid-cell, never an edge
-  float weather = cloud_noise[first + wcell.y * nw + wcell.x];
+  float weather = CloudNoise(first + wcell.y * nw + wcell.x);
   float coverage = clamp(2.0 * layer.weather.x - 1.0 + weather, 0.0, 1.0);
   ivec3 cell = CloudSkipCell(vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y, ns, edge);
-  float shape = cloud_noise[first + nw * nw + (cell.z * ns + cell.y) * ns + cell.x];
+  float shape = CloudNoise(first + nw * nw + (cell.z * ns + cell.y) * ns + cell.x);
   float base = mix(1.0, shape, layer.shape.x) * profile;
   if (edge) return inside ? 1.0 : -1.0;
   return inside && coverage > 0.0 ? base - (1.0 - coverage) + 1e-4 : -1.0;
@@ -420,11 +427,11 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
 // holds the point), wrapping: one load where the trilinear read takes 8.
 float SampleVolumeNearest(int first, int n, vec3 uvw) {
   ivec3 i = min(ivec3(fract(uvw) * float(n)), ivec3(n - 1));
-  return cloud_noise[first + (i.z * n + i.y) * n + i.x];
+  return CloudNoise(first + (i.z * n + i.y) * n + i.x);
 }
 float SampleMapNearest(int first, int n, vec2 uv) {
   ivec2 i = min(ivec2(fract(uv) * float(n)), ivec2(n - 1));
-  return cloud_noise[first + i.y * n + i.x];
+  return CloudNoise(first + i.y * n + i.x);
 }
 
 // LayerExtinction without the detail erosion (the light march's density),
@@ -605,7 +612,7 @@ void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 su
 }
 
 float CloudLightVolumeAt(int i, int j, int k) {
-  return cloud_noise[gpu_clouds.light_volume.w + (j * CloudLightVolumeColumns() + i) * CloudLightVolumeSlices() + k];
+  return CloudNoise(gpu_clouds.light_volume.w + (j * CloudLightVolumeColumns() + i) * CloudLightVolumeSlices() + k);
 }
 
 // The optical depth toward the Sun from the point `s` along it from a view
@@ -689,8 +696,8 @@ void CloudAmbientRows(float h, out vec3 up, out vec3 down) {
   float y = clamp(h / gpu_clouds.range.y, 0.0, 1.0) * float(rows - 1);
   int y0 = min(int(y), rows - 2);
   float f = y - float(y0);
-  up = mix(cloud_lut[CloudAmbientIndex(y0, 0)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 0)].xyz, f);
-  down = mix(cloud_lut[CloudAmbientIndex(y0, 1)].xyz, cloud_lut[CloudAmbientIndex(y0 + 1, 1)].xyz, f);
+  up = mix(CloudTable(CloudAmbientIndex(y0, 0)), CloudTable(CloudAmbientIndex(y0 + 1, 0)), f);
+  down = mix(CloudTable(CloudAmbientIndex(y0, 1)), CloudTable(CloudAmbientIndex(y0 + 1, 1)), f);
 }
 
 // Mean incident radiance over the sphere at height fraction hf, the sky half
@@ -725,8 +732,8 @@ CloudApTexel CloudApTexelOf(vec3 view, vec3 sun) {
 
 vec3 CloudApRead(IN(CloudApTexel) t, int k, int half_) {
   int o = half_ * CloudApTexels();
-  vec3 a = mix(cloud_lut[o + CloudApIndex(t.x0, t.y0, k)].xyz, cloud_lut[o + CloudApIndex(t.x1, t.y0, k)].xyz, t.fx);
-  vec3 b = mix(cloud_lut[o + CloudApIndex(t.x0, t.y1, k)].xyz, cloud_lut[o + CloudApIndex(t.x1, t.y1, k)].xyz, t.fx);
+  vec3 a = mix(CloudTable(o + CloudApIndex(t.x0, t.y0, k)), CloudTable(o + CloudApIndex(t.x1, t.y0, k)), t.fx);
+  vec3 b = mix(CloudTable(o + CloudApIndex(t.x0, t.y1, k)), CloudTable(o + CloudApIndex(t.x1, t.y1, k)), t.fx);
   return mix(a, b, t.fy);
 }
 

@@ -52,6 +52,17 @@ layout(push_constant) uniform PushBlock {
 };
 #define push dispatch_constants[dispatch_index]
 
+// The LUTs' texel views (gpu_shared.h): lavapipe loads a storage buffer lane
+// by lane, with a branch on the lane's mask and one on the buffer's bound per
+// component, and a texel buffer with a vector gather. The values are the
+// same, so are the bytes; the LUT passes write the storage buffers. Off
+// (kTexelViews false) where a buffer has more texels than the device's texel
+// buffers hold: the reads then use the storage buffers.
+layout(constant_id = SPEC_TEXEL_VIEWS) const bool kTexelViews = true;
+layout(set = 0, binding = BINDING_TRANSMITTANCE_TEXELS) uniform samplerBuffer transmittance_view;
+layout(set = 0, binding = BINDING_MULTISCATTERING_TEXELS) uniform samplerBuffer multiscattering_view;
+layout(set = 0, binding = BINDING_SKYVIEW_TEXELS) uniform usamplerBuffer skyview_view;
+
 // Optional effects (EffectSettings); off effects are compiled out.
 layout(constant_id = SPEC_MULTIPLE_SCATTERING) const bool kMultipleScattering = true;
 layout(constant_id = SPEC_SUN_DISC) const bool kSunDisc = true;
@@ -110,11 +121,13 @@ layout(constant_id = SPEC_TWILIGHT_MARCH) const bool kTwilightMarch = false;
 #endif
 
 vec3 TransmittanceLutTexel(int x, int y) {
-  return transmittance_texels[y * gpu_atmosphere.lut_sizes.x + x].xyz;
+  int i = y * gpu_atmosphere.lut_sizes.x + x;
+  return kTexelViews ? texelFetch(transmittance_view, i).xyz : transmittance_texels[i].xyz;
 }
 
 vec3 MultipleScatteringLutTexel(int x, int y) {
-  return multiscattering_texels[y * gpu_atmosphere.lut_sizes.z + x].xyz;
+  int i = y * gpu_atmosphere.lut_sizes.z + x;
+  return kTexelViews ? texelFetch(multiscattering_view, i).xyz : multiscattering_texels[i].xyz;
 }
 
 // Three non-negative floats in one 64-bit word, 21 bits each: the float32
@@ -134,7 +147,8 @@ vec3 UnpackSkyViewTexel(uint64_t word) {
 }
 
 vec3 SkyViewLutTexel(int x, int y) {
-  return UnpackSkyViewTexel(skyview_texels[y * gpu_atmosphere.render.y + x]);
+  int i = y * gpu_atmosphere.render.y + x;
+  return UnpackSkyViewTexel(kTexelViews ? packUint2x32(texelFetch(skyview_view, i).xy) : skyview_texels[i]);
 }
 
 vec4 ShapeSegmentStart(int i) { return gpu_aoas.shape_segments[2 * i]; }

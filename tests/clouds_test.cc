@@ -16,6 +16,7 @@
 #include <glm/glm.hpp>
 
 #include "skybake/model/clouds.h"
+#include "skybake/model/cloud_shadow.h"
 #include "skybake/input/config.h"
 #include "skybake/model/envmap.h"
 #include "skybake/pipeline/pass_plan.h"
@@ -852,6 +853,59 @@ TEST(CloudEarthShadow, ShadowedFramesSkipTheLightMarchWithTheSameBytes) {
   }
   // W3's layer (top 3 km, 300 km) from the ground: the bound of the header's comment.
   EXPECT_NEAR(CloudEarthShadowElevationDeg(6360.0, 0.0, 3.0, 300.0, 0.004675), -3.80, 0.005);
+  testing::ExpectNoValidationMessages();
+}
+
+// The shaders read the LUTs, the cloud noise and the cloud tables through
+// texel views (SPEC_TEXEL_VIEWS), the same bytes as their storage buffers
+// hold: every view, the panorama's and the marched latlong's, explicit
+// directions and the cloud shadow map keep their bytes with the views on and
+// off (SKYBAKE_TEXEL_VIEWS=0, ShaderSwitches::texel_views), for a clear sky,
+// W3's cumulus with the ground's cloud shadow, two bands and a cirrus in
+// twilight, and the observer above the layers.
+TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
+  struct ViewCase {
+    const char* name;
+    std::string toml;
+    double sun;
+  };
+  const std::vector<ViewCase> cases = {
+      {"clear, day", "", 30.0},
+      {"clear, twilight", "", -4.0},
+      {"W3 cumulus, ground shadow", "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
+                                         Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
+       20.0},
+      {"two bands and a cirrus, twilight", Layer(1500, 1500, "coverage = 0.6") +
+                                               Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4") +
+                                               Layer(8000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
+       -2.0},
+      {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
+  };
+  for (const ViewCase& c : cases) {
+    const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
+    auto render = [&](bool texel_views) {
+      ShaderSwitches shaders;
+      shaders.texel_views = texel_views;
+      CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
+      ApplyGroundCloudShadow(style.cloud_shadow, clouds);
+      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                    OutputScale(style.output.units), false,
+                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)), clouds, shaders);
+      EXPECT_EQ(r.reads_texel_views(), texel_views) << c.name;
+      const int n = 24;
+      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+      const glm::dvec3 sun = Sun(c.sun);
+      std::vector<std::vector<float>> images = r.Render(sun, views);
+      images.push_back(r.Render(sun, {views[0]})[0]);
+      images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, -0.05, -0.8)}));
+      if (style.cloud_shadow.enabled) images.push_back(r.RenderCloudShadow(sun, style.cloud_shadow));
+      return images;
+    };
+    const std::vector<std::vector<float>> on = render(true), off = render(false);
+    ASSERT_EQ(on.size(), off.size());
+    for (size_t i = 0; i < on.size(); ++i) EXPECT_TRUE(on[i] == off[i]) << c.name << ", image " << i;
+  }
   testing::ExpectNoValidationMessages();
 }
 

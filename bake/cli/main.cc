@@ -567,6 +567,7 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");
   args.shaders.shadowed_clouds = !EnvIs("SKYBAKE_SHADOWED_CLOUDS", "0");
   args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
+  args.shaders.texel_views = !EnvIs("SKYBAKE_TEXEL_VIEWS", "0");
 }
 
 int RunCommand(Cli& cli) {

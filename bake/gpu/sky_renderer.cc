@@ -36,9 +36,15 @@
 namespace skybake {
 namespace {
 
-// Of the bindings of gpu_shared.h, the atmosphere, AOAS and cloud blocks are uniform.
-bool IsUniformBinding(uint32_t binding) {
-  return binding == BINDING_AOAS || binding == BINDING_CLOUDS;
+// Of the bindings of gpu_shared.h, the AOAS and cloud blocks are uniform
+// buffers, the texel views uniform texel buffers and the rest storage buffers.
+bool IsTexelView(uint32_t binding) {
+  return binding >= BINDING_CLOUD_NOISE_TEXELS && binding < BINDING_CLOUD_NOISE_TEXELS + TEXEL_VIEW_COUNT;
+}
+VkDescriptorType BindingType(uint32_t binding) {
+  if (binding == BINDING_AOAS || binding == BINDING_CLOUDS) return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  if (IsTexelView(binding)) return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+  return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
 
 // Texels of the cloud tables: the aerial-perspective LUT's in-scattering and
@@ -89,7 +95,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       output_directions_(output_directions),
       style_pass_(role == Role::kStylePass),
       shadowed_clouds_(shaders.shadowed_clouds),
-      twilight_rows_(shaders.twilight_rows) {
+      twilight_rows_(shaders.twilight_rows),
+      texel_views_allowed_(shaders.texel_views) {
   if (quality.wavelengths > kRgbWavelengths && !output_directions && !style_pass_) {
     spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
     SyncSpectral();
@@ -104,7 +111,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   cloud_weather_images_ = clouds.weather_images;
   VkDevice device = context_.device();
 
-  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  // Every buffer a texel view reads (gpu_shared.h) is a texel buffer too.
+  const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
   atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), storage);
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
   aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -127,6 +135,18 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       storage);
   cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
   dispatch_buffer_ = CreateBuffer(64 * sizeof(gpu::SkyPush), storage);  // grown by Submit when a submission needs more
+  // The shaders read through texel views, not the storage buffers (the same
+  // values): lavapipe loads a storage buffer's value lane by lane, behind a
+  // bounds test per lane, where a texel fetch is one gather for all lanes
+  // (docs/performance.md). The views hold their whole ranges where the
+  // device's texel buffers are large enough (lavapipe: 2^27 texels), which
+  // only a noise of several 256^3 layers is not; else, or with
+  // ShaderSwitches::texel_views off, each is a view of one texel, never read,
+  // and the shaders read the storage buffers.
+  texel_views_whole_ = texel_views_allowed_;
+  for (int i = 0; i < TEXEL_VIEW_COUNT; ++i)
+    texel_views_whole_ = texel_views_whole_ && TexelViewRange(i).texels <= context_.properties().limits.maxTexelBufferElements;
+  for (int i = 0; i < TEXEL_VIEW_COUNT; ++i) CreateTexelView(i);
 
   CreateDescriptorSet();
 
@@ -219,8 +239,7 @@ void SkyRenderer::CreateDescriptorSet() {
   VkDescriptorSetLayoutBinding bindings[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
     bindings[i].binding = i;
-    bindings[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    bindings[i].descriptorType = BindingType(i);
     bindings[i].descriptorCount = 1;
     bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
   }
@@ -228,11 +247,12 @@ void SkyRenderer::CreateDescriptorSet() {
   set_layout_ = layouts.set;
   pipeline_layout_ = layouts.pipeline;
 
-  VkDescriptorPoolSize pool_sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2}};
+  VkDescriptorPoolSize pool_sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+                                        {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, TEXEL_VIEW_COUNT},
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2 - TEXEL_VIEW_COUNT}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
-  pool_info.poolSizeCount = 2;
+  pool_info.poolSizeCount = 3;
   pool_info.pPoolSizes = pool_sizes;
   VK_CHECK(vkCreateDescriptorPool(device, &pool_info, nullptr, &descriptor_pool_));
   VkDescriptorSetAllocateInfo alloc_info{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
@@ -323,6 +343,10 @@ void SkyRenderer::DestroyAll() {
   DestroyBuffer(skyview_buffer_);
   DestroyBuffer(cloud_lut_buffer_);
   DestroyBuffer(dispatch_buffer_);
+  for (VkBufferView& view : texel_views_) {
+    vkDestroyBufferView(device, view, nullptr);
+    view = VK_NULL_HANDLE;
+  }
   DestroyBuffer(cloud_noise_buffer_);
   DestroyBuffer(clouds_buffer_);
   DestroyBuffer(output_buffer_);
@@ -363,6 +387,33 @@ void AdviseHugePages(void* mapped, VkDeviceSize size) {
 }
 
 }  // namespace
+
+SkyRenderer::TexelRange SkyRenderer::TexelViewRange(int i) const {
+  switch (BINDING_CLOUD_NOISE_TEXELS + i) {
+    case BINDING_CLOUD_NOISE_TEXELS:
+      return {&cloud_noise_buffer_, VK_FORMAT_R32_SFLOAT, 4, cloud_noise_buffer_.size / 4};
+    case BINDING_CLOUD_TABLE_TEXELS:  // the tables only: the panorama after them may outgrow a view
+      return {&cloud_lut_buffer_, VK_FORMAT_R32G32B32A32_SFLOAT, 16,
+              cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) : 1};
+    case BINDING_TRANSMITTANCE_TEXELS:
+      return {&transmittance_buffer_, VK_FORMAT_R32G32B32A32_SFLOAT, 16, transmittance_buffer_.size / 16};
+    case BINDING_MULTISCATTERING_TEXELS:
+      return {&multiscattering_buffer_, VK_FORMAT_R32G32B32A32_SFLOAT, 16, multiscattering_buffer_.size / 16};
+    default:
+      return {&skyview_buffer_, VK_FORMAT_R32G32_UINT, 8, skyview_buffer_.size / 8};
+  }
+}
+
+void SkyRenderer::CreateTexelView(int i) {
+  vkDestroyBufferView(context_.device(), texel_views_[i], nullptr);
+  const TexelRange r = TexelViewRange(i);
+  VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+  info.buffer = r.buffer->buffer;
+  info.format = r.format;
+  info.offset = 0;
+  info.range = (texel_views_whole_ ? r.texels : 1) * r.texel_bytes;
+  VK_CHECK(vkCreateBufferView(context_.device(), &info, nullptr, &texel_views_[i]));
+}
 
 SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage) {
   VkDevice device = context_.device();
@@ -409,7 +460,9 @@ void SkyRenderer::DestroyBuffer(Buffer& b) {
 void SkyRenderer::EnsureCloudLutCapacity(size_t texels) {
   if (VkDeviceSize(texels) * 16 <= cloud_lut_buffer_.size) return;
   DestroyBuffer(cloud_lut_buffer_);
-  cloud_lut_buffer_ = CreateBuffer(VkDeviceSize(texels) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+  cloud_lut_buffer_ = CreateBuffer(VkDeviceSize(texels) * 16,
+                                   VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT);
+  CreateTexelView(BINDING_CLOUD_TABLE_TEXELS - BINDING_CLOUD_NOISE_TEXELS);
   UpdateDescriptors();
   cloud_tables_ready_ = false;  // the new buffer holds no tables yet
 }
@@ -453,6 +506,7 @@ void SkyRenderer::UpdateDescriptors() {
       {cloud_noise_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {cloud_lut_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {dispatch_buffer_.buffer, 0, VK_WHOLE_SIZE},
+      {}, {}, {}, {}, {},  // the texel views
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -460,9 +514,9 @@ void SkyRenderer::UpdateDescriptors() {
     writes[i].dstSet = descriptor_set_;
     writes[i].dstBinding = i;
     writes[i].descriptorCount = 1;
-    writes[i].descriptorType = IsUniformBinding(i) ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-                                                   : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    writes[i].pBufferInfo = &infos[i];
+    writes[i].descriptorType = BindingType(i);
+    if (IsTexelView(i)) writes[i].pTexelBufferView = &texel_views_[i - BINDING_CLOUD_NOISE_TEXELS];
+    else writes[i].pBufferInfo = &infos[i];
   }
   vkUpdateDescriptorSets(context_.device(), kBindingCount, writes, 0, nullptr);
   bound_output_ = output_buffer_.buffer;
@@ -618,23 +672,23 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
-    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow;
+    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow, texel_views;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
               twilight_march,               cloud_sun_light, cloud_light_volume,
-              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f};
-  const VkSpecializationMapEntry entries[19] = {
+              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f, texel_views_whole_};
+  const VkSpecializationMapEntry entries[20] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
       {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
-      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}};
-  VkSpecializationInfo specialization{19, entries, sizeof(values), &values};
+      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4}};
+  VkSpecializationInfo specialization{20, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 

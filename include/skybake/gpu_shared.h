@@ -40,6 +40,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_CLOUD_SUN_LIGHT 21     // bool: the Sun lights the clouds (off: every band in the Earth's shadow)
 #define SPEC_CLOUD_LIGHT_VOLUME 22  // bool: the light march's far part read from the frame's light volume (clouds.h)
 #define SPEC_GROUND_CLOUD_SHADOW 23  // bool: the clouds' shadow on the ground below the horizon (GpuClouds.ground_shadow.x > 0)
+#define SPEC_TEXEL_VIEWS 24          // bool: the reads go through the texel views (off: a buffer has more texels than the device's texel buffers hold)
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere
@@ -52,6 +53,14 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define BINDING_CLOUD_NOISE 7      // storage float[], per layer: shape volume, detail volume, weather map
 #define BINDING_CLOUD_LUT 8        // storage vec4[], aerial perspective LUT, then the ambient light table
 #define BINDING_DISPATCH 9         // storage SkyPush[], each dispatch's constants (the push constant is its index)
+// Texel views (uniform texel buffers) of the storage buffers above, the
+// same bytes, for the shaders' reads (SPEC_TEXEL_VIEWS; SkyRenderer::TexelViewRange).
+#define BINDING_CLOUD_NOISE_TEXELS 10     // samplerBuffer, R32_SFLOAT: BINDING_CLOUD_NOISE
+#define BINDING_CLOUD_TABLE_TEXELS 11     // samplerBuffer, R32G32B32A32_SFLOAT: BINDING_CLOUD_LUT's tables (not the panorama after them)
+#define BINDING_TRANSMITTANCE_TEXELS 12   // samplerBuffer, R32G32B32A32_SFLOAT: BINDING_TRANSMITTANCE
+#define BINDING_MULTISCATTERING_TEXELS 13 // samplerBuffer, R32G32B32A32_SFLOAT: BINDING_MULTISCATTERING
+#define BINDING_SKYVIEW_TEXELS 14         // usamplerBuffer, R32G32_UINT: BINDING_SKYVIEW's 64-bit words
+#define TEXEL_VIEW_COUNT 5                // bindings BINDING_CLOUD_NOISE_TEXELS on
 
 // Output mappings (SkyPush.view.x).
 #define MAPPING_LATLONG 0      // OpenEXR latlong, 2N x N, Imf::LatLongMap

@@ -46,6 +46,10 @@ struct ShaderSwitches {
   // SKYBAKE_TWILIGHT_ROWS=0: a twilight frame's views wholly with the twilight pipeline, not only the rows
   // that can hold a marched texel (SkyRenderer::TwilightRows)
   bool twilight_rows = true;
+  // SKYBAKE_TEXEL_VIEWS=0: the shaders read the LUTs, the cloud noise and the cloud tables from their
+  // storage buffers, not through the texel views (SPEC_TEXEL_VIEWS), as on a device whose texel buffers
+  // are too small for them
+  bool texel_views = true;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
@@ -178,6 +182,8 @@ class SkyRenderer {
 
   const std::vector<PassTiming>& last_timings() const { return timings_; }
   const RenderCounters& counters() const { return counters_; }
+  // Whether the shaders read through the texel views (SPEC_TEXEL_VIEWS).
+  bool reads_texel_views() const { return texel_views_whole_; }
 
  private:
   struct Buffer {
@@ -215,6 +221,15 @@ class SkyRenderer {
   void CreateDescriptorSet();  // the layouts, the pool and the set of kBindingCount bindings
 
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
+  // The texel view of binding BINDING_CLOUD_NOISE_TEXELS + i over its buffer,
+  // made again (after its buffer was), its descriptor not written.
+  void CreateTexelView(int i);
+  struct TexelRange {
+    const Buffer* buffer;
+    VkFormat format;
+    VkDeviceSize texel_bytes, texels;
+  };
+  TexelRange TexelViewRange(int i) const;
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
   void EnsureCloudLutCapacity(size_t texels);  // the cloud tables and the panorama after them
@@ -295,7 +310,7 @@ class SkyRenderer {
   std::unique_ptr<SpectralSky> spectral_;
   void SyncSpectral();
 
-  static constexpr uint32_t kBindingCount = 10;  // bindings 0..9 of gpu_shared.h
+  static constexpr uint32_t kBindingCount = 15;  // bindings 0..14 of gpu_shared.h
 
   VulkanContext& context_;
   gpu::GpuAtmosphere gpu_atmosphere_{};
@@ -326,6 +341,11 @@ class SkyRenderer {
   Buffer skyview_buffer_;
   Buffer clouds_buffer_;       // GpuClouds
   Buffer cloud_noise_buffer_;  // noise volumes and weather maps
+  // The texel views of BINDING_CLOUD_NOISE_TEXELS on (gpu_shared.h), and
+  // whether each holds its whole range and the shaders read them
+  // (SPEC_TEXEL_VIEWS; off, each is one texel, never read).
+  VkBufferView texel_views_[TEXEL_VIEW_COUNT] = {};
+  bool texel_views_whole_ = false;
   Buffer cloud_lut_buffer_;    // aerial-perspective LUT and ambient table
   Buffer dispatch_buffer_;     // a submission's SkyPush constants, one per dispatch (BINDING_DISPATCH)
   std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
@@ -349,6 +369,7 @@ class SkyRenderer {
   VkPipeline marched_light_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the light volume
   bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
   bool twilight_rows_ = true;                            // ShaderSwitches::twilight_rows
+  bool texel_views_allowed_ = true;                      // ShaderSwitches::texel_views
   // TwilightRows per view shape (mapping, width, height, face).
   std::vector<std::pair<ViewRequest, std::vector<RowRange>>> twilight_row_runs_;
   VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
