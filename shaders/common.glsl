@@ -15,7 +15,10 @@
 
 layout(local_size_x = SKYBAKE_LOCAL_SIZE_X, local_size_y = SKYBAKE_LOCAL_SIZE_Y) in;
 
-layout(std430, set = 0, binding = BINDING_ATMOSPHERE) readonly buffer AtmosphereBlock {
+// A uniform block: lavapipe reads a uniform block's member at an offset the
+// same for every lane once, a storage buffer's lane by lane (the LUT reads
+// take the LUT sizes from it).
+layout(std140, set = 0, binding = BINDING_ATMOSPHERE) uniform AtmosphereBlock {
   GpuAtmosphere gpu_atmosphere;
 };
 layout(std430, set = 0, binding = BINDING_TRANSMITTANCE) buffer TransmittanceBuffer {

@@ -36,13 +36,15 @@
 namespace skybake {
 namespace {
 
-// Of the bindings of gpu_shared.h, the AOAS and cloud blocks are uniform
-// buffers, the texel views uniform texel buffers and the rest storage buffers.
+// Of the bindings of gpu_shared.h, the atmosphere, AOAS and cloud blocks are
+// uniform buffers, the texel views uniform texel buffers and the rest storage
+// buffers.
 bool IsTexelView(uint32_t binding) {
   return binding >= BINDING_CLOUD_NOISE_TEXELS && binding < BINDING_CLOUD_NOISE_TEXELS + TEXEL_VIEW_COUNT;
 }
 VkDescriptorType BindingType(uint32_t binding) {
-  if (binding == BINDING_AOAS || binding == BINDING_CLOUDS) return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+  if (binding == BINDING_ATMOSPHERE || binding == BINDING_AOAS || binding == BINDING_CLOUDS)
+    return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
   if (IsTexelView(binding)) return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
   return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 }
@@ -113,7 +115,7 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
 
   // Every buffer a texel view reads (gpu_shared.h) is a texel buffer too.
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
-  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), storage);
+  atmosphere_buffer_ = CreateBuffer(sizeof(gpu::GpuAtmosphere), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
   aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
@@ -247,9 +249,9 @@ void SkyRenderer::CreateDescriptorSet() {
   set_layout_ = layouts.set;
   pipeline_layout_ = layouts.pipeline;
 
-  VkDescriptorPoolSize pool_sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2},
+  VkDescriptorPoolSize pool_sizes[3] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3},
                                         {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, TEXEL_VIEW_COUNT},
-                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 2 - TEXEL_VIEW_COUNT}};
+                                        {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindingCount - 3 - TEXEL_VIEW_COUNT}};
   VkDescriptorPoolCreateInfo pool_info{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
   pool_info.maxSets = 1;
   pool_info.poolSizeCount = 3;
