@@ -391,6 +391,13 @@ std::string Layer(double altitude_m, double thickness_m, const std::string& extr
   return fmt::format("[[cloud_layer]]\naltitude_m = {}\nthickness_m = {}\n{}\n", altitude_m, thickness_m, extra);
 }
 
+// A named style (cloud layers after kFast) rendered at one sun elevation (deg).
+struct StyleAtSun {
+  const char* name;
+  std::string toml;
+  double sun;
+};
+
 INSTANTIATE_TEST_SUITE_P(
     Cases, CloudHardCase,
     ::testing::Values(
@@ -747,12 +754,7 @@ TEST(CloudSkip, CellMaximaBoundEveryReadOfTheirCell) {
 // overcast deck, two overlapping layers with shear, a thin high layer, and
 // the observer inside and above the layers, at a high, a low and a set sun.
 TEST(CloudSkip, SkippingEmptySpaceKeepsTheBytes) {
-  struct SkipCase {
-    const char* name;
-    std::string toml;
-    double sun;
-  };
-  const std::vector<SkipCase> cases = {
+  const std::vector<StyleAtSun> cases = {
       {"W3 cumulus", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"), 30.0},
       {"W3 cumulus, low sun", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45"), 4.0},
       {"overcast stratus", Layer(800, 600, "type = \"stratus\"\ncoverage = 1.0"), 45.0},
@@ -762,7 +764,7 @@ TEST(CloudSkip, SkippingEmptySpaceKeepsTheBytes) {
       {"observer inside", "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
       {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
   };
-  for (const SkipCase& c : cases) {
+  for (const StyleAtSun& c : cases) {
     const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
     auto render = [&](bool skip) {
       CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
@@ -864,12 +866,7 @@ TEST(CloudEarthShadow, ShadowedFramesSkipTheLightMarchWithTheSameBytes) {
 // W3's cumulus with the ground's cloud shadow, two bands and a cirrus in
 // twilight, and the observer above the layers.
 TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
-  struct ViewCase {
-    const char* name;
-    std::string toml;
-    double sun;
-  };
-  const std::vector<ViewCase> cases = {
+  const std::vector<StyleAtSun> cases = {
       {"clear, day", "", 30.0},
       {"clear, twilight", "", -4.0},
       {"W3 cumulus, ground shadow", "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
@@ -881,7 +878,7 @@ TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
        -2.0},
       {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
   };
-  for (const ViewCase& c : cases) {
+  for (const StyleAtSun& c : cases) {
     const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
     auto render = [&](bool texel_views) {
       ShaderSwitches shaders;
