@@ -2,6 +2,9 @@
 // layer the other tests rely on is really listening.
 #include <filesystem>
 #include <string>
+#include <thread>
+#include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -71,6 +74,50 @@ TEST(VulkanDriversTest, OnlyLavapipeWithoutAGpuDeviceNodeUnlessTheUserChose) {
   no_lavapipe.manifests = {"intel_icd.x86_64.json", "radeon_icd.x86_64.json"};
   EXPECT_EQ(SoftwareDriverSelection(no_lavapipe), "");  // leave the loader to find whatever exists
   EXPECT_EQ(SoftwareDriverSelection(DriverEnvironment{}), "");
+}
+
+TEST(VulkanDriversTest, LavapipeGetsTwiceTheHardwareThreadsUnlessTheUserSetACount) {
+  EXPECT_EQ(LavapipeThreadCount({}, 2), "4");
+  EXPECT_EQ(LavapipeThreadCount({}, 16), "32");
+  EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", ""}}, 2), "4");  // empty: as if unset
+  EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "3"}}, 2), "");  // the user's count stays
+  EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "0"}}, 8), "");
+  EXPECT_EQ(LavapipeThreadCount({}, 0), "");                         // hardware threads unknown
+}
+
+// The CLI sets lavapipe's thread count when the user set none and keeps
+// the user's, and a cloudy bake is the same bytes with 1 thread, the
+// count the CLI chose and 5: a thread count changes only the time.
+TEST(VulkanDriversTest, LavapipeThreadCountChangesNoByte) {
+  const unsigned hardware = std::thread::hardware_concurrency();
+  ASSERT_GT(hardware, 0u);
+  const std::string chosen = "(lavapipe: " + std::to_string(2 * hardware) + " threads";
+  testing::CommandRun devices = testing::RunSkybake("devices", "LP_NUM_THREADS=");
+  ASSERT_EQ(devices.exit_code, 0) << devices.output;
+  const bool lavapipe = devices.output.find("llvmpipe") != std::string::npos;
+  EXPECT_EQ(devices.output.find(chosen) != std::string::npos, lavapipe) << devices.output;
+  testing::CommandRun users = testing::RunSkybake("devices", "LP_NUM_THREADS=3");
+  ASSERT_EQ(users.exit_code, 0) << users.output;
+  EXPECT_EQ(users.output.find("(lavapipe:"), std::string::npos) << users.output;
+
+  const std::string dir = testing::FreshTempDir("lavapipe_threads");
+  const std::string style = testing::SourceDir() +
+                            "/configs/styles/cumulus_sunset.toml --size 48 --vulkan-validation --set output.preview=false";
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"one", "LP_NUM_THREADS=1"}, {"chosen", "LP_NUM_THREADS="}, {"five", "LP_NUM_THREADS=5"}};
+  for (const auto& [name, environment] : runs) {
+    testing::CommandRun run = testing::RunSkybake("bake " + style + " --out " + dir + "/" + name, environment);
+    ASSERT_EQ(run.exit_code, 0) << name << ": " << run.output;
+    const bool reported = run.output.find("lavapipe threads " + std::to_string(2 * hardware)) != std::string::npos;
+    EXPECT_EQ(reported, lavapipe && name == "chosen") << name << ": " << run.output;
+  }
+  for (const char* file : {"sky_latlong.exr", "sky_cube.exr", "sky_px.exr", "sky_ny.exr"}) {
+    const std::string one = testing::ReadFileBytes(dir + "/one/" + file);
+    ASSERT_FALSE(one.empty()) << file;
+    EXPECT_EQ(one, testing::ReadFileBytes(dir + "/chosen/" + file)) << file;
+    EXPECT_EQ(one, testing::ReadFileBytes(dir + "/five/" + file)) << file;
+  }
+  std::filesystem::remove_all(dir);
 }
 
 // The CLI asks the loader for lavapipe alone exactly when this machine

@@ -11,6 +11,7 @@
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -18,6 +19,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -72,7 +74,7 @@ bool EnvIs(const char* name, const char* value) {
   return v && std::string(v) == value;
 }
 
-int RunDevices(const std::string& software_driver_selection) {
+int RunDevices(const std::string& software_driver_selection, const std::string& lavapipe_threads) {
   std::vector<DeviceInfo> devices = VulkanContext::ListDevices();
   if (devices.empty()) {
     std::fprintf(stderr,
@@ -87,6 +89,11 @@ int RunDevices(const std::string& software_driver_selection) {
   if (!software_driver_selection.empty())
     std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
                 "every installed driver)\n");
+  const bool lavapipe = std::any_of(devices.begin(), devices.end(),
+                                    [](const DeviceInfo& d) { return d.name.find("llvmpipe") != std::string::npos; });
+  if (lavapipe && !lavapipe_threads.empty())
+    std::printf("(lavapipe: %s threads, twice the hardware threads; LP_NUM_THREADS sets another count)\n",
+                lavapipe_threads.c_str());
   return kExitOk;
 }
 
@@ -109,8 +116,9 @@ struct BakeArgs {
   ShaderSwitches shaders;  // from the environment (main)
   std::string engine;    // --engine NAME: output.engine
   // From the environment (main, ReadEnvironment): the loader's driver
-  // choice, the default star catalogue.
+  // choice, lavapipe's thread count, the default star catalogue.
   std::string software_driver_selection;
+  std::string lavapipe_threads;  // LP_NUM_THREADS main set, or ""
   std::string star_catalogue = DefaultStarCataloguePath();
 };
 
@@ -247,6 +255,7 @@ void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part,
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation;
   options.vulkan.software_driver_selection = args.software_driver_selection;
+  options.vulkan.lavapipe_threads = args.lavapipe_threads;
   options.shaders = args.shaders;
   options.star_catalogue = args.star_catalogue;
   // A frame's files are printed as they are recorded, and not kept: a long
@@ -357,6 +366,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.bake.vulkan.device_index = args.device;
   options.bake.vulkan.validation = args.validation;
   options.bake.vulkan.software_driver_selection = args.software_driver_selection;
+  options.bake.vulkan.lavapipe_threads = args.lavapipe_threads;
   options.bake.shaders = args.shaders;
   options.bake.star_catalogue = args.star_catalogue;
   options.bake.force = args.force;
@@ -559,6 +569,9 @@ void ReadEnvironment(BakeArgs& args) {
   args.software_driver_selection = SoftwareDriverSelection(ProbeDriverEnvironment(variables));
   if (!args.software_driver_selection.empty())
     ::setenv("VK_LOADER_DRIVERS_SELECT", args.software_driver_selection.c_str(), 1);
+  // Lavapipe reads LP_NUM_THREADS when its device is made.
+  args.lavapipe_threads = LavapipeThreadCount(variables, std::thread::hardware_concurrency());
+  if (!args.lavapipe_threads.empty()) ::setenv("LP_NUM_THREADS", args.lavapipe_threads.c_str(), 1);
   if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) SetOiioModuleDir(dir);
   if (const char* catalogue = std::getenv("SKYBAKE_STAR_CATALOGUE"); catalogue && *catalogue)
     args.star_catalogue = catalogue;
@@ -571,7 +584,7 @@ void ReadEnvironment(BakeArgs& args) {
 }
 
 int RunCommand(Cli& cli) {
-  if (cli.devices->parsed()) return RunDevices(cli.args.software_driver_selection);
+  if (cli.devices->parsed()) return RunDevices(cli.args.software_driver_selection, cli.args.lavapipe_threads);
   if (cli.accuracy->parsed()) {
     cli.study.progress = [](const std::string& line) { std::fprintf(stderr, "skybake: %s\n", line.c_str()); };
     std::string report = RunAccuracyStudy(cli.study);

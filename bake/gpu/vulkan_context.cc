@@ -157,7 +157,7 @@ const std::vector<std::string>& DriverEnvironmentVariableNames() {
   static const std::vector<std::string> names = {
       "VK_ICD_FILENAMES", "VK_DRIVER_FILES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
       "VK_LOADER_DRIVERS_DISABLE", "SKYBAKE_ALL_VULKAN_DRIVERS", "HOME", "XDG_CONFIG_HOME", "XDG_CONFIG_DIRS",
-      "XDG_DATA_HOME", "XDG_DATA_DIRS"};
+      "XDG_DATA_HOME", "XDG_DATA_DIRS", "LP_NUM_THREADS"};
   return names;
 }
 
@@ -194,6 +194,12 @@ std::string SoftwareDriverSelection(const DriverEnvironment& environment) {
   for (const std::string& manifest : environment.manifests)
     if (StartsWith(manifest, "lvp_icd")) return "*lvp_icd*";
   return "";
+}
+
+std::string LavapipeThreadCount(const EnvironmentVariables& environment, unsigned hardware_threads) {
+  auto it = environment.find("LP_NUM_THREADS");
+  if ((it != environment.end() && !it->second.empty()) || hardware_threads == 0) return "";
+  return std::to_string(2 * hardware_threads);
 }
 
 const char* VkResultName(VkResult result) {

@@ -202,9 +202,13 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   VulkanContext context(options.vulkan);
   std::optional<NightSkyRenderer> night_renderer;  // the moonlit sky's renderer, destroyed before the device
   if (night) night_renderer.emplace(context);
-  timer.Finish("device", fmt::format("{} ({}){}", context.device_info().name, context.device_info().type,
-                                     options.vulkan.software_driver_selection.empty() ? ""
-                                                                         : ", software driver only (no GPU device node)"));
+  timer.Finish("device", fmt::format("{} ({}){}{}", context.device_info().name, context.device_info().type,
+                                     options.vulkan.software_driver_selection.empty()
+                                         ? ""
+                                         : ", software driver only (no GPU device node)",
+                                     options.vulkan.lavapipe_threads.empty()
+                                         ? ""
+                                         : fmt::format(", lavapipe threads {}", options.vulkan.lavapipe_threads)));
   CheckDeviceLimits(plan, context);
 
   RendererCache renderers(context, result, options.shaders);

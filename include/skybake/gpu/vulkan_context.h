@@ -68,8 +68,8 @@ struct DriverEnvironment {
 
 // The environment variables the driver choice reads (VK_ICD_FILENAMES,
 // VK_DRIVER_FILES, VK_ADD_DRIVER_FILES, VK_LOADER_DRIVERS_SELECT/_DISABLE,
-// SKYBAKE_ALL_VULKAN_DRIVERS, and HOME and XDG_* for the manifest folders),
-// by name; a name that is not set is absent. main reads them (the library
+// SKYBAKE_ALL_VULKAN_DRIVERS, HOME and XDG_* for the manifest folders, and
+// LP_NUM_THREADS for lavapipe's thread count), by name; a name that is not set is absent. main reads them (the library
 // reads no environment).
 using EnvironmentVariables = std::map<std::string, std::string>;
 const std::vector<std::string>& DriverEnvironmentVariableNames();
@@ -84,6 +84,15 @@ DriverEnvironment ProbeDriverEnvironment(const EnvironmentVariables& environment
 // before any Vulkan call and any thread starts, and passes it in as
 // VulkanOptions::software_driver_selection.
 std::string SoftwareDriverSelection(const DriverEnvironment& environment);
+
+// The LP_NUM_THREADS main sets for lavapipe when the user set none (absent
+// or empty in `environment`): twice `hardware_threads`, or "" to leave it.
+// Lavapipe's own default, one thread per core, leaves cores idle between
+// its work items; twice as many keep them busy, with the same user CPU time
+// and the same bytes in every file (docs/performance.md, "Lavapipe
+// threads"). Lavapipe caps the count at its own maximum. "" also when
+// `hardware_threads` is 0 (unknown) or the user's value is set.
+std::string LavapipeThreadCount(const EnvironmentVariables& environment, unsigned hardware_threads);
 
 // The layouts of a compute pipeline with one descriptor set of `bindings`
 // and one push-constant block of `push_bytes` bytes; the caller destroys both.
@@ -106,6 +115,9 @@ struct VulkanOptions {
   // The VK_LOADER_DRIVERS_SELECT main set (SoftwareDriverSelection), or ""
   // when every driver is loaded; reported with the device.
   std::string software_driver_selection;
+  // The LP_NUM_THREADS main set (LavapipeThreadCount), or "" when it set
+  // none; reported with the device.
+  std::string lavapipe_threads;
 };
 
 class VulkanContext {
