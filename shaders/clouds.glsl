@@ -271,11 +271,9 @@ float CloudExtinction(vec2 xz, float h, bool detail) {
 // clouds.h): per layer the maximum of its weather map over each cell between
 // 2 x 2 texel centres, then of its shape volume over each cell between 2^3
 // voxel centres (one cell per texel).
-int CloudSkipCells(int n) { return n; }
 int CloudSkipFirst(int l) {
   int ns = gpu_clouds.resolution.x, nd = gpu_clouds.resolution.y, nw = gpu_clouds.resolution.z;
-  int wc = CloudSkipCells(nw), sc = CloudSkipCells(ns);
-  return gpu_clouds.counts.x * (ns * ns * ns + nd * nd * nd + nw * nw) + l * (wc * wc + sc * sc * sc);
+  return gpu_clouds.counts.x * (ns * ns * ns + nd * nd * nd + nw * nw) + l * (nw * nw + ns * ns * ns);
 }
 // The cells that hold coordinates u (wrapped) of n-texel axes: the read's
 // first texels, as SampleVolume and SampleMap find them; `edge` is set where

@@ -194,8 +194,6 @@ size_t CloudNoiseFloats(const gpu::GpuClouds& c) {
   return std::max<size_t>(CloudSkipFirst(c) + layers * CloudSkipFloatsPerLayer(c), 4);
 }
 
-int CloudSkipCells(int resolution) { return resolution; }
-
 size_t CloudSkipFirst(const gpu::GpuClouds& c) {
   const size_t per_layer = size_t(c.resolution.x) * c.resolution.x * c.resolution.x +
                            size_t(c.resolution.y) * c.resolution.y * c.resolution.y +
@@ -204,8 +202,8 @@ size_t CloudSkipFirst(const gpu::GpuClouds& c) {
 }
 
 size_t CloudSkipFloatsPerLayer(const gpu::GpuClouds& c) {
-  const size_t wc = size_t(CloudSkipCells(c.resolution.z)), sc = size_t(CloudSkipCells(c.resolution.x));
-  return wc * wc + sc * sc * sc;
+  const size_t nw = size_t(c.resolution.z), ns = size_t(c.resolution.x);
+  return nw * nw + ns * ns * ns;  // one cell per texel
 }
 
 namespace {
@@ -239,9 +237,8 @@ void FillCloudSkipMaps(const gpu::GpuClouds& c, float* noise) {
     weather = CellMaxAlong(CellMaxAlong(weather, {nw, nw, 1}, 0), {nw, nw, 1}, 1);
     std::copy(weather.begin(), weather.end(), out);
     float* shape_out = out + weather.size();
-    const int sc = CloudSkipCells(ns);
     if (layer.weather.w > 1.5f) {
-      std::fill(shape_out, shape_out + size_t(sc) * sc * sc, 1.0f);
+      std::fill(shape_out, shape_out + size_t(ns) * ns * ns, 1.0f);
       continue;
     }
     std::vector<float> shape(noise + layer.noise.x, noise + layer.noise.x + size_t(ns) * ns * ns);

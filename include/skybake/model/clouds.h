@@ -208,14 +208,13 @@ size_t CloudNoiseFloats(const gpu::GpuClouds& clouds);
 // every layer's noise in the noise buffer: per layer its weather map's
 // maximum over each cell between 2 x 2 texel centres, then its shape
 // volume's over each cell between 2^3 voxel centres (cell i along an axis:
-// texels i and i + 1, wrapping as the noise tiles; CloudSkipCells(n) = n).
+// texels i and i + 1, wrapping as the noise tiles: one cell per texel).
 // Those are exactly the texels a bilinear (trilinear) read at a point of the
 // cell reads, so the bound is the tightest a maximum can be; a point within
 // CLOUD_SKIP_EDGE of a cell's edge is not bounded (rounding could put the
 // read in the next cell) and is marched. Where the weather and shape maxima
 // times the height profile stay below Schneider's coverage threshold,
 // LayerExtinction is 0 and the march skips the density.
-int CloudSkipCells(int resolution);
 size_t CloudSkipFirst(const gpu::GpuClouds& clouds);  // the first float of layer 0's bounds
 size_t CloudSkipFloatsPerLayer(const gpu::GpuClouds& clouds);
 // Writes every layer's bounds from its noise (`noise`: CloudNoiseFloats
