@@ -247,17 +247,24 @@ void PrintFiles(const std::vector<BakedFile>& files) {
 }
 
 // The bake's options from the command line (and the environment main read).
-void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, BakeOptions& options) {
-  options.out_dir = args.out_dir;
-  options.force = args.force;
-  options.resume = args.resume;
-  options.frames = part;
+// The device, its driver and thread count, the shader switches and the
+// star catalogue: what every command that bakes takes from the arguments
+// and the environment alike.
+void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation;
   options.vulkan.software_driver_selection = args.software_driver_selection;
   options.vulkan.lavapipe_threads = args.lavapipe_threads;
   options.shaders = args.shaders;
   options.star_catalogue = args.star_catalogue;
+}
+
+void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, BakeOptions& options) {
+  options.out_dir = args.out_dir;
+  options.force = args.force;
+  options.resume = args.resume;
+  options.frames = part;
+  SetDeviceOptions(args, options);
   // A frame's files are printed as they are recorded, and not kept: a long
   // sequence's memory stays flat.
   options.keep_frame_records = false;
@@ -363,12 +370,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.latlong_height = gallery.size;
   options.columns = gallery.columns;
   options.overrides = args.overrides;
-  options.bake.vulkan.device_index = args.device;
-  options.bake.vulkan.validation = args.validation;
-  options.bake.vulkan.software_driver_selection = args.software_driver_selection;
-  options.bake.vulkan.lavapipe_threads = args.lavapipe_threads;
-  options.bake.shaders = args.shaders;
-  options.bake.star_catalogue = args.star_catalogue;
+  SetDeviceOptions(args, options.bake);
   options.bake.force = args.force;
   size_t done = 0;
   if (!args.quiet) {
