@@ -83,6 +83,11 @@ TEST(VulkanDriversTest, LavapipeGetsTwiceTheHardwareThreadsUnlessTheUserSetACoun
   EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "3"}}, 2), "");  // the user's count stays
   EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "0"}}, 8), "");
   EXPECT_EQ(LavapipeThreadCount({}, 0), "");                         // hardware threads unknown
+  DeviceInfo device;
+  device.name = "llvmpipe (LLVM 15.0.6, 256 bits)";
+  EXPECT_TRUE(IsLavapipe(device));  // the count is reported only with lavapipe's device
+  device.name = "AMD Radeon RX 6600 (RADV NAVI23)";
+  EXPECT_FALSE(IsLavapipe(device));
 }
 
 // The CLI sets lavapipe's thread count when the user set none and keeps

@@ -89,8 +89,7 @@ int RunDevices(const std::string& software_driver_selection, const std::string& 
   if (!software_driver_selection.empty())
     std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
                 "every installed driver)\n");
-  const bool lavapipe = std::any_of(devices.begin(), devices.end(),
-                                    [](const DeviceInfo& d) { return d.name.find("llvmpipe") != std::string::npos; });
+  const bool lavapipe = std::any_of(devices.begin(), devices.end(), IsLavapipe);
   if (lavapipe && !lavapipe_threads.empty())
     std::printf("(lavapipe: %s threads, twice the hardware threads; LP_NUM_THREADS sets another count)\n",
                 lavapipe_threads.c_str());

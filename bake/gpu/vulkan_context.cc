@@ -196,6 +196,8 @@ std::string SoftwareDriverSelection(const DriverEnvironment& environment) {
   return "";
 }
 
+bool IsLavapipe(const DeviceInfo& device) { return device.name.find("llvmpipe") != std::string::npos; }
+
 std::string LavapipeThreadCount(const EnvironmentVariables& environment, unsigned hardware_threads) {
   auto it = environment.find("LP_NUM_THREADS");
   if ((it != environment.end() && !it->second.empty()) || hardware_threads == 0) return "";

@@ -206,7 +206,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
                                      options.vulkan.software_driver_selection.empty()
                                          ? ""
                                          : ", software driver only (no GPU device node)",
-                                     options.vulkan.lavapipe_threads.empty()
+                                     options.vulkan.lavapipe_threads.empty() || !IsLavapipe(context.device_info())
                                          ? ""
                                          : fmt::format(", lavapipe threads {}", options.vulkan.lavapipe_threads)));
   CheckDeviceLimits(plan, context);

@@ -52,6 +52,10 @@ struct DeviceInfo {
   std::string rejected_because;  // empty when usable
 };
 
+// Mesa's lavapipe, the software driver LP_NUM_THREADS speaks to (its device
+// is named "llvmpipe (LLVM ...)").
+bool IsLavapipe(const DeviceInfo& device);
+
 // Loading a Vulkan driver costs start-up whether or not it finds a device:
 // the loader opens every installed driver, and Mesa's hardware drivers each
 // link LLVM, whose relocation is most of lavapipe's 0.07-0.09 s device
@@ -69,8 +73,8 @@ struct DriverEnvironment {
 // The environment variables the driver choice reads (VK_ICD_FILENAMES,
 // VK_DRIVER_FILES, VK_ADD_DRIVER_FILES, VK_LOADER_DRIVERS_SELECT/_DISABLE,
 // SKYBAKE_ALL_VULKAN_DRIVERS, HOME and XDG_* for the manifest folders, and
-// LP_NUM_THREADS for lavapipe's thread count), by name; a name that is not set is absent. main reads them (the library
-// reads no environment).
+// LP_NUM_THREADS for lavapipe's thread count), by name; a name that is not
+// set is absent. main reads them (the library reads no environment).
 using EnvironmentVariables = std::map<std::string, std::string>;
 const std::vector<std::string>& DriverEnvironmentVariableNames();
 
@@ -116,7 +120,7 @@ struct VulkanOptions {
   // when every driver is loaded; reported with the device.
   std::string software_driver_selection;
   // The LP_NUM_THREADS main set (LavapipeThreadCount), or "" when it set
-  // none; reported with the device.
+  // none; reported with the device when the device is lavapipe.
   std::string lavapipe_threads;
 };
 
