@@ -40,6 +40,11 @@ layout(constant_id = SPEC_CLOUD_SUN_LIGHT) const bool kCloudSunLight = true;
 // (GpuClouds.light_volume, CloudLightVolumeDepth); off: every light sample
 // marched (the reference, a style of two or more bands, a low Sun).
 layout(constant_id = SPEC_CLOUD_LIGHT_VOLUME) const bool kCloudLightVolume = false;
+// Whether some layer's density is a formation's volume (weather.w 2,
+// CloudFormationDensityOn in clouds.h). Off, that read is compiled out: both
+// sides of an `if` run on lavapipe, so every density call of a style without
+// a formation paid for that volume's trilinear read too.
+layout(constant_id = SPEC_CLOUD_FORMATION) const bool kCloudFormation = true;
 
 // ---------------------------------------------------------------- hashing and tiling noise
 
@@ -228,7 +233,7 @@ float LayerExtinction(int l, vec2 xz, float h, bool detail) {
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
   vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
   float d;
-  if (layer.weather.w > 1.5) {
+  if (kCloudFormation && layer.weather.w > 1.5) {
     // A formation's whole density (cloud_formation.h): its volume, x and y
     // over the lattice as the weather map, z the height fraction (texel
     // centres at the bottom and the top: clamped, not wrapped).
@@ -298,7 +303,7 @@ float LayerCloudMargin(int l, vec2 xz, float h) {
   GpuCloudLayer layer = gpu_clouds.layers[l];
   float hf = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
   bool inside = hf > 0.0 && hf < 1.0;
-  if (layer.weather.w > 1.5) return inside ? 1.0 : -1.0;
+  if (kCloudFormation && layer.weather.w > 1.5) return inside ? 1.0 : -1.0;
   float profile = HeightProfile(layer.profile, hf);
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
   vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
@@ -443,7 +448,7 @@ float LayerLightExtinctionNearest(int l, vec2 xz, float h) {
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
   vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
   float d;
-  if (layer.weather.w > 1.5) {
+  if (kCloudFormation && layer.weather.w > 1.5) {
     float n = float(gpu_clouds.resolution.x);
     d = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x,
                             vec3(weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), weather_uv.y));

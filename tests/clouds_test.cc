@@ -905,5 +905,80 @@ TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
   testing::ExpectNoValidationMessages();
 }
 
+// A style without a formation's density volume (weather.w 2) compiles that
+// read out of its cloud pipelines (SPEC_CLOUD_FORMATION): the same bytes as
+// with it kept (ShaderSwitches::formation_read_always, SKYBAKE_FORMATION_READ=1)
+// in every view, the panorama's and the marched latlong's, explicit
+// directions and the cloud shadow map, for W3's cumulus with the ground's
+// shadow and for two bands with a weather image's coverage. The switch
+// follows the layers (CloudFormationDensityOn: only active layers count),
+// and a renderer built without the read refuses clouds that need it
+// (UpdateClouds false: a sequence builds a new one).
+TEST(CloudFormationRead, CompiledOutWithoutAFormationKeepsTheBytes) {
+  gpu::GpuClouds g{};
+  g.counts.x = 2;
+  g.layers[1].weather.w = 1.0f;  // a weather image's coverage
+  EXPECT_FALSE(CloudFormationDensityOn(g));
+  g.layers[1].weather.w = 2.0f;
+  EXPECT_TRUE(CloudFormationDensityOn(g));
+  g.counts.x = 1;
+  EXPECT_FALSE(CloudFormationDensityOn(g)) << "layer 1 is not active";
+
+  const std::string dir = testing::FreshTempDir("cloud_formation_read");
+  const std::string image = dir + "/weather.png";
+  {
+    std::vector<unsigned char> pixels(32 * 32);
+    for (int y = 0; y < 32; ++y)
+      for (int x = 0; x < 32; ++x) pixels[y * 32 + x] = (x / 8 + y / 8) % 2 ? 230 : 40;
+    auto out = OIIO::ImageOutput::create(image);
+    ASSERT_TRUE(out && out->open(image, OIIO::ImageSpec(32, 32, 1, OIIO::TypeDesc::UINT8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, pixels.data()));
+    out->close();
+  }
+  const std::vector<StyleAtSun> cases = {
+      {"W3 cumulus, ground shadow", "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
+                                         Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
+       30.0},
+      {"two bands, weather image", Layer(1500, 1000, "weather_image = \"" + image + "\"") +
+                                       Layer(6000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
+       20.0},
+  };
+  for (const StyleAtSun& c : cases) {
+    const SkyStyle style = PrunedStyle(Style(std::string(kFast) + c.toml));
+    auto render = [&](bool always) {
+      ShaderSwitches shaders;
+      shaders.formation_read_always = always;
+      CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
+      ApplyGroundCloudShadow(style.cloud_shadow, clouds);
+      EXPECT_FALSE(CloudFormationDensityOn(clouds.uniform)) << c.name;
+      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                    OutputScale(style.output.units), false,
+                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)), clouds, shaders);
+      const int n = 24;
+      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+      const glm::dvec3 sun = Sun(c.sun);
+      std::vector<std::vector<float>> images = r.Render(sun, views);
+      images.push_back(r.Render(sun, {views[0]})[0]);
+      images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, -0.05, -0.8)}));
+      if (style.cloud_shadow.enabled) images.push_back(r.RenderCloudShadow(sun, style.cloud_shadow));
+      // The same clouds are taken; without the read, clouds with a
+      // formation's density are refused before anything changes.
+      EXPECT_TRUE(r.UpdateClouds(clouds)) << c.name;
+      if (!always) {
+        CloudInputs formation = clouds;
+        formation.uniform.layers[0].weather.w = 2.0f;
+        EXPECT_FALSE(r.UpdateClouds(formation)) << c.name;
+      }
+      return images;
+    };
+    const std::vector<std::vector<float>> out = render(false), kept = render(true);
+    ASSERT_EQ(out.size(), kept.size());
+    for (size_t i = 0; i < out.size(); ++i) EXPECT_TRUE(out[i] == kept[i]) << c.name << ", image " << i;
+  }
+  std::filesystem::remove_all(dir);
+  testing::ExpectNoValidationMessages();
+}
+
 }  // namespace
 }  // namespace skybake

@@ -582,6 +582,7 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.shadowed_clouds = !EnvIs("SKYBAKE_SHADOWED_CLOUDS", "0");
   args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
   args.shaders.texel_views = !EnvIs("SKYBAKE_TEXEL_VIEWS", "0");
+  args.shaders.formation_read_always = EnvIs("SKYBAKE_FORMATION_READ", "1");
 }
 
 int RunCommand(Cli& cli) {

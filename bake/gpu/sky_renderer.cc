@@ -98,7 +98,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
       style_pass_(role == Role::kStylePass),
       shadowed_clouds_(shaders.shadowed_clouds),
       twilight_rows_(shaders.twilight_rows),
-      texel_views_allowed_(shaders.texel_views) {
+      texel_views_allowed_(shaders.texel_views),
+      formation_read_always_(shaders.formation_read_always) {
   if (quality.wavelengths > kRgbWavelengths && !output_directions && !style_pass_) {
     spectral_ = std::make_unique<SpectralSky>(context, atmosphere, quality, effects, aoas, clouds, shaders);
     SyncSpectral();
@@ -130,6 +131,7 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   std::memcpy(clouds_buffer_.mapped, &gpu_clouds_, sizeof(gpu_clouds_));
   // The light volume (clouds.h, CloudLightVolume) after the noise.
   cloud_light_volume_ = cloud_layers_ > 0 && CloudLightVolumeOn(gpu_clouds_);
+  cloud_formation_ = cloud_layers_ > 0 && CloudFormationRead(gpu_clouds_);
   cloud_noise_buffer_ = CreateBuffer(
       cloud_layers_ > 0
           ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_) + (cloud_light_volume_ ? CloudLightVolumeFloats(gpu_clouds_) : 0)) * 4
@@ -674,23 +676,25 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t integrator;
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
-    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow, texel_views;
+    VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow, texel_views, cloud_formation;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
               quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
               twilight_march,               cloud_sun_light, cloud_light_volume,
-              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f, texel_views_whole_};
-  const VkSpecializationMapEntry entries[20] = {
+              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f, texel_views_whole_,
+              cloud_formation_};
+  const VkSpecializationMapEntry entries[21] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
       {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
       {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
-      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4}};
-  VkSpecializationInfo specialization{20, entries, sizeof(values), &values};
+      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4},
+      {SPEC_CLOUD_FORMATION, 80, 4}};
+  VkSpecializationInfo specialization{21, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
 }
 
@@ -1248,6 +1252,10 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
   return true;
 }
 
+bool SkyRenderer::CloudFormationRead(const gpu::GpuClouds& clouds) const {
+  return formation_read_always_ || CloudFormationDensityOn(clouds);
+}
+
 bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   if (spectral_) return spectral_->UpdateClouds(clouds);
   const gpu::GpuClouds& c = clouds.uniform;
@@ -1255,6 +1263,7 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
   if (output_directions_ || c.counts.x != cloud_layers_ || !same(c.resolution, gpu_clouds_.resolution) ||
       !same(c.lut, gpu_clouds_.lut) || !same(c.light_volume, gpu_clouds_.light_volume) ||
       (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_) ||
+      (cloud_layers_ > 0 && CloudFormationRead(c) != cloud_formation_) ||  // SPEC_CLOUD_FORMATION
       (c.ground_shadow.x > 0.0f) != (gpu_clouds_.ground_shadow.x > 0.0f))  // kGroundCloudShadow's pipelines
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.

@@ -364,6 +364,12 @@ bool CloudLightVolumeOn(const gpu::GpuClouds& c) {
   return c.counts.x > 0 && c.light_volume.x > 0 && c.resolution.w == 1;
 }
 
+bool CloudFormationDensityOn(const gpu::GpuClouds& c) {
+  for (int l = 0; l < std::min(c.counts.x, CLOUD_MAX_LAYERS); ++l)
+    if (c.layers[l].weather.w > 1.5f) return true;
+  return false;
+}
+
 bool CloudLightVolumeForSun(const gpu::GpuClouds& c, double sun_y) {
   return CloudLightVolumeOn(c) && sun_y >= std::sin(kCloudLightVolumeMinElevationDeg * M_PI / 180.0);
 }

@@ -41,6 +41,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_CLOUD_LIGHT_VOLUME 22  // bool: the light march's far part read from the frame's light volume (clouds.h)
 #define SPEC_GROUND_CLOUD_SHADOW 23  // bool: the clouds' shadow on the ground below the horizon (GpuClouds.ground_shadow.x > 0)
 #define SPEC_TEXEL_VIEWS 24          // bool: the reads go through the texel views (off: a buffer has more texels than the device's texel buffers hold)
+#define SPEC_CLOUD_FORMATION 25      // bool: some layer's density is a formation's volume (GpuCloudLayer.weather.w = 2; CloudFormationDensityOn)
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere

@@ -50,6 +50,9 @@ struct ShaderSwitches {
   // storage buffers, not through the texel views (SPEC_TEXEL_VIEWS), as on a device whose texel buffers
   // are too small for them
   bool texel_views = true;
+  // SKYBAKE_FORMATION_READ=1: the cloud pipelines keep a formation's density read (SPEC_CLOUD_FORMATION)
+  // even when no layer has one, as the generic build did
+  bool formation_read_always = false;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
@@ -329,6 +332,8 @@ class SkyRenderer {
   bool cloud_tables_ready_ = false;
   glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
   bool cloud_light_volume_ = false;  // cloud_pipeline_ reads the light volume (CloudLightVolumeOn)
+  bool cloud_formation_ = false;     // the cloud pipelines read a formation's density (CloudFormationRead)
+  bool CloudFormationRead(const gpu::GpuClouds& clouds) const;
   bool cloud_light_volume_ready_ = false;
   glm::dvec3 cloud_light_volume_sun_{0.0};  // the sun the light volume holds
   std::vector<float> cloud_weather_images_;
@@ -370,6 +375,7 @@ class SkyRenderer {
   bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
   bool twilight_rows_ = true;                            // ShaderSwitches::twilight_rows
   bool texel_views_allowed_ = true;                      // ShaderSwitches::texel_views
+  bool formation_read_always_ = false;                   // ShaderSwitches::formation_read_always
   // TwilightRows per view shape (mapping, width, height, face).
   std::vector<std::pair<ViewRequest, std::vector<RowRange>>> twilight_row_runs_;
   VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass

@@ -184,6 +184,10 @@ size_t CloudLightVolumeFloats(const gpu::GpuClouds& clouds);
 // Whether a frame with the Sun at `sun_y` (the sine of its elevation) reads
 // the light volume: on, one band, the Sun high enough.
 bool CloudLightVolumeOn(const gpu::GpuClouds& clouds);
+// Whether some layer's density is a cloud formation's volume (weather.w = 2,
+// cloud_formation.h); off, the shaders compile that read out
+// (SPEC_CLOUD_FORMATION).
+bool CloudFormationDensityOn(const gpu::GpuClouds& clouds);
 bool CloudLightVolumeForSun(const gpu::GpuClouds& clouds, double sun_y);
 
 // What the renderer needs: the uniform block, the weather images (R channel,
