@@ -567,9 +567,14 @@ void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 su
   float rb = atm.bottom_radius + bottom;
   float y = sqrt(max(rb * rb - dot(foot, foot), 0.0));
   float mu = dot(vec3(foot.x, y, foot.y), sun) / rb;
-  int substeps = int(gpu_clouds.light_volume_grid.z);  // kCloudLightVolumeSubsteps (clouds.h)
+  const int substeps = CLOUD_LIGHT_VOLUME_SUBSTEPS;  // kCloudLightVolumeSubsteps (clouds.h)
   for (int k = 0; k < n; ++k) cloud_noise[first + k] = 0.0;
   int total = (n - 1) * substeps;
+  // The interval being summed (its slice, 0: none yet) and its sum so far,
+  // stored when the march moves on to the next interval with cloud: the
+  // slices only grow along the column, so each is stored once.
+  int slice = 0;
+  float sum = 0.0;
   for (int next = 0; next < total;) {
     int m = next;
     vec2 xz = vec2(0.0);
@@ -586,8 +591,15 @@ void ComputeCloudLightColumn(IN(AtmosphereParameters) atm, int i, int j, vec3 su
     }
     if (m >= total) break;
     next = m + 1;
-    cloud_noise[first + 1 + m / substeps] += CloudLightExtinction(xz, h, true) * ds;
+    int k = 1 + m / substeps;
+    if (k != slice) {
+      if (slice > 0) cloud_noise[first + slice] = sum;
+      slice = k;
+      sum = 0.0;
+    }
+    sum += CloudLightExtinction(xz, h, true) * ds;
   }
+  if (slice > 0) cloud_noise[first + slice] = sum;
   float depth = 0.0;
   for (int k = 1; k < n; ++k) {
     depth += cloud_noise[first + k];

@@ -179,6 +179,9 @@ SKYBAKE_GPU_STRUCT(SkyPush) {
 // which a bilinear or trilinear read at any point of it touches alone). A point within this
 // fraction of a cell of its edge is not bounded (rounding could put the read in the next cell).
 #define CLOUD_SKIP_EDGE 1e-3
+// The light volume's column march (clouds.glsl, ComputeCloudLightColumn): samples per slice interval.
+// Compiled in: a per-lane integer division by a uniform is a scalar division per lane on lavapipe.
+#define CLOUD_LIGHT_VOLUME_SUBSTEPS 1
 
 SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
   vec4 shell;           // x: bottom altitude km; y: top altitude km; z: extinction at full density km^-1; w: albedo
@@ -215,7 +218,8 @@ SKYBAKE_GPU_STRUCT(GpuClouds) {
   // float of the volume in the noise buffer.
   ivec4 light_volume;
   // x: L, km, and y: U of the columns' warped grid, world x = L sinh(u) for u
-  // over [-U, U]; z: the column march's samples per slice interval; w: unused.
+  // over [-U, U]; z: the column march's samples per slice interval (CLOUD_LIGHT_VOLUME_SUBSTEPS, which the
+  // shader uses); w: unused.
   vec4 light_volume_grid;
 };
 

@@ -177,8 +177,8 @@ double CloudEarthShadowElevationDeg(const gpu::GpuClouds& clouds, const gpu::Gpu
 constexpr double kCloudLightVolumeWarpKm = 1.0;
 constexpr double kCloudLightVolumeNearStepKm = 0.1;
 constexpr double kCloudLightVolumeMinElevationDeg = 6.0;
-// Samples of the column's march per slice interval.
-constexpr int kCloudLightVolumeSubsteps = 1;
+// Samples of the column's march per slice interval (compiled into the shader).
+constexpr int kCloudLightVolumeSubsteps = CLOUD_LIGHT_VOLUME_SUBSTEPS;
 // Floats of the light volume (0 when off).
 size_t CloudLightVolumeFloats(const gpu::GpuClouds& clouds);
 // Whether a frame with the Sun at `sun_y` (the sine of its elevation) reads
