@@ -9,6 +9,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <memory>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -857,6 +858,35 @@ TEST(CloudEarthShadow, ShadowedFramesSkipTheLightMarchWithTheSameBytes) {
   testing::ExpectNoValidationMessages();
 }
 
+// The clouds of `style` at 600 s with its ground cloud shadow, and a
+// renderer of them with the given shader switches.
+CloudInputs CloudsAt600s(const SkyStyle& style) {
+  CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
+  ApplyGroundCloudShadow(style.cloud_shadow, clouds);
+  return clouds;
+}
+std::unique_ptr<SkyRenderer> RendererWithSwitches(const SkyStyle& style, const ShaderSwitches& shaders) {
+  return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas),
+                                       style.quality, style.effects, OutputScale(style.output.units), false,
+                                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                                       CloudsAt600s(style), shaders);
+}
+
+// Every view a bake renders, at 24 texels a face: the latlong, the strip and
+// the six faces (from the cloud panorama), the latlong alone (marched), two
+// explicit directions, and the cloud shadow map when the style has one.
+std::vector<std::vector<float>> RenderEveryView(SkyRenderer& r, const SkyStyle& style, double sun_deg) {
+  const int n = 24;
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
+  for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
+  const glm::dvec3 sun = Sun(sun_deg);
+  std::vector<std::vector<float>> images = r.Render(sun, views);
+  images.push_back(r.Render(sun, {views[0]})[0]);
+  images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, -0.05, -0.8)}));
+  if (style.cloud_shadow.enabled) images.push_back(r.RenderCloudShadow(sun, style.cloud_shadow));
+  return images;
+}
+
 // The shaders read the LUTs, the cloud noise and the cloud tables through
 // texel views (SPEC_TEXEL_VIEWS), the same bytes as their storage buffers
 // hold: every view, the panorama's and the marched latlong's, explicit
@@ -882,21 +912,9 @@ TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
     auto render = [&](bool texel_views) {
       ShaderSwitches shaders;
       shaders.texel_views = texel_views;
-      CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
-      ApplyGroundCloudShadow(style.cloud_shadow, clouds);
-      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-                    OutputScale(style.output.units), false,
-                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)), clouds, shaders);
-      EXPECT_EQ(r.reads_texel_views(), texel_views) << c.name;
-      const int n = 24;
-      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
-      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
-      const glm::dvec3 sun = Sun(c.sun);
-      std::vector<std::vector<float>> images = r.Render(sun, views);
-      images.push_back(r.Render(sun, {views[0]})[0]);
-      images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, -0.05, -0.8)}));
-      if (style.cloud_shadow.enabled) images.push_back(r.RenderCloudShadow(sun, style.cloud_shadow));
-      return images;
+      const std::unique_ptr<SkyRenderer> r = RendererWithSwitches(style, shaders);
+      EXPECT_EQ(r->reads_texel_views(), texel_views) << c.name;
+      return RenderEveryView(*r, style, c.sun);
     };
     const std::vector<std::vector<float>> on = render(true), off = render(false);
     ASSERT_EQ(on.size(), off.size());
@@ -948,27 +966,17 @@ TEST(CloudFormationRead, CompiledOutWithoutAFormationKeepsTheBytes) {
     auto render = [&](bool always) {
       ShaderSwitches shaders;
       shaders.formation_read_always = always;
-      CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed, "", 600.0);
-      ApplyGroundCloudShadow(style.cloud_shadow, clouds);
+      const CloudInputs clouds = CloudsAt600s(style);
       EXPECT_FALSE(CloudFormationDensityOn(clouds.uniform)) << c.name;
-      SkyRenderer r(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-                    OutputScale(style.output.units), false,
-                    ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)), clouds, shaders);
-      const int n = 24;
-      std::vector<ViewRequest> views = {{MAPPING_LATLONG, 4 * n, 2 * n, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
-      for (int f = 0; f < 6; ++f) views.push_back({MAPPING_VULKAN_FACE, n, n, f});
-      const glm::dvec3 sun = Sun(c.sun);
-      std::vector<std::vector<float>> images = r.Render(sun, views);
-      images.push_back(r.Render(sun, {views[0]})[0]);
-      images.push_back(r.RenderDirections(sun, {glm::dvec3(0.0, 0.2, 0.98), glm::dvec3(0.6, -0.05, -0.8)}));
-      if (style.cloud_shadow.enabled) images.push_back(r.RenderCloudShadow(sun, style.cloud_shadow));
+      const std::unique_ptr<SkyRenderer> r = RendererWithSwitches(style, shaders);
+      std::vector<std::vector<float>> images = RenderEveryView(*r, style, c.sun);
       // The same clouds are taken; without the read, clouds with a
       // formation's density are refused before anything changes.
-      EXPECT_TRUE(r.UpdateClouds(clouds)) << c.name;
+      EXPECT_TRUE(r->UpdateClouds(clouds)) << c.name;
       if (!always) {
         CloudInputs formation = clouds;
         formation.uniform.layers[0].weather.w = 2.0f;
-        EXPECT_FALSE(r.UpdateClouds(formation)) << c.name;
+        EXPECT_FALSE(r->UpdateClouds(formation)) << c.name;
       }
       return images;
     };
