@@ -112,7 +112,6 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   cloud_layers_ = output_directions || style_pass_ ? 0 : clouds.layers();
   gpu_clouds_ = clouds.uniform;
   cloud_weather_images_ = clouds.weather_images;
-  VkDevice device = context_.device();
 
   // Every buffer a texel view reads (gpu_shared.h) is a texel buffer too.
   const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT;
@@ -154,6 +153,13 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
 
   CreateDescriptorSet();
 
+  CompilePipelines(quality, effects, aoas.switches, shaders);
+  CreateCommandObjects();
+  timestamps_supported_ = context_.SupportsTimestamps();
+}
+
+void SkyRenderer::CompilePipelines(const QualitySettings& quality, const EffectSettings& effects,
+                                   const AoasSwitches& aoas, const ShaderSwitches& shaders) {
   // Pipelines are built once per renderer, never per frame, and only those
   // the effects need. Compiling is most of a short bake's start-up on
   // lavapipe (LLVM), and pipeline creation may run on several threads at once
@@ -170,9 +176,9 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   // compile 10-20 times faster; they compute the same values to float
   // rounding (tests/sky_renderer_test.cc). shaders.generic turns them off,
   // to tell a variant's fault from the shader's.
-  const ShaderSources sources = ChooseShaderSources(quality, aoas.switches.skydome, shaders);
+  const ShaderSources sources = ChooseShaderSources(quality, aoas.skydome, shaders);
   const bool analytic = sources.analytic_luts;
-  const bool sky_view = quality.sky_view_lut && !aoas.switches.skydome;
+  const bool sky_view = quality.sky_view_lut && !aoas.skydome;
   auto job = [this](VkPipeline* pipeline, bool variant, const auto& variant_code, const auto& generic_code) {
     if (variant) ++counters_.variant_pipelines;
     return variant ? PipelineJob{pipeline, variant_code, sizeof(variant_code)}
@@ -222,7 +228,10 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
     DestroyAll();
     std::rethrow_exception(failure);
   }
+}
 
+void SkyRenderer::CreateCommandObjects() {
+  VkDevice device = context_.device();
   VkCommandPoolCreateInfo command_pool_info{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
   command_pool_info.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
   command_pool_info.queueFamilyIndex = context_.queue_family();
@@ -234,8 +243,6 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   VK_CHECK(vkAllocateCommandBuffers(device, &cb_info, &command_buffer_));
   VkFenceCreateInfo fence_info{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   VK_CHECK(vkCreateFence(device, &fence_info, nullptr, &fence_));
-
-  timestamps_supported_ = context_.SupportsTimestamps();
 }
 
 void SkyRenderer::CreateDescriptorSet() {

@@ -222,6 +222,10 @@ class SkyRenderer {
               const EffectSettings& effects, const Rgb& output_scale, bool output_directions, const AoasInputs& aoas,
               const CloudInputs& clouds, const ShaderSwitches& shaders);
   void CreateDescriptorSet();  // the layouts, the pool and the set of kBindingCount bindings
+  // The pipelines the style's effects need, compiled on one thread each (the constructor's).
+  void CompilePipelines(const QualitySettings& quality, const EffectSettings& effects, const AoasSwitches& aoas,
+                        const ShaderSwitches& shaders);
+  void CreateCommandObjects();  // the command pool, its one command buffer and the fence
 
   Buffer CreateBuffer(VkDeviceSize size, VkBufferUsageFlags usage);
   // The texel view of binding BINDING_CLOUD_NOISE_TEXELS + i over its buffer,
