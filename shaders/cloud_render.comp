@@ -26,7 +26,8 @@ void main() {
   // A row marches its own width of texels (CloudPanoramaRowWidth).
   int row_width = push.view.y;
   if (push.rect.w == CLOUD_MODE_PANORAMA) {
-    texel.y += CloudPanoramaFirstRow();
+    texel.y = CloudPanoramaRowBlock(int(gl_WorkGroupID.y), int(gl_NumWorkGroups.y)) * SKYBAKE_LOCAL_SIZE_Y +
+              int(gl_LocalInvocationID.y) + CloudPanoramaFirstRow();
     if (texel.y >= CloudPanoramaEndRow()) return;
     row_width = CloudPanoramaRowWidth(push.view.y, push.view.z, texel.y);
   }
