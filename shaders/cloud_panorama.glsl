@@ -19,26 +19,10 @@ vec4 CloudPanoramaTexel(int first, int width, int index, int y) {
   return cloud_lut[first + index];
 }
 
-// The block of rows workgroup row g of n marches: g x s mod n, s the first
-// integer from 0.618 n on that is coprime with n, so any run of consecutive
-// groups holds rows from all over the marched range. lavapipe deals a
-// dispatch's groups out to its threads in runs of consecutive groups, and the
-// rows near the horizon, whose rays cross most of the deck, cost several
-// times the rows near the zenith: in row order one thread took the costly
-// rows and the others waited for it.
-int CloudPanoramaRowBlock(int g, int n) {
-  int s = max(int(0.618 * float(n)), 1);
-  for (;; ++s) {
-    int a = s, b = n;
-    while (b != 0) {
-      int r = a % b;
-      a = b;
-      b = r;
-    }
-    if (a == 1) break;
-  }
-  return (g * s) % n;
-}
+// The block of rows workgroup row g of n marches: g x stride mod n, the
+// stride SkyPush.view.w of the panorama pass (CloudPanoramaBlockStride in
+// cloud_panorama.h: coprime with n, so every block is marched once).
+int CloudPanoramaRowBlock(int g, int n) { return (g * push.view.w) % n; }
 
 // The texels row y of a width x height panorama marches: one more than
 // width x cos(latitude), so its texels are no farther apart in longitude

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <memory>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <glm/glm.hpp>
@@ -80,6 +81,21 @@ double MeanRelativeDifference(const std::vector<float>& a, const std::vector<flo
     sum += std::abs(vb);
   }
   return diff / sum;
+}
+
+TEST(CloudPanoramaChoice, TheRowBlocksRunInAnOrderThatMarchesEachOnce) {
+  for (int n = 1; n <= 300; ++n) {
+    const int stride = CloudPanoramaBlockStride(n);
+    std::vector<int> seen(size_t(n), 0);
+    for (int g = 0; g < n; ++g) ++seen[size_t((g * stride) % n)];
+    EXPECT_EQ(std::count(seen.begin(), seen.end(), 1), n) << n << " blocks, stride " << stride;
+  }
+  // W3's 512 marched rows in 64 blocks: a run of a quarter of the groups (one
+  // of lavapipe's 4 threads) holds blocks from every quarter of the rows.
+  const int stride = CloudPanoramaBlockStride(64);
+  std::vector<int> quarters(4, 0);
+  for (int g = 0; g < 16; ++g) ++quarters[size_t((g * stride) % 64 / 16)];
+  for (int q : quarters) EXPECT_GE(q, 3) << "stride " << stride;
 }
 
 TEST(CloudPanoramaChoice, ARowMarchesItsWidthTimesTheCosineOfItsLatitude) {

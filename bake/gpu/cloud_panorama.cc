@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "skybake/gpu_shared.h"
 
@@ -63,6 +64,12 @@ int CloudPanoramaRowWidth(const CloudPanorama& panorama, int y) {
   const double cos_latitude = std::sin(kPi * double(y) / double(panorama.height - 1));
   const int w = int(std::ceil(double(panorama.width) * cos_latitude)) + 1;
   return std::clamp(w, std::min(CLOUD_PANORAMA_MIN_ROW_WIDTH, panorama.width), panorama.width);
+}
+
+int CloudPanoramaBlockStride(int blocks) {
+  int stride = std::max(int(0.618 * double(blocks)), 1);
+  while (std::gcd(stride, blocks) != 1) ++stride;
+  return stride;
 }
 
 size_t CloudPanoramaMarchedTexels(const CloudPanorama& panorama, const CloudPanoramaRows& rows) {

@@ -1113,13 +1113,13 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
     if (panorama.width > 0) {
       gpu::SkyPush push{};
       push.sun_direction = {float(sun.x), float(sun.y), float(sun.z), 0.0f};
-      push.view = {MAPPING_LATLONG, panorama.width, panorama.height, 0};
+      const uint32_t row_blocks = GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y);
+      push.view = {MAPPING_LATLONG, panorama.width, panorama.height, CloudPanoramaBlockStride(int(row_blocks))};
       push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
       push.offsets.w = panorama_row_range;
       // Read by the cloud passes after the barrier the sun disc or the composites set.
       dispatches.push_back({"clouds panorama", cloud_pipeline, push,
-                            GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X),
-                            GroupCount(panorama_rows.end - panorama_rows.begin, SKYBAKE_LOCAL_SIZE_Y)});
+                            GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X), row_blocks});
       barriers.push_back(false);
       ++counters_.cloud_dispatches;
     }

@@ -151,7 +151,8 @@ SKYBAKE_GPU_STRUCT(GpuAoas) {
 
 SKYBAKE_GPU_STRUCT(SkyPush) {
   vec4 sun_direction;  // xyz: unit vector towards the Sun; w: unused
-  ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE)
+  ivec4 view;          // x: mapping; y: width; z: height; w: cube face (MAPPING_VULKAN_FACE), or the
+                       // cloud panorama pass's block stride (CloudPanoramaBlockStride)
   ivec4 offsets;       // x: first output texel of this view in the output buffer; y: 1 = no sun disc;
                        // z: first direction of a MAPPING_DIRECTIONS view; w: cloud panorama and
                        // resample passes: the panorama's marched rows, begin + end x 65536

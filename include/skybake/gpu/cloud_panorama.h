@@ -68,6 +68,16 @@ constexpr double kCloudPanoramaRowMargin = 0.02;
 int CloudPanoramaRowWidth(const CloudPanorama& panorama, int y);
 size_t CloudPanoramaMarchedTexels(const CloudPanorama& panorama, const CloudPanoramaRows& rows);
 
+// The stride of the order in which the panorama's n blocks of marched rows
+// run (cloud_panorama.glsl, CloudPanoramaRowBlock: workgroup row g marches
+// block g x stride mod n): the first integer from 0.618 n on that is coprime
+// with n, so g -> g x stride mod n is a permutation and any run of
+// consecutive groups holds rows from all over the marched range. lavapipe
+// deals a dispatch's groups out to its threads in runs of consecutive
+// groups, and the rows near the horizon cost several times the rows near
+// the zenith: in row order one thread took the costly rows.
+int CloudPanoramaBlockStride(int blocks);
+
 // 4096 x 2048 texels of RGBA float: 128 MiB.
 constexpr int kMaxCloudPanoramaHeight = 2048;
 
