@@ -666,6 +666,19 @@ vec3 GroundRadiance(IN(AtmosphereParameters) atm, IN(SkyRay) ray) {
   return sun_transmittance * max(mu_s_ground, 0.0) * atm.ground_albedo / kPi;
 }
 
+// The sunlit ground's radiance as the viewer sees it at the end of `ray`
+// (which hits the ground from the observer): GroundRadiance times T_air, the
+// air's transmittance from the viewer to the ground, from the transmittance
+// LUT (the ratio of the two rays to the top, Bruneton 2008); per unit solar
+// irradiance.
+vec3 SunlitGroundSeen(IN(AtmosphereParameters) atm, IN(SkyRay) ray) {
+  Real mu_ground = ClampCosine((ray.r * ray.mu + ray.t_max) / atm.bottom_radius);
+  vec3 to_top_ground = GetTransmittanceToTopBoundary(atm, atm.bottom_radius, 0.0, -mu_ground);
+  vec3 to_top_viewer = GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, -ray.mu);
+  vec3 air = min(to_top_ground / max(to_top_viewer, vec3(1e-30)), vec3(1.0));
+  return air * GroundRadiance(atm, ray);
+}
+
 // Radiance reaching the observer along unit direction `view` (world frame,
 // +Y up) with the Sun along unit `sun`, without the solar disc, and the
 // transmittance along the view ray (0 where it hits the ground).

@@ -48,6 +48,7 @@ void main() {
   vec4 sky = output_texels[index];
   if (ground_loss != vec3(0.0))
     sky.xyz = max(sky.xyz - ground_loss * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz, vec3(0.0));
-  output_texels[index] = vec4(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
-                                  m.transmittance * sky.xyz, sky.w);
+  // max: the sky light the clouds scatter may lie outside the output's gamut (ComputeCloudAmbientRow).
+  output_texels[index] = vec4(max(m.radiance * atm.solar_irradiance * gpu_atmosphere.output_scale.xyz +
+                                      m.transmittance * sky.xyz, vec3(0.0)), sky.w);
 }

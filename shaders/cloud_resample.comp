@@ -39,6 +39,7 @@ void main() {
   vec4 sky = output_texels[index];
   if (ground_loss != vec3(0.0))
     sky.xyz = max(sky.xyz - ground_loss * gpu_atmosphere.solar_irradiance.xyz * gpu_atmosphere.output_scale.xyz, vec3(0.0));
-  output_texels[index] = vec4(c.xyz * gpu_atmosphere.solar_irradiance.xyz * gpu_atmosphere.output_scale.xyz +
-                                  c.w * sky.xyz, sky.w);
+  // max: the sky light the clouds scatter may lie outside the output's gamut (ComputeCloudAmbientRow).
+  output_texels[index] = vec4(max(c.xyz * gpu_atmosphere.solar_irradiance.xyz * gpu_atmosphere.output_scale.xyz +
+                                      c.w * sky.xyz, vec3(0.0)), sky.w);
 }

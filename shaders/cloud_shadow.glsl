@@ -34,11 +34,9 @@ float CloudShadowOpticalDepth(vec2 xz, float h0, vec3 sun, int steps) {
 
 // The sunlight the clouds take from the ground a texel shows (rays that hit
 // the ground): (1 - T_shadow) x T_air x the ground's direct sunlit radiance
-// (GroundRadiance), per unit solar irradiance; 0 unless the style's
+// (SunlitGroundSeen), per unit solar irradiance; 0 unless the style's
 // cloud_shadow.ground is on (ground_shadow.x: the strength, .y: the steps), the
-// ground is on and the Sun's centre is above the horizon. T_air, the air's
-// transmittance from the viewer to the ground, from the transmittance LUT
-// (the ratio of the two rays to the top, Bruneton 2008).
+// ground is on and the Sun's centre is above the horizon.
 // The pipelines of a style without it have it compiled out
 // (kGroundCloudShadow): on lavapipe a branch not taken still runs, masked.
 layout(constant_id = SPEC_GROUND_CLOUD_SHADOW) const bool kGroundCloudShadow = true;
@@ -53,11 +51,7 @@ vec3 GroundCloudShadowLoss(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
   float tau = CloudShadowOpticalDepth(ground.xz, 0.0, sun, int(gpu_clouds.ground_shadow.y));
   float lit = exp(-gpu_clouds.ground_shadow.x * tau);
   if (lit >= 1.0) return vec3(0.0);
-  float mu_ground = ClampCosine((ray.r * ray.mu + t) / atm.bottom_radius);
-  vec3 to_top_ground = GetTransmittanceToTopBoundary(atm, atm.bottom_radius, 0.0, -mu_ground);
-  vec3 to_top_viewer = GetTransmittanceToTopBoundary(atm, ray.r, ray.altitude, -ray.mu);
-  vec3 air = min(to_top_ground / max(to_top_viewer, vec3(1e-30)), vec3(1.0));
-  return (1.0 - lit) * air * GroundRadiance(atm, ray);
+  return (1.0 - lit) * SunlitGroundSeen(atm, ray);
 }
 
 #endif  // SKYBAKE_CLOUD_SHADOW_GLSL

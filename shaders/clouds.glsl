@@ -402,6 +402,11 @@ void ComputeCloudAmbientRow(IN(AtmosphereParameters) atm_in, int row, vec3 sun) 
       down += ComputeSkyRadianceWithoutSun(atm, vec3(s * cos(phi), -mu, s * sin(phi)), sun).radiance;
     }
   }
+  // The sky's light keeps the sky's spectrum when a cloud scatters it: the
+  // cloud pass converts its light as direct sunlight (output_scale), so the
+  // table holds the sky light in the terms that give it the sky conversion.
+  up = vec3(dot(gpu_atmosphere.ambient_to_direct[0].xyz, up), dot(gpu_atmosphere.ambient_to_direct[1].xyz, up),
+            dot(gpu_atmosphere.ambient_to_direct[2].xyz, up));
   cloud_lut[CloudAmbientIndex(row, 0)] = vec4(up / 32.0, 0.0);
   cloud_lut[CloudAmbientIndex(row, 1)] = vec4(down / 32.0, 0.0);
 }

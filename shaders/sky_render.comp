@@ -47,5 +47,8 @@ void main() {
   if (push.offsets.y != 0) atm.sun_disc = false;
   AoasParameters aoas = AoasFromUniform();
   vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz, kUseSkyView);
-  output_texels[index] = vec4(radiance * gpu_atmosphere.output_scale.xyz, 1.0);
+  vec3 colour = SkyToOutput(radiance);
+  if (gpu_atmosphere.ground_correction[0].w != 0.0) colour += GroundConversionCorrection(atm, view, push.sun_direction.xyz);
+  // Colours outside the output's gamut (a deep twilight blue) are clamped to it.
+  output_texels[index] = vec4(max(colour, vec3(0.0)), 1.0);
 }

@@ -273,8 +273,10 @@ TEST(EnginePresetTest, EngineFileScaleIsTheBakesUnlessTheyNeedASmallerOne) {
 // faces went from 1 to 2^-16.
 TEST(EnginePresetCliTest, PresetKeepsTheHalfScaleOfTheBakesOwnFiles) {
   const std::string dir = testing::FreshTempDir("engine_scale");
+  // The disc in the maps (output.sun = "map"): the panorama's texels inside it need a scale.
   const std::string sizes = " --set output.latlong=false --set output.preview=false --set output.cube_strip=false "
-                            "--set gltf.enabled=false --set render.cube_size=16 --set render.latlong_height=1024";
+                            "--set gltf.enabled=false --set render.cube_size=16 --set render.latlong_height=1024 "
+                            "--set output.sun=map";
   for (const char* engine : {"", "godot"}) {
     const std::string out = dir + "/" + (*engine ? engine : "none");
     testing::CommandRun r = testing::RunSkybake("bake " + Style() + sizes + " -q --out " + out +

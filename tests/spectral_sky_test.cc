@@ -722,13 +722,16 @@ TEST(SpectralSkyTest, SunOfASpectralBakeIsTheSpectralSun) {
                                          sun["irradiance"][1].get<double>(), 1e-4 * sh_sun / irradiance)
         << "channel " << c;
   }
-  // Three wavelengths give a sun of another colour (blue against red).
+  // Three wavelengths give the Sun the spectral mode's colour too: its light
+  // is converted with the Sun's own spectrum through the frame's air,
+  // integrated over 48 bins (colour_conversion.h); 16 bins integrate the
+  // same spectrum a little differently.
   const json& sun3 = manifests[3]["frames"][0]["sun"]["irradiance"];
   const double ratio3 = sun3[2].get<double>() / sun3[0].get<double>();
   const double ratio16 = sun["irradiance"][2].get<double>() / sun["irradiance"][0].get<double>();
   std::printf("sun at %.0f deg, blue / red: 3 wavelengths %.4f, 16 bins %.4f, expected %.4f\n", elevation_deg,
               ratio3, ratio16, expected[2] / expected[0]);
-  EXPECT_GT(std::abs(ratio3 / ratio16 - 1.0), 0.03);
+  EXPECT_LT(std::abs(ratio3 / ratio16 - 1.0), 0.02);
 }
 
 // A sequence whose frames differ in their number of wavelengths gets a

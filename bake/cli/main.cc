@@ -280,8 +280,8 @@ int ReportBake(const BakeResult& result) {
   PrintFiles(result.files);
   if (result.half_scale != 1.0)
     std::fprintf(stderr,
-                 "skybake: warning: values exceeded half range; every EXR was scaled by %.9g "
-                 "(recorded as skybake:scale and whiteLuminance)\n",
+                 "skybake: warning: values exceeded half range; EXRs were scaled by as little as %.9g "
+                 "(each records its own scale as skybake:scale and whiteLuminance)\n",
                  result.half_scale);
   if (result.validation_messages > 0) {
     std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d message%s\n",

@@ -203,6 +203,7 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
            {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
   v.Choice("output.units", o.units,
            {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
+  v.Choice("output.sun", o.sun, {{"light", SunOutput::kLight}, {"map", SunOutput::kMap}});
   v.Choice("output.color_space", o.color_space, {{"rec709", ColorSpace::kRec709}, {"acescg", ColorSpace::kAcesCg}});
   v.Bool("output.faces", o.faces);
   v.Bool("output.cube_strip", o.cube_strip);

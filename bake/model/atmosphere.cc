@@ -93,6 +93,15 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.radii = {float(a.bottom_radius_km), float(a.top_radius_km),
              float(a.observer_altitude_m * 1e-3), float(a.limb_darkening_u)};
   g.output_scale = v4(output_scale, 0.0);
+  for (int i = 0; i < 3; ++i) {  // one conversion for every path until SetOutputConversion (colour_conversion.h)
+    Rgb row{};
+    row[i] = output_scale[i];
+    g.sky_to_output[i] = v4(row, 0.0);
+    g.ground_correction[i] = v4({0.0, 0.0, 0.0}, 0.0);
+    Rgb identity{};
+    identity[i] = 1.0;
+    g.ambient_to_direct[i] = v4(identity, 0.0);
+  }
   g.lut_sizes = {q.transmittance_width, q.transmittance_height, q.multiscattering_size,
                  q.multiscattering_size};
   g.samples = {q.view_steps, q.transmittance_steps, q.multiscattering_steps, q.integrator};

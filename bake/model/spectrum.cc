@@ -70,6 +70,27 @@ double ScaledAt(const Rgb& style, double spectral_tables::AtmosphereRow::*field,
   return table * TripletAt(ratio, lambda_nm);
 }
 
+std::array<double, 3> XyzOfChromaticity(const std::array<double, 2>& xy) {
+  return {xy[0] / xy[1], 1.0, (1.0 - xy[0] - xy[1]) / xy[1]};
+}
+
+// Linear RGB to XYZ from the primaries and white point (SMPTE RP 177), white
+// of luminance 1.
+Matrix3 RgbToXyz(ColorSpace space) {
+  const auto c = Chromaticities(space);
+  Matrix3 p{};
+  for (int primary = 0; primary < 3; ++primary) {
+    const std::array<double, 3> xyz = XyzOfChromaticity(c[primary]);
+    for (int row = 0; row < 3; ++row) p[row][primary] = xyz[row];
+  }
+  const std::array<double, 3> s = Apply(Inverse(p), XyzOfChromaticity(c[3]));
+  for (int row = 0; row < 3; ++row)
+    for (int primary = 0; primary < 3; ++primary) p[row][primary] *= s[primary];
+  return p;
+}
+
+}  // namespace
+
 Matrix3 Multiply(const Matrix3& a, const Matrix3& b) {
   Matrix3 m{};
   for (int i = 0; i < 3; ++i)
@@ -100,26 +121,6 @@ std::array<double, 3> Apply(const Matrix3& m, const std::array<double, 3>& v) {
           m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
 }
 
-std::array<double, 3> XyzOfChromaticity(const std::array<double, 2>& xy) {
-  return {xy[0] / xy[1], 1.0, (1.0 - xy[0] - xy[1]) / xy[1]};
-}
-
-// Linear RGB to XYZ from the primaries and white point (SMPTE RP 177), white
-// of luminance 1.
-Matrix3 RgbToXyz(ColorSpace space) {
-  const auto c = Chromaticities(space);
-  Matrix3 p{};
-  for (int primary = 0; primary < 3; ++primary) {
-    const std::array<double, 3> xyz = XyzOfChromaticity(c[primary]);
-    for (int row = 0; row < 3; ++row) p[row][primary] = xyz[row];
-  }
-  const std::array<double, 3> s = Apply(Inverse(p), XyzOfChromaticity(c[3]));
-  for (int row = 0; row < 3; ++row)
-    for (int primary = 0; primary < 3; ++primary) p[row][primary] *= s[primary];
-  return p;
-}
-
-}  // namespace
 
 SpectralBins WavelengthBins(int count) {
   SpectralBins bins;

@@ -25,7 +25,7 @@ std::vector<RgbaImage> RenderEngineImages(SkyRenderer& renderer, const glm::dvec
   const EnginePreset* preset = FindEnginePreset(style.output.engine);
   if (!preset) return images;
   for (const EngineImage& e : EngineImages(*preset, style.render.cube_size, style.render.latlong_height))
-    images.push_back({e.width, e.height, renderer.RenderDirections(sun, e.directions), nullptr});
+    images.push_back({e.width, e.height, renderer.RenderDirections(sun, e.directions, style.output.sun == SunOutput::kMap), nullptr});
   return images;
 }
 

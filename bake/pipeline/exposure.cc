@@ -52,7 +52,8 @@ void ChooseEv100(const RenderPlan& plan, RendererCache& renderers, BakeExposure&
   } else if (ref.style->preview.auto_exposure) {
     const int h = ref.style->render.latlong_height;
     std::vector<float> latlong =
-        renderers.Main(*ref.style, ref.CloudTimeSeconds()).Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}})[0];
+        renderers.Main(*ref.style, ref.CloudTimeSeconds(), ref.sun)
+            .Render(ref.sun, {{MAPPING_LATLONG, 2 * h, h, 0}}, ref.style->output.sun == SunOutput::kMap)[0];
     exposure.ev100 = AutoEv100(DisplayLuminance(latlong.data(), latlong.size() / 4, ref.style->output.units), 2 * h, h);
     exposure.source = fmt::format("auto exposure of frame {} (highest sun), applied to every frame", ref.number);
   } else {
@@ -62,13 +63,16 @@ void ChooseEv100(const RenderPlan& plan, RendererCache& renderers, BakeExposure&
 }
 
 // The brightest texel of a frame is the sun disc's centre, or else the sky
-// near it. While the disc is above the horizon of some frame, its
-// unattenuated centre radiance bounds the sequence without rendering;
-// otherwise a coarse latlong plus the disc centre of every frame does.
+// near it. While the disc is in the maps and above the horizon of some
+// frame, its unattenuated centre radiance bounds the sequence without
+// rendering; otherwise a coarse latlong plus the direction of the Sun's
+// centre (the disc's, or the sky's brightest there without it) of every
+// frame does.
 double SequenceMaxValue(const RenderPlan& plan, RendererCache& renderers) {
   double max_value = 0.0;
   for (const FramePlan& frame : plan.frames)
-    if (auto bound = VisibleDiscBound(*frame.style, frame.elevation_deg)) {
+    if (auto bound = VisibleDiscBound(*frame.style, frame.elevation_deg);
+        bound && frame.style->output.sun == SunOutput::kMap) {
       // ibl.include_sun puts the Sun's energy into one texel of the
       // specular level 0: brighter than the disc by the ratio of their
       // solid angles when the texel is the smaller (ibl.h).
@@ -82,9 +86,10 @@ double SequenceMaxValue(const RenderPlan& plan, RendererCache& renderers) {
     }
   if (max_value > 0.0) return max_value;
   for (const FramePlan& frame : plan.frames) {
-    SkyRenderer& r = renderers.Main(*frame.style, frame.CloudTimeSeconds());
-    std::vector<float> coarse = r.Render(frame.sun, {{MAPPING_LATLONG, 128, 64, 0}})[0];
-    std::vector<float> centre = r.RenderDirections(frame.sun, {frame.sun});
+    SkyRenderer& r = renderers.Main(*frame.style, frame.CloudTimeSeconds(), frame.sun);
+    const bool disc = frame.style->output.sun == SunOutput::kMap;
+    std::vector<float> coarse = r.Render(frame.sun, {{MAPPING_LATLONG, 128, 64, 0}}, disc)[0];
+    std::vector<float> centre = r.RenderDirections(frame.sun, {frame.sun}, disc);
     RgbaImage a{128, 64, coarse}, b{1, 1, centre};
     max_value = std::max(max_value, CheckedMaxValue({&a, &b}));
   }
@@ -97,8 +102,10 @@ BakeExposure ChooseSequenceExposure(const RenderPlan& plan, RendererCache& rende
   BakeExposure exposure;
   if (!plan.sequence) return exposure;
   ChooseEv100(plan, renderers, exposure);
-  // A factor 2 of margin; writing checks the bound.
-  if (plan.first().output.pixel_type == PixelType::kHalf)
+  // A factor 2 of margin; writing checks the bound. With the Sun as a
+  // light the maps hold no disc: every frame is written unscaled unless its
+  // own sky overflows (FrameHalfScale), so no frame is rendered twice here.
+  if (plan.first().output.pixel_type == PixelType::kHalf && plan.first().output.sun == SunOutput::kMap)
     exposure.half_scale = HalfRangeScale(2.0 * SequenceMaxValue(plan, renderers), plan.first().output.overflow);
   timer.Finish("exposure", fmt::format("EV100 {} ({}), half scale {:.9g}",
                                        exposure.ev100 ? fmt::format("{:.2f}", *exposure.ev100) : "-", exposure.source,

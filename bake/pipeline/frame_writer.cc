@@ -19,7 +19,9 @@ namespace {
 std::string FormatVector(const glm::dvec3& v) { return fmt::format("{:.9g} {:.9g} {:.9g}", v.x, v.y, v.z); }
 
 // The frame's half-float scale: a single bake's from its brightest value, a
-// sequence's checked against it.
+// sequence's checked against it. With the Sun as a light a sequence has no
+// disc to fit and keeps scale 1: a frame whose own sky overflows (a very
+// hazy aureole) gets a scale of its own, recorded in its files.
 double FrameHalfScale(const FrameJob& job, bool sequence) {
   const SkyStyle& style = *job.plan->style;
   std::vector<const RgbaImage*> all;
@@ -30,7 +32,7 @@ double FrameHalfScale(const FrameJob& job, bool sequence) {
   // own files (WriteEngineFiles gives them a smaller one when they need it).
   const double max_value = CheckedMaxValue(all);
   if (style.output.pixel_type != PixelType::kHalf) return job.half_scale;
-  if (!sequence) return HalfRangeScale(max_value, style.output.overflow);
+  if (!sequence || style.output.sun == SunOutput::kLight) return HalfRangeScale(max_value, style.output.overflow);
   if (max_value * job.half_scale > kHalfMax)
     throw OutputError(fmt::format(
         "frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
@@ -255,6 +257,8 @@ void FrameWriter::Collect() {
   if (!plan_.sequence) {
     exposure_.half_scale = w.half_scale;
     result_.half_scale = w.half_scale;
+  } else if (w.half_scale != exposure_.half_scale) {
+    result_.half_scale = std::min(result_.half_scale, w.half_scale);  // a frame of its own scale (FrameHalfScale)
   }
   frame.files = std::move(w.files);
   frame.write_seconds = w.write_seconds;

@@ -112,10 +112,10 @@ void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
   // In place: the writer thread reads the texels where the device wrote
   // them while the next frame renders into other memory.
   Clock::time_point render_start = Clock::now();
-  SkyRenderer& renderer = s.renderers.Main(style, plan.CloudTimeSeconds());
+  SkyRenderer& renderer = s.renderers.Main(style, plan.CloudTimeSeconds(), plan.sun);
   RenderedViews rendered;
   if (!verified) {
-    rendered = renderer.RenderInPlace(plan.sun, plan.views);
+    rendered = renderer.RenderInPlace(plan.sun, plan.views, style.output.sun == SunOutput::kMap);
     for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
   }
   std::optional<FrameNight> night;

@@ -13,10 +13,30 @@ StyledInputs StyledInputsOf(const SkyStyle& style) {
           ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance))};
 }
 
+SkyRenderer& RendererCache::Main(const SkyStyle& style, double cloud_time_s, const glm::dvec3& sun) {
+  Update(style, cloud_time_s);
+  if (!luminance_) return *main_;
+  if (!conversion_sun_ || *conversion_sun_ != sun) {
+    conversion_ = FrameOutputConversion(conversion_atmosphere_, conversion_effects_, sun);
+    conversion_sun_ = sun;
+  }
+  main_->SetOutputConversion(conversion_);
+  return *main_;
+}
+
 void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   // The pass plan's pruning: zero-strength and unused effects compiled out.
   const SkyStyle style = PrunedStyle(unpruned);
   StyledInputs in = StyledInputsOf(style);
+  const bool luminance = style.output.units == OutputUnits::kLuminance && style.quality.wavelengths <= kRgbWavelengths;
+  // The conversion's probe reads the atmosphere and whether aerosols and ozone are on.
+  if (luminance != luminance_ || std::memcmp(&in.atmosphere, &conversion_atmosphere_, sizeof in.atmosphere) != 0 ||
+      style.effects.mie != conversion_effects_.mie || style.effects.ozone != conversion_effects_.ozone) {
+    luminance_ = luminance;
+    conversion_atmosphere_ = in.atmosphere;
+    conversion_effects_ = style.effects;
+    conversion_sun_.reset();
+  }
   CloudInputs clouds = ToCloudInputs(style.clouds, style.aoas.seed,
                                      std::filesystem::path(style.source_path).parent_path().string(), cloud_time_s);
   ApplyGroundCloudShadow(style.cloud_shadow, clouds);  // the ground below the horizon in the clouds' shadow

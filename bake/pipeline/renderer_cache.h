@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "skybake/gpu/sky_renderer.h"
@@ -37,6 +38,9 @@ class RendererCache {
     Update(style, cloud_time_s);
     return *main_;
   }
+  // The same, with the output conversion of a frame whose Sun is along
+  // `sun` set on it (colour_conversion.h; luminance output only).
+  SkyRenderer& Main(const SkyStyle& style, double cloud_time_s, const glm::dvec3& sun);
   // The renderer of the last frame.
   SkyRenderer& Current() { return *main_; }
  private:
@@ -50,6 +54,12 @@ class RendererCache {
   gpu::GpuAtmosphere key_{};
   int wavelengths_ = 0;  // quality.wavelengths of main_
   AoasInputs aoas_key_;
+  // What the frame's output conversion is computed from (Update), and the last one.
+  bool luminance_ = false;
+  AtmosphereParams conversion_atmosphere_;
+  EffectSettings conversion_effects_;
+  std::optional<glm::dvec3> conversion_sun_;
+  OutputConversion conversion_;
 };
 
 }  // namespace skybake

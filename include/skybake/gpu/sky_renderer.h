@@ -12,6 +12,7 @@
 
 #include "skybake/model/aoas.h"
 #include "skybake/model/atmosphere.h"
+#include "skybake/model/colour_conversion.h"
 #include "skybake/model/cloud_shadow.h"
 #include "skybake/model/clouds.h"
 #include "skybake/model/view.h"
@@ -159,6 +160,14 @@ class SkyRenderer {
   // needed).
   bool UpdateAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                         const EffectSettings& effects, const Rgb& output_scale);
+
+  // The output conversion of the next renders (colour_conversion.h): sky
+  // texels through `conversion.sky`, direct sunlight (the disc, sunlit clouds
+  // and ground) through `conversion.direct`. Until the first call, and after
+  // UpdateAtmosphere keeps it, every path gets the constructor's
+  // `output_scale`. The LUTs hold radiance and stay. The spectral mode
+  // integrates its bins and ignores it.
+  void SetOutputConversion(const OutputConversion& conversion);
 
   // Replaces the per-texel AOAS parameters (drift, strengths, shapes) without
   // touching the LUTs or pipelines; false when the switches differ (a new

@@ -18,6 +18,14 @@ enum class OverflowPolicy { kScale, kRefuse };
 // SKY_SPECTRAL_RADIANCE_TO_LUMINANCE); kSpectral: W m^-2 sr^-1 nm^-1 at
 // 680/550/440 nm, the unit of the Kider 2014 measurements.
 enum class OutputUnits { kLuminance, kSpectral };
+// Where the Sun goes (docs/colour.md): kLight, the maps hold the sky (and
+// Moon, stars, clouds) without the solar disc and the Sun is a light (its
+// illuminance, colour, direction and angular radius in the manifest, the
+// glTF and the engine files), so half-float files need no scale; kMap, the
+// disc is drawn into the maps too (a half-float bake then scales every file
+// by a power of two to fit it, skybake:scale) and the light is written as
+// well: a client that uses both counts the Sun twice.
+enum class SunOutput { kLight, kMap };
 
 // Deflate level of ZIP-compressed EXRs, chosen from the codec table of
 // docs/performance.md (`build/tests/exr_codec_benchmark`).
@@ -30,6 +38,7 @@ struct OutputSettings {
   int zip_level = kDefaultZipLevel;  // deflate level of zip and zips, 1..9
   OverflowPolicy overflow = OverflowPolicy::kScale;
   OutputUnits units = OutputUnits::kLuminance;
+  SunOutput sun = SunOutput::kLight;
   // Primaries of luminance output's EXR maps (their `chromaticities`
   // attribute when not Rec.709); previews, glTF and SH stay Rec.709.
   ColorSpace color_space = ColorSpace::kRec709;

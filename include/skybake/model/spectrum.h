@@ -63,6 +63,11 @@ enum class ColorSpace { kRec709, kAcesCg };
 std::array<std::array<double, 2>, 4> Chromaticities(ColorSpace space);
 
 using Matrix3 = std::array<std::array<double, 3>, 3>;  // rows
+// 3x3 matrix products, inverse and application to a vector.
+Matrix3 Multiply(const Matrix3& a, const Matrix3& b);
+Matrix3 Inverse(const Matrix3& m);
+std::array<double, 3> Apply(const Matrix3& m, const std::array<double, 3>& v);
+
 // XYZ (the space's own white) to linear RGB of `space`.
 Matrix3 XyzToRgb(ColorSpace space);
 // Linear Rec.709 to linear ACEScg: Rec.709 -> XYZ, Bradford adaptation from
