@@ -7,6 +7,7 @@
 //   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
 //   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
+//   skybake --version
 //
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
@@ -19,6 +20,7 @@
 #include <new>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
 
@@ -41,6 +43,8 @@
 #include "skybake/pipeline/test_pattern.h"
 #include "skybake/pipeline/viewer_page.h"
 #include "skybake/pipeline/night_sky.h"
+
+#include "build_commit.h"
 
 namespace {
 
@@ -246,10 +250,11 @@ void PrintFiles(const std::vector<BakedFile>& files) {
 }
 
 // The bake's options from the command line (and the environment main read).
-// The device, its driver and thread count, the shader switches and the
-// star catalogue: what every command that bakes takes from the arguments
-// and the environment alike.
+// The device, its driver and thread count, the shader switches, the
+// star catalogue and the build's commit: what every command that bakes
+// takes from the arguments and the environment alike.
 void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
+  options.build_commit = kBuildCommit;
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation;
   options.vulkan.software_driver_selection = args.software_driver_selection;
@@ -634,9 +639,28 @@ int RunReportingErrors(Cli& cli) {
   }
 }
 
+// `skybake --version`: the version and the commit it was built from. Alone
+// only: beside a subcommand or another option it is a usage error (it would
+// otherwise be unclear whether the rest ran).
+int RunVersion(int argc, char** argv) {
+  if (argc != 2) {
+    std::string rest;
+    for (int i = 1; i < argc; ++i)
+      if (std::string_view(argv[i]) != "--version") rest += std::string(rest.empty() ? "" : " ") + argv[i];
+    std::fprintf(stderr, "skybake: error: --version takes no subcommand or other option (given: %s): run "
+                         "'skybake --version' alone\n",
+                 Printable(rest.empty() ? "--version twice" : rest).c_str());
+    return kExitUsage;
+  }
+  std::printf("skybake %s (commit %s)\n", SKYBAKE_VERSION, kBuildCommit);
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string_view(argv[i]) == "--version") return RunVersion(argc, argv);
   KeepFrameMemoryInHeap();
   CLI::App app{"skybake " SKYBAKE_VERSION
                ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
@@ -645,6 +669,9 @@ int main(int argc, char** argv) {
                "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
                "manifests that do not merge."};
   app.require_subcommand(1);
+  // Handled before parsing (RunVersion); here for the help.
+  app.add_flag("--version")->description(
+      "Print the version and the git commit skybake was built from, and exit (alone only)");
   app.get_formatter()->column_width(34);
   Cli cli;
   AddBakeCommands(app, cli);

@@ -35,6 +35,9 @@ struct BakeOptions {
   // $SKYBAKE_STAR_CATALOGUE when set).
   std::string star_catalogue = DefaultStarCataloguePath();
   ProgressCallback progress;  // may be empty
+  // The git commit of the running binary ("unknown" outside git; main:
+  // `skybake --version`'s), recorded in the manifest beside the version.
+  std::string build_commit = "unknown";
   bool force = false;   // overwrite files of a previous bake in out_dir
   bool resume = false;  // sequence: keep frames verified against its manifest in out_dir, bake the rest
   // Sequence: bake only these frames (a part, for a farm): their files,
