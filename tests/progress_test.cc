@@ -153,7 +153,8 @@ TEST(ProgressCliTest, FiveFramesOffATerminalAndAsJson) {
   ASSERT_EQ(run.exit_code, 0) << run.output;
   for (char c : run.output)
     EXPECT_TRUE(c == '\n' || (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f)) << "control character " << int(c);
-  const std::regex frame_line(R"(skybake: frame (\d) of 5 \(#(\d)\) done in (\d+\.\d\d) s, (\d+(\.\d)? s/frame|\d+ frames/min), (\d+s|\d+m\d\ds|\d+h\d\dm) left)");
+  const std::regex frame_line(R"(skybake: frame (\d) of 5 \(#(\d)\) done in (\d+\.\d\d) s, )"
+                              R"((\d+(\.\d)? s/frame|\d+ frames/min), (\d+s|\d+m\d\ds|\d+h\d\dm) left)");
   int frames = 0;
   for (const std::string& line : Lines(run.output)) {
     std::smatch m;

@@ -524,7 +524,8 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
         fmt::format("{}: invalid JSON: not a skybake manifest, or one from another version", path));
   Manifest m;
   m.version = r.Get<std::string>(j, "version");
-  if (j.contains("commit")) m.commit = r.Get<std::string>(j, "commit");  // absent from manifests written before skybake recorded its commit
+  // Absent from the manifests of skybake before it recorded its commit.
+  if (j.contains("commit")) m.commit = r.Get<std::string>(j, "commit");
   m.style = r.Get<std::string>(j, "style");
   m.schedule = r.Get<std::string>(j, "schedule");
   m.sequence_sha256 = r.Get<std::string>(j, "sequence_sha256");

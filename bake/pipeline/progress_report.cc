@@ -140,7 +140,8 @@ void ProgressReport::DrawLiveLine() {
   if (frame_->sequence) line += fmt::format(" (#{})", frame_->number);
   if (done_ > 0) line += ", " + FormatRate(seconds_per_frame_);
   if (to_go == 0) line += ", done in " + FormatDuration(Elapsed());
-  else line += (done_ > 0 ? ", " + FormatDuration(seconds_per_frame_ * to_go - in_frame) + " left" : "") + ", " + stage_;
+  else if (done_ > 0) line += ", " + FormatDuration(seconds_per_frame_ * to_go - in_frame) + " left, " + stage_;
+  else line += ", " + stage_;
   const size_t width = TerminalWidth(text_) - 1;
   if (line.size() > width) line.resize(width);
   // Over the previous line: back to its start, the new text, blanks over
