@@ -177,5 +177,34 @@ TEST(CliTest, HelpShowsDefaultsAndUsageErrorsExitTwo) {
   EXPECT_EQ(usage.exit_code, 2) << usage.output;
 }
 
+// `skybake --version`: the project's version and the git commit of the
+// checkout it was built from (this one: the build looks it up), exit 0; with
+// anything else beside it a usage error saying so, exit 2, nothing run. A
+// bake's manifest records both.
+TEST(CliTest, VersionPrintsTheVersionAndCommitAndTheManifestRecordsThem) {
+  const auto [git_status, git_head] = testing::RunCommand("git -C '" + testing::SourceDir() + "' rev-parse HEAD");
+  const std::string commit = git_status == 0 ? git_head.substr(0, git_head.find('\n')) : "unknown";
+  CommandRun version = Skybake("--version");
+  EXPECT_EQ(version.exit_code, 0) << version.output;
+  EXPECT_EQ(version.output, std::string("skybake ") + SKYBAKE_VERSION + " (commit " + commit + ")\n");
+
+  for (const char* args : {"--version bake " SKYBAKE_SOURCE_DIR "/configs/default.toml", "bake --version",
+                           "--version --help", "devices --version", "--version --version"}) {
+    CommandRun mixed = Skybake(args);
+    EXPECT_EQ(mixed.exit_code, 2) << args << ": " << mixed.output;
+    EXPECT_EQ(mixed.output.rfind("skybake: error: --version takes no subcommand or other option (given: ", 0), 0u)
+        << args << ": " << mixed.output;
+    EXPECT_NE(mixed.output.find("run 'skybake --version' alone"), std::string::npos) << mixed.output;
+  }
+
+  const std::string out = FreshDir("version");
+  CommandRun bake = Skybake("bake " + Style() + " --size 8 -q --set gltf.enabled=false --out " + out);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  const nlohmann::json manifest = nlohmann::json::parse(testing::ReadFileBytes(out + "/manifest.json"));
+  EXPECT_EQ(manifest["version"], SKYBAKE_VERSION);
+  EXPECT_EQ(manifest["commit"], commit);
+  std::filesystem::remove_all(out);
+}
+
 }  // namespace
 }  // namespace skybake

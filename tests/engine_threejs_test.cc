@@ -7,15 +7,20 @@
 // OpenEXR latlong loaded the same way puts it a quarter turn away (three.js's
 // equirectUv centres +X, OpenEXR +Z): the trap the preset removes.
 #include <algorithm>
+#include <array>
+#include <filesystem>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <cmath>
 
+#include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/model/envmap.h"
 #include "skybake/pipeline/test_pattern.h"
 #include "test_support.h"
 
@@ -84,6 +89,105 @@ TEST(EngineThreejsTest, TestPatternIsWhereItSaysInThreejs) {
     EXPECT_GT(seen[8][2], TestPatternFaceColor(5)[2] + 0.1) << name << ": N above the horizon at -Z";
   }
 }
+
+// The KTX2 cubes of an IBL bake in three.js through the documented loader
+// (docs/engines/threejs_ktx2_cube.js; three.js's KTX2Loader makes a 2D
+// texture of them), in each format: a cube texture with every level of the
+// file; three.js's own background lookup along the Sun (default style: 35
+// degrees up, South-East, so a mirror image would put it South-West) far
+// brighter than turned 90, 180 or 270 degrees; and, at every level, texels
+// read back along their own directions as three.js looks up a cube texture
+// equal to the same texels of the EXR level (the brightest, and one off the
+// middle of each face, where a face swapped or mirrored would show). What
+// three.js's KTX2Loader makes of the same file is printed: a 2D texture
+// (rgba16f) or "Unsupported vkFormat" (the packed formats).
+class EngineThreejsKtx2Test : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
+
+TEST_P(EngineThreejsKtx2Test, CubeLoadsWithEveryLevelTheRightWayRound) {
+  const auto [format, zstd] = GetParam();
+  const std::string dir = testing::FreshTempDir("engine_threejs_ktx2_" + format + std::to_string(zstd));
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() +
+      "/configs/default.toml --size 16 -q --set gltf.enabled=false --set ibl.size=32 --set ibl.specular=true "
+      "--set ibl.irradiance=true --set ibl.irradiance_size=8 --set ibl.ktx2=true --set ibl.ktx2_format=" +
+      format + " --set ibl.ktx2_zstd_level=" + std::to_string(zstd) + " --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  std::filesystem::copy_file(testing::SourceDir() + "/docs/engines/threejs_ktx2_cube.js",
+                             dir + "/threejs_ktx2_cube.js");
+  const nlohmann::json manifest = nlohmann::json::parse(testing::ReadFileBytes(dir + "/manifest.json"));
+  const std::vector<double> sun = manifest["frames"][0]["sun"]["direction"].get<std::vector<double>>();
+
+  struct File {
+    std::string ktx2;
+    std::vector<std::string> exrs;  // level by level, six faces stacked
+  };
+  for (const File& f : std::vector<File>{
+           {"sky_specular.ktx2", {"sky_specular_m0.exr", "sky_specular_m1.exr", "sky_specular_m2.exr"}},
+           {"sky_irradiance.ktx2", {"sky_irradiance.exr"}}}) {
+    SCOPED_TRACE(f.ktx2);
+    // The probes: per level, the brightest texel and a texel off the middle
+    // of each face; their EXR values.
+    std::string probes;
+    std::vector<std::array<float, 3>> expected;
+    std::vector<int> sizes;
+    for (size_t level = 0; level < f.exrs.size(); ++level) {
+      int width = 0, height = 0;
+      std::vector<float> rgb;
+      ASSERT_TRUE(testing::ReadRgb(dir + "/" + f.exrs[level], width, height, rgb)) << f.exrs[level];
+      sizes.push_back(width);
+      size_t brightest = 0;
+      for (size_t i = 0; i < rgb.size() / 3; ++i)
+        if (rgb[3 * i] + rgb[3 * i + 1] + rgb[3 * i + 2] >
+            rgb[3 * brightest] + rgb[3 * brightest + 1] + rgb[3 * brightest + 2])
+          brightest = i;
+      std::vector<std::array<int, 3>> texels = {{int(brightest / (width * width)), int(brightest % width),
+                                                 int(brightest / width % width)}};
+      for (int face = 0; face < 6; ++face) texels.push_back({face, width / 4, width * 3 / 4});
+      for (const auto& [face, x, y] : texels) {
+        const glm::dvec3 d = VulkanCubeTexelDirection(face, x, y, width);
+        probes += fmt::format("{}{},{:.9f},{:.9f},{:.9f}", probes.empty() ? "" : ";", level, d.x, d.y, d.z);
+        const size_t i = size_t(face) * width * width + size_t(y) * width + x;
+        expected.push_back({rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]});
+      }
+    }
+    const std::string query =
+        fmt::format("file={}&sun={:.9f},{:.9f},{:.9f}&probes={}", f.ktx2, sun[0], sun[1], sun[2], probes);
+    nlohmann::json report = RunPage("engine_threejs_ktx2.html", dir, query);
+    ASSERT_TRUE(report.is_object()) << report.dump();
+    ASSERT_EQ(report.value("ok", false), true) << report.dump();
+    nlohmann::json shown = report;
+    shown.erase("probes");
+    std::printf("three.js %s %s zstd %d: %s\n", f.ktx2.c_str(), format.c_str(), zstd, shown.dump().c_str());
+    EXPECT_TRUE(report["isCubeTexture"].get<bool>());
+    // The trap: three.js's KTX2Loader makes no cube of these files.
+    EXPECT_NE(report["ktx2loader"].value("isCubeTexture", false), true) << report["ktx2loader"].dump();
+    EXPECT_EQ(report["faces"], 6);
+    EXPECT_EQ(report["levels"], std::vector<size_t>(6, f.exrs.size())) << "every face has every level";
+    EXPECT_EQ(report["levelSizes"].get<std::vector<int>>(), sizes);
+    if (f.exrs.size() > 1) {  // the roughness-0 level: the sky itself, its Sun's aureole along the Sun
+      const std::vector<double> r = report["sun"].get<std::vector<double>>();
+      EXPECT_GT(r[0], 1.5 * std::max({r[1], r[2], r[3]})) << "the sky's Sun is not along the Sun's direction";
+    }
+    const auto seen = report["probes"].get<std::vector<std::vector<double>>>();
+    ASSERT_EQ(seen.size(), expected.size());
+    for (size_t p = 0; p < seen.size(); ++p) {
+      const float max_want = std::max({expected[p][0], expected[p][1], expected[p][2]});
+      for (int c = 0; c < 3; ++c) {
+        // As in ktx2_test.cc: equal for rgba16f (the GPU reads the same
+        // half); within half a step of the packed format otherwise.
+        const double want = expected[p][size_t(c)];
+        const double tolerance = format == "rgba16f"    ? 1e-6 * want
+                                 : format == "b10g11r11" ? (c == 2 ? 1.0 / 64 : 1.0 / 128) * want + 1e-3 * want
+                                                         : max_want / 512.0 + 1e-3 * want;
+        EXPECT_NEAR(seen[p][size_t(c)], want, tolerance) << "probe " << p << " channel " << c;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Formats, EngineThreejsKtx2Test,
+                         ::testing::Values(std::make_tuple("rgba16f", 0), std::make_tuple("b10g11r11", 0),
+                                           std::make_tuple("e5b9g9r9", 3)));
 
 }  // namespace
 }  // namespace skybake

@@ -7,6 +7,7 @@
 //   skybake check <style.toml> [--schedule day.toml] [--set key=value ...]
 //   skybake gallery [styles_dir] [--out DIR] [--size H] [--set key=value ...]
 //   skybake devices
+//   skybake --version
 //
 // main reads as the pipeline: parse, validate, bake (device, pipelines,
 // LUTs, render, files, preview), report.
@@ -16,11 +17,16 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <memory>
 #include <new>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <thread>
 #include <vector>
+
+#include <unistd.h>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -41,6 +47,9 @@
 #include "skybake/pipeline/test_pattern.h"
 #include "skybake/pipeline/viewer_page.h"
 #include "skybake/pipeline/night_sky.h"
+#include "skybake/pipeline/progress_report.h"
+
+#include "build_commit.h"
 
 namespace {
 
@@ -58,8 +67,16 @@ std::string Printable(const std::string& text) {
   return out;
 }
 
+// The first error this run reported, for the progress stream's last event.
+std::string first_error;
+
+void PrintError(const std::string& message) {
+  if (first_error.empty()) first_error = message;
+  std::fprintf(stderr, "skybake: error: %s\n", Printable(message).c_str());
+}
+
 void PrintErrors(const std::vector<ConfigError>& errors) {
-  for (const ConfigError& e : errors) std::fprintf(stderr, "skybake: error: %s\n", Printable(e.Format()).c_str());
+  for (const ConfigError& e : errors) PrintError(e.Format());
   std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
                errors.size() == 1 ? "" : "s");
 }
@@ -103,7 +120,8 @@ struct BakeArgs {
   int size = 0;
   int device = -1;
   std::vector<std::string> overrides;
-  bool quiet = false;
+  bool quiet = false;             // errors only: no progress, no warnings
+  std::string progress_json;      // --progress-json PATH: JSON lines of progress events, or ""
   bool validation = false;
   bool force = false;
   bool resume = false;
@@ -155,8 +173,9 @@ bool LoadBake(const BakeArgs& args, LoadedBake& bake) {
     PrintErrors(bake.config.errors);
     return false;
   }
-  for (const ConfigError& w : bake.config.warnings)
-    std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
+  if (!args.quiet)
+    for (const ConfigError& w : bake.config.warnings)
+      std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
   // A schedule makes a sequence: every frame's style is resolved and checked
   // before any GPU work.
   bake.schedule_path = args.schedule_path;
@@ -168,8 +187,9 @@ bool LoadBake(const BakeArgs& args, LoadedBake& bake) {
     return false;
   }
   FrameStyles styles = ResolveFrameStyles(args.style_path, overrides, loaded.schedule);
-  for (const ConfigError& w : styles.warnings)
-    std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
+  if (!args.quiet)
+    for (const ConfigError& w : styles.warnings)
+      std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
   if (!styles.ok()) {
     PrintErrors(styles.errors);
     return false;
@@ -246,10 +266,11 @@ void PrintFiles(const std::vector<BakedFile>& files) {
 }
 
 // The bake's options from the command line (and the environment main read).
-// The device, its driver and thread count, the shader switches and the
-// star catalogue: what every command that bakes takes from the arguments
-// and the environment alike.
+// The device, its driver and thread count, the shader switches, the
+// star catalogue and the build's commit: what every command that bakes
+// takes from the arguments and the environment alike.
 void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
+  options.build_commit = kBuildCommit;
   options.vulkan.device_index = args.device;
   options.vulkan.validation = args.validation;
   options.vulkan.software_driver_selection = args.software_driver_selection;
@@ -258,40 +279,44 @@ void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
   options.star_catalogue = args.star_catalogue;
 }
 
-void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, BakeOptions& options) {
+void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, ProgressReport& progress,
+                    BakeOptions& options) {
   options.out_dir = args.out_dir;
   options.force = args.force;
   options.resume = args.resume;
   options.frames = part;
   SetDeviceOptions(args, options);
+  // Stages and frames to the progress report (lines, the live line, JSON).
+  progress.Attach(options);
   // A frame's files are printed as they are recorded, and not kept: a long
-  // sequence's memory stays flat.
+  // sequence's memory stays flat. On a terminal, below the live line.
   options.keep_frame_records = false;
-  options.frame_files = PrintFiles;
-  if (!args.quiet) {
-    options.progress = [](const StageReport& s) {
-      std::fprintf(stderr, "skybake: %-10s %8.3f s  %s\n", s.name.c_str(), s.seconds, s.detail.c_str());
-    };
-  }
+  options.frame_files = [&progress](const std::vector<BakedFile>& files) {
+    progress.Suspend();
+    PrintFiles(files);
+    std::fflush(stdout);
+    progress.Resume();
+  };
 }
 
 // The last files, then anything the validation layer said.
-int ReportBake(const BakeResult& result) {
+int ReportBake(const BakeResult& result, bool quiet) {
   PrintFiles(result.files);
-  if (result.half_scale != 1.0)
+  if (result.half_scale != 1.0 && !quiet)
     std::fprintf(stderr,
                  "skybake: warning: values exceeded half range; EXRs were scaled by as little as %.9g "
                  "(each records its own scale as skybake:scale and whiteLuminance)\n",
                  result.half_scale);
   if (result.validation_messages > 0) {
-    std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d message%s\n",
-                 result.validation_messages, result.validation_messages == 1 ? "" : "s");
+    PrintError(fmt::format("the Vulkan validation layer reported {} message{}", result.validation_messages,
+                           result.validation_messages == 1 ? "" : "s"));
     return kExitVulkan;
   }
   return kExitOk;
 }
 
-int RunBake(const BakeArgs& args, Mode mode) {
+// `progress` is the bake's report (null for check and plan).
+int RunBake(const BakeArgs& args, Mode mode, ProgressReport* progress = nullptr) {
   // Parse and validate: every error at once, before any GPU work.
   std::optional<FrameRange> frames;
   std::optional<ShardSpec> shard;
@@ -313,18 +338,18 @@ int RunBake(const BakeArgs& args, Mode mode) {
     part = SelectFrames(*bake.schedule, frames, shard);
   }
   if (args.resume && !bake.schedule) {
-    std::fprintf(stderr, "skybake: error: --resume continues a sequence bake: give --schedule (or a style with "
-                         "an inline [schedule]), or use --force to bake a single style again\n");
+    PrintError("--resume continues a sequence bake: give --schedule (or a style with an inline [schedule]), or use "
+               "--force to bake a single style again");
     return kExitUsage;
   }
   if (mode == Mode::kPlan || args.dry_run) return PrintPlan(args, bake, part);
   if (mode == Mode::kCheck) return PrintCheck(args, bake, largest);
 
   // Bake: device, pipelines, LUTs, render, files, preview; then report.
-  SetBakeOptions(args, part, options);
+  SetBakeOptions(args, part, *progress, options);
   const BakeResult result = bake.schedule ? BakeSequence(bake.frame_styles, *bake.schedule, options)
                                           : BakeStyle(bake.config.style, options);
-  return ReportBake(result);
+  return ReportBake(result, args.quiet);
 }
 
 int RunMergeManifest(const MergeOptions& options) {
@@ -437,6 +462,9 @@ struct Cli {
   AccuracyStudyOptions study;
   CLI::App *bake = nullptr, *check = nullptr, *plan = nullptr, *gallery = nullptr, *testpattern = nullptr,
            *view = nullptr, *merge = nullptr, *devices = nullptr, *accuracy = nullptr;
+  // A bake's progress report, and the file of its JSON lines (or null).
+  std::FILE* progress_file = nullptr;
+  std::unique_ptr<ProgressReport> progress;
 };
 
 // bake, check and plan: a style (and its schedule) each.
@@ -472,7 +500,14 @@ void AddBakeCommands(CLI::App& app, Cli& cli) {
         ->check(CLI::IsMember(EngineNames()));
   }
   cli.bake->add_flag("--dry-run", cli.args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
-  cli.bake->add_flag("--quiet,-q", cli.args.quiet, "No progress lines (errors and warnings still print)");
+  cli.bake->add_flag("--quiet,-q", cli.args.quiet,
+                     "Errors only on stderr: no progress, no warnings (the files written still go to stdout)");
+  cli.bake->add_option("--progress-json", cli.args.progress_json,
+                       "Also write progress as JSON lines to PATH, one object per event (start, stage, frame_start, "
+                       "frame_end with the rate and time left, end with the exit code), each flushed as it happens; "
+                       "/dev/fd/N writes to an open file descriptor. Checked before anything else: a PATH that cannot "
+                       "be written stops the bake (exit 5) with nothing touched")
+      ->type_name("PATH");
   cli.bake->add_flag("--vulkan-validation", cli.args.validation,
                  "Load the Khronos validation layer; any message fails the bake (also "
                  "SKYBAKE_VULKAN_VALIDATION=1)");
@@ -609,7 +644,20 @@ int RunCommand(Cli& cli) {
     cli.merge_options.verify_checksums = !cli.sizes_only;
     return RunMergeManifest(cli.merge_options);
   }
-  return RunBake(cli.args, Mode::kBake);
+  // The bake's progress: its JSON lines' file opened before anything else,
+  // so that a path that cannot be written stops the bake with nothing
+  // touched; a live line on a terminal, lines in a log, nothing with -q.
+  if (!cli.args.progress_json.empty()) {
+    cli.progress_file = std::fopen(cli.args.progress_json.c_str(), "w");
+    if (!cli.progress_file)
+      throw OutputError(fmt::format("--progress-json {} cannot be written: {}; nothing was baked",
+                                    cli.args.progress_json, std::strerror(errno)));
+  }
+  const ProgressStyle style = cli.args.quiet              ? ProgressStyle::kQuiet
+                              : isatty(STDERR_FILENO) == 1 ? ProgressStyle::kLiveLine
+                                                           : ProgressStyle::kLines;
+  cli.progress = std::make_unique<ProgressReport>(style, stderr, cli.progress_file, SKYBAKE_VERSION, kBuildCommit);
+  return RunBake(cli.args, Mode::kBake, cli.progress.get());
 }
 
 // Runs the command given; maps every error to its exit code.
@@ -619,24 +667,44 @@ int RunReportingErrors(Cli& cli) {
   } catch (const Error& e) {
     // Every user error of every layer (base/errors.h): its message, its exit code.
     if (const auto* config = dynamic_cast<const ConfigFailure*>(&e)) PrintErrors(config->errors);
-    else std::fprintf(stderr, "skybake: error: %s\n", Printable(e.message()).c_str());
+    else PrintError(e.message());
     return e.exit_code();
   } catch (const std::bad_alloc&) {
-    std::fprintf(stderr, "skybake: error: out of memory: lower render.cube_size or render.latlong_height, or "
-                         "--max-memory-mib so that the budget check refuses such bakes (README \"Limits\")\n");
+    PrintError("out of memory: lower render.cube_size or render.latlong_height, or --max-memory-mib so that the "
+               "budget check refuses such bakes (README \"Limits\")");
     return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
-    std::fprintf(stderr, "skybake: error: %s\n", Printable(e.what()).c_str());
+    PrintError(e.what());
     return kExitOutput;
   } catch (const std::exception& e) {
+    if (first_error.empty()) first_error = std::string("internal error: ") + e.what();
     std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());
     return kExitInternal;
   }
 }
 
+// `skybake --version`: the version and the commit it was built from. Alone
+// only: beside a subcommand or another option it is a usage error (it would
+// otherwise be unclear whether the rest ran).
+int RunVersion(int argc, char** argv) {
+  if (argc != 2) {
+    std::string rest;
+    for (int i = 1; i < argc; ++i)
+      if (std::string_view(argv[i]) != "--version") rest += std::string(rest.empty() ? "" : " ") + argv[i];
+    std::fprintf(stderr, "skybake: error: --version takes no subcommand or other option (given: %s): run "
+                         "'skybake --version' alone\n",
+                 Printable(rest.empty() ? "--version twice" : rest).c_str());
+    return kExitUsage;
+  }
+  std::printf("skybake %s (commit %s)\n", SKYBAKE_VERSION, kBuildCommit);
+  return kExitOk;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i)
+    if (std::string_view(argv[i]) == "--version") return RunVersion(argc, argv);
   KeepFrameMemoryInHeap();
   CLI::App app{"skybake " SKYBAKE_VERSION
                ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
@@ -645,6 +713,9 @@ int main(int argc, char** argv) {
                "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
                "manifests that do not merge."};
   app.require_subcommand(1);
+  // Handled before parsing (RunVersion); here for the help.
+  app.add_flag("--version")->description(
+      "Print the version and the git commit skybake was built from, and exit (alone only)");
   app.get_formatter()->column_width(34);
   Cli cli;
   AddBakeCommands(app, cli);
@@ -662,5 +733,9 @@ int main(int argc, char** argv) {
     return code == 0 ? kExitOk : kExitUsage;
   }
   ReadEnvironment(cli.args);
-  return RunReportingErrors(cli);
+  const int code = RunReportingErrors(cli);
+  // The progress stream's last event: how the bake ended.
+  if (cli.progress) cli.progress->End(code, first_error);
+  if (cli.progress_file) std::fclose(cli.progress_file);
+  return code;
 }

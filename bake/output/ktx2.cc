@@ -88,7 +88,18 @@ void EncodeTexels(const float* rgba, size_t texels, const Ktx2Options& o, std::s
 }
 
 // Khronos basic data format descriptor (Khronos Data Format Specification
-// 1.3, section 5): one block, RGBSDA model, BT.709 primaries, linear.
+// 1.3, section 5): one block, RGBSDA model, BT.709 primaries, linear, alpha
+// straight. KTX-Software's validator (`ktx validate`, error 6028) compares
+// each sample field by field with the descriptor its dfdutils library makes
+// for the VkFormat (external/dfdutils: vk2dfd.inl, createdfd.c), and libktx
+// refuses a file whose samples differ; each format's samples here are the
+// ones that mapping gives:
+//   rgba16f    R, G, B, A (channel 15): 16 bits each at 0, 16, 32, 48;
+//              FLOAT | SIGNED; lower -1.0f, upper 1.0f
+//   b10g11r11  R 11 bits at 0, G 11 at 11, B 10 at 22; FLOAT; 0.0f to 1.0f
+//   e5b9g9r9   per channel its 9-bit mantissa (no qualifier, lower 0, upper
+//              8448) then the shared 5-bit exponent at 27 (EXPONENT, lower
+//              15 = the bias, upper 31)
 std::string DataFormatDescriptor(KtxFormat format) {
   struct Sample {
     uint32_t bit_offset, bit_length, channel, qualifiers, lower, upper;
@@ -105,10 +116,12 @@ std::string DataFormatDescriptor(KtxFormat format) {
       samples = {{0, 11, 0, kFloat, 0, kOneF}, {11, 11, 1, kFloat, 0, kOneF}, {22, 10, 2, kFloat, 0, kOneF}};
       break;
     case KtxFormat::kE5b9g9r9:
-      // Each channel: its 9-bit mantissa (1.0 = 256 at exponent bias 15),
-      // then the shared 5-bit exponent (bias 15, max 31).
+      // Each channel: its 9-bit mantissa, then the shared 5-bit exponent
+      // (bias 15, max 31). The mantissa's upper bound is 8448, the value
+      // dfdutils' createDFDPackedShifted gives for this format (256 was
+      // refused with error 6028).
       for (uint32_t c = 0; c < 3; ++c) {
-        samples.push_back({9 * c, 9, c, 0, 0, 256});
+        samples.push_back({9 * c, 9, c, 0, 0, 8448});
         samples.push_back({27, 5, c, kExponent, 15, 31});
       }
       break;

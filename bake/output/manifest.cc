@@ -92,6 +92,7 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
 json ManifestJson(const Manifest& m) {
   json j = {
       {"version", m.version},
+      {"commit", m.commit},
       {"style", m.style},
       {"schedule", m.schedule},
       {"sequence_sha256", m.sequence_sha256},
@@ -523,6 +524,8 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
         fmt::format("{}: invalid JSON: not a skybake manifest, or one from another version", path));
   Manifest m;
   m.version = r.Get<std::string>(j, "version");
+  // Absent from the manifests of skybake before it recorded its commit.
+  if (j.contains("commit")) m.commit = r.Get<std::string>(j, "commit");
   m.style = r.Get<std::string>(j, "style");
   m.schedule = r.Get<std::string>(j, "schedule");
   m.sequence_sha256 = r.Get<std::string>(j, "sequence_sha256");

@@ -30,6 +30,7 @@ Manifest ManifestBuilder::Head() const {
   const Schedule* schedule = plan_.schedule;
   Manifest m;
   m.version = SKYBAKE_VERSION;
+  m.commit = options_.build_commit;
   m.style = first.source_path;
   m.schedule = schedule ? schedule->source_path : "";
   m.sequence_sha256 = sequence_sha256_;

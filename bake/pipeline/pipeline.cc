@@ -226,10 +226,17 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   FrameWriter writer(plan, options, timer, exposure, manifest, result);
   FrameStages stages{plan,     options, context,  renderers,  ibl_baker, night.get(),
                      night_renderer ? &*night_renderer : nullptr, previous, exposure, timer};
+  const int frame_count = int(std::count_if(plan.frames.begin(), plan.frames.end(),
+                                             [&](const FramePlan& f) { return plan.Bakes(f); }));
+  int frame_index = 0;
   for (const FramePlan& frame : plan.frames) {
     if (!plan.Bakes(frame)) continue;  // another part's frame
+    FrameProgress progress{FrameProgress::Event::kStart, ++frame_index, frame_count, frame.number, plan.sequence};
+    if (options.frame_progress) options.frame_progress(progress);
     BakeFrame(frame, stages, writer);
-    if (&frame == &plan.frames.back()) writer.Collect();  // the last frame's files are waited for at once
+    if (frame_index == frame_count) writer.Collect();  // the last frame's files are waited for at once
+    progress.event = FrameProgress::Event::kDone;
+    if (options.frame_progress) options.frame_progress(progress);
   }
   writer.Collect();
 

@@ -74,6 +74,7 @@ struct ManifestScene {
 
 struct Manifest {
   std::string version;           // SKYBAKE_VERSION
+  std::string commit;            // the git commit skybake was built from, "unknown" outside git
   std::string style, schedule;   // paths as given on the command line (recorded in every EXR too)
   std::string sequence_sha256;   // every frame's number, time, sun and resolved style: one bake, one value
   std::string units;

@@ -27,6 +27,19 @@ namespace skybake {
 
 using ProgressCallback = std::function<void(const StageReport&)>;
 
+// A frame of a bake starting, or done: rendered, and its files written (the
+// last frame's) or handed to the writer thread, which writes them while the
+// next frame renders. Frames are reported in order, index 1 to count.
+struct FrameProgress {
+  enum class Event { kStart, kDone };
+  Event event = Event::kStart;
+  int index = 0;          // 1-based among the frames this run bakes (a part's, with --frames or --shard)
+  int count = 0;          // the frames this run bakes
+  int number = 0;         // the frame's number in file names (sequences)
+  bool sequence = false;  // false: a single bake, one frame
+};
+using FrameProgressCallback = std::function<void(const FrameProgress&)>;
+
 struct BakeOptions {
   std::string out_dir = "out";
   VulkanOptions vulkan;
@@ -35,6 +48,10 @@ struct BakeOptions {
   // $SKYBAKE_STAR_CATALOGUE when set).
   std::string star_catalogue = DefaultStarCataloguePath();
   ProgressCallback progress;  // may be empty
+  FrameProgressCallback frame_progress;  // may be empty
+  // The git commit of the running binary ("unknown" outside git; main:
+  // `skybake --version`'s), recorded in the manifest beside the version.
+  std::string build_commit = "unknown";
   bool force = false;   // overwrite files of a previous bake in out_dir
   bool resume = false;  // sequence: keep frames verified against its manifest in out_dir, bake the rest
   // Sequence: bake only these frames (a part, for a farm): their files,
