@@ -162,23 +162,21 @@ int PerlinPermutation(int i) { return gpu_aoas.perlin_permutation[i >> 2][i & 3]
 #include "aoas.glsl"
 #include "envmap.glsl"
 
-// The air's scattered radiance (with the ground in it, GroundToSky) to the
-// output's colour: the frame's sky conversion (colour_conversion.h).
+// The air's scattered radiance to the output's colour: the frame's sky
+// conversion (colour_conversion.h).
 vec3 SkyToOutput(vec3 radiance) {
   return vec3(dot(gpu_atmosphere.sky_to_output[0].xyz, radiance), dot(gpu_atmosphere.sky_to_output[1].xyz, radiance),
               dot(gpu_atmosphere.sky_to_output[2].xyz, radiance));
 }
 
-// What turns the sunlit ground's share of a texel from the sky conversion
-// (SkyToOutput of the whole texel) into the direct one: direct sunlight
-// reflected keeps the Sun's spectrum, not the sky's (colour_conversion.h).
-vec3 GroundConversionCorrection(IN(AtmosphereParameters) atm, vec3 view, vec3 sun) {
-  if (!atm.ground) return vec3(0.0);
-  SkyRay ray = SetUpSkyRay(atm, view, sun);
-  if (!ray.in_atmosphere || !ray.hits_ground) return vec3(0.0);
-  vec3 ground = SunlitGroundSeen(atm, ray) * atm.solar_irradiance;
-  return vec3(dot(gpu_atmosphere.ground_correction[0].xyz, ground), dot(gpu_atmosphere.ground_correction[1].xyz, ground),
-              dot(gpu_atmosphere.ground_correction[2].xyz, ground));
+// Whether `view` meets the ground: the test of SetUpSkyRay, which for an
+// observer inside the atmosphere needs none of the ray's distances.
+bool SeesGround(IN(AtmosphereParameters) atm, vec3 view) {
+  if (atm.observer_altitude > atm.top_radius - atm.bottom_radius) {
+    SkyRay ray = SetUpSkyRay(atm, view, vec3(0.0, 1.0, 0.0));
+    return ray.in_atmosphere && ray.hits_ground;
+  }
+  return RayIntersectsGround(atm, atm.bottom_radius + atm.observer_altitude, atm.observer_altitude, ClampCosine(view.y));
 }
 
 AtmosphereParameters AtmosphereFromUniform() {

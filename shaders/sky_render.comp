@@ -47,8 +47,11 @@ void main() {
   if (push.offsets.y != 0) atm.sun_disc = false;
   AoasParameters aoas = AoasFromUniform();
   vec3 radiance = ComputeStyledSkyRadiance(atm, aoas, view, push.sun_direction.xyz, kUseSkyView);
-  vec3 colour = SkyToOutput(radiance);
-  if (gpu_atmosphere.ground_correction[0].w != 0.0) colour += GroundConversionCorrection(atm, view, push.sun_direction.xyz);
+  // A ray that meets the ground shows the sunlit ground, direct sunlight's
+  // spectrum, through the air between: converted as direct sunlight
+  // (colour_conversion.h); the air's own light along it is small from near
+  // the ground (aerial perspective from altitude takes the same conversion).
+  vec3 colour = atm.ground && SeesGround(atm, view) ? radiance * gpu_atmosphere.output_scale.xyz : SkyToOutput(radiance);
   // Colours outside the output's gamut (a deep twilight blue) are clamped to it.
   output_texels[index] = vec4(max(colour, vec3(0.0)), 1.0);
 }

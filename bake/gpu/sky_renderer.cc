@@ -1247,8 +1247,6 @@ bool SkyRenderer::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
   // The frame's conversion stays (SetOutputConversion owns it).
   g.output_scale = gpu_atmosphere_.output_scale;
   std::copy(std::begin(gpu_atmosphere_.sky_to_output), std::end(gpu_atmosphere_.sky_to_output), g.sky_to_output);
-  std::copy(std::begin(gpu_atmosphere_.ground_correction), std::end(gpu_atmosphere_.ground_correction),
-            g.ground_correction);
   std::copy(std::begin(gpu_atmosphere_.ambient_to_direct), std::end(gpu_atmosphere_.ambient_to_direct),
             g.ambient_to_direct);
   // The shader variant (specialization constants) and the buffer sizes must
@@ -1276,18 +1274,12 @@ void SkyRenderer::SetOutputConversion(const OutputConversion& conversion) {
   gpu::GpuAtmosphere g = gpu_atmosphere_;
   auto v4 = [](const Rgb& rgb) { return gpu::vec4{float(rgb[0]), float(rgb[1]), float(rgb[2]), 0.0f}; };
   g.output_scale = v4(conversion.direct);
-  bool correction = false;
   for (int i = 0; i < 3; ++i) {
-    Rgb row{};
-    for (int j = 0; j < 3; ++j) row[j] = (i == j ? conversion.direct[i] : 0.0) - conversion.sky[i][j];
-    for (double v : row) correction = correction || v != 0.0;
     g.sky_to_output[i] = v4(conversion.sky[i]);
-    g.ground_correction[i] = v4(row);
     Rgb ambient{};
     for (int j = 0; j < 3; ++j) ambient[j] = conversion.sky[i][j] / conversion.direct[i];
     g.ambient_to_direct[i] = v4(ambient);
   }
-  g.ground_correction[0].w = correction ? 1.0f : 0.0f;
   // The clouds' ambient table holds the sky light re-expressed (ComputeCloudAmbientRow).
   if (std::memcmp(g.ambient_to_direct, gpu_atmosphere_.ambient_to_direct, sizeof g.ambient_to_direct) != 0)
     cloud_tables_ready_ = false;

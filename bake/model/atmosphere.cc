@@ -97,7 +97,6 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
     Rgb row{};
     row[i] = output_scale[i];
     g.sky_to_output[i] = v4(row, 0.0);
-    g.ground_correction[i] = v4({0.0, 0.0, 0.0}, 0.0);
     Rgb identity{};
     identity[i] = 1.0;
     g.ambient_to_direct[i] = v4(identity, 0.0);

@@ -104,8 +104,6 @@ SKYBAKE_GPU_STRUCT(GpuAtmosphere) {
   vec4 twilight;               // x: twilight march band, rad (0: off); y: its view steps; z: sine of the Sun's
                                // elevation below which a frame is twilight; w: unused
   vec4 sky_to_output[3];       // rows (xyz): the air's scattered radiance to output (colour_conversion.h); w: unused
-  vec4 ground_correction[3];   // rows (xyz): diag(output_scale) - sky_to_output, which turns the sunlit ground's
-                               // sky conversion into the direct one; [0].w: 1 when it is not zero
   vec4 ambient_to_direct[3];   // rows (xyz): inverse(diag(output_scale)) x sky_to_output, which gives the sky light
                                // that clouds scatter (their ambient table) the sky conversion; w: unused
 };
@@ -259,7 +257,7 @@ SKYBAKE_GPU_STRUCT(IblPush) {
 static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
 static_assert(sizeof(GpuClouds) == (9 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(IblPush) == 7 * 16, "IblPush must be vec4-packed");
-static_assert(sizeof(GpuAtmosphere) == 24 * 16, "GpuAtmosphere must be vec4-packed");
+static_assert(sizeof(GpuAtmosphere) == 21 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");
 static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
               "GpuAoas must be vec4-packed");
