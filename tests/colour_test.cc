@@ -249,6 +249,29 @@ TEST(SunSkySplit, SunInTheMapsOnRequestScalesHalfFiles) {
   EXPECT_NE(r.output.find("scaled"), std::string::npos) << r.output;
 }
 
+// The disc's visibility and the Sun's light are separate: a style without
+// the disc (effects.sun_disc = false) keeps its light in the manifest and the
+// glTF, the same as with it (within 1%: the host's 48 bins against the disc
+// pass through the transmittance LUT), in lux and in colour.
+TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
+  const std::string dir = testing::FreshTempDir("colour_no_disc");
+  for (const std::string disc : {"true", "false"}) {
+    const testing::CommandRun r = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --set effects.sun_disc=" +
+        disc + " --out " + dir + "/" + disc);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const json with = json::parse(testing::ReadFileBytes(dir + "/true/manifest.json"))["frames"][0]["sun"];
+  const json without = json::parse(testing::ReadFileBytes(dir + "/false/manifest.json"))["frames"][0]["sun"];
+  ASSERT_GT(with["illuminance_lux"].get<double>(), 50000.0);
+  EXPECT_NEAR(without["illuminance_lux"].get<double>() / with["illuminance_lux"].get<double>(), 1.0, 0.01);
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(without["irradiance"][c].get<double>() / with["irradiance"][c].get<double>(), 1.0, 0.01) << c;
+  const json gltf = json::parse(testing::ReadFileBytes(dir + "/false/sky.gltf"));
+  EXPECT_NEAR(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(),
+              without["illuminance_lux"].get<double>(), 1e-6 * without["illuminance_lux"].get<double>());
+}
+
 // A half-float day and night in one sequence: no frame is all zero where
 // the float32 bake's is not (the night sky's Moon and stars stay).
 TEST(SunSkySplit, NightFramesOfAHalfDaySequenceKeepTheirSky) {

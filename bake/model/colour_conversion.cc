@@ -211,6 +211,19 @@ OutputConversion UniformOutputConversion(const Rgb& scale) {
 Rgb BrunetonSkyFactors() { return {114974.916437, 71305.954816, 65310.548555}; }
 Rgb BrunetonSunFactors() { return {98242.79, 69954.40, 66475.01}; }
 
+SunLight SunLightAtObserver(const AtmosphereParams& atmosphere, const EffectSettings& effects,
+                            const glm::dvec3& sun) {
+  SunLight light;
+  const Probe probe = MakeProbe(atmosphere, effects);
+  const glsl::AtmosphereParameters atm = ColumnAtmosphere(atmosphere, effects);
+  const glm::dvec3 column = ColumnsToTop(atm, atm.observer_altitude, std::clamp(sun.y, -1.0, 1.0));
+  if (column.x < 0.0) return light;  // the disc's centre is below the horizon
+  for (int c = 0; c < 3; ++c) light.radiance[c] = probe.rgb[c].solar * std::exp(-Extinction(probe.rgb[c], column));
+  for (const Wavelength& w : probe.bins)
+    for (int c = 0; c < 3; ++c) light.luminance[c] += w.rgb[c] * w.solar * std::exp(-Extinction(w, column));
+  return light;
+}
+
 OutputConversion FrameOutputConversion(const AtmosphereParams& atmosphere, const EffectSettings& effects,
                                        const glm::dvec3& sun) {
   OutputConversion c = UniformOutputConversion(BrunetonSkyFactors());

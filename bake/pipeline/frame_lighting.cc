@@ -5,6 +5,8 @@
 
 #include <fmt/format.h>
 
+#include "skybake/model/aoas.h"
+#include "skybake/model/colour_conversion.h"
 #include "skybake/model/sh.h"
 #include "skybake/output/gltf_ibl.h"
 
@@ -22,19 +24,23 @@ std::vector<ViewRequest> ShViews(const SkyStyle& style) {
 }
 
 // The Sun's irradiance from the disc's centre radiance, and its illuminance.
-void RecordSun(const SkyStyle& style, const std::vector<float>& with_disc, const std::vector<float>& without_disc,
-               FrameResult& frame) {
+// A style whose disc is not drawn (effects.sun_disc = false, or strength 0)
+// keeps the Sun's light, from the host's 48 bins (SunLightAtObserver); so do
+// the spectral units' lux.
+void RecordSun(const SkyStyle& style, const glm::dvec3& sun, const std::vector<float>& with_disc,
+               const std::vector<float>& without_disc, FrameResult& frame) {
   const double alpha = style.atmosphere.sun_angular_radius_rad;
   const double disc_solid_angle = M_PI * alpha * alpha * (1.0 - style.atmosphere.limb_darkening_u / 3.0);
   for (int c = 0; c < 3; ++c)
     frame.sun_irradiance[c] = std::max(0.0, double(with_disc[c]) - double(without_disc[c])) * disc_solid_angle;
-  if (!style.effects.sun_disc) frame.sun_irradiance = {0.0, 0.0, 0.0};
-  Rgb sun_luminance = frame.sun_irradiance;
-  if (style.output.units == OutputUnits::kSpectral) {
-    Rgb k = OutputScale(OutputUnits::kLuminance);
-    for (int c = 0; c < 3; ++c) sun_luminance[c] *= k[c];
+  const bool disc = style.effects.sun_disc && style.effects.sun_disc_strength > 0.0;
+  if (disc && style.output.units == OutputUnits::kLuminance) {
+    frame.sun_illuminance_lux = Luminance(frame.sun_irradiance);
+    return;
   }
-  frame.sun_illuminance_lux = Luminance(sun_luminance);
+  const SunLight light = SunLightAtObserver(StyledAtmosphere(style.atmosphere, style.aoas), style.effects, sun);
+  if (!disc) frame.sun_irradiance = style.output.units == OutputUnits::kLuminance ? light.luminance : light.radiance;
+  frame.sun_illuminance_lux = Luminance(light.luminance);
 }
 
 }  // namespace
@@ -48,7 +54,7 @@ void ComputeFrameLighting(SkyRenderer& renderer, const FramePlan& plan, const st
   std::vector<std::vector<float>> sh_faces = renderer.Render(plan.sun, sh_views, false);
   for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
   if (night) night->AddToFaces(style, sh_views, sh_faces);
-  RecordSun(style, with_disc, without_disc, frame);
+  RecordSun(style, plan.sun, with_disc, without_disc, frame);
   ShRgb sky = ProjectCubeFaces({sh_faces[0].data(), sh_faces[1].data(), sh_faces[2].data(), sh_faces[3].data(),
                                 sh_faces[4].data(), sh_faces[5].data()},
                                sh_views[0].width);

@@ -51,4 +51,16 @@ Rgb BrunetonSunFactors();
 OutputConversion FrameOutputConversion(const AtmosphereParams& atmosphere, const EffectSettings& effects,
                                        const glm::dvec3& sun);
 
+// The Sun's light at the observer, at normal incidence, through the frame's
+// air: `luminance`, linear Rec.709 in cd/m^2 x sr (lux per channel), from
+// the 48 bins (so the direct conversion's colour); `radiance`, the same at
+// the three wavelengths in W m^-2 nm^-1 (the spectral units). Zero when the
+// disc's centre is below the observer's horizon. For a style whose disc is
+// not drawn (effects.sun_disc = false): its light stays.
+struct SunLight {
+  Rgb luminance{};
+  Rgb radiance{};
+};
+SunLight SunLightAtObserver(const AtmosphereParams& atmosphere, const EffectSettings& effects, const glm::dvec3& sun);
+
 }  // namespace skybake
