@@ -105,9 +105,10 @@ TEST(CliTest, FloatOutputNeedsNoScale) {
 
 TEST(CliTest, RefusedOverflowWritesNothing) {
   std::string out = FreshDir("refuse");
-  // The disc in the maps (output.sun = "map") is beyond half range.
-  CommandRun run =
-      Skybake("bake " + Style() + " --size 8 -q --set output.sun=map --set output.overflow=refuse --out " + out);
+  // A sky beyond half range (a style made a thousand times brighter) is refused when written.
+  CommandRun run = Skybake("bake " + Style() +
+                           " --size 8 -q --set sun.irradiance=[1474.0,1850.4,1911.98] --set output.overflow=refuse --out " +
+                           out);
   EXPECT_EQ(run.exit_code, 5) << run.output;
   EXPECT_NE(run.output.find("exceeds the half-float maximum"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("output.pixel_type"), std::string::npos) << "names the fix";
@@ -204,6 +205,19 @@ TEST(CliTest, VersionPrintsTheVersionAndCommitAndTheManifestRecordsThem) {
   EXPECT_EQ(manifest["version"], SKYBAKE_VERSION);
   EXPECT_EQ(manifest["commit"], commit);
   std::filesystem::remove_all(out);
+}
+
+// The disc in half-float maps with no scale allowed can never be written:
+// refused before any GPU work, at the key, with the fixes.
+TEST(CliTest, SunInHalfMapsWithoutAScaleIsRefusedUpFront) {
+  std::string out = FreshDir("sun_map_refuse");
+  CommandRun run =
+      Skybake("bake " + Style() + " --size 8 -q --set output.sun=map --set output.overflow=refuse --out " + out);
+  EXPECT_EQ(run.exit_code, 3) << run.output;
+  EXPECT_NE(run.output.find("output.sun: the solar disc in half-float maps exceeds half range"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("output.sun = \"light\""), std::string::npos) << "names the fix";
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace

@@ -1259,6 +1259,21 @@ void CheckIbl(const SkyStyle& style, StyleChecks& c) {
   }
 }
 
+// The disc in half-float maps of luminance (output.sun = "map"): its centre,
+// about 1e9 cd/m^2 by day, is beyond half range (65504) whatever the sky, so
+// with output.overflow = "refuse" the bake could only fail after its GPU work.
+void CheckSunInMaps(const SkyStyle& style, StyleChecks& c) {
+  const OutputSettings& o = style.output;
+  if (o.sun != SunOutput::kMap || o.pixel_type != PixelType::kHalf || o.overflow != OverflowPolicy::kRefuse ||
+      o.units != OutputUnits::kLuminance || !style.effects.sun_disc || style.effects.sun_disc_strength <= 0.0)
+    return;
+  ConfigError e = c.Locate("output.sun");
+  e.message = "the solar disc in half-float maps exceeds half range (65504 cd/m^2) and output.overflow = \"refuse\" "
+              "forbids a scale: set output.sun = \"light\" (the Sun as a light, the default), "
+              "output.pixel_type = \"float\", or output.overflow = \"scale\"";
+  c.errors.push_back(e);
+}
+
 // The spectral mode (quality.wavelengths > 3) integrates radiance to colour:
 // radiance output keeps the three named wavelengths. (The per-texel effects
 // that act on RGB colour, the AOAS saturation clouds and shapes and the night
@@ -1346,6 +1361,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   CheckSceneAndEngine(result.style, checks);
   CheckIbl(result.style, checks);
   CheckSpectral(result.style, checks);
+  CheckSunInMaps(result.style, checks);
   WarnPresetChangesNothing(result.style, reader, checks);
   if (!result.ok()) return result;
 
