@@ -272,6 +272,33 @@ TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
               without["illuminance_lux"].get<double>(), 1e-6 * without["illuminance_lux"].get<double>());
 }
 
+// A hue-styled sky (AOAS [hue]) is a colour, not a spectrum: its sky texels
+// keep the sky factors its target colour was solved with (the raw radiance
+// times Bruneton's sky factors), while its Sun takes the direct conversion.
+TEST(SunSkySplit, HueStyledSkyKeepsTheConversionOfItsTargetColour) {
+  const std::string dir = testing::FreshTempDir("colour_hue");
+  for (const std::string units : {"luminance", "spectral"}) {
+    const testing::CommandRun r = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/styles/yellow_turbulent.toml --size 16 -q --vulkan-validation "
+        "--set output.pixel_type=float --set output.units=" + units + " --out " + dir + "/" + units);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const Latlong lum = ReadLatlong(dir + "/luminance/sky_latlong.exr");
+  const Latlong raw = ReadLatlong(dir + "/spectral/sky_latlong.exr");
+  const Rgb k = BrunetonSkyFactors();
+  int checked = 0;
+  for (int y = 0; y < lum.height / 2; ++y)
+    for (int x = 0; x < lum.width; ++x) {
+      const std::array<double, 3> a = lum.at(x, y), b = raw.at(x, y);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c] * k[c], 1e-5 * a[c] + 1e-6) << x << "," << y << " channel " << c;
+      ++checked;
+    }
+  EXPECT_EQ(checked, lum.width * lum.height / 2);
+  const json m = json::parse(testing::ReadFileBytes(dir + "/luminance/manifest.json"));
+  const std::array<double, 3> sun = SunIrradiance(m, 0);
+  EXPECT_GT(sun[2] / sun[0], 0.5) << "the Sun is not the sky's yellow";
+}
+
 // A half-float day and night in one sequence: no frame is all zero where
 // the float32 bake's is not (the night sky's Moon and stars stay).
 TEST(SunSkySplit, NightFramesOfAHalfDaySequenceKeepTheirSky) {

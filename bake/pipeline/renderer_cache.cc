@@ -18,6 +18,10 @@ SkyRenderer& RendererCache::Main(const SkyStyle& style, double cloud_time_s, con
   if (!luminance_) return *main_;
   if (!conversion_sun_ || *conversion_sun_ != sun) {
     conversion_ = FrameOutputConversion(conversion_atmosphere_, conversion_effects_, sun);
+    // A hue-styled sky (AOAS [hue]: a free RGB vector for the Rayleigh
+    // constants) is a colour, not a spectrum: it keeps the conversion its
+    // target colour is solved with (RayleighForTargetColor, the sky factors).
+    if (hue_) conversion_.sky = UniformOutputConversion(BrunetonSkyFactors()).sky;
     conversion_sun_ = sun;
   }
   main_->SetOutputConversion(conversion_);
@@ -30,9 +34,12 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   StyledInputs in = StyledInputsOf(style);
   const bool luminance = style.output.units == OutputUnits::kLuminance && style.quality.wavelengths <= kRgbWavelengths;
   // The conversion's probe reads the atmosphere and whether aerosols and ozone are on.
-  if (luminance != luminance_ || std::memcmp(&in.atmosphere, &conversion_atmosphere_, sizeof in.atmosphere) != 0 ||
+  const bool hue = style.aoas.hue.enabled && style.aoas.hue.strength > 0.0;
+  if (luminance != luminance_ || hue != hue_ ||
+      std::memcmp(&in.atmosphere, &conversion_atmosphere_, sizeof in.atmosphere) != 0 ||
       style.effects.mie != conversion_effects_.mie || style.effects.ozone != conversion_effects_.ozone) {
     luminance_ = luminance;
+    hue_ = hue;
     conversion_atmosphere_ = in.atmosphere;
     conversion_effects_ = style.effects;
     conversion_sun_.reset();

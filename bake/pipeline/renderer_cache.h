@@ -56,6 +56,7 @@ class RendererCache {
   AoasInputs aoas_key_;
   // What the frame's output conversion is computed from (Update), and the last one.
   bool luminance_ = false;
+  bool hue_ = false;  // the style's sky is a hue vector's colour
   AtmosphereParams conversion_atmosphere_;
   EffectSettings conversion_effects_;
   std::optional<glm::dvec3> conversion_sun_;
