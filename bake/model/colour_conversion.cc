@@ -76,10 +76,10 @@ glm::dvec3 ColumnsToTop(const glsl::AtmosphereParameters& atm, double altitude, 
   return glsl::ComputeOpticalDepthToTopBoundary(atm, r, altitude, mu, kColumnSteps);
 }
 
-// The observer's view: 9 elevations from 1 to 85 deg above the horizontal,
-// 8 azimuths from the Sun's over half a turn (the sky is symmetric about
-// the Sun's vertical).
-std::vector<glm::dvec3> ProbeDirections(const glm::dvec3& sun) {
+}  // namespace
+
+// The sky is symmetric about the Sun's vertical: half a turn of azimuths.
+std::vector<glm::dvec3> SkyProbeDirections(const glm::dvec3& sun) {
   const double sun_azimuth = std::atan2(sun.x, -sun.z);
   std::vector<glm::dvec3> views;
   for (double elevation_deg : {1.0, 3.0, 6.0, 10.0, 15.0, 25.0, 40.0, 60.0, 85.0})
@@ -89,6 +89,8 @@ std::vector<glm::dvec3> ProbeDirections(const glm::dvec3& sun) {
     }
   return views;
 }
+
+namespace {
 
 // Single-scattered radiance along `view` at every probe wavelength (the 48
 // bins, then the three), per unit of each wavelength's solar irradiance
@@ -140,10 +142,10 @@ Rgb Integrate(const Probe& probe, const std::vector<double>& radiance) {
   return rgb;
 }
 
-// Least squares of sky * sample = target over the probe, each direction
-// weighted by the inverse of its luminance (so that every direction's
-// colour counts, not the brightest's). False when too few directions see
-// sunlit air.
+}  // namespace
+
+// Each direction weighted by the inverse of its luminance, so that every
+// direction's colour counts, not the brightest's.
 bool FitSkyMatrix(const std::vector<Rgb>& samples, const std::vector<Rgb>& targets, Matrix3& sky) {
   double brightest = 0.0;
   for (const Rgb& t : targets) brightest = std::max(brightest, Rec709Luminance(t));
@@ -160,6 +162,7 @@ bool FitSkyMatrix(const std::vector<Rgb>& samples, const std::vector<Rgb>& targe
   }
   if (used < 12) return false;
   const Matrix3 inverse = Inverse(gram);
+  Matrix3 fitted{};
   for (int row = 0; row < 3; ++row) {
     Rgb rhs{};
     for (size_t i = 0; i < samples.size(); ++i) {
@@ -167,13 +170,16 @@ bool FitSkyMatrix(const std::vector<Rgb>& samples, const std::vector<Rgb>& targe
       if (!(y > 1e-9 * brightest)) continue;
       for (int a = 0; a < 3; ++a) rhs[a] += samples[i][a] * targets[i][row] / (y * y);
     }
-    sky[row] = Apply(inverse, rhs);
+    fitted[row] = Apply(inverse, rhs);
   }
-  for (const Rgb& r : sky)
+  for (const Rgb& r : fitted)
     for (double v : r)
       if (!std::isfinite(v)) return false;
+  sky = fitted;
   return true;
 }
+
+namespace {
 
 // Direct sunlight where it lights the frame: at the observer, or, with the
 // Sun below the observer's horizon, at the lowest altitude above it that the
@@ -231,7 +237,7 @@ OutputConversion FrameOutputConversion(const AtmosphereParams& atmosphere, const
   const glsl::AtmosphereParameters atm = ColumnAtmosphere(atmosphere, effects);
   if (!DirectFactors(atm, probe, sun, c.direct)) c.direct = BrunetonSunFactors();
   std::vector<Rgb> samples, targets;
-  for (const glm::dvec3& view : ProbeDirections(sun)) {
+  for (const glm::dvec3& view : SkyProbeDirections(sun)) {
     const std::vector<double> radiance = SingleScattering(atm, probe, view, sun, atmosphere.mie_g);
     const size_t three = probe.bins.size();
     samples.push_back({radiance[three], radiance[three + 1], radiance[three + 2]});

@@ -55,8 +55,16 @@ class RendererCache {
   int wavelengths_ = 0;  // quality.wavelengths of main_
   AoasInputs aoas_key_;
   // What the frame's output conversion is computed from (Update), and the last one.
+  // Near and below the horizon the host's single-scattering probe does not
+  // hold (a twilight sky is multiple scattering and ozone): the sky matrix
+  // is fitted to the spectral mode's own sky, 24 bins on the GPU, at the
+  // same probe directions (FitTwilightSky).
+  bool FitTwilightSky(const glm::dvec3& sun, Matrix3& sky);
   bool luminance_ = false;
   bool hue_ = false;  // the style's sky is a hue vector's colour
+  QualitySettings probe_quality_;
+  EffectSettings probe_effects_;
+  std::unique_ptr<SkyRenderer> probe_;  // the 48-bin renderer of FitTwilightSky, built on first use
   AtmosphereParams conversion_atmosphere_;
   EffectSettings conversion_effects_;
   std::optional<glm::dvec3> conversion_sun_;

@@ -21,6 +21,8 @@
 // mode and what it costs.
 #pragma once
 
+#include <vector>
+
 #include <glm/vec3.hpp>
 
 #include "skybake/model/atmosphere.h"
@@ -50,6 +52,16 @@ Rgb BrunetonSunFactors();
 // the air above it, `direct` is Bruneton's sun factors.
 OutputConversion FrameOutputConversion(const AtmosphereParams& atmosphere, const EffectSettings& effects,
                                        const glm::dvec3& sun);
+
+// The probe's directions for a Sun along `sun`: 9 elevations from 1 to 85
+// deg above the horizontal, 8 azimuths from the Sun's over half a turn.
+std::vector<glm::dvec3> SkyProbeDirections(const glm::dvec3& sun);
+
+// The sky matrix that maps `samples` (radiance at 680/550/440 nm) onto
+// `targets` (linear Rec.709), by least squares with each direction weighted
+// by the inverse of its target's luminance. False (and `sky` untouched) when
+// fewer than 12 directions are lit or the fit is not finite.
+bool FitSkyMatrix(const std::vector<Rgb>& samples, const std::vector<Rgb>& targets, Matrix3& sky);
 
 // The Sun's light at the observer, at normal incidence, through the frame's
 // air: `luminance`, linear Rec.709 in cd/m^2 x sr (lux per channel), from
