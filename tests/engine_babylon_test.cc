@@ -18,11 +18,13 @@
 #include <vector>
 
 #include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include "skybake/pipeline/test_pattern.h"
+#include "sky_and_sun.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -97,6 +99,45 @@ TEST(EngineBabylonTest, TestPatternFacesAreWhereTheySayInBabylon) {
   }
   EXPECT_GT(wrong, 0) << "the Vulkan faces load right in Babylon without the preset";
   std::printf("Babylon.js: %d of 6 face axes show another face with skybake's Vulkan faces\n", wrong);
+}
+
+// The default bake's sky and Sun together in Babylon.js, in units (issue
+// 48; sky_and_sun.h, tests/viewer/engine_babylon_sun_sky.html):
+// sky_latlong.exr as an EXRCubeTexture (Babylon's own equirect EXR loader),
+// the scene's environment and its default skybox; the sun through Babylon's
+// glTF loader from sky.glb; an up-facing grey card (PBRMaterial, metallic 0,
+// roughness 1, metallicF0Factor 0, the Lambert diffuse model); one exposure
+// (image processing "by post-process" with none and skipFinalColorClamp:
+// linear, unclamped, into a float render target). Babylon's glTF loader
+// sets the light's intensity to the glTF intensity and its diffuse to the
+// colour; a directional light's intensityMode AUTOMATIC is illuminance, a
+// photometric scale of 1 (Light._getPhotometricScale), so the light is
+// colour x intensity in lux; the Lambert model's diffuse term is 1 / pi
+// (computeDiffuseLighting); the environment lights the card from the
+// texture's spherical harmonics as irradiance / pi. So the card is
+// albedo / pi x (intensity x Y(colour) x sin(elevation) + E_sky), and the
+// sky the latlong's texels: the float32 bake's figures, to 5%. Measured
+// (2026-12-07): the harmonics' E_sky is 10% short of the latlong's integral
+// (358 against 398 cd/m^2 on the card), 1% of the card with the Sun at 35
+// degrees; a lower Sun gives the sky more of it.
+TEST(EngineBabylonTest, SkyAndSunShowOneExposure) {
+  testing::SkyAndSun bake;
+  ASSERT_TRUE(testing::BakeSkyAndSun("engine_babylon_sun_sky", bake));
+  const std::string query =
+      fmt::format("latlong=sky_latlong.exr&scene=sky.glb&albedo={}&fov={}&size={}&sky={}", testing::kGreyCardAlbedo,
+                  testing::kProbeFovDeg, testing::kProbeSize, testing::SkyProbeQuery());
+  const nlohmann::json line =
+      testing::RunViewerPage("engine_babylon_sun_sky.html", bake.half_dir, bake.half_dir + "/babylon.png", query);
+  ASSERT_FALSE(line.is_null());
+  const nlohmann::json report = line["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("Babylon.js: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["light"]["scaledIntensity"].get<double>(), bake.light_intensity)
+      << "a photometric scale of 1: the glTF's lux as they are";
+  testing::ExpectClientMatchesFloatBake(
+      "Babylon.js " + report["version"].get<std::string>(), bake, report["sky"].get<std::vector<double>>(),
+      report["card"].get<std::vector<double>>(), report["cardLightOnly"].get<std::vector<double>>(),
+      report["cardEnvironmentOnly"].get<std::vector<double>>());
 }
 
 }  // namespace

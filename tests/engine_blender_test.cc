@@ -9,12 +9,15 @@
 // latlong, set the same way, puts it a quarter turn away (Blender's
 // equirect centre faces +X, OpenEXR's +Z): the trap the preset removes.
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <vector>
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "sky_and_sun.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -63,6 +66,62 @@ TEST(EngineBlenderTest, SkysSunIsAlongTheImportedSunLight) {
   std::printf("OpenEXR latlong: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
               openexr.radiance[0], openexr.radiance[1], openexr.radiance[2], openexr.radiance[3]);
   EXPECT_GT(openexr.radiance[1], 2.0 * std::max({openexr.radiance[0], openexr.radiance[2], openexr.radiance[3]}));
+}
+
+// The default bake's sky and Sun together in Blender, in units (issue 48;
+// sky_and_sun.h, tests/engines/blender_sun_sky.py): Blender's glTF importer
+// brings in sky.glb's sun, sky_latlong.exr is the World's Environment
+// Texture, an up-facing grey card (Diffuse BSDF, roughness 0: Lambertian)
+// is lit by both, and Cycles renders at one exposure (Standard view
+// transform, exposure 0, a float EXR: linear). Units, from the importer's
+// source (io_import_scene_gltf2 in Debian's blender-data 3.4.1,
+// blender/imp/gltf2_blender_light.py): its Lighting Mode "Standard"
+// (convert_lighting_mode = SPEC, the default) makes a directional light's
+// Strength intensity / 683 (PBR_WATTS_TO_LUMENS: lux to W/m^2 at 555 nm);
+// "Unitless" (COMPAT) keeps the lux. Cycles lights a diffuse surface with
+// Strength x colour x cos and albedo / pi, and shows the World's texels x
+// the Background Strength. So with Standard the sky must be brought into
+// the same units, Background Strength 1/683 (the render is then in
+// cd/m^2 / 683: the one exposure, undone here); with Unitless the sky stays
+// at Strength 1 and the render is in cd/m^2. Either way the card is
+// albedo / pi x (intensity x Y(colour) x sin(elevation) + E_sky) in the
+// sky's units: the float32 bake's figures, to 5%.
+TEST(EngineBlenderTest, SkyAndSunShowOneExposure) {
+  auto [which, where] = testing::RunCommand("command -v blender");
+  ASSERT_EQ(which, 0) << "blender is missing: run .ci/setup (Debian package blender)";
+  testing::SkyAndSun bake;
+  ASSERT_TRUE(testing::BakeSkyAndSun("engine_blender_sun_sky", bake));
+  struct Mode {
+    std::string lighting_mode;     // the importer's convert_lighting_mode
+    double background_strength;    // the World's, so that the sky is in the sun's units
+    double strength_per_lux;       // the imported sun's Strength per glTF lux
+  };
+  for (const Mode& mode : {Mode{"SPEC", 1.0 / 683.0, 1.0 / 683.0}, Mode{"COMPAT", 1.0, 1.0}}) {
+    SCOPED_TRACE(mode.lighting_mode);
+    const std::string command = fmt::format(
+        "blender -b --factory-startup --python '{}/tests/engines/blender_sun_sky.py' -- '{}/sky.glb' "
+        "'{}/sky_latlong.exr' '{}' {} {} {} {} {:.9g} 64 '{}'",
+        testing::SourceDir(), bake.half_dir, bake.half_dir, bake.half_dir, testing::kGreyCardAlbedo,
+        testing::kProbeFovDeg, testing::kProbeSize, mode.lighting_mode, mode.background_strength,
+        testing::SkyProbeQuery());
+    auto [code, output] = testing::RunCommand(command);
+    ASSERT_EQ(code, 0) << command << "\n" << output;
+    const size_t at = output.find("RESULT ");
+    ASSERT_NE(at, std::string::npos) << "blender printed no result:\n" << output;
+    const nlohmann::json result = nlohmann::json::parse(output.substr(at + 7, output.find('\n', at) - at - 7));
+    std::printf("Blender %s: %s\n", mode.lighting_mode.c_str(), result.dump().c_str());
+    EXPECT_NEAR(result["sun"]["strength"].get<double>(), bake.light_intensity * mode.strength_per_lux,
+                1e-6 * bake.light_intensity * mode.strength_per_lux);
+    // The one exposure undone: the render's units back to cd/m^2.
+    auto in_cd_m2 = [&](const char* view) {
+      std::vector<double> rgb = result[view].get<std::vector<double>>();
+      for (double& v : rgb) v /= mode.background_strength;
+      return rgb;
+    };
+    testing::ExpectClientMatchesFloatBake("Blender 3.4 Cycles, Lighting Mode " + mode.lighting_mode, bake,
+                                          in_cd_m2("sky"), in_cd_m2("card"), in_cd_m2("card_sun_only"),
+                                          in_cd_m2("card_sky_only"));
+  }
 }
 
 }  // namespace

@@ -22,6 +22,7 @@
 
 #include "skybake/model/envmap.h"
 #include "skybake/pipeline/test_pattern.h"
+#include "sky_and_sun.h"
 #include "test_support.h"
 
 namespace skybake {
@@ -188,6 +189,40 @@ TEST_P(EngineThreejsKtx2Test, CubeLoadsWithEveryLevelTheRightWayRound) {
 INSTANTIATE_TEST_SUITE_P(Formats, EngineThreejsKtx2Test,
                          ::testing::Values(std::make_tuple("rgba16f", 0), std::make_tuple("b10g11r11", 0),
                                            std::make_tuple("e5b9g9r9", 3)));
+
+// The default bake's sky and Sun together in three.js, in units (issue 48;
+// sky_and_sun.h, tests/viewer/engine_threejs_sun_sky.html): sky_latlong.exr
+// through EXRLoader as scene.background and scene.environment
+// (EquirectangularReflectionMapping; three.js prefilters the environment
+// with PMREM and lights physical materials with it), the sun through
+// GLTFLoader from sky.glb, an up-facing grey card (MeshPhysicalMaterial,
+// metalness 0, roughness 1, specularIntensity 0: Lambertian), one exposure
+// (NoToneMapping, a float render target: linear). three.js 0.170 has no
+// legacy light units (useLegacyLights is gone since r165): a directional
+// light's irradiance is colour x intensity, so intensity is lux, and the
+// diffuse lobe is albedo / pi (BRDF_Lambert); the image-based light's
+// irradiance is pi x the PMREM's roughness-1 level along the normal. So the
+// card is albedo / pi x (intensity x Y(colour) x sin(elevation) + the
+// PMREM's estimate of E_sky), and the sky the latlong's texels: the float32
+// bake's figures, to 5%. Measured (2026-12-07): the PMREM's E_sky is 12%
+// short of the latlong's integral (350 against 398 cd/m^2 on the card), 1.2%
+// of the card with the Sun at 35 degrees; a lower Sun gives the sky more of it.
+TEST(EngineThreejsTest, SkyAndSunShowOneExposure) {
+  testing::SkyAndSun bake;
+  ASSERT_TRUE(testing::BakeSkyAndSun("engine_threejs_sun_sky", bake));
+  const std::string query =
+      fmt::format("latlong=sky_latlong.exr&scene=sky.glb&albedo={}&fov={}&size={}&sky={}", testing::kGreyCardAlbedo,
+                  testing::kProbeFovDeg, testing::kProbeSize, testing::SkyProbeQuery());
+  nlohmann::json report = RunPage("engine_threejs_sun_sky.html", bake.half_dir, query);
+  ASSERT_TRUE(report.is_object()) << report.dump();
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("three.js: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["light"]["intensity"].get<double>(), bake.light_intensity) << "GLTFLoader keeps the lux";
+  testing::ExpectClientMatchesFloatBake(
+      "three.js r" + report["revision"].get<std::string>(), bake, report["sky"].get<std::vector<double>>(),
+      report["card"].get<std::vector<double>>(), report["cardLightOnly"].get<std::vector<double>>(),
+      report["cardEnvironmentOnly"].get<std::vector<double>>());
+}
 
 }  // namespace
 }  // namespace skybake

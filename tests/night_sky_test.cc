@@ -28,6 +28,7 @@
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/tools/reference_model.h"
 #include "skybake/input/schedule.h"
+#include "skybake/model/spectrum.h"
 #include "skybake/model/view.h"
 #include "test_support.h"
 
@@ -389,8 +390,12 @@ TEST_F(NightBake, GltfHasTheMoonAsASecondLightAndValidates) {
   const json& lights = gltf["extensions"]["KHR_lights_punctual"]["lights"];
   ASSERT_EQ(lights.size(), 2u);
   EXPECT_EQ(lights[1]["name"].get<std::string>(), "moon");
-  EXPECT_GT(lights[1]["intensity"].get<double>(), 0.1);  // lux, the brightest frame's
-  EXPECT_LT(lights[1]["intensity"].get<double>(), 0.3);
+  // lux, the brightest frame's: intensity x Y(colour), as clients light with colour x intensity.
+  const double moon_lux = lights[1]["intensity"].get<double>() *
+                          Rec709Luminance({lights[1]["color"][0].get<double>(), lights[1]["color"][1].get<double>(),
+                                           lights[1]["color"][2].get<double>()});
+  EXPECT_GT(moon_lux, 0.1);
+  EXPECT_LT(moon_lux, 0.3);
   EXPECT_EQ(gltf["animations"][0]["channels"].size(), 2u);
   auto [status, output] = RunCommand("cd '" + SourceDir() + "/tests/viewer' && node validate.mjs '" + dir_ +
                                      "/out/sky.gltf' '" + dir_ + "/out/sky.glb'");

@@ -2,6 +2,7 @@
 // 24-frame schedule, its manifest checked file by file against sha256sum,
 // and the glTF scenes checked by the Khronos glTF-Validator and rendered by
 // three.js in headless Chromium (node scripts in tests/viewer/).
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -20,6 +21,7 @@
 
 #include "skybake/pipeline/pipeline.h"
 #include "skybake/input/schedule.h"
+#include "skybake/model/spectrum.h"
 #include "schedule_fixtures.h"
 #include "test_support.h"
 
@@ -197,8 +199,14 @@ TEST_F(Sequence, GltfSunShinesAwayFromTheBakedSun) {
   // The light (the highest-sun frame, the last) shines along the node's -Z.
   const FrameResult& last = result_->frames.back();
   EXPECT_LT(glm::length(Rotate(sun_node["rotation"], {0, 0, -1}) + last.sun_direction), 1e-6);
-  EXPECT_NEAR(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(),
-              last.sun_illuminance_lux, 1e-6 * last.sun_illuminance_lux);
+  // Clients light with colour x intensity: intensity x Y(colour) is the
+  // illuminance, the colour's brightest channel 1.
+  const json& light = gltf["extensions"]["KHR_lights_punctual"]["lights"][0];
+  const std::array<double, 3> colour = {light["color"][0].get<double>(), light["color"][1].get<double>(),
+                                        light["color"][2].get<double>()};
+  EXPECT_NEAR(std::max({colour[0], colour[1], colour[2]}), 1.0, 1e-12);
+  EXPECT_NEAR(light["intensity"].get<double>() * Rec709Luminance(colour), last.sun_illuminance_lux,
+              1e-6 * last.sun_illuminance_lux);
   // Every animation key points the light away from its frame's sun.
   const json& sampler = gltf["animations"][0]["samplers"][0];
   const json& output = gltf["accessors"][sampler["output"].get<int>()];

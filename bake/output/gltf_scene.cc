@@ -28,6 +28,7 @@
 
 #include <OpenEXR/ImfRgbaFile.h>
 
+#include "skybake/model/spectrum.h"
 #include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/output/json_spool.h"
@@ -311,12 +312,19 @@ namespace {
 
 // A KHR_lights_punctual directional light of `sun`'s illuminance (lux) and
 // colour, and the node that turns it (its -Z along the sun's direction);
-// returns the node.
+// returns the node. Clients light with colour x intensity (three.js,
+// Babylon.js, Blender's importer, Filament), so the illuminance they apply
+// is intensity x Y(colour); the colour's brightest channel is 1 (glTF keeps
+// colours in [0, 1]), so the intensity is the illuminance / Y(colour): the
+// Sun's lux at Y(colour) = 0.85 would otherwise light a scene 15% short
+// (EngineThreejsTest.SkyAndSunShowOneExposure and its Babylon.js and Blender
+// twins).
 int AddDirectionalLight(tinygltf::Model& model, const std::string& name, const SceneSun& sun) {
   tinygltf::Light light;
   light.name = name;
   light.type = "directional";
-  light.intensity = sun.illuminance_lux;
+  const double y = Rec709Luminance({sun.color[0], sun.color[1], sun.color[2]});
+  light.intensity = y > 0.0 ? sun.illuminance_lux / y : 0.0;
   light.color = {sun.color[0], sun.color[1], sun.color[2]};
   model.lights.push_back(light);
   tinygltf::Node node;
@@ -442,7 +450,7 @@ tinygltf::Model BuildSceneModel(const SceneDescription& scene) {
   json asset_extras = {
       {"skybake",
        {{"units", {{"length", "metre"},
-                   {"sun_intensity", "lux (KHR_lights_punctual directional)"},
+                   {"sun_intensity", "lux (KHR_lights_punctual directional): intensity x Y(colour) is the illuminance"},
                    {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
         {"frame", "+Y up, right-handed, North -Z, East +X; sun light shines along its node's -Z"},
         {"texture_layout", "OpenEXR latlong (Imf::LatLongMap): u = 0 at longitude +pi, v = 0 at latitude +pi/2"}}}};
