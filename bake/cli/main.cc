@@ -55,18 +55,6 @@ namespace {
 
 using namespace skybake;
 
-// A message for the terminal: control characters read from a file or the
-// command line (an escape sequence, a newline in a key) shown as \xNN.
-std::string Printable(const std::string& text) {
-  std::string out;
-  for (char ch : text) {
-    const unsigned char c = static_cast<unsigned char>(ch);
-    if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
-    else out += ch;
-  }
-  return out;
-}
-
 // The first error this run reported, for the progress stream's last event.
 std::string first_error;
 

@@ -26,8 +26,9 @@ size_t TerminalWidth(std::FILE* file) {
   return 80;
 }
 
-// A line for a log: control characters from a style, a path or a detail
-// (an escape sequence, a newline) shown as \xNN.
+
+}  // namespace
+
 std::string Printable(const std::string& text) {
   std::string out;
   for (char ch : text) {
@@ -37,8 +38,6 @@ std::string Printable(const std::string& text) {
   }
   return out;
 }
-
-}  // namespace
 
 std::string FormatDuration(double seconds) {
   const long s = std::lround(std::max(0.0, seconds));

@@ -45,6 +45,10 @@ namespace skybake {
 enum class ProgressStyle { kQuiet, kLines, kLiveLine };
 
 // "42s", "6m05s", "2h07m": a time left or a frame's time, to the second.
+// Text for a terminal or a log: control characters read from a file, a
+// style or the command line (an escape sequence, a newline) shown as \xNN.
+std::string Printable(const std::string& text);
+
 std::string FormatDuration(double seconds);
 // "4.2 s/frame" at a second or more a frame, else "14 frames/min".
 std::string FormatRate(double seconds_per_frame);
