@@ -23,7 +23,7 @@ SkyRenderer& RendererCache::Main(const SkyStyle& style, double cloud_time_s, con
     // target colour is solved with (RayleighForTargetColor, the sky factors).
     if (hue_)
       conversion_.sky = UniformOutputConversion(BrunetonSkyFactors()).sky;
-    else
+    else if (twilight_fit_)
       FitTwilightSky(sun, conversion_.sky);
     conversion_sun_ = sun;
   }
@@ -65,7 +65,15 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
   const bool luminance = style.output.units == OutputUnits::kLuminance && style.quality.wavelengths <= kRgbWavelengths;
   // The conversion's probe reads the atmosphere and whether aerosols and ozone are on.
   const bool hue = style.aoas.hue.enabled && style.aoas.hue.strength > 0.0;
-  if (luminance != luminance_ || hue != hue_ ||
+  // The twilight fit compares the renderer's radiance with the spectral
+  // mode's sky: a style whose principles change a texel's colour or direction
+  // (AOAS noise, shapes, ambiguity, the skydome; the night floor), or whose
+  // cloud layers stand in front of the sky, keeps the host's fit, which
+  // they do not touch.
+  const AoasSwitches& s = in.aoas.switches;
+  const bool twilight_fit = !style.effects.night_dimming && !s.skydome && !s.ambiguity && !s.cloud_noise &&
+                            !s.cloud_shapes && ActiveCloudLayers(style.clouds).empty();
+  if (luminance != luminance_ || hue != hue_ || twilight_fit != twilight_fit_ ||
       std::memcmp(&in.atmosphere, &conversion_atmosphere_, sizeof in.atmosphere) != 0 ||
       style.effects.mie != conversion_effects_.mie || style.effects.ozone != conversion_effects_.ozone) {
     luminance_ = luminance;
@@ -80,6 +88,7 @@ void RendererCache::Update(const SkyStyle& unpruned, double cloud_time_s) {
     probe_quality_.sky_view_height = 72;
     probe_effects_ = style.effects;
     probe_.reset();
+    twilight_fit_ = twilight_fit;
     conversion_atmosphere_ = in.atmosphere;
     conversion_effects_ = style.effects;
     conversion_sun_.reset();

@@ -62,6 +62,7 @@ class RendererCache {
   bool FitTwilightSky(const glm::dvec3& sun, Matrix3& sky);
   bool luminance_ = false;
   bool hue_ = false;  // the style's sky is a hue vector's colour
+  bool twilight_fit_ = false;  // FitTwilightSky applies to the style
   QualitySettings probe_quality_;
   EffectSettings probe_effects_;
   std::unique_ptr<SkyRenderer> probe_;  // the 48-bin renderer of FitTwilightSky, built on first use
