@@ -260,9 +260,13 @@ TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
   EXPECT_NEAR(without["illuminance_lux"].get<double>() / with["illuminance_lux"].get<double>(), 1.0, 0.01);
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(without["irradiance"][c].get<double>() / with["irradiance"][c].get<double>(), 1.0, 0.01) << c;
+  // The glTF light: intensity x Y(colour) is the illuminance (clients light with colour x intensity).
   const json gltf = json::parse(testing::ReadFileBytes(dir + "/false/sky.gltf"));
-  EXPECT_NEAR(gltf["extensions"]["KHR_lights_punctual"]["lights"][0]["intensity"].get<double>(),
-              without["illuminance_lux"].get<double>(), 1e-6 * without["illuminance_lux"].get<double>());
+  const json& light = gltf["extensions"]["KHR_lights_punctual"]["lights"][0];
+  const double y = Luminance({light["color"][0].get<double>(), light["color"][1].get<double>(),
+                              light["color"][2].get<double>()});
+  EXPECT_NEAR(light["intensity"].get<double>() * y, without["illuminance_lux"].get<double>(),
+              1e-5 * without["illuminance_lux"].get<double>());
 }
 
 // A hue-styled sky (AOAS [hue]) is a colour, not a spectrum: its sky texels
