@@ -354,6 +354,16 @@ vec3 CloudApDirection(int x, int y, out vec3 sun_frame_sun, float mu_s) {
   return vec3(sin(zenith) * cos(azimuth), cos(zenith), sin(zenith) * sin(azimuth));
 }
 
+// The cloud pass converts its light as direct sunlight (output_scale); sky
+// light in its tables (the air's in-scattering in front of the clouds, the
+// sky light the clouds scatter) is held in the terms that give it the sky's
+// conversion instead.
+vec3 AmbientToDirect(vec3 sky_radiance) {
+  return vec3(dot(gpu_atmosphere.ambient_to_direct[0].xyz, sky_radiance),
+              dot(gpu_atmosphere.ambient_to_direct[1].xyz, sky_radiance),
+              dot(gpu_atmosphere.ambient_to_direct[2].xyz, sky_radiance));
+}
+
 // The atmosphere's in-scattering and transmittance from the observer along
 // the texel's direction to every slice distance (Hillaire 2020's aerial
 // perspective, in the sky-view LUT's sun frame), 4 analytic steps per slice.
@@ -378,7 +388,7 @@ void ComputeCloudApColumn(IN(AtmosphereParameters) atm, int x, int y, vec3 sun_w
       transmittance *= exp(-sample_.extinction * dt);
     }
     t_start = t_end;
-    cloud_lut[CloudApIndex(x, y, k)] = vec4(radiance, 0.0);
+    cloud_lut[CloudApIndex(x, y, k)] = vec4(AmbientToDirect(radiance), 0.0);
     cloud_lut[CloudApTexels() + CloudApIndex(x, y, k)] = vec4(transmittance, 0.0);
   }
 }
@@ -402,11 +412,8 @@ void ComputeCloudAmbientRow(IN(AtmosphereParameters) atm_in, int row, vec3 sun) 
       down += ComputeSkyRadianceWithoutSun(atm, vec3(s * cos(phi), -mu, s * sin(phi)), sun).radiance;
     }
   }
-  // The sky's light keeps the sky's spectrum when a cloud scatters it: the
-  // cloud pass converts its light as direct sunlight (output_scale), so the
-  // table holds the sky light in the terms that give it the sky conversion.
-  up = vec3(dot(gpu_atmosphere.ambient_to_direct[0].xyz, up), dot(gpu_atmosphere.ambient_to_direct[1].xyz, up),
-            dot(gpu_atmosphere.ambient_to_direct[2].xyz, up));
+  // The sky's light keeps the sky's spectrum when a cloud scatters it.
+  up = AmbientToDirect(up);
   cloud_lut[CloudAmbientIndex(row, 0)] = vec4(up / 32.0, 0.0);
   cloud_lut[CloudAmbientIndex(row, 1)] = vec4(down / 32.0, 0.0);
 }

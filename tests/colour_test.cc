@@ -167,8 +167,7 @@ TEST_F(ColourAgainstSpectral, TheClearSkyMatchesTheSpectralMode) {
 
 // White clouds lit by the Sun and the overcast deck, over the upper
 // hemisphere (the clouds and the sky between them): mean within 0.003 with
-// the Sun at 45 deg (cumulus_noon and overcast_stratus) and at 10 deg
-// (cumulus_noon). Latlongs of 16 x 8: a 48-bin cloud bake compiles and fills
+// the Sun at 45 and at 10 deg (cumulus_noon and overcast_stratus). Latlongs of 16 x 8: a 48-bin cloud bake compiles and fills
 // the cloud passes of 16 renderer groups.
 TEST(ColourClouds, CloudsMatchTheSpectralMode) {
   const std::string dir = testing::FreshTempDir("colour_clouds");
@@ -180,7 +179,6 @@ TEST(ColourClouds, CloudsMatchTheSpectralMode) {
       const Latlong b = ReadLatlong(FrameLatlong(dir + "/" + style + "/spectral48", f));
       const Distances d = Compare(a, b, 0, a.height / 2);
       std::printf("%s, sun %s deg: u'v' mean %.5f worst %.5f\n", style.c_str(), f == 0 ? "45" : "10", d.mean, d.worst);
-      if (style == "overcast_stratus" && f == 1) continue;  // 0.003-0.004: docs/colour.md, "Not yet"
       EXPECT_LE(d.mean, 0.003) << style << ", sun at " << (f == 0 ? 45 : 10) << " deg";
     }
   }
