@@ -191,7 +191,10 @@ glm::dvec3 Rotate(const json& q, const glm::dvec3& v) {
 TEST_F(Sequence, GltfSunShinesAwayFromTheBakedSun) {
   std::ifstream in(out_dir_ + "/sequence/sky.gltf");
   json gltf = json::parse(in);
-  ASSERT_EQ(gltf["extensionsUsed"].size(), 2u);
+  // A sequence animates its light's intensity and colour (KHR_animation_pointer).
+  ASSERT_EQ(gltf["extensionsUsed"].size(), 3u);
+  EXPECT_EQ(gltf["extensionsUsed"][2], "KHR_animation_pointer");
+  EXPECT_FALSE(gltf.contains("extensionsRequired")) << "clients without the extension still load the scene";
   for (const json& name : gltf["extensionsUsed"]) EXPECT_NE(name.get<std::string>(), "KHR_materials_emissive_strength");
   const json& sun_node = gltf["nodes"][1];
   ASSERT_EQ(sun_node["extensions"]["KHR_lights_punctual"]["light"].get<int>(), 0);
@@ -219,6 +222,51 @@ TEST_F(Sequence, GltfSunShinesAwayFromTheBakedSun) {
     json q = {keys[4 * k], keys[4 * k + 1], keys[4 * k + 2], keys[4 * k + 3]};
     EXPECT_LT(glm::length(Rotate(q, {0, 0, -1}) + result_->frames[k].sun_direction), 1e-5) << "key " << k;
   }
+}
+
+// The light follows every frame: Babylon.js (which plays KHR_animation_pointer
+// channels) moved to each frame's animation time lights with that frame's
+// Sun: intensity x Y(colour) is the frame's illuminance (float32 keys), and
+// the colour is the frame's (its brightest channel 1). The channels name no
+// node, so clients without the extension skip them (three.js's test above,
+// Blender's importer).
+TEST_F(Sequence, BabylonLightsEachFrameWithItsOwnSun) {
+  const json gltf = json::parse(std::ifstream(out_dir_ + "/sequence/sky.gltf"));
+  int pointers = 0;
+  for (const json& channel : gltf["animations"][0]["channels"]) {
+    if (channel["target"]["path"] != "pointer") continue;
+    ++pointers;
+    EXPECT_FALSE(channel["target"].contains("node")) << channel.dump();
+    const std::string pointer = channel["target"]["extensions"]["KHR_animation_pointer"]["pointer"];
+    EXPECT_TRUE(pointer == "/extensions/KHR_lights_punctual/lights/0/intensity" ||
+                pointer == "/extensions/KHR_lights_punctual/lights/0/color")
+        << pointer;
+  }
+  EXPECT_EQ(pointers, 2);
+  const json manifest = json::parse(std::ifstream(out_dir_ + "/sequence/manifest.json"));
+  std::string times;
+  for (const json& frame : manifest["frames"])
+    times += (times.empty() ? "" : ",") + fmt::format("{}", frame["animation_time_s"].get<double>());
+  const json line = testing::RunViewerPage("engine_babylon_sun_path.html", out_dir_ + "/sequence",
+                                           out_dir_ + "/sun_path.png", "scene=sky.glb&times=" + times);
+  ASSERT_FALSE(line.is_null());
+  const json& report = line["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  ASSERT_EQ(report["frames"].size(), result_->frames.size());
+  for (size_t k = 0; k < result_->frames.size(); ++k) {
+    const FrameResult& frame = result_->frames[k];
+    const json& seen = report["frames"][k];
+    const std::array<double, 3> colour = {seen["color"][0].get<double>(), seen["color"][1].get<double>(),
+                                          seen["color"][2].get<double>()};
+    const double lux = seen["intensity"].get<double>() * Rec709Luminance(colour);
+    EXPECT_NEAR(lux, frame.sun_illuminance_lux, 1e-5 * frame.sun_illuminance_lux + 1e-3) << "frame " << k;
+    const double peak = std::max({frame.sun_irradiance[0], frame.sun_irradiance[1], frame.sun_irradiance[2]});
+    if (!(peak > 0.0)) continue;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(colour[c], frame.sun_irradiance[c] / peak, 1e-5) << "frame " << k;
+  }
+  std::printf("Babylon.js %s: %zu frames, each lit by its own sun (noon %.0f lx)\n",
+              report["version"].get<std::string>().c_str(), result_->frames.size(),
+              report["frames"][result_->frames.size() / 2]["intensity"].get<double>());
 }
 
 // Mean sRGB colour of the top tenth of a screenshot.

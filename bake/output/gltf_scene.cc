@@ -391,8 +391,59 @@ void AnimateRotation(tinygltf::Model& model, const std::string& name, const Rota
   animation.channels.push_back(channel);
 }
 
-// The Moon: light 1, node 2, its rotation keys in the animation (a second
-// one when the Sun has none).
+// The light that `node` carries (KHR_lights_punctual), by index.
+int LightOfNode(const tinygltf::Model& model, int node) {
+  return model.nodes.at(size_t(node)).extensions.at("KHR_lights_punctual").Get("light").GetNumberAsInt();
+}
+
+// Animates `property` of light `light` (KHR_animation_pointer) by the keys in
+// `values` (`components` floats a key) at the times of accessor `times`.
+// Core glTF animates nodes only; a channel whose target is a pointer names
+// no node (WithoutPlaceholderNodes removes the placeholder tinygltf writes).
+void AnimateLightProperty(tinygltf::Model& model, int light, const std::string& property, int times,
+                          const std::vector<float>& values, int components) {
+  const size_t count = values.size() / size_t(components);
+  const int output = AddAccessor(model, AddBufferView(model, values.data(), values.size() * 4, 0),
+                                 TINYGLTF_COMPONENT_TYPE_FLOAT, count,
+                                 components == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3);
+  model.bufferViews[model.accessors[output].bufferView].target = 0;
+  tinygltf::Animation& animation = model.animations.front();
+  tinygltf::AnimationSampler sampler;
+  sampler.input = times;
+  sampler.output = output;
+  sampler.interpolation = "LINEAR";
+  animation.samplers.push_back(sampler);
+  tinygltf::AnimationChannel channel;
+  channel.sampler = int(animation.samplers.size()) - 1;
+  channel.target_path = "pointer";
+  tinygltf::Value::Object pointer;
+  pointer["pointer"] = tinygltf::Value(fmt::format("/extensions/KHR_lights_punctual/lights/{}/{}", light, property));
+  channel.target_extensions["KHR_animation_pointer"] = tinygltf::Value(pointer);
+  animation.channels.push_back(channel);
+}
+
+// A light's path over a sequence: its node's rotation, and its intensity
+// and colour per frame (intensity x Y(colour) is the frame's illuminance,
+// as AddDirectionalLight writes it), one key a frame.
+void AnimateLight(tinygltf::Model& model, const std::string& name, const std::vector<SceneSun>& keys, int node) {
+  const RotationKeys track = AddRotationKeys(model, keys);
+  AnimateRotation(model, name, track, node);
+  std::vector<float> intensities, colours;
+  for (const SceneSun& k : keys) {
+    const double y = Rec709Luminance({k.color[0], k.color[1], k.color[2]});
+    intensities.push_back(float(y > 0.0 ? k.illuminance_lux / y : 0.0));
+    colours.insert(colours.end(), {float(k.color[0]), float(k.color[1]), float(k.color[2])});
+  }
+  const int light = LightOfNode(model, node);
+  AnimateLightProperty(model, light, "intensity", track.input, intensities, 1);
+  AnimateLightProperty(model, light, "color", track.input, colours, 3);
+  if (std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(), "KHR_animation_pointer") ==
+      model.extensionsUsed.end())
+    model.extensionsUsed.push_back("KHR_animation_pointer");
+}
+
+// The Moon: light 1, node 2, its path in the animation (a second one when
+// the Sun has none).
 void AddMoonLight(tinygltf::Model& model, const std::vector<SceneSun>& moons, tinygltf::Scene& gltf_scene) {
   size_t brightest = 0;
   for (size_t i = 1; i < moons.size(); ++i)
@@ -400,7 +451,7 @@ void AddMoonLight(tinygltf::Model& model, const std::vector<SceneSun>& moons, ti
   const int node = AddDirectionalLight(model, "moon", moons[brightest]);
   gltf_scene.nodes.push_back(node);
   if (moons.size() < 2) return;
-  AnimateRotation(model, "moon_path", AddRotationKeys(model, moons), node);
+  AnimateLight(model, "moon_path", moons, node);
 }
 
 // The sky dome, mesh 0 and node 0: its geometry and the tone-mapped sRGB
@@ -418,10 +469,10 @@ void AddSkyDome(const SceneDescription& scene, tinygltf::Model& model) {
 }
 
 // The sun, light 0 and node 1, at the scene's light frame; with more than
-// one frame its path as the animation "sun_path", one rotation key a frame.
+// one frame its path as the animation "sun_path", one key a frame.
 void AddSun(const SceneDescription& scene, tinygltf::Model& model) {
   const int node = AddDirectionalLight(model, "sun", scene.suns.at(size_t(scene.light_frame)));
-  if (scene.suns.size() > 1) AnimateRotation(model, "sun_path", AddRotationKeys(model, scene.suns), node);
+  if (scene.suns.size() > 1) AnimateLight(model, "sun_path", scene.suns, node);
 }
 
 // The whole scene: dome, sun, and what the bake adds (image-based light,
@@ -473,6 +524,23 @@ std::string WithProvenance(const std::string& text, const std::string& provenanc
   return SplicedJson(text, marker, pretty ? IndentedJson(provenance, indent) : provenance);
 }
 
+// The channels whose target is a pointer (AnimateLightProperty) name no
+// node: tinygltf writes every channel's node, -1 where it has none.
+// Returns whether it changed `document`.
+bool WithoutPlaceholderNodes(json& document) {
+  bool changed = false;
+  if (!document.contains("animations")) return false;
+  for (json& animation : document["animations"])
+    for (json& channel : animation["channels"]) {
+      json& target = channel["target"];
+      if (target.value("path", "") == "pointer" && target.contains("node")) {
+        target.erase("node");
+        changed = true;
+      }
+    }
+  return changed;
+}
+
 // name.gltf + name.bin: the JSON references the .bin and the PNG by name.
 void WriteGltfAndBin(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, const SceneDescription& scene,
                      const WrittenScene& written) {
@@ -481,6 +549,7 @@ void WriteGltfAndBin(tinygltf::TinyGLTF& writer, const tinygltf::Model& model, c
   if (!writer.WriteGltfSceneToStream(&model, out, true, false))
     throw OutputError(fmt::format("cannot serialise {}", written.gltf_path));
   json document = json::parse(out.str());
+  WithoutPlaceholderNodes(document);
   document["buffers"][0]["uri"] = scene.name + ".bin";
   WriteFileAtomically(written.bin_path, bin);
   const std::string pretty = scene.extras_json_pretty.empty() && !scene.extras_json.empty()
@@ -503,6 +572,7 @@ std::string GlbWithProvenance(const std::string& glb, const std::string& provena
   const uint32_t json_length = ReadU32(glb, 12);
   std::string content = glb.substr(20, json_length);
   content.erase(content.find_last_not_of(' ') + 1);  // the padding
+  if (json document = json::parse(content); WithoutPlaceholderNodes(document)) content = document.dump();
   content = WithProvenance(content, provenance, false);
   content.append((4 - content.size() % 4) % 4, ' ');
   std::string out = glb.substr(0, 20) + content + glb.substr(20 + json_length);
