@@ -269,6 +269,24 @@ TEST_F(Sequence, BabylonLightsEachFrameWithItsOwnSun) {
               report["frames"][result_->frames.size() / 2]["intensity"].get<double>());
 }
 
+// Blender 3.4's glTF importer, which has no KHR_animation_pointer, loads the
+// sequence's scene: the dome, the sun light and its path (rotation keys).
+TEST_F(Sequence, BlenderImportsTheAnimatedScene) {
+  auto [which, where] = RunCommand("command -v blender");
+  ASSERT_EQ(which, 0) << "blender is missing: run .ci/setup (Debian package blender)";
+  const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
+                              "/tests/engines/blender_import_scene.py' -- '" + out_dir_ + "/sequence/sky.glb'";
+  auto [code, output] = RunCommand(command);
+  ASSERT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("RESULT ");
+  ASSERT_NE(at, std::string::npos) << output;
+  const json result = json::parse(output.substr(at + 7, output.find('\n', at) - at - 7));
+  std::printf("Blender: %s\n", result.dump().c_str());
+  EXPECT_EQ(result["lights"], json::parse(R"([["sun", "SUN"]])"));
+  EXPECT_EQ(result["fcurves"], json::parse(R"(["rotation_quaternion"])"));
+  EXPECT_NE(std::find(result["objects"].begin(), result["objects"].end(), "skydome"), result["objects"].end());
+}
+
 // Mean sRGB colour of the top tenth of a screenshot.
 std::array<double, 3> TopMean(const std::string& png) {
   auto in = OIIO::ImageInput::open(png);
