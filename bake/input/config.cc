@@ -5,6 +5,7 @@
 // resolved TOML for provenance (StyleWriter), and the unknown-key check.
 #include "skybake/input/config.h"
 #include "skybake/input/engine_preset.h"
+#include "skybake/input/ocio_color_space.h"
 #include "cloud_formation_config.h"
 
 #include <algorithm>
@@ -204,7 +205,8 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
   v.Choice("output.units", o.units,
            {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
   v.Choice("output.sun", o.sun, {{"light", SunOutput::kLight}, {"map", SunOutput::kMap}});
-  v.Choice("output.color_space", o.color_space, {{"rec709", ColorSpace::kRec709}, {"acescg", ColorSpace::kAcesCg}});
+  v.Text("output.color_space", o.color_space.name);  // resolved by CheckColorSpace
+  if (v.kReads || !o.ocio_config.empty()) v.Text("output.ocio_config", o.ocio_config);
   v.Bool("output.faces", o.faces);
   v.Bool("output.cube_strip", o.cube_strip);
   v.Bool("output.latlong", o.latlong);
@@ -1274,6 +1276,23 @@ void CheckSunInMaps(const SkyStyle& style, StyleChecks& c) {
   c.errors.push_back(e);
 }
 
+// output.color_space names a built-in space or one of an OpenColorIO config
+// (output.ocio_config, relative to the style's folder, else $OCIO).
+void CheckColorSpace(SkyStyle& style, StyleChecks& c) {
+  OutputSettings& o = style.output;
+  std::string config = o.ocio_config;
+  if (!config.empty() && std::filesystem::path(config).is_relative())
+    config = (std::filesystem::path(c.name).parent_path() / config).string();
+  ColorSpaceLookup lookup = ResolveOutputColorSpace(o.color_space.name, config);
+  if (lookup.space) {
+    o.color_space = *lookup.space;
+    return;
+  }
+  ConfigError e = c.Locate("output.color_space");
+  e.message = lookup.error;
+  c.errors.push_back(e);
+}
+
 // The spectral mode (quality.wavelengths > 3) integrates radiance to colour:
 // radiance output keeps the three named wavelengths. (The per-texel effects
 // that act on RGB colour, the AOAS saturation clouds and shapes and the night
@@ -1281,7 +1300,7 @@ void CheckSunInMaps(const SkyStyle& style, StyleChecks& c) {
 // with cloud layers to the sky behind them, as with three wavelengths.)
 void CheckSpectral(SkyStyle& style, StyleChecks& c) {
   const bool radiance = style.output.units == OutputUnits::kSpectral;
-  if (radiance && style.output.color_space != ColorSpace::kRec709) {
+  if (radiance && !style.output.color_space.IsRec709()) {
     ConfigError e = c.Locate("output.color_space");
     e.message = "radiance at 680/550/440 nm (output.units = \"spectral\") has no primaries: set "
                 "output.units = \"luminance\" or output.color_space = \"rec709\"";
@@ -1329,7 +1348,7 @@ std::string ResolvedToml(SkyStyle& style) {
   if (style.output.engine == "none") recorded["output"].as_table()->erase("engine");
   if (!style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
   if (style.quality.wavelengths == kRgbWavelengths) recorded["quality"].as_table()->erase("wavelengths");
-  if (style.output.color_space == ColorSpace::kRec709) recorded["output"].as_table()->erase("color_space");
+  if (style.output.color_space.IsRec709()) recorded["output"].as_table()->erase("color_space");
   std::ostringstream resolved;
   resolved << recorded;
   return resolved.str();
@@ -1360,6 +1379,7 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   CheckFaceNames(result.style, checks);
   CheckSceneAndEngine(result.style, checks);
   CheckIbl(result.style, checks);
+  CheckColorSpace(result.style, checks);
   CheckSpectral(result.style, checks);
   CheckSunInMaps(result.style, checks);
   WarnPresetChangesNothing(result.style, reader, checks);

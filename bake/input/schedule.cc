@@ -646,7 +646,8 @@ FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<
     }
     std::vector<std::string> all = overrides;
     for (const FrameOverride& o : frame_overrides) all.push_back(o.Assignment());
-    ConfigResult styled = errors.empty() ? ParseSkyStyle(text, style_path, all) : ConfigResult{};
+    ConfigResult styled;
+    if (errors.empty()) styled = ParseSkyStyle(text, style_path, all);
     for (ConfigError e : styled.errors) {
       // Errors from the frame's assignments point back into the schedule.
       for (const FrameOverride& o : frame_overrides) {

@@ -77,6 +77,7 @@ std::array<double, 3> XyzOfChromaticity(const std::array<double, 2>& xy) {
 // Linear RGB to XYZ from the primaries and white point (SMPTE RP 177), white
 // of luminance 1.
 Matrix3 RgbToXyz(ColorSpace space) {
+  if (space == ColorSpace::kXyz) return {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};  // its blue primary has y = 0
   const auto c = Chromaticities(space);
   Matrix3 p{};
   for (int primary = 0; primary < 3; ++primary) {
@@ -168,22 +169,65 @@ std::vector<std::array<double, 3>> CieWeights(const SpectralBins& bins) {
 }
 
 std::array<std::array<double, 2>, 4> Chromaticities(ColorSpace space) {
-  if (space == ColorSpace::kAcesCg)  // AP1 primaries, ACES white (SMPTE ST 2065-1, S-2014-004)
-    return {{{0.713, 0.293}, {0.165, 0.830}, {0.128, 0.044}, {0.32168, 0.33767}}};
+  switch (space) {
+    case ColorSpace::kAcesCg:  // AP1 primaries, ACES white (SMPTE ST 2065-1, S-2014-004)
+      return {{{0.713, 0.293}, {0.165, 0.830}, {0.128, 0.044}, {0.32168, 0.33767}}};
+    case ColorSpace::kAces2065:  // AP0 primaries, ACES white (SMPTE ST 2065-1)
+      return {{{0.7347, 0.2653}, {0.0, 1.0}, {0.0001, -0.0770}, {0.32168, 0.33767}}};
+    case ColorSpace::kRec2020:  // ITU-R BT.2020, D65
+      return {{{0.708, 0.292}, {0.170, 0.797}, {0.131, 0.046}, {0.3127, 0.3290}}};
+    case ColorSpace::kXyz:  // OpenEXR's chromaticities of XYZ data (ImfChromaticities.h)
+      return {{{1.0, 0.0}, {0.0, 1.0}, {0.0, 0.0}, {1.0 / 3.0, 1.0 / 3.0}}};
+    case ColorSpace::kRec709:
+      break;
+  }
   return {{{0.64, 0.33}, {0.30, 0.60}, {0.15, 0.06}, {0.3127, 0.3290}}};  // ITU-R BT.709, D65
 }
 
 Matrix3 XyzToRgb(ColorSpace space) { return Inverse(RgbToXyz(space)); }
 
-Matrix3 Rec709ToAcesCg() {
+Matrix3 Rec709To(ColorSpace space) {
+  const Matrix3 to_xyz = RgbToXyz(ColorSpace::kRec709);
+  if (space == ColorSpace::kRec709) return {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  if (space == ColorSpace::kXyz) return to_xyz;  // the light's XYZ, D65 white as measured
   // Bradford cone response (Lam 1985), the von Kries scaling between whites.
   const Matrix3 bradford = {{{0.8951, 0.2664, -0.1614}, {-0.7502, 1.7135, 0.0367}, {0.0389, -0.0685, 1.0296}}};
   const std::array<double, 3> from = Apply(bradford, XyzOfChromaticity(Chromaticities(ColorSpace::kRec709)[3]));
-  const std::array<double, 3> to = Apply(bradford, XyzOfChromaticity(Chromaticities(ColorSpace::kAcesCg)[3]));
+  const std::array<double, 3> to = Apply(bradford, XyzOfChromaticity(Chromaticities(space)[3]));
   Matrix3 scale{};
   for (int i = 0; i < 3; ++i) scale[i][i] = to[i] / from[i];
   const Matrix3 adapt = Multiply(Inverse(bradford), Multiply(scale, bradford));
-  return Multiply(XyzToRgb(ColorSpace::kAcesCg), Multiply(adapt, RgbToXyz(ColorSpace::kRec709)));
+  return Multiply(XyzToRgb(space), Multiply(adapt, to_xyz));
+}
+
+Matrix3 Rec709ToAcesCg() { return Rec709To(ColorSpace::kAcesCg); }
+
+const std::vector<NamedColorSpace>& BuiltinColorSpaces() {
+  static const std::vector<NamedColorSpace> spaces = {
+      {"rec709", ColorSpace::kRec709, "linear Rec.709 (sRGB primaries, D65 white)"},
+      {"acescg", ColorSpace::kAcesCg, "linear ACEScg (AP1 primaries, ACES white)"},
+      {"aces2065-1", ColorSpace::kAces2065, "linear ACES2065-1 (AP0 primaries, ACES white)"},
+      {"rec2020", ColorSpace::kRec2020, "linear Rec.2020 (BT.2020 primaries, D65 white)"},
+      {"xyz", ColorSpace::kXyz, "CIE 1931 XYZ (D65-referred, no adaptation)"},
+  };
+  return spaces;
+}
+
+OutputColorSpace BuiltinOutputColorSpace(ColorSpace space) {
+  OutputColorSpace o;
+  for (const NamedColorSpace& n : BuiltinColorSpaces())
+    if (n.space == space) {
+      o.name = n.name;
+      o.description = n.description;
+    }
+  o.chromaticities = Chromaticities(space);
+  if (space != ColorSpace::kRec709) o.from_rec709 = Rec709To(space);
+  return o;
+}
+
+std::array<double, 2> ChromaticityOf(const std::array<double, 3>& xyz) {
+  const double sum = xyz[0] + xyz[1] + xyz[2];
+  return {xyz[0] / sum, xyz[1] / sum};
 }
 
 AtmosphereParams AtmosphereAtWavelengths(const AtmosphereParams& style, const std::array<double, 3>& lambda_nm,

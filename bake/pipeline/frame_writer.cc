@@ -61,6 +61,7 @@ ExrWriteOptions FrameExrOptions(const FramePlan& plan, double half_scale) {
       {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
       {"skybake:sun_direction", FormatVector(plan.sun)},
   };
+  if (luminance) exr.attributes["skybake:color_space"] = "rec709";  // InOutputColorSpace names another
   if (plan.number > 0) exr.attributes["skybake:frame_number"] = std::to_string(plan.number);
   if (plan.time) exr.attributes["skybake:time"] = plan.time->Iso8601();
   return exr;
@@ -75,14 +76,14 @@ const RgbaImage* LatlongOf(const FrameJob& job) {
 }
 
 // The views in the maps' colour space (output.color_space): Rec.709 as
-// rendered, or converted copies (ACEScg) with the EXR options saying so.
+// rendered, or converted copies with the EXR options saying so.
 std::vector<RgbaImage> InOutputColorSpace(const FrameJob& job, ExrWriteOptions& exr) {
-  if (job.plan->style->output.color_space != ColorSpace::kAcesCg) return {};
-  const std::array<std::array<double, 2>, 4> xy = Chromaticities(ColorSpace::kAcesCg);
-  for (int i = 0; i < 8; ++i) exr.chromaticities[i] = float(xy[i / 2][i % 2]);
-  exr.attributes["skybake:units"] = "linear ACEScg (AP1 primaries, ACES white) luminance, cd/m^2 per 1.0 divided "
-                                    "by skybake:scale";
-  const Matrix3 m = Rec709ToAcesCg();
+  const OutputColorSpace& space = job.plan->style->output.color_space;
+  if (space.IsRec709()) return {};
+  for (int i = 0; i < 8; ++i) exr.chromaticities[i] = float(space.chromaticities[i / 2][i % 2]);
+  exr.attributes["skybake:units"] = space.description + " luminance, cd/m^2 per 1.0 divided by skybake:scale";
+  exr.attributes["skybake:color_space"] = space.name;
+  const Matrix3& m = space.from_rec709;
   std::vector<RgbaImage> converted;
   for (const RgbaImage& image : job.images) {
     RgbaImage c{image.width, image.height, std::vector<float>(image.texels() * 4), nullptr};

@@ -39,9 +39,12 @@ struct OutputSettings {
   OverflowPolicy overflow = OverflowPolicy::kScale;
   OutputUnits units = OutputUnits::kLuminance;
   SunOutput sun = SunOutput::kLight;
-  // Primaries of luminance output's EXR maps (their `chromaticities`
-  // attribute when not Rec.709); previews, glTF and SH stay Rec.709.
-  ColorSpace color_space = ColorSpace::kRec709;
+  // The colour space of luminance output's EXR maps (their
+  // `chromaticities` and `skybake:color_space`): a built-in space or one of
+  // an OpenColorIO config (ocio_color_space.h); previews, glTF and SH stay
+  // Rec.709.
+  OutputColorSpace color_space;
+  std::string ocio_config;  // the config that names color_space; empty: $OCIO
   bool faces = true;       // six face files
   bool cube_strip = true;  // one N x 6N cube strip
   bool latlong = true;     // one 2N x N latlong

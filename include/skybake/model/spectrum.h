@@ -55,8 +55,11 @@ std::array<double, 3> CieXyzBar(double lambda_nm);
 // L_k W m^-2 sr^-1 nm^-1 across bin k is sum_k weight[k] * L_k.
 std::vector<std::array<double, 3>> CieWeights(const SpectralBins& bins);
 
-// Linear RGB colour spaces of the output.
-enum class ColorSpace { kRec709, kAcesCg };
+// Linear RGB colour spaces of the output, built in: linear Rec.709 (sRGB
+// primaries, D65), ACEScg (AP1, ACES white), ACES2065-1 (AP0, ACES white),
+// linear Rec.2020 (D65) and CIE XYZ (D65-referred: the XYZ of the light as
+// measured, no adaptation; OpenEXR's XYZ chromaticities, white (1/3, 1/3)).
+enum class ColorSpace { kRec709, kAcesCg, kAces2065, kRec2020, kXyz };
 
 // CIE xy chromaticities of a colour space's primaries and white point:
 // red, green, blue, white (the EXR `chromaticities` attribute).
@@ -70,9 +73,33 @@ std::array<double, 3> Apply(const Matrix3& m, const std::array<double, 3>& v);
 
 // XYZ (the space's own white) to linear RGB of `space`.
 Matrix3 XyzToRgb(ColorSpace space);
-// Linear Rec.709 to linear ACEScg: Rec.709 -> XYZ, Bradford adaptation from
-// D65 to the ACES white, XYZ -> AP1. White maps to white.
-Matrix3 Rec709ToAcesCg();
+// Linear Rec.709 to linear `space`: Rec.709 -> XYZ, Bradford adaptation
+// from D65 to the space's white (none for CIE XYZ), XYZ -> the space. In an
+// RGB space white maps to white.
+Matrix3 Rec709To(ColorSpace space);
+Matrix3 Rec709ToAcesCg();  // Rec709To(ColorSpace::kAcesCg)
+
+// The colour space of the output maps: its name (output.color_space: a
+// built-in name or a colour space of an OpenColorIO config), a description
+// for the files' units, the matrix from the renderer's linear Rec.709 and
+// its primaries and white (the EXR `chromaticities`).
+struct OutputColorSpace {
+  std::string name = "rec709";
+  std::string description = "linear Rec.709 (sRGB primaries, D65 white)";
+  Matrix3 from_rec709 = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}};
+  std::array<std::array<double, 2>, 4> chromaticities = {{{0.64, 0.33}, {0.30, 0.60}, {0.15, 0.06}, {0.3127, 0.3290}}};
+  bool IsRec709() const { return name == "rec709"; }
+};
+// The built-in spaces by name, in the order the docs list them.
+struct NamedColorSpace {
+  const char* name;
+  ColorSpace space;
+  const char* description;
+};
+const std::vector<NamedColorSpace>& BuiltinColorSpaces();
+OutputColorSpace BuiltinOutputColorSpace(ColorSpace space);
+// XYZ to the chromaticity xy of a colour (Y > 0).
+std::array<double, 2> ChromaticityOf(const std::array<double, 3>& xyz);
 
 // The atmosphere at three wavelengths (one renderer group): the style's
 // atmosphere with every spectral coefficient, the albedo and the solar
