@@ -72,6 +72,14 @@ struct ManifestScene {
   int texture_width = 0, texture_height = 0;
 };
 
+// What the USD layer takes from the style (usd_layer.h): recorded only when
+// it is on, so that a bake without it keeps its manifest's bytes.
+struct ManifestUsd {
+  bool enabled = false;
+  std::string name;                    // output.basename: name.usda
+  double sun_angular_radius_rad = 0.0;  // the first frame's sun.angular_radius_rad
+};
+
 struct Manifest {
   std::string version;           // SKYBAKE_VERSION
   std::string commit;            // the git commit skybake was built from, "unknown" outside git
@@ -86,9 +94,10 @@ struct Manifest {
   std::optional<FrameRange> sequence;  // every frame of the schedule; unset for a single bake
   std::optional<FrameRange> part;      // the frames of a part (--frames, --shard); unset for a whole bake
   ManifestScene gltf;
+  ManifestUsd usd;
   std::vector<ManifestFrame> frames;   // by frame number
   bool complete = false;               // every frame of the bake (or part) is done
-  std::vector<ManifestFile> scene;     // the glTF scene's files, once written
+  std::vector<ManifestFile> scene;     // the glTF scene's files and the USD layer, once written
 };
 
 // manifest.json for a whole bake, manifest.shard-0003-0004.json for the part
@@ -139,14 +148,15 @@ enum class ManifestNames { kChecked, kUnchecked };
 Manifest ReadManifest(const std::string& path, ManifestNames names = ManifestNames::kChecked);
 
 // How a whole bake ends, and a merge: writes the glTF scene (when
-// manifest.gltf.enabled) from the frames' suns and SH and the texture PNG in
+// manifest.gltf.enabled) and the USD layer (manifest.usd.enabled) from the frames' suns and SH and the texture PNG in
 // `out_dir`, lists its files in manifest.scene, marks the manifest complete
 // and writes out_dir/manifest.json. Returns the scene's files. Throws
 // OutputError.
 std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir);
 // Its first half: the scene alone, listed in manifest.scene. It reads of
 // the frames their suns, SH, times and Moons, and the files of the texture
-// frame only.
+// frame only; the USD layer every frame's latlong EXR (its name, and the
+// skybake:scale in its header) and style_sha256.
 std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir);
 
 // Run-dependent facts of a bake, kept out of the manifest: the output folder,
