@@ -243,6 +243,9 @@ TEST(UsdLayerTest, SingleBakeParsesWithItsLightsAndTheSunOnTheBrightestTexel) {
       plus_z = {m[8], m[9], m[10]};
     }
   ASSERT_EQ(lights, 1) << report["nodes"].dump();
+  bool dome_node = false;
+  for (const json& node : report["nodes"]) dome_node = dome_node || node["path"] == "/Sky/Dome";
+  EXPECT_TRUE(dome_node) << report["nodes"].dump();
   const std::vector<double> manifest_sun = frame["sun"]["direction"].get<std::vector<double>>();
   const glm::dvec3 sun_direction(manifest_sun[0], manifest_sun[1], manifest_sun[2]);
   EXPECT_LT(AngleDeg(plus_z, sun_direction), 1e-3);
@@ -342,6 +345,29 @@ sun = { elevation_deg = [5.0, 20.0, 40.0, 60.0], azimuth_deg = [100.0, 140.0, 18
   ASSERT_FALSE(whole.empty());
   EXPECT_EQ(testing::ReadFileBytes(root + "/parts/sky.usda"), whole);
   EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"), testing::ReadFileBytes(root + "/whole/manifest.json"));
+  fs::remove_all(root);
+}
+
+// The provenance's strings come back as written through an independent
+// parser: a style path with a quote, a backslash, a space and @ signs.
+TEST(UsdLayerTest, ProvenanceStringsSurviveAnIndependentParser) {
+  const std::string root = testing::FreshTempDir("usd_strings");
+  const std::string folder = "we\"ird\\dir @x";
+  fs::create_directories(root + "/" + folder);
+  const std::string style = folder + "/st@@@yle.toml";
+  fs::copy_file(testing::SourceDir() + "/configs/default.toml", root + "/" + style);
+  const testing::CommandRun bake = testing::RunSkybake(
+      "bake 'we\"ird\\dir @x/st@@@yle.toml' --size 8 --usd -q --vulkan-validation --out out", "cd " + root + " && ");
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  EXPECT_EQ(ReadJson(root + "/out/manifest.json")["style"], style);
+  const json report = ReadWithTinyUsdz(root + "/out");
+  ASSERT_TRUE(report.is_object());
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  EXPECT_TRUE(report["layer_loaded"].get<bool>()) << report["layer_error"];
+  // TinyUSDZ prints the string it read in single quotes, its backslash escaped.
+  EXPECT_NE(report["text"].get<std::string>().find("string style = 'we\"ird\\\\dir @x/st@@@yle.toml'\n"),
+            std::string::npos)
+      << report["text"].get<std::string>();
   fs::remove_all(root);
 }
 
