@@ -88,6 +88,7 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
           {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
           {"files", files}};
   if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
+  if (f.sun_angular_radius_rad) frame["sun"]["angular_radius_rad"] = *f.sun_angular_radius_rad;
   return frame;
 }
 
@@ -116,7 +117,7 @@ json ManifestJson(const Manifest& m) {
                              {"height", m.gltf.texture_height}}}}},
   };
   if (m.usd.enabled)
-    j["usd"] = {{"enabled", true}, {"name", m.usd.name}, {"sun_angular_radius_rad", m.usd.sun_angular_radius_rad}};
+    j["usd"] = {{"enabled", true}, {"name", m.usd.name}};
   if (m.place) j["place"] = {{"latitude_deg", m.place->latitude_deg}, {"longitude_deg", m.place->longitude_deg}};
   if (m.sequence) j["sequence"] = RangeJson(*m.sequence);
   if (m.part) {
@@ -494,6 +495,7 @@ ManifestFrame FrameOf(const Reader& r, const json& f) {
   frame.sun_direction = r.Vector(sun, "direction");
   frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
   frame.sun_irradiance = r.RgbOf(sun, "irradiance");
+  if (sun.contains("angular_radius_rad")) frame.sun_angular_radius_rad = r.Get<double>(sun, "angular_radius_rad");
   frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
   frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
   if (f.contains("moon")) frame.moon = MoonOf(r, r.Get<json>(f, "moon"));
@@ -545,7 +547,6 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
     const json& usd = r.Get<json>(j, "usd");
     m.usd.enabled = r.Get<bool>(usd, "enabled");
     m.usd.name = r.Get<std::string>(usd, "name");
-    m.usd.sun_angular_radius_rad = r.Get<double>(usd, "sun_angular_radius_rad");
   }
   if (j.contains("place"))
     m.place = GeoLocation{r.Get<double>(j["place"], "latitude_deg"), r.Get<double>(j["place"], "longitude_deg")};
@@ -586,8 +587,9 @@ UsdLayerDescription UsdLayerOf(const Manifest& manifest, const std::string& out_
     frame.sun_elevation_deg = f.sun_elevation_deg;
     frame.sun_azimuth_deg = f.sun_azimuth_deg;
     frame.style_sha256 = f.style_sha256;
-    frame.sun = {f.sun_direction, f.sun_illuminance_lux, f.sun_irradiance,
-                 Degrees(2.0 * manifest.usd.sun_angular_radius_rad)};
+    if (!f.sun_angular_radius_rad)
+      throw OutputError(fmt::format("frame {} has no sun.angular_radius_rad for the USD layer's Sun", f.number));
+    frame.sun = {f.sun_direction, f.sun_illuminance_lux, f.sun_irradiance, Degrees(2.0 * *f.sun_angular_radius_rad)};
     if (f.moon && f.moon->light)
       frame.moon = UsdDistantKey{f.moon->direction, f.moon->illuminance_lux, f.moon->irradiance,
                                  Degrees(2.0 * f.moon->angular_radius_rad)};

@@ -50,7 +50,7 @@ Manifest ManifestBuilder::Head() const {
   const SkyStyle& ref = *reference.style;
   m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, reference.names.png,
             2 * ref.render.latlong_height, ref.render.latlong_height};
-  if (first.usd.enabled) m.usd = {true, first.output.basename, first.atmosphere.sun_angular_radius_rad};
+  if (first.usd.enabled) m.usd = {true, first.output.basename};
   return m;
 }
 
@@ -61,6 +61,7 @@ void ManifestBuilder::Add(const FrameResult& f) {
   frame.hours_from_start = plan_.frames[i].hours_from_start;
   frame.animation_time_s =
       plan_.schedule && plan_.schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
+  if (plan_.first().usd.enabled) frame.sun_angular_radius_rad = plan_.frames[i].style->atmosphere.sun_angular_radius_rad;
   spool_.Add(ManifestFrameText(frame));
   if (!keeps_scene_frames_) return;
   // The scene keeps of the frames what it reads (WriteScene): the texture

@@ -57,6 +57,9 @@ struct ManifestFrame {
   Rgb sun_irradiance{0, 0, 0};  // transmitted sun at the observer, output units x sr
   ShRgb sh_irradiance_with_sun{};
   ShRgb sh_irradiance_without_sun{};
+  // The style's sun.angular_radius_rad of the frame, recorded (as
+  // sun.angular_radius_rad) only with the USD layer, whose Sun takes it.
+  std::optional<double> sun_angular_radius_rad;
   std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
   std::vector<ManifestFile> files;  // in the order they are written
   std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
@@ -76,8 +79,7 @@ struct ManifestScene {
 // it is on, so that a bake without it keeps its manifest's bytes.
 struct ManifestUsd {
   bool enabled = false;
-  std::string name;                    // output.basename: name.usda
-  double sun_angular_radius_rad = 0.0;  // the first frame's sun.angular_radius_rad
+  std::string name;  // output.basename: name.usda
 };
 
 struct Manifest {
