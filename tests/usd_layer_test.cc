@@ -228,7 +228,7 @@ TEST(UsdLayerTest, SingleBakeParsesWithItsLightsAndTheSunOnTheBrightestTexel) {
   EXPECT_EQ(Number(ValueOf(sun, "float inputs:exposure")), 0.0);
   EXPECT_EQ(ValueOf(sun, "bool inputs:normalize"), "1");
   ExpectRelativelyNear(Number(ValueOf(sun, "float inputs:angle")),
-                       2.0 * manifest["usd"]["sun_angular_radius_rad"].get<double>() * 180.0 / M_PI, 1e-6, "angle");
+                       2.0 * frame["sun"]["angular_radius_rad"].get<double>() * 180.0 / M_PI, 1e-6, "angle");
   EXPECT_EQ(PrimBlock(text, "def DistantLight \"Moon\""), "") << "a day bake has no Moon";
 
   // Its direction as TinyUSDZ evaluates the transform: the third row of the
@@ -328,14 +328,36 @@ times = [12:00:00, 16:00:00, 21:00:00]
 }
 
 // A sequence baked in two shards and merged writes the whole bake's layer,
-// byte for byte.
-TEST(UsdLayerTest, MergedShardsWriteTheWholeBakesLayer) {
+// byte for byte, and so does a resumed bake; a frame whose style sets its
+// own solar disc gives the Sun's angle a sample of its own.
+TEST(UsdLayerTest, MergedShardsAndResumeWriteTheWholeBakesLayer) {
   const std::string root = testing::FreshTempDir("usd_merge");
   const std::string style = testing::SourceDir() + "/configs/default.toml";
   const std::string schedule = testing::WriteFile(root, "schedule.toml", R"([schedule]
-sun = { elevation_deg = [5.0, 20.0, 40.0, 60.0], azimuth_deg = [100.0, 140.0, 180.0, 220.0] }
+[[schedule.frames]]
+elevation_deg = 5.0
+azimuth_deg = 100.0
+[[schedule.frames]]
+elevation_deg = 20.0
+azimuth_deg = 140.0
+set = { "sun.angular_radius_rad" = 0.009 }
+[[schedule.frames]]
+elevation_deg = 40.0
+azimuth_deg = 180.0
+[[schedule.frames]]
+elevation_deg = 60.0
+azimuth_deg = 220.0
 )");
   testing::BakeSequence16(style, schedule, root + "/whole", "--usd");
+  const json report = ReadWithTinyUsdz(root + "/whole");
+  ASSERT_TRUE(report.is_object());
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  EXPECT_TRUE(report["layer_loaded"].get<bool>()) << report["layer_error"];
+  const std::map<int, std::string> angles =
+      SamplesOf(PrimBlock(report["text"].get<std::string>(), "def DistantLight \"Sun\""), "float inputs:angle");
+  ASSERT_EQ(angles.size(), 4u) << report["text"].get<std::string>();
+  ExpectRelativelyNear(Number(angles.at(1)), 2.0 * 0.004675 * 180.0 / M_PI, 1e-6, "frame 1's angle");
+  ExpectRelativelyNear(Number(angles.at(2)), 2.0 * 0.009 * 180.0 / M_PI, 1e-6, "frame 2's angle");
   testing::BakeSequence16(style, schedule, root + "/parts", "--usd --shard 1/2");
   testing::BakeSequence16(style, schedule, root + "/parts", "--usd --shard 2/2");
   EXPECT_FALSE(fs::exists(root + "/parts/sky.usda")) << "a part writes no layer";
@@ -345,6 +367,10 @@ sun = { elevation_deg = [5.0, 20.0, 40.0, 60.0], azimuth_deg = [100.0, 140.0, 18
   ASSERT_FALSE(whole.empty());
   EXPECT_EQ(testing::ReadFileBytes(root + "/parts/sky.usda"), whole);
   EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"), testing::ReadFileBytes(root + "/whole/manifest.json"));
+
+  fs::remove(root + "/whole/sky_latlong.0002.exr");
+  testing::BakeSequence16(style, schedule, root + "/whole", "--usd --resume");
+  EXPECT_EQ(testing::ReadFileBytes(root + "/whole/sky.usda"), whole);
   fs::remove_all(root);
 }
 
