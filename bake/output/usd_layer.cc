@@ -84,25 +84,23 @@ double DomeExposure(double texture_scale) {
   return std::abs(e - std::round(e)) < 1e-6 ? std::round(e) + 0.0 : e;
 }
 
-// One attribute: `decl` (type and name) with its value, or its time
-// samples (one per frame that `value` gives one for) in a sequence.
-// `value` returns "" for a frame without a sample.
-template <class ValueOf>
+// One attribute: `decl` (type and name) with its value, or in a sequence
+// its time samples at the frame numbers. `values` holds each frame's value
+// text, "" for a frame without a sample.
 void Attribute(std::string& out, const std::string& indent, const std::string& decl, const UsdLayerDescription& layer,
-               ValueOf value) {
+               const std::vector<std::string>& values) {
   if (!layer.sequence) {
-    const std::string v = value(layer.frames.front());
-    if (!v.empty()) out += indent + decl + " = " + v + "\n";
+    if (!values.front().empty()) out += indent + decl + " = " + values.front() + "\n";
     return;
   }
-  // A value the same in every frame needs no samples.
   std::vector<std::pair<int, std::string>> samples;
-  for (const UsdFrame& f : layer.frames)
-    if (std::string v = value(f); !v.empty()) samples.emplace_back(f.number, std::move(v));
+  for (size_t i = 0; i < layer.frames.size(); ++i)
+    if (!values[i].empty()) samples.emplace_back(layer.frames[i].number, values[i]);
   if (samples.empty()) return;
-  const bool constant = std::all_of(samples.begin(), samples.end(),
-                                    [&](const auto& s) { return s.second == samples.front().second; }) &&
-                        samples.size() == layer.frames.size();
+  // A value the same in every frame needs no samples.
+  const bool constant = samples.size() == layer.frames.size() &&
+                        std::all_of(samples.begin(), samples.end(),
+                                    [&](const auto& s) { return s.second == samples.front().second; });
   if (constant) {
     out += indent + decl + " = " + samples.front().second + "\n";
     return;
@@ -110,6 +108,14 @@ void Attribute(std::string& out, const std::string& indent, const std::string& d
   out += indent + decl + ".timeSamples = {\n";
   for (const auto& [number, v] : samples) out += fmt::format("{}    {}: {},\n", indent, number, v);
   out += indent + "}\n";
+}
+
+// Each frame's value text: `value(frame)`.
+template <class ValueOf>
+std::vector<std::string> PerFrame(const UsdLayerDescription& layer, ValueOf value) {
+  std::vector<std::string> values;
+  for (const UsdFrame& f : layer.frames) values.push_back(value(f));
+  return values;
 }
 
 // The rotation keys of a light, with the azimuth angle kept continuous
@@ -140,25 +146,23 @@ void DistantLight(std::string& out, const UsdLayerDescription& layer, const char
                      "Rec.709) on a surface facing it (normalize); shines along -Z, +Z towards the {}\"\n",
                      moon ? "The Moon" : "The Sun", moon ? "Moon" : "Sun");
   out += "    )\n    {\n";
-  Attribute(out, in, "float inputs:angle", layer, [&](const UsdFrame& f) {
-    const UsdDistantKey* k = key(f);
-    return k ? Float(k->angular_diameter_deg) : std::string();
-  });
-  Attribute(out, in, "color3f inputs:color", layer, [&](const UsdFrame& f) {
-    const UsdDistantKey* k = key(f);
-    return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
-  });
+  Attribute(out, in, "float inputs:angle", layer, PerFrame(layer, [&](const UsdFrame& f) {
+              const UsdDistantKey* k = key(f);
+              return k ? Float(k->angular_diameter_deg) : std::string();
+            }));
+  Attribute(out, in, "color3f inputs:color", layer, PerFrame(layer, [&](const UsdFrame& f) {
+              const UsdDistantKey* k = key(f);
+              return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
+            }));
   out += in + "float inputs:exposure = 0\n";
-  Attribute(out, in, "float inputs:intensity", layer, [&](const UsdFrame& f) {
-    const UsdDistantKey* k = key(f);
-    return Float(k ? KeyIntensity(*k) : 0.0);
-  });
+  Attribute(out, in, "float inputs:intensity", layer, PerFrame(layer, [&](const UsdFrame& f) {
+              const UsdDistantKey* k = key(f);
+              return Float(k ? KeyIntensity(*k) : 0.0);
+            }));
   out += in + "bool inputs:normalize = 1\n";
-  const std::vector<std::optional<glm::dvec3>> rotations = RotationKeys(layer, moon);
-  size_t i = 0;
-  std::vector<std::string> rotation_text;
-  for (const std::optional<glm::dvec3>& r : rotations) rotation_text.push_back(r ? Float3(*r) : "");
-  Attribute(out, in, "float3 xformOp:rotateXYZ", layer, [&](const UsdFrame&) { return rotation_text[i++]; });
+  std::vector<std::string> rotations;
+  for (const std::optional<glm::dvec3>& r : RotationKeys(layer, moon)) rotations.push_back(r ? Float3(*r) : "");
+  Attribute(out, in, "float3 xformOp:rotateXYZ", layer, rotations);
   out += in + "uniform token[] xformOpOrder = [\"xformOp:rotateXYZ\"]\n";
   out += "    }\n";
 }
@@ -223,11 +227,12 @@ std::string UsdLayerText(const UsdLayerDescription& layer) {
          "-log2(skybake:scale of the EXR). OpenEXR latlong layout, +Y pole, +Z at longitude 0: no transform\"\n";
   out += "    )\n    {\n";
   out += in + "color3f inputs:color = (1, 1, 1)\n";
-  Attribute(out, in, "float inputs:exposure", layer, [](const UsdFrame& f) { return Float(DomeExposure(f.texture_scale)); });
+  Attribute(out, in, "float inputs:exposure", layer,
+            PerFrame(layer, [](const UsdFrame& f) { return Float(DomeExposure(f.texture_scale)); }));
   out += in + "float inputs:intensity = 1\n";
   out += in + "bool inputs:normalize = 0\n";
   Attribute(out, in, "asset inputs:texture:file", layer,
-            [](const UsdFrame& f) { return UsdAssetPathLiteral("./" + f.latlong_file); });
+            PerFrame(layer, [](const UsdFrame& f) { return UsdAssetPathLiteral("./" + f.latlong_file); }));
   out += in + "token inputs:texture:format = \"latlong\"\n";
   out += "    }\n\n";
   DistantLight(out, layer, "Sun", false);
