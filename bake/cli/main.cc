@@ -120,6 +120,7 @@ struct BakeArgs {
   std::string shard;     // --shard I/N, empty: no split
   ShaderSwitches shaders;  // from the environment (main)
   std::string engine;    // --engine NAME: output.engine
+  bool usd = false;      // --usd: usd.enabled
   // From the environment (main, ReadEnvironment): the loader's driver
   // choice, lavapipe's thread count, the default star catalogue.
   std::string software_driver_selection;
@@ -137,6 +138,7 @@ std::vector<std::string> StyleOverrides(const BakeArgs& args) {
     overrides.push_back(fmt::format("render.latlong_height={}", args.size));
   }
   if (!args.engine.empty()) overrides.push_back("output.engine=" + args.engine);
+  if (args.usd) overrides.push_back("usd.enabled=true");
   return overrides;
 }
 
@@ -487,6 +489,9 @@ void AddBakeCommands(CLI::App& app, Cli& cli) {
         ->type_name(engines)
         ->check(CLI::IsMember(EngineNames()));
   }
+  cli.bake->add_flag("--usd", cli.args.usd,
+                     "Also write NAME.usda, a USD layer: a DomeLight of the latlong EXRs and DistantLights for the "
+                     "Sun and Moon, time-sampled over a sequence (usd.enabled; docs/usd.md)");
   cli.bake->add_flag("--dry-run", cli.args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   cli.bake->add_flag("--quiet,-q", cli.args.quiet,
                      "Errors only on stderr: no progress, no warnings (the files written still go to stdout)");

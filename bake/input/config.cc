@@ -284,6 +284,12 @@ void VisitGltf(SkyStyle& s, Visitor& v) {
   v.Bool("gltf.image_based_light", g.image_based_light);
 }
 
+// The USD sky layer (usd_layer.h).
+template <class Visitor>
+void VisitUsd(SkyStyle& s, Visitor& v) {
+  v.Bool("usd.enabled", s.usd.enabled);
+}
+
 // The prefiltered image-based light (ibl.h).
 template <class Visitor>
 void VisitIbl(SkyStyle& s, Visitor& v) {
@@ -338,6 +344,7 @@ void VisitStyle(SkyStyle& s, Visitor& v) {
   VisitAoas(s, v);
   VisitClouds(s, v);
   VisitGltf(s, v);
+  VisitUsd(s, v);
   VisitIbl(s, v);
   VisitNight(s, v);
 }
@@ -1224,6 +1231,25 @@ void CheckSceneAndEngine(const SkyStyle& style, StyleChecks& c) {
                 "(and gltf.enabled = true), or gltf.image_based_light = false";
     c.errors.push_back(e);
   }
+  // The USD layer's dome is the latlong EXR, in cd/m^2 (UsdLux: nits).
+  if (style.usd.enabled && !style.output.latlong) {
+    ConfigError e = c.Locate("usd.enabled");
+    e.message = "the USD layer's DomeLight is textured with the latlong EXR: set output.latlong = true, or "
+                "usd.enabled = false";
+    c.errors.push_back(e);
+  }
+  if (style.usd.enabled && style.output.units != OutputUnits::kLuminance) {
+    ConfigError e = c.Locate("usd.enabled");
+    e.message = "UsdLux lights emit in nits (cd/m^2): the USD layer needs output.units = \"luminance\", or "
+                "usd.enabled = false";
+    c.errors.push_back(e);
+  }
+  if (style.usd.enabled && style.output.color_space != ColorSpace::kRec709) {
+    ConfigError e = c.Locate("usd.enabled");
+    e.message = "the USD layer's lights and dome share one colour space, linear Rec.709: set "
+                "output.color_space = \"rec709\", or usd.enabled = false";
+    c.errors.push_back(e);
+  }
   if (std::optional<std::string> engine = EngineStyleError(style)) {
     ConfigError e = c.Locate("output.engine");
     e.message = *engine;
@@ -1347,6 +1373,7 @@ std::string ResolvedToml(SkyStyle& style) {
   else if (style.ibl.full_samples_roughness == 0.0) recorded["ibl"].as_table()->erase("full_samples_roughness");
   if (style.output.engine == "none") recorded["output"].as_table()->erase("engine");
   if (!style.gltf.image_based_light) recorded["gltf"].as_table()->erase("image_based_light");
+  if (!style.usd.enabled) recorded.erase("usd");
   if (style.quality.wavelengths == kRgbWavelengths) recorded["quality"].as_table()->erase("wavelengths");
   if (style.output.color_space.IsRec709()) recorded["output"].as_table()->erase("color_space");
   std::ostringstream resolved;

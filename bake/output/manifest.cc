@@ -2,6 +2,7 @@
 #include "skybake/output/sha256.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <set>
@@ -18,6 +19,7 @@
 #include "skybake/output/gltf_scene.h"
 #include "skybake/output/json_spool.h"
 #include "skybake/output/output_lock.h"
+#include "skybake/output/usd_layer.h"
 #include "skybake/input/engine_preset.h"
 #include "skybake/model/envmap.h"
 
@@ -86,6 +88,7 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
           {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
           {"files", files}};
   if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
+  if (f.sun_angular_radius_rad) frame["sun"]["angular_radius_rad"] = *f.sun_angular_radius_rad;
   return frame;
 }
 
@@ -113,6 +116,8 @@ json ManifestJson(const Manifest& m) {
                              {"width", m.gltf.texture_width},
                              {"height", m.gltf.texture_height}}}}},
   };
+  if (m.usd.enabled)
+    j["usd"] = {{"enabled", true}, {"name", m.usd.name}};
   if (m.place) j["place"] = {{"latitude_deg", m.place->latitude_deg}, {"longitude_deg", m.place->longitude_deg}};
   if (m.sequence) j["sequence"] = RangeJson(*m.sequence);
   if (m.part) {
@@ -406,10 +411,12 @@ void CheckNames(const std::string& path, const Manifest& m) {
   }
   static const std::map<std::string, std::string> kSceneExtension = {
       {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}, {"gltf_ground", "_ground.png"}};
+  if (m.usd.enabled && !IsPlainFileName(m.usd.name)) FailName(path, "usd.name", m.usd.name, "a plain file name");
   for (const ManifestFile& file : m.scene) {
+    if (file.kind == "usd" && m.usd.enabled && file.file == m.usd.name + ".usda") continue;
     auto it = kSceneExtension.find(file.kind);
     if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
-      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png)", m.gltf.name));
+      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png, .usda)", m.gltf.name));
   }
 }
 
@@ -488,6 +495,7 @@ ManifestFrame FrameOf(const Reader& r, const json& f) {
   frame.sun_direction = r.Vector(sun, "direction");
   frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
   frame.sun_irradiance = r.RgbOf(sun, "irradiance");
+  if (sun.contains("angular_radius_rad")) frame.sun_angular_radius_rad = r.Get<double>(sun, "angular_radius_rad");
   frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
   frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
   if (f.contains("moon")) frame.moon = MoonOf(r, r.Get<json>(f, "moon"));
@@ -535,6 +543,11 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
   m.texture_frame = r.Int(j, "texture_frame");
   m.half_scale = r.Get<double>(j, "half_scale");
   m.gltf = SceneOf(r, r.Get<json>(j, "gltf"));
+  if (j.contains("usd")) {
+    const json& usd = r.Get<json>(j, "usd");
+    m.usd.enabled = r.Get<bool>(usd, "enabled");
+    m.usd.name = r.Get<std::string>(usd, "name");
+  }
   if (j.contains("place"))
     m.place = GeoLocation{r.Get<double>(j["place"], "latitude_deg"), r.Get<double>(j["place"], "longitude_deg")};
   if (j.contains("sequence")) m.sequence = r.Range(j, "sequence");
@@ -545,6 +558,47 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
   if (names == ManifestNames::kChecked) CheckNames(path, m);
   return m;
 }
+
+namespace {
+
+double Degrees(double radians) { return radians * 180.0 / M_PI; }
+
+// The USD layer of the manifest's frames: each frame's latlong EXR (and the
+// scale in its header), sun, Moon and provenance.
+UsdLayerDescription UsdLayerOf(const Manifest& manifest, const std::string& out_dir) {
+  UsdLayerDescription layer;
+  layer.name = manifest.usd.name;
+  layer.out_dir = out_dir;
+  layer.sequence = manifest.sequence.has_value();
+  layer.version = manifest.version;
+  layer.commit = manifest.commit;
+  layer.style = manifest.style;
+  layer.schedule = manifest.schedule;
+  layer.sequence_sha256 = manifest.sequence_sha256;
+  for (const ManifestFrame& f : manifest.frames) {
+    UsdFrame frame;
+    frame.number = f.number;
+    for (const ManifestFile& file : f.files)
+      if (file.kind == "latlong") frame.latlong_file = file.file;
+    if (frame.latlong_file.empty())
+      throw OutputError(fmt::format("frame {} has no latlong EXR for the USD layer's dome", f.number));
+    frame.texture_scale = ExrSkybakeScale((fs::path(out_dir) / frame.latlong_file).string());
+    frame.time = f.time.value_or("");
+    frame.sun_elevation_deg = f.sun_elevation_deg;
+    frame.sun_azimuth_deg = f.sun_azimuth_deg;
+    frame.style_sha256 = f.style_sha256;
+    if (!f.sun_angular_radius_rad)
+      throw OutputError(fmt::format("frame {} has no sun.angular_radius_rad for the USD layer's Sun", f.number));
+    frame.sun = {f.sun_direction, f.sun_illuminance_lux, f.sun_irradiance, Degrees(2.0 * *f.sun_angular_radius_rad)};
+    if (f.moon && f.moon->light)
+      frame.moon = UsdDistantKey{f.moon->direction, f.moon->illuminance_lux, f.moon->irradiance,
+                                 Degrees(2.0 * f.moon->angular_radius_rad)};
+    layer.frames.push_back(std::move(frame));
+  }
+  return layer;
+}
+
+}  // namespace
 
 std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir) {
   // Scene: the dome textured with the reference frame, the sun (animated
@@ -618,6 +672,12 @@ std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir
       manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
                                 scene_files.back().sha256});
     }
+  }
+  if (manifest.usd.enabled && !manifest.frames.empty()) {
+    const std::string path = WriteUsdLayer(UsdLayerOf(manifest, out_dir));
+    scene_files.push_back({path, "usd", fs::file_size(path), Sha256OfFile(path)});
+    manifest.scene.push_back({fs::path(path).filename().string(), "usd", scene_files.back().bytes,
+                              scene_files.back().sha256});
   }
   return scene_files;
 }
@@ -840,6 +900,7 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
   std::vector<std::string> outputs = {ManifestFileName(std::nullopt)};
   if (merged.gltf.enabled)
     for (const char* ext : {".gltf", ".bin", ".glb"}) outputs.push_back(merged.gltf.name + ext);
+  if (merged.usd.enabled) outputs.push_back(merged.usd.name + ".usda");
   const OutputLock lock = OutputLock::Claim(options.dir, outputs);
   if (!options.force) {
     for (const std::string& name : outputs)

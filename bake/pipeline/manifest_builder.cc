@@ -21,7 +21,7 @@ ManifestBuilder::ManifestBuilder(const RenderPlan& plan, const BakeOptions& opti
     frame_index_[frame.number] = i;
   }
   sequence_sha256_ = Sha256OfText(sequence_identity);
-  keeps_scene_frames_ = !plan.part && plan.first().gltf.enabled;
+  keeps_scene_frames_ = !plan.part && (plan.first().gltf.enabled || plan.first().usd.enabled);
   result_.manifest_path = OutputPath(options_, plan_.manifest_name);
 }
 
@@ -50,6 +50,7 @@ Manifest ManifestBuilder::Head() const {
   const SkyStyle& ref = *reference.style;
   m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, reference.names.png,
             2 * ref.render.latlong_height, ref.render.latlong_height};
+  if (first.usd.enabled) m.usd = {true, first.output.basename};
   return m;
 }
 
@@ -60,10 +61,15 @@ void ManifestBuilder::Add(const FrameResult& f) {
   frame.hours_from_start = plan_.frames[i].hours_from_start;
   frame.animation_time_s =
       plan_.schedule && plan_.schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
+  if (plan_.first().usd.enabled) frame.sun_angular_radius_rad = plan_.frames[i].style->atmosphere.sun_angular_radius_rad;
   spool_.Add(ManifestFrameText(frame));
   if (!keeps_scene_frames_) return;
-  frame.style_sha256 = {};
-  if (frame.number != plan_.frames[plan_.reference].number) frame.files = {};
+  // The scene keeps of the frames what it reads (WriteScene): the texture
+  // frame's files; with the USD layer every frame's latlong and style hash.
+  const bool usd = plan_.first().usd.enabled;
+  if (!usd) frame.style_sha256 = {};
+  if (frame.number != plan_.frames[plan_.reference].number)
+    std::erase_if(frame.files, [&](const ManifestFile& file) { return !usd || file.kind != "latlong"; });
   scene_frames_.push_back(std::move(frame));
 }
 

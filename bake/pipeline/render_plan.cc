@@ -92,6 +92,7 @@ RenderPlan Completed(RenderPlan plan) {
   const SkyStyle& first = plan.first();
   if (first.gltf.enabled && !plan.part)
     for (const char* ext : {".gltf", ".bin", ".glb"}) plan.files.push_back(first.output.basename + ext);
+  if (first.usd.enabled && !plan.part) plan.files.push_back(first.output.basename + ".usda");
   plan.files.push_back(plan.manifest_name);
   plan.files.push_back(TimingsFileName(plan.part));
   return plan;

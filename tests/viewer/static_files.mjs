@@ -5,7 +5,7 @@ import path from 'node:path';
 
 const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
                 '.gltf': 'model/gltf+json', '.glb': 'model/gltf-binary', '.bin': 'application/octet-stream',
-                '.png': 'image/png' };
+                '.png': 'image/png', '.wasm': 'application/wasm', '.usda': 'text/plain' };
 
 // Answers with the file `urlPath` names: below `mountedDir` when it starts
 // with `/<mount>/`, else below `defaultDir`; 404 for anything outside them,

@@ -69,6 +69,13 @@ struct GltfSettings {
   bool image_based_light = false;   // EXT_lights_image_based from ibl.specular (gltf_ibl.h)
 };
 
+// The USD sky layer written beside the maps (usd_layer.h): NAME.usda with
+// a DomeLight textured with each frame's latlong EXR and a DistantLight for
+// the Sun (and the Moon). Off by default, and then no key is recorded.
+struct UsdSettings {
+  bool enabled = false;  // write name.usda (needs output.latlong and luminance units)
+};
+
 // Image-based lighting outputs from the same bake (include/skybake/ibl.h):
 // split-sum GGX-prefiltered radiance, an irradiance cube, the DFG table. All
 // off by default, and then no pass runs and no key is recorded.

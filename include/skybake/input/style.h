@@ -38,6 +38,7 @@ struct SkyStyle {
   CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   CloudShadowSettings cloud_shadow;  // [cloud_shadow]: the frame's cloud shadow map (cloud_shadow.h)
   GltfSettings gltf;
+  UsdSettings usd;
   IblSettings ibl;
   NightSettings night;        // stars, the Moon, moonlight (pipeline/night_sky.h)
   std::string source_path;    // where it was read from

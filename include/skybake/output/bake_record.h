@@ -27,7 +27,7 @@ struct StageReport {
 
 struct BakedFile {
   std::string path;
-  std::string kind;  // "face", "cube", "latlong", "preview", "gltf", "gltf_bin", "glb", "manifest"
+  std::string kind;  // "face", "cube", "latlong", "preview", "gltf", "gltf_bin", "glb", "usd", "manifest"
   uint64_t bytes = 0;
   std::string sha256;  // hex; empty for the manifest itself
 };

@@ -57,6 +57,9 @@ struct ManifestFrame {
   Rgb sun_irradiance{0, 0, 0};  // transmitted sun at the observer, output units x sr
   ShRgb sh_irradiance_with_sun{};
   ShRgb sh_irradiance_without_sun{};
+  // The style's sun.angular_radius_rad of the frame, recorded (as
+  // sun.angular_radius_rad) only with the USD layer, whose Sun takes it.
+  std::optional<double> sun_angular_radius_rad;
   std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
   std::vector<ManifestFile> files;  // in the order they are written
   std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
@@ -70,6 +73,13 @@ struct ManifestScene {
   GltfSettings dome;
   std::string texture_file;  // the reference frame's PNG
   int texture_width = 0, texture_height = 0;
+};
+
+// What the USD layer takes from the style (usd_layer.h): recorded only when
+// it is on, so that a bake without it keeps its manifest's bytes.
+struct ManifestUsd {
+  bool enabled = false;
+  std::string name;  // output.basename: name.usda
 };
 
 struct Manifest {
@@ -86,9 +96,10 @@ struct Manifest {
   std::optional<FrameRange> sequence;  // every frame of the schedule; unset for a single bake
   std::optional<FrameRange> part;      // the frames of a part (--frames, --shard); unset for a whole bake
   ManifestScene gltf;
+  ManifestUsd usd;
   std::vector<ManifestFrame> frames;   // by frame number
   bool complete = false;               // every frame of the bake (or part) is done
-  std::vector<ManifestFile> scene;     // the glTF scene's files, once written
+  std::vector<ManifestFile> scene;     // the glTF scene's files and the USD layer, once written
 };
 
 // manifest.json for a whole bake, manifest.shard-0003-0004.json for the part
@@ -139,14 +150,15 @@ enum class ManifestNames { kChecked, kUnchecked };
 Manifest ReadManifest(const std::string& path, ManifestNames names = ManifestNames::kChecked);
 
 // How a whole bake ends, and a merge: writes the glTF scene (when
-// manifest.gltf.enabled) from the frames' suns and SH and the texture PNG in
+// manifest.gltf.enabled) and the USD layer (manifest.usd.enabled) from the frames' suns and SH and the texture PNG in
 // `out_dir`, lists its files in manifest.scene, marks the manifest complete
 // and writes out_dir/manifest.json. Returns the scene's files. Throws
 // OutputError.
 std::vector<BakedFile> WriteSceneAndManifest(Manifest& manifest, const std::string& out_dir);
 // Its first half: the scene alone, listed in manifest.scene. It reads of
 // the frames their suns, SH, times and Moons, and the files of the texture
-// frame only.
+// frame only; the USD layer every frame's latlong EXR (its name, and the
+// skybake:scale in its header) and style_sha256.
 std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir);
 
 // Run-dependent facts of a bake, kept out of the manifest: the output folder,
