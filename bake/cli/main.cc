@@ -126,6 +126,7 @@ struct BakeArgs {
   std::string software_driver_selection;
   std::string lavapipe_threads;  // LP_NUM_THREADS main set, or ""
   std::string star_catalogue = DefaultStarCataloguePath();
+  std::optional<int> stop_after_frame;  // $SKYBAKE_STOP_AFTER_FRAME: BakeOptions::stop_after_frame (farm tests)
 };
 
 enum class Mode { kBake, kCheck, kPlan };
@@ -267,6 +268,7 @@ void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
   options.vulkan.lavapipe_threads = args.lavapipe_threads;
   options.shaders = args.shaders;
   options.star_catalogue = args.star_catalogue;
+  options.stop_after_frame = args.stop_after_frame;
 }
 
 void SetBakeOptions(const BakeArgs& args, const std::optional<FrameRange>& part, ProgressReport& progress,
@@ -604,6 +606,8 @@ void ReadEnvironment(BakeArgs& args) {
   if (const char* dir = std::getenv("SKYBAKE_MODULE_DIR")) SetOiioModuleDir(dir);
   if (const char* catalogue = std::getenv("SKYBAKE_STAR_CATALOGUE"); catalogue && *catalogue)
     args.star_catalogue = catalogue;
+  if (const char* stop = std::getenv("SKYBAKE_STOP_AFTER_FRAME"); stop && *stop)
+    args.stop_after_frame = std::atoi(stop);
   args.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
   args.shaders.generic = EnvIs("SKYBAKE_GENERIC_SHADERS", "1");
   args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");

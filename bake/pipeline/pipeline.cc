@@ -9,6 +9,8 @@
 #include "skybake/pipeline/pipeline.h"
 
 #include <algorithm>
+#include <csignal>
+#include <cstdio>
 #include <filesystem>
 #include <malloc.h>
 #include <memory>
@@ -99,8 +101,8 @@ std::string RenderDetail(const FramePlan& plan, bool verified) {
 
 // One frame: its views in one submission, its lighting, its IBL maps and
 // engine images; then its files on the writer thread, or, resumed, its
-// verified files as they are.
-void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
+// verified files as they are. Returns whether it rendered the frame.
+bool BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
   const SkyStyle& style = *plan.style;
   FrameResult frame = FrameResultOf(plan);
   // A resumed sequence skips frames whose files are verified against the manifest.
@@ -146,7 +148,10 @@ void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
       for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
     }
   }
-  if (verified) return writer.RecordVerified(std::move(frame), std::move(*verified));
+  if (verified) {
+    writer.RecordVerified(std::move(frame), std::move(*verified));
+    return false;
+  }
 
   // Files: encoded, written and checksummed on the writer thread while the
   // device renders the next frame.
@@ -159,6 +164,21 @@ void BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
     s.timer.Report("night sky", s.night->TakeSeconds(), plan.Label() + ": " + NightSkyBake::Describe(night->frame));
   }
   writer.Write(std::move(frame), std::move(job));
+  return true;
+}
+
+// A fault injected at a frame boundary (BakeOptions::stop_after_frame): the
+// frame's files are written and the manifest lists them, then the process
+// stops itself, as a frozen node would, for a farm test to kill or requeue
+// it at a known frame instead of racing a poll.
+void StopHere() {
+  std::fflush(nullptr);
+  std::raise(SIGSTOP);
+}
+void StopAtFrameBoundary(FrameWriter& writer, ManifestBuilder& manifest) {
+  writer.Collect();
+  manifest.Write(false);
+  StopHere();
 }
 
 // Scene and manifest: a whole bake ends as merge-manifest does, through
@@ -195,6 +215,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   // below still comes from every frame of the plan); the night sky's
   // catalogues read and its input checked (night_sky.h).
   const OutputLock lock = ClaimOutputs(plan, options);
+  if (options.stop_after_frame == 0) StopHere();  // fault injection: the lock held, no frame yet
   std::unique_ptr<NightSkyBake> night = NightSkyBake::For(plan.styles(), plan.schedule, options.star_catalogue);
   const PreviousBake previous = PrepareOutputs(plan, options, timer, result);
 
@@ -233,8 +254,9 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
     if (!plan.Bakes(frame)) continue;  // another part's frame
     FrameProgress progress{FrameProgress::Event::kStart, ++frame_index, frame_count, frame.number, plan.sequence};
     if (options.frame_progress) options.frame_progress(progress);
-    BakeFrame(frame, stages, writer);
+    const bool rendered = BakeFrame(frame, stages, writer);
     if (frame_index == frame_count) writer.Collect();  // the last frame's files are waited for at once
+    if (rendered && options.stop_after_frame == frame.number) StopAtFrameBoundary(writer, manifest);
     progress.event = FrameProgress::Event::kDone;
     if (options.frame_progress) options.frame_progress(progress);
   }

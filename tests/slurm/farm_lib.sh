@@ -148,13 +148,26 @@ frames_in() { [ -f "$1" ] && grep -o '"frame": *[0-9]*' "$1" | wc -l || echo 0; 
 # Shard I of TASKS: its first frame, padded like the file names.
 shard_first() { printf '%04d' $(((($1 - 1) * FRAMES) / TASKS + 1)); }
 shard_last() { printf '%04d' $((($1 * FRAMES) / TASKS)); }
-# Waits until the shard manifest $1 lists at least one frame.
-wait_first_frame() {
-  local deadline=$(deadline_in)
-  until [ "$(frames_in "$1")" -ge 1 ]; do
-    [ "$(date +%s)" -lt "$deadline" ] || fail "$1 lists no frame after $TIMEOUT s"
-    sleep 0.02
+# Waits until the task baking shard $1 has stopped itself at its frame
+# boundary (SKYBAKE_STOP_AFTER_FRAME, set at submission: the product stops
+# once that frame's files and the manifest listing them are written), so
+# the fault lands at a known frame, not where a poll happens to catch it.
+wait_stopped_task() {
+  local deadline=$(deadline_in) pid
+  while :; do
+    for pid in $(pgrep -x skybake); do
+      tr '\0' ' ' < "/proc/$pid/cmdline" 2>/dev/null | grep -q -- "--shard $1/$TASKS" || continue
+      [ "$(ps -o stat= -p "$pid" | cut -c1)" = T ] && return 0
+    done
+    [ "$(date +%s)" -lt "$deadline" ] || fail "task $1 did not stop itself at its frame boundary in $TIMEOUT s"
+    sleep 0.1
   done
+}
+# Submits the README's array ($1) with task 2 set to stop itself after its first frame.
+submit_stopping_task_2() {
+  export SKYBAKE_STOP_AFTER_FRAME=$((10#$(shard_first 2)))
+  submit "$1"
+  unset SKYBAKE_STOP_AFTER_FRAME
 }
 # Folder $1 holds the reference's files byte for byte, plus the parts' manifests and timings, and nothing else.
 expect_identical() {

@@ -5,8 +5,9 @@
 #
 #   bash tests/slurm/farm_lock_test.sh BUILD_DIR      # ctest: slurm_farm_lock
 #
-# F  the README's array (3 tasks) into one folder; every task is stopped
-#    (SIGSTOP) as soon as it holds its part's lock, before its first frame;
+# F  the README's array (3 tasks) into one folder; every task stops itself
+#    (SKYBAKE_STOP_AFTER_FRAME=0) as soon as it holds its part's lock,
+#    before its first frame;
 #    the same array and merge are submitted again into the same folder:
 #    every task of the second exits with code 6 before any GPU work, its log
 #    naming the first array's task of the same part (pid, command) as the
@@ -20,31 +21,19 @@ TEST_NAME=slurm_farm_lock
 source "$(dirname "$0")/farm_lib.sh"
 
 step "F: the README's array, every task stopped once it holds its part's lock"
+# Every task stops itself as soon as it holds its part's lock
+# (SKYBAKE_STOP_AFTER_FRAME=0): before its device, pipelines and first frame,
+# so no task can finish first, however fast or loaded the machine.
+export SKYBAKE_STOP_AFTER_FRAME=0
 submit "$tmp/f"
+unset SKYBAKE_STOP_AFTER_FRAME
 FIRST_JOB=$JOB FIRST_MERGE=$MERGE
-# Every task is watched at once and stopped as soon as its claim (the lock
-# file naming its part's manifest) is in the folder: that is before its
-# device, pipelines and first frame, so no task can finish first, however
-# fast the machine. (Waiting for the tasks one after another let a later
-# task finish all its frames on a quiet machine.)
-declare -A held=()
-deadline=$(deadline_in)
-while [ "${#held[@]}" -lt "$TASKS" ]; do
-  for i in $(seq 1 "$TASKS"); do
-    [ -z "${held[$i]:-}" ] || continue
-    if grep -qsF "manifest.shard-$(shard_first "$i")-$(shard_last "$i").json" "$tmp/f"/.skybake.lock.*; then
-      scancel --full --signal=STOP "${FIRST_JOB}_$i"
-      held[$i]=1
-    fi
-  done
-  [ "$(date +%s)" -lt "$deadline" ] || fail "F: only ${#held[@]} of $TASKS tasks claimed their part within $TIMEOUT s"
-  sleep 0.01
-done
-sleep 0.5
 for i in $(seq 1 "$TASKS"); do
+  wait_stopped_task "$i"
+  grep -qsF "manifest.shard-$(shard_first "$i")-$(shard_last "$i").json" "$tmp/f"/.skybake.lock.* ||
+    fail "F: task $i stopped without its part's claim in the folder"
   n=$(frames_in "$tmp/f/manifest.shard-$(shard_first "$i")-$(shard_last "$i").json")
-  last=$((10#$(shard_last "$i") - 10#$(shard_first "$i") + 1))
-  [ "$n" -lt "$last" ] || fail "F: task $i finished ($n of $last frames) before it could be stopped"
+  [ "$n" = 0 ] || fail "F: task $i wrote $n frames before it stopped"
 done
 first_pids=$(pgrep -f "skybake bake .*--out $tmp/f " | tr '\n' ' ')
 [ -n "$first_pids" ] || fail "F: no skybake process of the first array"

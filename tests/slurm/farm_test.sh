@@ -17,14 +17,14 @@
 #   A  the array and the dependent merge: every task runs at the same time
 #      into one folder; every EXR, PNG, manifest.json and the glTF scene are
 #      byte-identical to an unsharded bake of the same command;
-#   B  a task stopped part-way (SIGSTOP after its first frame, then SIGKILL
-#      by scancel): the merge stays pending with DependencyNeverSatisfied and
-#      never runs; the README's retry (scancel the merge, srun the shard with
-#      --resume, srun the merge) keeps the frames already written and ends
-#      byte-identical;
-#   C  a task requeued by Slurm (scontrol requeue) part-way: it resumes (its
-#      first frame's files are not rewritten) and the original merge runs
-#      after it: byte-identical;
+#   B  a task stopped part-way (it stops itself after its first frame,
+#      SKYBAKE_STOP_AFTER_FRAME, then SIGKILL by scancel): the merge stays
+#      pending with DependencyNeverSatisfied and never runs; the README's
+#      retry (scancel the merge, srun the shard with --resume, srun the
+#      merge) keeps the frames already written and ends byte-identical;
+#   C  a task requeued by Slurm (scontrol requeue) part-way, stopped after
+#      its first frame as in B: it resumes (its first frame's files are not
+#      rewritten) and the original merge runs after it: byte-identical;
 #   D  a merge run without the dependency while a task is held: exit code 8
 #      naming the missing frames and the --frames that bakes them; released,
 #      the task finishes and the merge is byte-identical;
@@ -63,12 +63,10 @@ expect_identical "$tmp/a"
 
 # --- B: a task killed part-way, the merge held, the README's retry ----------
 step "B: task 2 stopped after its first frame and killed"
-submit "$tmp/b"
+submit_stopping_task_2 "$tmp/b"
 part2=$tmp/b/manifest.shard-$(shard_first 2)-$(shard_last 2).json
 shard2_frames=$((10#$(shard_last 2) - 10#$(shard_first 2) + 1))
-wait_first_frame "$part2"
-scancel --full --signal=STOP "${JOB}_2"
-sleep 0.5
+wait_stopped_task 2
 done_frames=$(frames_in "$part2")
 [ "$done_frames" -ge 1 ] && [ "$done_frames" -lt "$shard2_frames" ] ||
   fail "B: task 2 was not stopped part-way: its manifest lists $done_frames of $shard2_frames frames"
@@ -96,11 +94,9 @@ expect_identical "$tmp/b"
 
 # --- C: a task requeued by Slurm part-way resumes ---------------------------
 step "C: task 2 requeued by scontrol after its first frame"
-submit "$tmp/c"
+submit_stopping_task_2 "$tmp/c"
 part2=$tmp/c/manifest.shard-$(shard_first 2)-$(shard_last 2).json
-wait_first_frame "$part2"
-scancel --full --signal=STOP "${JOB}_2"
-sleep 0.5
+wait_stopped_task 2
 done_frames=$(frames_in "$part2")
 [ "$done_frames" -ge 1 ] && [ "$done_frames" -lt "$shard2_frames" ] ||
   fail "C: task 2 was not stopped part-way: its manifest lists $done_frames of $shard2_frames frames"

@@ -68,6 +68,11 @@ struct BakeOptions {
   // timings.json's record on disk; BakeResult keeps the scene's, manifest's
   // and timings' files alone.
   bool keep_frame_records = true;
+  // Fault injection for farm tests (main: $SKYBAKE_STOP_AFTER_FRAME): once
+  // this frame number is rendered, its files written and the manifest
+  // rewritten to list it, the process stops itself (SIGSTOP); 0: once the
+  // bake holds its outputs' lock, before its device and first frame.
+  std::optional<int> stop_after_frame;
   std::function<void(const std::vector<BakedFile>&)> frame_files;  // may be empty
 };
 
