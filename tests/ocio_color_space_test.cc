@@ -8,6 +8,7 @@
 // - a name that is neither built in nor in the config, or a space that is
 //   not linear, is refused with the names there are, before any GPU work.
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <string>
 #include <vector>
@@ -178,6 +179,56 @@ TEST(OcioColorSpace, EachSpaceBackToRec709IsTheRec709Bake) {
     }
     std::printf("%-14s back to Rec.709 through OpenColorIO: worst %.2e of the texel's brightest channel\n",
                 name.c_str(), worst);
+  }
+}
+
+// The IBL maps follow the maps' space: their EXRs carry its chromaticities
+// and name and hold the Rec.709 bake's radiance through its matrix; the
+// KTX2 file's data format descriptor names its primaries (ACEScg: AP1,
+// colorPrimaries 7) and its key/value data its name; the glTF's RGBD PNGs
+// stay Rec.709 (byte-identical).
+TEST(OcioColorSpace, IblFilesFollowTheMapsSpace) {
+  const std::string dir = testing::FreshTempDir("ocio_ibl");
+  const std::string ibl =
+      " --set ibl.specular=true --set ibl.irradiance=true --set ibl.ktx2=true --set ibl.size=16 --set ibl.samples=16 "
+      "--set gltf.image_based_light=true --set 'output.pixel_type=\"float\"'";
+  std::map<std::string, std::string> out;
+  for (const std::string space : {"rec709", "acescg"}) {
+    out[space] = dir + "/" + space;
+    const testing::CommandRun r = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/default.toml -q --size 16 --vulkan-validation --set "
+        "output.faces=false --set output.cube_strip=false --set 'output.color_space=\"" + space + "\"'" + ibl +
+        " --out " + out[space]);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  const Map rec = ReadMap(out["rec709"] + "/sky_irradiance.exr");
+  const Map cg = ReadMap(out["acescg"] + "/sky_irradiance.exr");
+  ASSERT_GT(rec.width, 0);
+  ASSERT_EQ(rec.rgb.size(), cg.rgb.size());
+  EXPECT_EQ(rec.color_space, "rec709");
+  EXPECT_EQ(cg.color_space, "acescg");
+  ASSERT_EQ(cg.chromaticities.size(), 8u);
+  EXPECT_FLOAT_EQ(cg.chromaticities[0], 0.713f);
+  EXPECT_FLOAT_EQ(cg.chromaticities[7], 0.33767f);
+  const Matrix3 m = Rec709To(ColorSpace::kAcesCg);
+  for (size_t t = 0; t < rec.rgb.size() / 3; ++t)
+    for (int i = 0; i < 3; ++i) {
+      const double want = m[i][0] * rec.rgb[3 * t] + m[i][1] * rec.rgb[3 * t + 1] + m[i][2] * rec.rgb[3 * t + 2];
+      ASSERT_NEAR(cg.rgb[3 * t + i], want, 1e-5 * std::abs(want) + 1e-9) << "texel " << t;
+    }
+  // KTX2: the DFD's colorPrimaries byte (header 48 bytes, then dfdByteOffset;
+  // in the DFD: dfdTotalSize, two words, then colorModel, colorPrimaries).
+  for (const auto& [space, primaries] : std::vector<std::pair<std::string, int>>{{"rec709", 1}, {"acescg", 7}}) {
+    const std::string ktx = testing::ReadFileBytes(out[space] + "/sky_specular.ktx2");
+    ASSERT_GT(ktx.size(), 80u);
+    uint32_t dfd = 0;
+    std::memcpy(&dfd, ktx.data() + 48, 4);
+    EXPECT_EQ(int(uint8_t(ktx[dfd + 13])), primaries) << space;
+    EXPECT_NE(ktx.find(std::string("skybake:color_space") + '\0' + space), std::string::npos) << space;
+  }
+  for (const char* face : {"px", "nz"}) {
+    const std::string png = std::string("/sky_specular_m0_") + face + ".png";
+    EXPECT_EQ(testing::ReadFileBytes(out["rec709"] + png), testing::ReadFileBytes(out["acescg"] + png)) << png;
   }
 }
 

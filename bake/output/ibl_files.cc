@@ -2,6 +2,7 @@
 #include "skybake/output/ibl_files.h"
 
 #include <algorithm>
+#include <optional>
 
 #include <fmt/format.h>
 
@@ -44,9 +45,42 @@ std::vector<RgbaImage> IblImagesForRangeCheck(const IblMaps& maps) {
   return images;
 }
 
-std::vector<std::string> EncodeIblFiles(const IblMaps& maps, const SkyStyle& style, const ExrWriteOptions& exr,
-                                        bool with_dfg) {
+namespace {
+
+// The radiance maps in the output's colour space (output.color_space): a
+// copy through its matrix; the DFG table is not a colour and stays.
+IblMaps InColorSpace(const IblMaps& rec709, const OutputColorSpace& space) {
+  IblMaps maps = rec709;
+  const Matrix3& m = space.from_rec709;
+  auto convert = [&](CubeLevel& level) {
+    for (std::vector<float>& face : level.faces)
+      for (size_t t = 0; t + 3 < face.size(); t += 4) {
+        const double r = face[t], g = face[t + 1], b = face[t + 2];
+        for (int i = 0; i < 3; ++i) face[t + i] = float(m[i][0] * r + m[i][1] * g + m[i][2] * b);
+      }
+  };
+  for (CubeLevel& level : maps.specular) convert(level);
+  convert(maps.irradiance);
+  return maps;
+}
+
+}  // namespace
+
+std::vector<std::string> EncodeIblFiles(const IblMaps& rec709_maps, const SkyStyle& style,
+                                        const ExrWriteOptions& rec709_exr, bool with_dfg) {
   const IblSettings& s = style.ibl;
+  // The EXR and KTX2 maps in the output's colour space; the glTF's RGBD PNGs stay Rec.709.
+  const OutputColorSpace& space = style.output.color_space;
+  const bool luminance = style.output.units == OutputUnits::kLuminance;
+  std::optional<IblMaps> converted;
+  if (luminance && !space.IsRec709()) converted = InColorSpace(rec709_maps, space);
+  const IblMaps& maps = converted ? *converted : rec709_maps;
+  ExrWriteOptions exr = rec709_exr;
+  if (converted) {
+    for (int i = 0; i < 8; ++i) exr.chromaticities[i] = float(space.chromaticities[i / 2][i % 2]);
+    exr.attributes["skybake:units"] = space.description + " luminance, cd/m^2 per 1.0 divided by skybake:scale";
+    exr.attributes["skybake:color_space"] = space.name;
+  }
   const int levels = IblLevelCount(s);
   const std::string layout =
       "six Vulkan cube faces (the Vulkan face-selection table, texel centres at (i + 0.5) / N) stacked from the "
@@ -111,6 +145,14 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& maps, const SkyStyle& sty
                   {"skybake:scale", exr.attributes.count("skybake:scale") ? exr.attributes.at("skybake:scale") : "1"},
                   {"skybake:units", exr.attributes.count("skybake:units") ? exr.attributes.at("skybake:units") : ""},
                   {"skybake:frame", "+Y up, North -Z, East +X; right-handed; faces in the KTX2 (Vulkan) order"}};
+    if (luminance) {
+      k.primaries = Ktx2Primaries(space);
+      k.metadata["skybake:color_space"] = space.name;
+      k.metadata["skybake:chromaticities"] =
+          fmt::format("{} {} {} {} {} {} {} {}", space.chromaticities[0][0], space.chromaticities[0][1],
+                      space.chromaticities[1][0], space.chromaticities[1][1], space.chromaticities[2][0],
+                      space.chromaticities[2][1], space.chromaticities[3][0], space.chromaticities[3][1]);
+    }
     if (s.specular) {
       Ktx2Options o = k;
       o.metadata["skybake:ibl"] = fmt::format(
@@ -139,8 +181,8 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& maps, const SkyStyle& sty
   if (s.specular && style.gltf.enabled && style.gltf.image_based_light)
     for (int level = 0; level < levels; ++level)
       for (int face = 0; face < 6; ++face)
-        encoded.push_back(EncodeRgbdFacePng(maps.specular[level].faces[face].data(), maps.specular[level].size,
-                                            maps.gltf_scale));
+        encoded.push_back(EncodeRgbdFacePng(rec709_maps.specular[level].faces[face].data(),
+                                            rec709_maps.specular[level].size, rec709_maps.gltf_scale));
   return encoded;
 }
 

@@ -88,7 +88,7 @@ void EncodeTexels(const float* rgba, size_t texels, const Ktx2Options& o, std::s
 }
 
 // Khronos basic data format descriptor (Khronos Data Format Specification
-// 1.3, section 5): one block, RGBSDA model, BT.709 primaries, linear, alpha
+// 1.3, section 5): one block, RGBSDA model, the options' primaries, linear, alpha
 // straight. KTX-Software's validator (`ktx validate`, error 6028) compares
 // each sample field by field with the descriptor its dfdutils library makes
 // for the VkFormat (external/dfdutils: vk2dfd.inl, createdfd.c), and libktx
@@ -100,7 +100,7 @@ void EncodeTexels(const float* rgba, size_t texels, const Ktx2Options& o, std::s
 //   e5b9g9r9   per channel its 9-bit mantissa (no qualifier, lower 0, upper
 //              8448) then the shared 5-bit exponent at 27 (EXPONENT, lower
 //              15 = the bias, upper 31)
-std::string DataFormatDescriptor(KtxFormat format) {
+std::string DataFormatDescriptor(KtxFormat format, uint32_t primaries) {
   struct Sample {
     uint32_t bit_offset, bit_length, channel, qualifiers, lower, upper;
   };
@@ -131,7 +131,7 @@ std::string DataFormatDescriptor(KtxFormat format) {
   Put32(d, 4 + block_size);                   // dfdTotalSize
   Put32(d, 0);                                // vendorId 0 (Khronos), descriptorType 0 (basic)
   Put32(d, 2u | (block_size << 16));          // versionNumber 2 (KDF 1.3), descriptorBlockSize
-  Put32(d, 1u | (1u << 8) | (1u << 16));      // colorModel RGBSDA, primaries BT709, transfer LINEAR, flags 0
+  Put32(d, 1u | (primaries << 8) | (1u << 16));  // colorModel RGBSDA, colorPrimaries, transfer LINEAR, flags 0
   Put32(d, 0);                                // texelBlockDimension 1 x 1 x 1 x 1
   Put32(d, Ktx2TexelBytes(format));           // bytesPlane0
   Put32(d, 0);                                // bytesPlane4..7
@@ -186,7 +186,7 @@ std::string Assemble(uint32_t width, uint32_t height, uint32_t faces, const std:
   out.resize(out.size() + 4 * 4 + 2 * 8);  // dfd and kvd offsets/lengths, sgd offset/length
   const size_t level_index_at = out.size();
   out.resize(out.size() + size_t(level_count) * 24);
-  const std::string dfd = DataFormatDescriptor(o.format);
+  const std::string dfd = DataFormatDescriptor(o.format, o.primaries);
   const size_t dfd_at = out.size();
   out += dfd;
   const std::string kvd = KeyValueData(o.metadata);
@@ -276,6 +276,28 @@ std::string EncodeKtx2Image(int width, int height, const std::vector<float>& rgb
   std::string bytes;
   EncodeTexels(rgba.data(), size_t(width) * height, options, bytes);
   return Assemble(uint32_t(width), uint32_t(height), 1, {bytes}, options);
+}
+
+uint32_t Ktx2Primaries(const OutputColorSpace& space) {
+  struct Known {
+    uint32_t primaries;
+    std::array<std::array<double, 2>, 4> xy;
+  };
+  static const Known known[] = {
+      {1, Chromaticities(ColorSpace::kRec709)},
+      {4, Chromaticities(ColorSpace::kRec2020)},
+      {5, Chromaticities(ColorSpace::kXyz)},
+      {6, Chromaticities(ColorSpace::kAces2065)},
+      {7, Chromaticities(ColorSpace::kAcesCg)},
+      {10, {{{0.680, 0.320}, {0.265, 0.690}, {0.150, 0.060}, {0.3127, 0.3290}}}},  // Display P3 (SMPTE EG 432-1)
+  };
+  for (const Known& k : known) {
+    bool same = true;
+    for (int i = 0; i < 4; ++i)
+      for (int j = 0; j < 2; ++j) same = same && std::abs(k.xy[i][j] - space.chromaticities[i][j]) < 5e-4;
+    if (same) return k.primaries;
+  }
+  return 0;
 }
 
 }  // namespace skybake

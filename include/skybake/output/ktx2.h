@@ -28,7 +28,14 @@ struct Ktx2Options {
   int zstd_level = 0;    // 0: none; else the zstd level of each mip level's data
   double scale = 1.0;    // multiplies every value before it is encoded
   std::map<std::string, std::string> metadata;  // key/value data (UTF-8 strings)
+  uint32_t primaries = 1;  // the DFD's colorPrimaries (Khronos Data Format 1.3, khr_df_primaries_e): 1 BT.709
 };
+
+// The DFD colorPrimaries of a colour space: BT.709 1, BT.2020 4, CIE XYZ 5,
+// ACES AP0 6, ACEScc/ACEScg AP1 7, Display P3 10, matched by chromaticities;
+// 0 (unspecified) for any other (its name and chromaticities then travel in
+// the key/value data).
+uint32_t Ktx2Primaries(const OutputColorSpace& space);
 
 // VkFormat number and texel size in bytes of a format.
 uint32_t Ktx2VkFormat(KtxFormat format);
