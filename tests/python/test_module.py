@@ -5,6 +5,7 @@ import json
 import os
 import pathlib
 import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -158,6 +159,18 @@ def test_dict_with_wrong_types(tmp_path):
     assert sorted(x.key for x in raised.value.errors) == ["render.cube_size[1]", "sun.elevation_deg"]
 
 
+def test_dict_values_as_toml():
+    """numpy scalars are numbers; strings keep quotes, backslashes and newlines (the error quotes
+    the value read back); a dict equals the TOML text of the same keys."""
+    from_dict = skybake.load_style({"sun": {"elevation_deg": np.float32(10.5), "azimuth_deg": np.int64(90)}})
+    from_text = skybake.parse_style("[sun]\nelevation_deg = 10.5\nazimuth_deg = 90\n", name="<dict>")
+    assert from_dict.toml == from_text.toml
+    with pytest.raises(skybake.StyleError) as raised:
+        skybake.load_style({"output": {"basename": 'a"b\\c\nd'}})
+    assert raised.value.errors[0].key == "output.basename"
+    assert raised.value.errors[0].message.startswith("'a\"b\\\\c\\nd' is not a plain file name")
+
+
 def test_overrides_are_checked_as_set(in_source):
     with pytest.raises(skybake.StyleError) as raised:
         skybake.load_style(STYLE, ["sun.elevation_deg=high"])
@@ -270,19 +283,29 @@ def test_an_error_in_the_callback_cancels_and_propagates(in_source, tmp_path):
     assert hidden(tmp_path / "out") == []
 
 
-def test_bake_from_another_thread(in_source, tmp_path):
-    """The GIL is released while the bake runs and taken back for the callback: a bake runs in a
-    thread of its own while this one waits on it."""
-    results, events = [], []
+def test_the_gil_is_released_while_baking(in_source, tmp_path, schedule_path):
+    """With no forced switching between threads, this thread runs while the bake's thread bakes
+    only if the bake lets go of the GIL: it sees the bake started and not yet ended."""
+    started, events, snapshot = threading.Event(), [], []
 
-    def work():
-        results.append(skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE,
-                                    progress=events.append))
+    def progress(event):
+        events.append(event["event"])
+        started.set()
 
-    worker = threading.Thread(target=work)
-    worker.start()
-    worker.join()
-    assert len(results) == 1 and events[-1]["event"] == "end"
+    worker = threading.Thread(target=lambda: skybake.bake(
+        skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE,
+        schedule=skybake.load_schedule(str(schedule_path)), progress=progress))
+    interval = sys.getswitchinterval()
+    sys.setswitchinterval(1000.0)
+    try:
+        worker.start()
+        started.wait()
+        snapshot.extend(events)
+        worker.join()
+    finally:
+        sys.setswitchinterval(interval)
+    assert snapshot[0] == "start" and "end" not in snapshot
+    assert events[-1] == "end"
 
 
 # === docs/python.md's Blender example, as it stands there, in Debian's Blender.
