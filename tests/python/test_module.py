@@ -53,6 +53,12 @@ def assert_same_folders(cli_dir, python_dir):
 
 # === Bytes: the module bakes what the CLI bakes.
 
+def test_the_cli_and_the_module_are_one_build(cli):
+    """The manifest records the build's commit: the byte comparisons need both built from one checkout."""
+    assert cli("--version").stdout.strip() == f"skybake {skybake.__version__} (commit {skybake.commit})", \
+        "rebuild skybake and skybake_python together"
+
+
 def test_single_bake_gives_the_cli_bytes(cli, in_source, tmp_path):
     run = cli("bake", STYLE, "--size", SIZE, "--out", tmp_path / "cli", "--vulkan-validation", "-q")
     assert run.returncode == 0, run.stderr
