@@ -138,6 +138,23 @@ def test_without_arrays_no_images_are_read(in_source, tmp_path):
     assert result.frames[0].latlong is None and result.frames[0].faces == {}
 
 
+def test_moon_and_lights_are_the_manifests(in_source, tmp_path):
+    """A moonlit frame (Cerro Paranal, the full moon of 2024-04-23): the Moon and the Sun as the
+    manifest records them."""
+    schedule = tmp_path / "moon.toml"
+    schedule.write_text("[schedule]\nfirst_frame = 1\ndate = 2024-04-23\nlatitude_deg = -24.6272\n"
+                        "longitude_deg = -70.4042\nutc_offset_hours = -4.0\ntimes = [23:30:00]\n")
+    result = skybake.bake(skybake.load_style(STYLE, ["night.moon=true", "night.moonlight=true"]),
+                          out=str(tmp_path / "out"), size=SIZE, schedule=skybake.load_schedule(str(schedule)),
+                          vulkan_validation=True)
+    frame, record = result.frames[0], result.manifest["frames"][0]
+    assert frame.sun_elevation_deg < 0 < frame.moon["elevation_deg"]
+    assert {k: list(v) if isinstance(v, tuple) else v for k, v in frame.moon.items()} == record["moon"]
+    assert frame.illuminance_lux == record["sun"]["illuminance_lux"]
+    assert list(frame.sun_direction) == record["sun"]["direction"]
+    assert frame.sh_with_sun.tolist() == record["sh_irradiance_with_sun"]
+
+
 # === Errors: the CLI's exit codes and located messages.
 
 def test_style_file_errors_are_located_as_the_cli_gives_them(cli, tmp_path):
