@@ -726,16 +726,28 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
             double max_memory_mib, double max_frame_seconds, const std::optional<std::string>& frames,
             const std::optional<std::string>& shard, const std::optional<std::string>& engine, bool usd) {
   const Environment& env = ReadEnvironment();
-  // Parse and validate: every error at once, before any GPU work.
-  LoadedBake bake = Load(style, schedule, ExtraOverrides(size, engine, usd));
+  // The progress events from the start, as --progress-json's: an error
+  // found before the bake ends them too, with its exit code.
+  PythonProgress report(progress);
+  LoadedBake bake;
   BakeOptions options;
-  options.max_memory_mib = max_memory_mib;
-  options.max_frame_seconds = max_frame_seconds;
-  CheckFrameBudgets(bake, options);
-  options.frames = SelectPart(bake, frames, shard);
-  if (resume && !bake.schedule)
-    throw UsageError("resume continues a sequence bake: give a schedule (or a style with an inline [schedule]), or "
-                     "force=True to bake a single style again");
+  try {
+    // Parse and validate: every error at once, before any GPU work.
+    bake = Load(style, schedule, ExtraOverrides(size, engine, usd));
+    options.max_memory_mib = max_memory_mib;
+    options.max_frame_seconds = max_frame_seconds;
+    CheckFrameBudgets(bake, options);
+    options.frames = SelectPart(bake, frames, shard);
+    if (resume && !bake.schedule)
+      throw UsageError("resume continues a sequence bake: give a schedule (or a style with an inline [schedule]), "
+                       "or force=True to bake a single style again");
+  } catch (const py::error_already_set&) {
+    throw;
+  } catch (...) {
+    const FailureKind f = FailureOf(std::current_exception());
+    report.End(f.code, f.message);
+    throw;
+  }
   options.out_dir = out;
   options.force = force;
   options.resume = resume;
@@ -748,7 +760,6 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
   options.star_catalogue = env.star_catalogue;
 
   // Bake, without the GIL; the progress callback takes it back.
-  PythonProgress report(progress);
   report.Attach(options);
   BakeResult result;
   std::exception_ptr failure;

@@ -215,9 +215,13 @@ def test_folder_budget_usage_and_output_errors(in_source, tmp_path):
     with pytest.raises(skybake.FolderError) as raised:
         skybake.bake(style, out=str(tmp_path / "out"), size=SIZE)
     assert raised.value.exit_code == 6 and "force" in str(raised.value)
+    events = []
     with pytest.raises(skybake.BudgetError) as raised:
-        skybake.bake(style, out=str(tmp_path / "budget"), size=SIZE, max_memory_mib=0.01)
+        skybake.bake(style, out=str(tmp_path / "budget"), size=SIZE, max_memory_mib=0.01, progress=events.append)
     assert raised.value.exit_code == 7 and not (tmp_path / "budget").exists()
+    # The progress events end as --progress-json's: the exit code and the error.
+    assert [e["event"] for e in events] == ["start", "end"]
+    assert events[-1]["exit_code"] == 7 and events[-1]["error"] == str(raised.value)
     with pytest.raises(skybake.UsageError) as raised:
         skybake.bake(style, out=str(tmp_path / "usage"), size=SIZE, resume=True)
     assert raised.value.exit_code == 2
