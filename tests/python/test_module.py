@@ -73,16 +73,27 @@ def test_single_bake_gives_the_cli_bytes(cli, in_source, tmp_path):
 
 
 def test_sequence_gives_the_cli_bytes(cli, in_source, tmp_path, schedule_path):
+    """A time-lapse of clock times, baked from a fresh Python process as the CLI bakes it from its
+    own (the sun positions of clock times depend on what the process computed before them:
+    test_sun_positions_do_not_depend_on_earlier_ones)."""
     run = cli("bake", STYLE, "--schedule", schedule_path, "--size", SIZE, "--out", tmp_path / "cli",
               "--vulkan-validation", "-q")
     assert run.returncode == 0, run.stderr
-    result = skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "py"), size=SIZE,
-                          schedule=skybake.load_schedule(str(schedule_path)), vulkan_validation=True)
+    script = f"""
+import json, skybake
+result = skybake.bake(skybake.load_style({STYLE!r}), out={str(tmp_path / "py")!r}, size={SIZE},
+                      schedule=skybake.load_schedule({str(schedule_path)!r}), vulkan_validation=True)
+print(json.dumps([[f.number, f.time, f.sun_elevation_deg] for f in result.frames]))
+"""
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(skybake.__file__))
+    baked = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True, text=True)
+    assert baked.returncode == 0, baked.stderr
     assert_same_folders(tmp_path / "cli", tmp_path / "py")
-    assert [f.number for f in result.frames] == [1, 2, 3]
-    for frame, record in zip(result.frames, result.manifest["frames"]):
-        assert frame.time == record["time"]
-        assert frame.sun_elevation_deg == pytest.approx(record["sun"]["elevation_deg"], abs=1e-9)
+    frames = json.loads(baked.stdout)
+    manifest = json.loads((tmp_path / "py" / "manifest.json").read_text())
+    assert [f[0] for f in frames] == [1, 2, 3]
+    for (number, time, elevation), record in zip(frames, manifest["frames"]):
+        assert time == record["time"] and elevation == record["sun"]["elevation_deg"]
 
 
 def test_dict_style_bakes_as_its_toml(in_source, tmp_path):
@@ -97,6 +108,33 @@ def test_dict_style_bakes_as_its_toml(in_source, tmp_path):
     assert a.frames[0].sun_elevation_deg == pytest.approx(35.5, abs=1e-6)
     assert a.frames[0].sun_azimuth_deg == pytest.approx(120.0, abs=1e-6)
     assert b.frames[0].illuminance_lux > 0
+
+
+@pytest.mark.xfail(strict=True, reason="libnova's nutation and solar series are cached by day and the sun's "
+                   "position (model/solar_position.cc) does not reset them as the Moon's does (input/astronomy.cc): "
+                   "a second load in one process differs at the 1e-10 degree level")
+def test_sun_positions_do_not_depend_on_earlier_ones(schedule_path, tmp_path):
+    """The same schedule gives the same sun positions whatever was computed before it in the process."""
+    first = skybake.load_schedule(str(schedule_path)).frames
+    other = tmp_path / "other.toml"
+    other.write_text(SCHEDULE.replace("times = [07:00:00, 12:00:00, 19:30:00]", "times = [19:45:00]"))
+    skybake.load_schedule(str(other))
+    assert skybake.load_schedule(str(schedule_path)).frames == first
+
+
+def test_dict_style_sequence_bakes_as_its_file(in_source, tmp_path):
+    """Each frame's style of a dict style is resolved from its TOML text as a file's from the file:
+    the same bytes, with a ramp changing a key per frame."""
+    (tmp_path / "hazy.toml").write_text('[atmosphere.mie]\ng = 0.7\n')
+    schedule = tmp_path / "ramp.toml"
+    schedule.write_text('[schedule]\nfirst_frame = 1\n'
+                        + "".join(f'[[schedule.frames]]\nelevation_deg = {e}\nazimuth_deg = 135.0\n' for e in (5, 25, 45))
+                        + '[schedule.ramp]\n"atmosphere.mie.g" = [0.7, 0.85]\n')
+    from_dict = skybake.load_style({"atmosphere": {"mie": {"g": 0.7}}}, name=str(tmp_path / "hazy.toml"))
+    for style, out in [(skybake.load_style(str(tmp_path / "hazy.toml")), "file"), (from_dict, "dict")]:
+        result = skybake.bake(style, out=str(tmp_path / out), size=SIZE, schedule=skybake.load_schedule(str(schedule)))
+    assert len({frame["style_sha256"] for frame in result.manifest["frames"]}) == 3
+    assert_same_folders(tmp_path / "file", tmp_path / "dict")
 
 
 # === Arrays: the files' texels.
