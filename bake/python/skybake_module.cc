@@ -575,6 +575,7 @@ struct PyFrame {
   py::object latlong = py::none();
   py::object cube = py::none();
   py::dict faces;
+  py::dict engine;
   double render_seconds = 0.0;
 };
 
@@ -634,7 +635,7 @@ std::map<std::string, RgbImage> ReadFrameExrs(const std::vector<FrameResult>& fr
   py::gil_scoped_release release;
   for (const FrameResult& frame : frames)
     for (const BakedFile& f : frame.files)
-      if ((f.kind == "latlong" || f.kind == "face" || f.kind == "cube") && IsExr(f.path))
+      if ((f.kind == "latlong" || f.kind == "face" || f.kind == "cube" || f.kind == "engine") && IsExr(f.path))
         images.emplace(f.path, ReadExrRgb(f.path));
   return images;
 }
@@ -661,6 +662,7 @@ PyFrame FrameOf(const FrameResult& f, std::map<std::string, RgbImage>* images) {
       if (file.kind == "latlong" && frame.latlong.is_none()) frame.latlong = array;
       else if (file.kind == "cube") frame.cube = array;
       else if (file.kind == "face") frame.faces[py::str(std::filesystem::path(file.path).filename().string())] = array;
+      else if (file.kind == "engine") frame.engine[py::str(std::filesystem::path(file.path).filename().string())] = array;
     }
   }
   return frame;
@@ -918,6 +920,9 @@ PYBIND11_MODULE(skybake, m) {
       .def_readonly("cube", &PyFrame::cube, "With arrays=True: the cube strip EXR's texels (when written), else None.")
       .def_readonly("faces", &PyFrame::faces,
                     "With arrays=True: each cube face EXR's texels, numpy float32 (N, N, 3), by file name.")
+      .def_readonly("engine", &PyFrame::engine,
+                    "With arrays=True and an engine preset: each of its EXRs' texels (the engine's own layout; "
+                    "docs/engines.md), numpy float32 (H, W, 3), by file name.")
       .def_readonly("render_seconds", &PyFrame::render_seconds, "The frame's render time, s.")
       .def("__repr__", [](const PyFrame& f) {
         return fmt::format("<skybake.Frame {} sun {:.2f} deg>", f.number, f.sun_elevation_deg);

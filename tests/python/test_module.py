@@ -171,6 +171,15 @@ def test_arrays_are_the_files_texels(in_source, tmp_path):
     assert frame.moon is None
 
 
+def test_engine_arrays_are_the_files_texels(in_source, tmp_path):
+    result = skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE, arrays=True,
+                          engine="blender")
+    frame = result.frames[0]
+    assert sorted(frame.engine) == ["sky_blender_latlong.exr"]
+    np.testing.assert_array_equal(frame.engine["sky_blender_latlong.exr"],
+                                  read_with_oiiotool(tmp_path / "out" / "sky_blender_latlong.exr"))
+
+
 def test_without_arrays_no_images_are_read(in_source, tmp_path):
     result = skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE)
     assert result.frames[0].latlong is None and result.frames[0].faces == {}
