@@ -618,15 +618,21 @@ std::vector<FrameOverride> FrameStyleOverrides(const Schedule& schedule, const S
 
 FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<std::string>& overrides,
                                const Schedule& schedule) {
-  FrameStyles result;
-  ConfigResult base = LoadSkyStyle(style_path, overrides);
-  if (!base.ok()) {
-    result.errors = base.errors;
-    return result;
-  }
   std::string text;
   if (std::optional<ConfigError> e = ReadInputFile(style_path, "style", text)) {
+    FrameStyles result;
     result.errors.push_back(*e);
+    return result;
+  }
+  return ResolveFrameStylesOfText(text, style_path, overrides, schedule);
+}
+
+FrameStyles ResolveFrameStylesOfText(std::string_view text, const std::string& style_path,
+                                     const std::vector<std::string>& overrides, const Schedule& schedule) {
+  FrameStyles result;
+  ConfigResult base = ParseSkyStyle(text, style_path, overrides);
+  if (!base.ok()) {
+    result.errors = base.errors;
     return result;
   }
   for (const ScheduleFrame& frame : schedule.frames) {

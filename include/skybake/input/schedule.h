@@ -104,5 +104,9 @@ struct FrameStyles {
 };
 FrameStyles ResolveFrameStyles(const std::string& style_path, const std::vector<std::string>& overrides,
                                const Schedule& schedule);
+// The same for a style given as TOML text (`style_path` names it in errors
+// and provenance): a style that was never a file, from the Python module.
+FrameStyles ResolveFrameStylesOfText(std::string_view text, const std::string& style_path,
+                                     const std::vector<std::string>& overrides, const Schedule& schedule);
 
 }  // namespace skybake
