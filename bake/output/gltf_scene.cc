@@ -372,23 +372,30 @@ RotationKeys AddRotationKeys(tinygltf::Model& model, const std::vector<SceneSun>
 
 // Animates `node`'s rotation by `track`: a sampler and a channel in the
 // scene's one animation, made (and named `name`) if there is none yet.
+// A linear sampler of the scene's one animation from accessors `input`
+// (times) and `output` (values), and a channel of it with no target yet.
+tinygltf::AnimationChannel& AddLinearChannel(tinygltf::Model& model, int input, int output) {
+  tinygltf::Animation& animation = model.animations.front();
+  tinygltf::AnimationSampler sampler;
+  sampler.input = input;
+  sampler.output = output;
+  sampler.interpolation = "LINEAR";
+  animation.samplers.push_back(sampler);
+  tinygltf::AnimationChannel channel;
+  channel.sampler = int(animation.samplers.size()) - 1;
+  animation.channels.push_back(channel);
+  return animation.channels.back();
+}
+
 void AnimateRotation(tinygltf::Model& model, const std::string& name, const RotationKeys& track, int node) {
   if (model.animations.empty()) {
     tinygltf::Animation animation;
     animation.name = name;
     model.animations.push_back(animation);
   }
-  tinygltf::Animation& animation = model.animations.front();
-  tinygltf::AnimationSampler sampler;
-  sampler.input = track.input;
-  sampler.output = track.output;
-  sampler.interpolation = "LINEAR";
-  animation.samplers.push_back(sampler);
-  tinygltf::AnimationChannel channel;
-  channel.sampler = int(animation.samplers.size()) - 1;
+  tinygltf::AnimationChannel& channel = AddLinearChannel(model, track.input, track.output);
   channel.target_node = node;
   channel.target_path = "rotation";
-  animation.channels.push_back(channel);
 }
 
 // The light that `node` carries (KHR_lights_punctual), by index.
@@ -407,19 +414,11 @@ void AnimateLightProperty(tinygltf::Model& model, int light, const std::string& 
                                  TINYGLTF_COMPONENT_TYPE_FLOAT, count,
                                  components == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3);
   model.bufferViews[model.accessors[output].bufferView].target = 0;
-  tinygltf::Animation& animation = model.animations.front();
-  tinygltf::AnimationSampler sampler;
-  sampler.input = times;
-  sampler.output = output;
-  sampler.interpolation = "LINEAR";
-  animation.samplers.push_back(sampler);
-  tinygltf::AnimationChannel channel;
-  channel.sampler = int(animation.samplers.size()) - 1;
+  tinygltf::AnimationChannel& channel = AddLinearChannel(model, times, output);
   channel.target_path = "pointer";
   tinygltf::Value::Object pointer;
   pointer["pointer"] = tinygltf::Value(fmt::format("/extensions/KHR_lights_punctual/lights/{}/{}", light, property));
   channel.target_extensions["KHR_animation_pointer"] = tinygltf::Value(pointer);
-  animation.channels.push_back(channel);
 }
 
 // A light's path over a sequence: its node's rotation, and its intensity
