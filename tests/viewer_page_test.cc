@@ -170,5 +170,17 @@ TEST(ViewerPageTest, NothingToShowIsRefused) {
   EXPECT_NE(r.output.find("holds no latlong to show"), std::string::npos) << r.output;
 }
 
+// --embed-mib takes a finite size: NaN, infinities and negatives are a bad
+// command line (exit 2), and no page is written.
+TEST(ViewerPageTest, EmbedSizeMustBeFinite) {
+  const std::string dir = testing::FreshTempDir("view_embed");
+  for (const char* value : {"nan", "inf", "-inf", "-1"}) {
+    testing::CommandRun r = testing::RunSkybake(std::string("view --embed-mib ") + value + " " + dir);
+    EXPECT_EQ(r.exit_code, 2) << value << ": " << r.output;
+    EXPECT_NE(r.output.find("expected a finite number at or above 0"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir + "/view.html"));
+}
+
 }  // namespace
 }  // namespace skybake

@@ -413,16 +413,19 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
 
 // A budget is a finite number above 0 (nan compares false with every
 // bound and would switch the budget off).
-CLI::Validator FinitePositive() {
+// A finite number above 0 (or, with `zero`, at or above 0): NaN and
+// infinities are refused.
+CLI::Validator FiniteNumber(bool zero) {
   return CLI::Validator(
-      [](std::string& text) -> std::string {
+      [zero](std::string& text) -> std::string {
         double value = 0.0;
-        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(value > 0.0))
-          return "expected a finite number above 0, got " + text;
+        if (!CLI::detail::lexical_cast(text, value) || !std::isfinite(value) || !(zero ? value >= 0.0 : value > 0.0))
+          return std::string("expected a finite number ") + (zero ? "at or above 0" : "above 0") + ", got " + text;
         return "";
       },
-      "POSITIVE");
+      zero ? "NONNEGATIVE" : "POSITIVE");
 }
+CLI::Validator FinitePositive() { return FiniteNumber(false); }
 
 void AddStyleOptions(CLI::App* cmd, BakeArgs& args) {
   const CLI::Validator finite_positive = FinitePositive();
@@ -557,7 +560,7 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
                        "Frames inside the page while their files total at most this many MiB (the first always); "
                        "later ones are loaded from their files when the page is served over HTTP")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(FiniteNumber(true));
 
   cli.merge = app.add_subcommand(
       "merge-manifest",
