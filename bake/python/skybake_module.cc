@@ -820,19 +820,11 @@ std::string Repr(const PyStyle& s) {
 }  // namespace
 }  // namespace skybake
 
-PYBIND11_MODULE(skybake, m) {
-  using namespace skybake;
-  m.doc() =
-      "skybake: physical, art-directable skies baked into HDR environment maps (OpenEXR cube faces, latlong, "
-      "preview, glTF scene, manifest), with the command-line tool's own libraries.\n\n"
-      "    style = skybake.load_style('configs/default.toml', ['sun.elevation_deg=10'])\n"
-      "    result = skybake.bake(style, out='out', size=64, force=True, arrays=True)\n"
-      "    result.frames[0].latlong   # numpy float32 (H, 2H, 3), the latlong EXR's texels\n\n"
-      "Errors raise skybake.Error subclasses carrying the CLI's exit code (README \"Exit codes\") and the located "
-      "errors; docs/python.md has the whole guide.";
-  m.attr("__version__") = SKYBAKE_VERSION;
-  m.attr("commit") = kBuildCommit;
+namespace skybake {
+namespace {
 
+// The exception classes (defined in Python, kExceptionClasses) and their translation.
+void RegisterExceptions(py::module_& m) {
   py::dict scope = m.attr("__dict__");
   py::exec(kExceptionClasses, scope);
   PythonClasses& c = Classes();
@@ -848,7 +840,10 @@ PYBIND11_MODULE(skybake, m) {
   c.cancel = m.attr("Cancel");
   py::register_exception_translator(&TranslateException);
   FindOiioModuleBesideThis();
+}
 
+// Style, Schedule, File, Frame and Bake.
+void RegisterTypes(py::module_& m) {
   py::class_<PyStyle>(m, "Style", "A loaded, validated sky style: load_style or parse_style give one.")
       .def_readonly("source", &PyStyle::source, "The style file's path, or the name of a dict or text style.")
       .def_readonly("text", &PyStyle::text, "The TOML text of a dict or text style; None for a file.")
@@ -941,7 +936,10 @@ PYBIND11_MODULE(skybake, m) {
       .def("__repr__", [](const PyBake& b) {
         return fmt::format("<skybake.Bake {} ({} frames, {} files)>", b.out, b.frames.size(), b.files.size());
       });
+}
 
+// load_style, parse_style, load_schedule, check, estimate, plan and bake.
+void RegisterFunctions(py::module_& m) {
   m.def("load_style", &LoadStyle, py::arg("source"), py::arg("overrides") = std::vector<std::string>{},
         py::kw_only(), py::arg("name") = py::none(),
         "Loads and validates a style: `source` is a TOML file's path, or a dict of style keys (nested dicts are "
@@ -989,4 +987,25 @@ PYBIND11_MODULE(skybake, m) {
         "it raised, is raised here), leaving the folder as a killed bake leaves it. vulkan_validation: the "
         "Khronos validation layer, any message raises VulkanError. arrays: read each frame's EXRs back as numpy "
         "arrays (Frame.latlong, .faces, .cube). The GIL is released while the bake runs. Returns a Bake.");
+}
+
+}  // namespace
+}  // namespace skybake
+
+PYBIND11_MODULE(skybake, m) {
+  using namespace skybake;
+  m.doc() =
+      "skybake: physical, art-directable skies baked into HDR environment maps (OpenEXR cube faces, latlong, "
+      "preview, glTF scene, manifest), with the command-line tool's own libraries.\n\n"
+      "    style = skybake.load_style('configs/default.toml', ['sun.elevation_deg=10'])\n"
+      "    result = skybake.bake(style, out='out', size=64, force=True, arrays=True)\n"
+      "    result.frames[0].latlong   # numpy float32 (H, 2H, 3), the latlong EXR's texels\n\n"
+      "Errors raise skybake.Error subclasses carrying the CLI's exit code (README \"Exit codes\") and the located "
+      "errors; docs/python.md has the whole guide.";
+  m.attr("__version__") = SKYBAKE_VERSION;
+  m.attr("commit") = kBuildCommit;
+
+  RegisterExceptions(m);
+  RegisterTypes(m);
+  RegisterFunctions(m);
 }
