@@ -140,5 +140,25 @@ TEST(EngineBabylonTest, SkyAndSunShowOneExposure) {
       report["cardEnvironmentOnly"].get<std::vector<double>>());
 }
 
+// The default glTF dome through Babylon.js's default camera
+// (tests/viewer/dome_babylon.html): a UniversalCamera clips at minZ 1 and
+// maxZ 10000 (Babylon.js 9 Camera); from the origin, looking along each axis,
+// the dome covers every pixel.
+TEST(EngineBabylonTest, DomeIsInsideTheDefaultCamerasRange) {
+  const std::string dir = testing::FreshTempDir("engine_babylon_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  const nlohmann::json line = testing::RunViewerPage("dome_babylon.html", dir, dir + "/babylon.png", "");
+  ASSERT_FALSE(line.is_null());
+  const nlohmann::json report = line["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("Babylon.js dome: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["maxZ"].get<double>(), 10000.0) << "Babylon's default maxZ";
+  const std::vector<double> covered = report["covered"].get<std::vector<double>>();
+  ASSERT_EQ(covered.size(), 6u);
+  for (size_t i = 0; i < covered.size(); ++i) EXPECT_EQ(covered[i], 1.0) << "view " << i << " sees past the dome";
+}
+
 }  // namespace
 }  // namespace skybake

@@ -124,5 +124,32 @@ TEST(EngineBlenderTest, SkyAndSunShowOneExposure) {
   }
 }
 
+// The default glTF dome through Blender's startup camera
+// (tests/engines/blender_dome_check.py): sky.glb imported into the factory
+// startup scene, whose camera clips at 0.1 and 100 m and stands 11.3 m from
+// the origin (Blender 3.4's startup file; a camera added later clips at
+// 1000 m, the viewport too). Cycles renders that camera into a transparent
+// film: every pixel must show the dome. The dome's farthest vertex from the
+// camera is within the clip range.
+TEST(EngineBlenderTest, DomeIsInsideTheStartupCamerasClipRange) {
+  auto [which, where] = testing::RunCommand("command -v blender");
+  ASSERT_EQ(which, 0) << "blender is missing: run .ci/setup (Debian package blender)";
+  const std::string dir = testing::FreshTempDir("engine_blender_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
+                              "/tests/engines/blender_dome_check.py' -- '" + dir + "/sky.glb' '" + dir + "'";
+  auto [code, output] = testing::RunCommand(command);
+  ASSERT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("RESULT ");
+  ASSERT_NE(at, std::string::npos) << "blender printed no result:\n" << output;
+  const nlohmann::json result = nlohmann::json::parse(output.substr(at + 7, output.find('\n', at) - at - 7));
+  std::printf("Blender dome: %s\n", result.dump().c_str());
+  EXPECT_EQ(result["clip_end"].get<double>(), 100.0) << "Blender's startup camera";
+  EXPECT_LT(result["farthest_vertex_m"].get<double>(), result["clip_end"].get<double>());
+  EXPECT_EQ(result["covered"].get<double>(), 1.0) << "the startup camera sees past the dome";
+}
+
 }  // namespace
 }  // namespace skybake

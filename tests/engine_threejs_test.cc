@@ -224,5 +224,24 @@ TEST(EngineThreejsTest, SkyAndSunShowOneExposure) {
       report["cardEnvironmentOnly"].get<std::vector<double>>());
 }
 
+// The default glTF dome through three.js's default camera
+// (tests/viewer/dome_threejs.html): `new THREE.PerspectiveCamera()` clips at
+// near 0.1 and far 2000 (three.js 0.170 src/cameras/PerspectiveCamera.js);
+// from the origin, looking along each axis, the dome covers every pixel.
+TEST(EngineThreejsTest, DomeIsInsideTheDefaultCamerasRange) {
+  const std::string dir = testing::FreshTempDir("engine_threejs_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  nlohmann::json report = RunPage("dome_threejs.html", dir);
+  ASSERT_TRUE(report.is_object()) << report.dump();
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("three.js dome: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["far"].get<double>(), 2000.0) << "three.js's default far plane";
+  const std::vector<double> covered = report["covered"].get<std::vector<double>>();
+  ASSERT_EQ(covered.size(), 6u);
+  for (size_t i = 0; i < covered.size(); ++i) EXPECT_EQ(covered[i], 1.0) << "view " << i << " sees past the dome";
+}
+
 }  // namespace
 }  // namespace skybake
