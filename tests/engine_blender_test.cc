@@ -27,10 +27,11 @@ struct Probe {
   std::vector<double> radiance;  // along the sun light, then turned 90, 180, 270 degrees
 };
 
-Probe RunBlender(const std::string& dir, const std::string& latlong) {
+// `turn_deg`: the Mapping node's rotation about +Z before the texture (none when empty).
+Probe RunBlender(const std::string& dir, const std::string& latlong, const std::string& turn_deg = "") {
   const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
                               "/tests/engines/blender_sun_check.py' -- '" + dir + "/sky.glb' '" + dir + "/" +
-                              latlong + "' '" + dir + "'";
+                              latlong + "' '" + dir + "' " + turn_deg;
   auto [code, output] = testing::RunCommand(command);
   Probe probe;
   EXPECT_EQ(code, 0) << command << "\n" << output;
@@ -66,6 +67,15 @@ TEST(EngineBlenderTest, SkysSunIsAlongTheImportedSunLight) {
   std::printf("OpenEXR latlong: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
               openexr.radiance[0], openexr.radiance[1], openexr.radiance[2], openexr.radiance[3]);
   EXPECT_GT(openexr.radiance[1], 2.0 * std::max({openexr.radiance[0], openexr.radiance[2], openexr.radiance[3]}));
+
+  // The OpenEXR latlong turned as docs/engines.md says (Texture Coordinate
+  // Generated -> Mapping, Point, Rotation Z 90 degrees): the Sun on the light.
+  const Probe turned = RunBlender(dir, "sky_latlong.exr", "90");
+  ASSERT_EQ(turned.radiance.size(), 4u);
+  std::printf("OpenEXR latlong turned 90 deg: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
+              turned.radiance[0], turned.radiance[1], turned.radiance[2], turned.radiance[3]);
+  EXPECT_GT(turned.radiance[0], 2.0 * std::max({turned.radiance[1], turned.radiance[2], turned.radiance[3]}))
+      << "the Mapping node's 90 degrees do not bring the OpenEXR latlong's Sun onto the light";
 }
 
 // The default bake's sky and Sun together in Blender, in units (issue 48;

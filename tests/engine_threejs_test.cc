@@ -5,7 +5,8 @@
 // CubeTexture. A 3-degree camera along the light must see the sky's Sun:
 // far brighter than turned 90, 180 or 270 degrees about +Y. The bake's
 // OpenEXR latlong loaded the same way puts it a quarter turn away (three.js's
-// equirectUv centres +X, OpenEXR +Z): the trap the preset removes.
+// equirectUv centres +X, OpenEXR +Z): the trap the preset removes, or a
+// quarter turn of the background (scene.backgroundRotation) undoes.
 #include <algorithm>
 #include <array>
 #include <filesystem>
@@ -51,6 +52,12 @@ TEST(EngineThreejsTest, SkysSunIsAlongTheSceneSunLight) {
   const std::vector<double> openexr = report["openexr"].get<std::vector<double>>();
   ASSERT_EQ(openexr.size(), 4u);
   EXPECT_GT(openexr[1], 2.0 * std::max({openexr[0], openexr[2], openexr[3]})) << "the trap is a quarter turn";
+  // The OpenEXR latlong with docs/engines.md's turn, scene.backgroundRotation.y = -pi / 2:
+  // the sky's Sun back on the light.
+  const std::vector<double> turned = report["openexr_turned"].get<std::vector<double>>();
+  ASSERT_EQ(turned.size(), 4u);
+  EXPECT_GT(turned[0], 2.0 * std::max({turned[1], turned[2], turned[3]}))
+      << "backgroundRotation.y = -pi / 2 does not bring the OpenEXR latlong's Sun onto the light";
 }
 
 // `skybake testpattern --engine threejs` in three.js: the colour seen along
