@@ -56,16 +56,16 @@ const OiioModule& LoadOiioModule() {
       tried += fmt::format("\n  {}: {}", path, ::dlerror());
       continue;
     }
-    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module"));
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v2"));
     if (!entry) {
-      tried += fmt::format("\n  {}: no skybake_oiio_module", path);
+      tried += fmt::format("\n  {}: no skybake_oiio_module_v2 (a module of another skybake version)", path);
       continue;
     }
     module = entry();
     return *module;
   }
-  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (PNG previews, glTF "
-                                "textures, galleries): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
+  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (the gallery, cloud "
+                                "weather and formation images): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
                                 "holding it; tried:{}", tried));
 }
 
