@@ -65,8 +65,9 @@ const OiioModule& LoadOiioModule() {
     return *module;
   }
   throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (the gallery, cloud "
-                                "weather and formation images): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
-                                "holding it; tried:{}", tried));
+                                "weather and formation images): it is built when OpenImageIO is installed "
+                                "(apt-get install libopenimageio-dev, then rebuild skybake), or set "
+                                "SKYBAKE_MODULE_DIR to the folder holding it; tried:{}", tried));
 }
 
 }  // namespace skybake
