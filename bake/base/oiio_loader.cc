@@ -1,6 +1,6 @@
 // Loading libskybake_oiio.so (oiio_module.h) on first use: from the folder
-// main passes in ($SKYBAKE_MODULE_DIR), beside the executable, the build tree's top folder, or
-// the folder it was built in.
+// main passes in ($SKYBAKE_MODULE_DIR), beside the executable, the build
+// tree's top folder, an install's lib/skybake/, or the folder it was built in.
 #include <dlfcn.h>
 
 #include <filesystem>
@@ -46,6 +46,9 @@ const OiioModule& LoadOiioModule() {
   if (!ec) {
     dirs.push_back(exe.parent_path());
     dirs.push_back(exe.parent_path().parent_path());  // tests/ of the build tree
+    // An installed skybake (`cmake --install`, the .deb): PREFIX/bin/skybake
+    // and PREFIX/LIBDIR/skybake/libskybake_oiio.so, wherever PREFIX is.
+    dirs.push_back(exe.parent_path().parent_path() / SKYBAKE_MODULE_INSTALL_SUBDIR);
   }
   dirs.emplace_back(SKYBAKE_MODULE_BUILD_DIR);
   std::string tried;
