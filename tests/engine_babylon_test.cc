@@ -14,6 +14,7 @@
 // Vulkan faces loaded the same way show the trap the preset removes.
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -101,6 +102,75 @@ TEST(EngineBabylonTest, TestPatternFacesAreWhereTheySayInBabylon) {
   std::printf("Babylon.js: %d of 6 face axes show another face with skybake's Vulkan faces\n", wrong);
 }
 
+// The preset's EXR faces as docs/engines/babylon_exr_cube.js loads them
+// (Babylon's EXR decoder, a RawCubeTexture; tests/viewer/
+// engine_babylon_exr_cube.html), floats, no PNG in between: the test
+// pattern's faces, horizon and North where they belong (as above), and a
+// default bake's sky Sun along the sun light Babylon's glTF loader makes
+// of sky.glb. Babylon's CubeTexture of the .exr files, which the
+// documentation named before, never becomes ready (a browser decodes no EXR
+// image): the page reports that too. skybake's own Vulkan faces loaded by
+// the snippet put the Sun a quarter turn off.
+TEST(EngineBabylonTest, PresetsExrFacesLoadWithTheDocumentedSnippet) {
+  const std::string snippet = testing::SourceDir() + "/docs/engines/babylon_exr_cube.js";
+  const std::string dir = testing::FreshTempDir("engine_babylon_exr");
+  testing::CommandRun r = testing::RunSkybake("testpattern --engine babylon --size 64 --out " + dir + "/pattern");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::filesystem::copy_file(snippet, dir + "/pattern/babylon_exr_cube.js");
+  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0}, {0, -1, 0}, {0, -0.18, 1},
+                                        {0, -0.18, -1},
+                                        {1, 0, 0.5},
+                                        {1, 0.2, 0.5},
+                                        {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
+  std::string query = "dirs=";
+  for (size_t i = 0; i < dirs.size(); ++i)
+    query += (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
+             std::to_string(dirs[i].z);
+  nlohmann::json line =
+      testing::RunViewerPage("engine_babylon_exr_cube.html", dir + "/pattern", dir + "/pattern.png", query);
+  ASSERT_FALSE(line.is_null());
+  nlohmann::json report = line["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("Babylon.js EXR faces, pattern: %s\n", report.dump().c_str());
+  const auto seen = report["seen"].get<std::vector<std::vector<double>>>();
+  ASSERT_EQ(seen.size(), dirs.size());
+  // Half floats: each colour within 1e-3 of the tint.
+  for (int face = 0; face < 6; ++face)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(seen[size_t(face)][size_t(c)], TestPatternFaceColor(face)[c], 1e-3)
+          << "along face " << face << " channel " << c;
+  EXPECT_GT(seen[6][1], TestPatternFaceColor(0)[1] + 0.1) << "horizon";
+  EXPECT_NEAR(seen[7][1], TestPatternFaceColor(0)[1], 1e-3) << "above the horizon";
+  EXPECT_GT(seen[8][2], TestPatternFaceColor(5)[2] + 0.1) << "N above the horizon at -Z";
+
+  // The CubeTexture of .exr faces: not ready (the page gives up after 30 s).
+  auto [cube_code, cube_output] = testing::RunCommand(
+      "cd '" + testing::SourceDir() + "/tests/viewer' && node run_page.mjs engine_babylon_cube.html '" + dir +
+      "/pattern' '" + dir + "/cube.png' 'bases=sky_babylon&ext=.exr&dirs=1,0,0'");
+  EXPECT_NE(cube_code, 0) << cube_output;
+  EXPECT_NE(cube_output.find("sky_babylon: not ready"), std::string::npos) << cube_output;
+
+  r = testing::RunSkybake("bake " + testing::SourceDir() +
+                          "/configs/default.toml --size 64 -q --vulkan-validation --engine babylon --out " + dir +
+                          "/bake");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::filesystem::copy_file(snippet, dir + "/bake/babylon_exr_cube.js");
+  for (const std::string base : {"sky_babylon", "sky"}) {
+    line = testing::RunViewerPage("engine_babylon_exr_cube.html", dir + "/bake", dir + "/bake.png",
+                                  "scene=sky.glb&base=" + base);
+    ASSERT_FALSE(line.is_null());
+    report = line["report"];
+    ASSERT_EQ(report.value("ok", false), true) << report.dump();
+    std::printf("Babylon.js EXR faces %s: %s\n", base.c_str(), report.dump().c_str());
+    const std::vector<double> v = report["radiance"].get<std::vector<double>>();
+    ASSERT_EQ(v.size(), 4u);
+    if (base == "sky_babylon")
+      EXPECT_GT(v[0], 2.0 * std::max({v[1], v[2], v[3]})) << "the sky's Sun is not along Babylon's sun light";
+    else
+      EXPECT_LT(v[0], 0.5 * std::max({v[1], v[2], v[3]})) << "skybake's Vulkan faces load right without the preset";
+  }
+}
+
 // The default bake's sky and Sun together in Babylon.js, in units (issue
 // 48; sky_and_sun.h, tests/viewer/engine_babylon_sun_sky.html):
 // sky_latlong.exr as an EXRCubeTexture (Babylon's own equirect EXR loader),
@@ -138,6 +208,26 @@ TEST(EngineBabylonTest, SkyAndSunShowOneExposure) {
       "Babylon.js " + report["version"].get<std::string>(), bake, report["sky"].get<std::vector<double>>(),
       report["card"].get<std::vector<double>>(), report["cardLightOnly"].get<std::vector<double>>(),
       report["cardEnvironmentOnly"].get<std::vector<double>>());
+}
+
+// The default glTF dome through Babylon.js's default camera
+// (tests/viewer/dome_babylon.html): a UniversalCamera clips at minZ 1 and
+// maxZ 10000 (Babylon.js 9 Camera); from the origin, looking along each axis,
+// the dome covers every pixel.
+TEST(EngineBabylonTest, DomeIsInsideTheDefaultCamerasRange) {
+  const std::string dir = testing::FreshTempDir("engine_babylon_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  const nlohmann::json line = testing::RunViewerPage("dome_babylon.html", dir, dir + "/babylon.png", "");
+  ASSERT_FALSE(line.is_null());
+  const nlohmann::json report = line["report"];
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("Babylon.js dome: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["maxZ"].get<double>(), 10000.0) << "Babylon's default maxZ";
+  const std::vector<double> covered = report["covered"].get<std::vector<double>>();
+  ASSERT_EQ(covered.size(), 6u);
+  for (size_t i = 0; i < covered.size(); ++i) EXPECT_EQ(covered[i], 1.0) << "view " << i << " sees past the dome";
 }
 
 }  // namespace

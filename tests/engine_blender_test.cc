@@ -27,10 +27,11 @@ struct Probe {
   std::vector<double> radiance;  // along the sun light, then turned 90, 180, 270 degrees
 };
 
-Probe RunBlender(const std::string& dir, const std::string& latlong) {
+// `turn_deg`: the Mapping node's rotation about +Z before the texture (none when empty).
+Probe RunBlender(const std::string& dir, const std::string& latlong, const std::string& turn_deg = "") {
   const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
                               "/tests/engines/blender_sun_check.py' -- '" + dir + "/sky.glb' '" + dir + "/" +
-                              latlong + "' '" + dir + "'";
+                              latlong + "' '" + dir + "' " + turn_deg;
   auto [code, output] = testing::RunCommand(command);
   Probe probe;
   EXPECT_EQ(code, 0) << command << "\n" << output;
@@ -66,6 +67,15 @@ TEST(EngineBlenderTest, SkysSunIsAlongTheImportedSunLight) {
   std::printf("OpenEXR latlong: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
               openexr.radiance[0], openexr.radiance[1], openexr.radiance[2], openexr.radiance[3]);
   EXPECT_GT(openexr.radiance[1], 2.0 * std::max({openexr.radiance[0], openexr.radiance[2], openexr.radiance[3]}));
+
+  // The OpenEXR latlong turned as docs/engines.md says (Texture Coordinate
+  // Generated -> Mapping, Point, Rotation Z 90 degrees): the Sun on the light.
+  const Probe turned = RunBlender(dir, "sky_latlong.exr", "90");
+  ASSERT_EQ(turned.radiance.size(), 4u);
+  std::printf("OpenEXR latlong turned 90 deg: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
+              turned.radiance[0], turned.radiance[1], turned.radiance[2], turned.radiance[3]);
+  EXPECT_GT(turned.radiance[0], 2.0 * std::max({turned.radiance[1], turned.radiance[2], turned.radiance[3]}))
+      << "the Mapping node's 90 degrees do not bring the OpenEXR latlong's Sun onto the light";
 }
 
 // The default bake's sky and Sun together in Blender, in units (issue 48;
@@ -122,6 +132,33 @@ TEST(EngineBlenderTest, SkyAndSunShowOneExposure) {
                                           in_cd_m2("sky"), in_cd_m2("card"), in_cd_m2("card_sun_only"),
                                           in_cd_m2("card_sky_only"));
   }
+}
+
+// The default glTF dome through Blender's startup camera
+// (tests/engines/blender_dome_check.py): sky.glb imported into the factory
+// startup scene, whose camera clips at 0.1 and 100 m and stands 11.3 m from
+// the origin (Blender 3.4's startup file; a camera added later clips at
+// 1000 m, the viewport too). Cycles renders that camera into a transparent
+// film: every pixel must show the dome. The dome's farthest vertex from the
+// camera is within the clip range.
+TEST(EngineBlenderTest, DomeIsInsideTheStartupCamerasClipRange) {
+  auto [which, where] = testing::RunCommand("command -v blender");
+  ASSERT_EQ(which, 0) << "blender is missing: run .ci/setup (Debian package blender)";
+  const std::string dir = testing::FreshTempDir("engine_blender_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
+                              "/tests/engines/blender_dome_check.py' -- '" + dir + "/sky.glb' '" + dir + "'";
+  auto [code, output] = testing::RunCommand(command);
+  ASSERT_EQ(code, 0) << command << "\n" << output;
+  const size_t at = output.find("RESULT ");
+  ASSERT_NE(at, std::string::npos) << "blender printed no result:\n" << output;
+  const nlohmann::json result = nlohmann::json::parse(output.substr(at + 7, output.find('\n', at) - at - 7));
+  std::printf("Blender dome: %s\n", result.dump().c_str());
+  EXPECT_EQ(result["clip_end"].get<double>(), 100.0) << "Blender's startup camera";
+  EXPECT_LT(result["farthest_vertex_m"].get<double>(), result["clip_end"].get<double>());
+  EXPECT_EQ(result["covered"].get<double>(), 1.0) << "the startup camera sees past the dome";
 }
 
 }  // namespace

@@ -254,6 +254,89 @@ TEST(EnginePresetCliTest, BakeWritesThePresetsFiles) {
   }
 }
 
+// Several presets in one bake (`--engine threejs,babylon --engine blender`):
+// every preset's files, in the order named, from the frame's one renderer.
+// three.js and Babylon.js look up a cube the same way (g = (-x, y, z)) and
+// three.js's equirect and Blender's are the same panorama, so those files
+// must hold the same pixels; and each preset's pixels are those of a bake
+// with that preset alone.
+TEST(EnginePresetCliTest, SeveralPresetsInOneBakeComeFromOneRender) {
+  const std::string dir = testing::FreshTempDir("engine_several");
+  const std::string common = "bake " + Style() + " --size 16 --vulkan-validation --set output.pixel_type=float";
+  testing::CommandRun r =
+      testing::RunSkybake(common + " --engine threejs,babylon --engine blender --out " + dir + "/several");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  // One engine stage for the three presets' images.
+  size_t stages = 0;
+  for (size_t at = r.output.find("skybake: engine "); at != std::string::npos;
+       at = r.output.find("skybake: engine ", at + 1))
+    ++stages;
+  EXPECT_EQ(stages, 1u) << r.output;
+  EXPECT_NE(r.output.find("14 images for threejs,babylon,blender"), std::string::npos) << r.output;
+
+  const std::string manifest = testing::ReadFileBytes(dir + "/several/manifest.json");
+  size_t last = 0;
+  for (const char* file :
+       {"sky_threejs_px.exr", "sky_threejs_nz.exr", "sky_threejs_latlong.exr", "sky_babylon_px.exr",
+        "sky_babylon_nz.exr", "sky_blender_latlong.exr"}) {
+    const size_t at = manifest.find("\"" + std::string(file) + "\"");
+    ASSERT_NE(at, std::string::npos) << file << "\n" << manifest;
+    EXPECT_GT(at, last) << file << " in the order the presets are named";
+    last = at;
+  }
+  auto pixels = [&](const std::string& folder, const std::string& file) {
+    Exr e = ReadExr(dir + "/" + folder + "/" + file);
+    EXPECT_FALSE(e.rgb.empty()) << folder << "/" << file;
+    return e.rgb;
+  };
+  for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"})
+    EXPECT_EQ(pixels("several", std::string("sky_threejs_") + face + ".exr"),
+              pixels("several", std::string("sky_babylon_") + face + ".exr"))
+        << face << ": three.js's and Babylon.js's faces differ";
+  EXPECT_EQ(pixels("several", "sky_threejs_latlong.exr"), pixels("several", "sky_blender_latlong.exr"))
+      << "three.js's and Blender's equirects differ";
+  for (const char* engine : {"threejs", "babylon"}) {
+    testing::CommandRun alone =
+        testing::RunSkybake(common + " -q --engine " + engine + " --out " + dir + "/" + engine);
+    ASSERT_EQ(alone.exit_code, 0) << alone.output;
+    SkyStyle style;  // basename "sky", as configs/default.toml
+    style.output.engine = engine;
+    for (const std::string& name : EngineFileNames(style, 0))
+      EXPECT_EQ(pixels("several", name), pixels(engine, name)) << name;
+  }
+}
+
+// Bad preset names among several are refused before any GPU work: on the
+// command line with exit code 2 and the names, in output.engine with exit
+// code 3 and the key.
+TEST(EnginePresetCliTest, BadNamesAmongSeveralAreRefusedBeforeGpuWork) {
+  for (const std::string args : {"--engine threejs,unreal5", "--engine threejs --engine unreal5",
+                                  "--engine threejs,", "--engine none"}) {
+    const std::string dir = testing::FreshTempDir("engine_several_bad");
+    testing::CommandRun r = testing::RunSkybake("bake " + Style() + " " + args + " --out " + dir);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find("unity,unreal,godot,blender,threejs,babylon,filament,exrenvmap"), std::string::npos)
+        << args << "\n" << r.output;
+    EXPECT_EQ(r.output.find("device"), std::string::npos) << "no GPU work: " << r.output;
+    EXPECT_TRUE(testing::FileNames(dir).empty()) << args;
+  }
+  struct Case {
+    std::string set, message;
+  };
+  for (const Case& c : std::vector<Case>{
+           {"'output.engine=\"threejs, unreal5\"'", "output.engine: 'unreal5' is not one of"},
+           {"'output.engine=\"threejs,none\"'", "output.engine: 'none' cannot be given with other presets"},
+           {"'output.engine=\"threejs,,babylon\"'", "output.engine: '' is not one of"},
+       }) {
+    const std::string dir = testing::FreshTempDir("engine_several_bad");
+    testing::CommandRun r = testing::RunSkybake("bake " + Style() + " --set " + c.set + " --out " + dir);
+    EXPECT_EQ(r.exit_code, 3) << c.set << "\n" << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.set << "\n" << r.output;
+    EXPECT_EQ(r.output.find("device"), std::string::npos) << "no GPU work: " << r.output;
+    EXPECT_TRUE(testing::FileNames(dir).empty()) << c.set;
+  }
+}
+
 // The engine files' half scale (EngineFileScale): the bake's own while they
 // fit in it, else a smaller power of two of their own.
 TEST(EnginePresetTest, EngineFileScaleIsTheBakesUnlessTheyNeedASmallerOne) {

@@ -5,7 +5,8 @@
 // CubeTexture. A 3-degree camera along the light must see the sky's Sun:
 // far brighter than turned 90, 180 or 270 degrees about +Y. The bake's
 // OpenEXR latlong loaded the same way puts it a quarter turn away (three.js's
-// equirectUv centres +X, OpenEXR +Z): the trap the preset removes.
+// equirectUv centres +X, OpenEXR +Z): the trap the preset removes, or a
+// quarter turn of the background (scene.backgroundRotation) undoes.
 #include <algorithm>
 #include <array>
 #include <filesystem>
@@ -51,6 +52,12 @@ TEST(EngineThreejsTest, SkysSunIsAlongTheSceneSunLight) {
   const std::vector<double> openexr = report["openexr"].get<std::vector<double>>();
   ASSERT_EQ(openexr.size(), 4u);
   EXPECT_GT(openexr[1], 2.0 * std::max({openexr[0], openexr[2], openexr[3]})) << "the trap is a quarter turn";
+  // The OpenEXR latlong with docs/engines.md's turn, scene.backgroundRotation.y = -pi / 2:
+  // the sky's Sun back on the light.
+  const std::vector<double> turned = report["openexr_turned"].get<std::vector<double>>();
+  ASSERT_EQ(turned.size(), 4u);
+  EXPECT_GT(turned[0], 2.0 * std::max({turned[1], turned[2], turned[3]}))
+      << "backgroundRotation.y = -pi / 2 does not bring the OpenEXR latlong's Sun onto the light";
 }
 
 // `skybake testpattern --engine threejs` in three.js: the colour seen along
@@ -222,6 +229,25 @@ TEST(EngineThreejsTest, SkyAndSunShowOneExposure) {
       "three.js r" + report["revision"].get<std::string>(), bake, report["sky"].get<std::vector<double>>(),
       report["card"].get<std::vector<double>>(), report["cardLightOnly"].get<std::vector<double>>(),
       report["cardEnvironmentOnly"].get<std::vector<double>>());
+}
+
+// The default glTF dome through three.js's default camera
+// (tests/viewer/dome_threejs.html): `new THREE.PerspectiveCamera()` clips at
+// near 0.1 and far 2000 (three.js 0.170 src/cameras/PerspectiveCamera.js);
+// from the origin, looking along each axis, the dome covers every pixel.
+TEST(EngineThreejsTest, DomeIsInsideTheDefaultCamerasRange) {
+  const std::string dir = testing::FreshTempDir("engine_threejs_dome");
+  testing::CommandRun bake = testing::RunSkybake(
+      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.output;
+  nlohmann::json report = RunPage("dome_threejs.html", dir);
+  ASSERT_TRUE(report.is_object()) << report.dump();
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  std::printf("three.js dome: %s\n", report.dump().c_str());
+  EXPECT_EQ(report["far"].get<double>(), 2000.0) << "three.js's default far plane";
+  const std::vector<double> covered = report["covered"].get<std::vector<double>>();
+  ASSERT_EQ(covered.size(), 6u);
+  for (size_t i = 0; i < covered.size(); ++i) EXPECT_EQ(covered[i], 1.0) << "view " << i << " sees past the dome";
 }
 
 }  // namespace

@@ -1,6 +1,6 @@
 // Loading libskybake_oiio.so (oiio_module.h) on first use: from the folder
-// main passes in ($SKYBAKE_MODULE_DIR), beside the executable, the build tree's top folder, or
-// the folder it was built in.
+// main passes in ($SKYBAKE_MODULE_DIR), beside the executable, the build
+// tree's top folder, an install's lib/skybake/, or the folder it was built in.
 #include <dlfcn.h>
 
 #include <filesystem>
@@ -46,6 +46,9 @@ const OiioModule& LoadOiioModule() {
   if (!ec) {
     dirs.push_back(exe.parent_path());
     dirs.push_back(exe.parent_path().parent_path());  // tests/ of the build tree
+    // An installed skybake (`cmake --install`, the .deb): PREFIX/bin/skybake
+    // and PREFIX/LIBDIR/skybake/libskybake_oiio.so, wherever PREFIX is.
+    dirs.push_back(exe.parent_path().parent_path() / SKYBAKE_MODULE_INSTALL_SUBDIR);
   }
   dirs.emplace_back(SKYBAKE_MODULE_BUILD_DIR);
   std::string tried;
@@ -56,17 +59,18 @@ const OiioModule& LoadOiioModule() {
       tried += fmt::format("\n  {}: {}", path, ::dlerror());
       continue;
     }
-    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module"));
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v2"));
     if (!entry) {
-      tried += fmt::format("\n  {}: no skybake_oiio_module", path);
+      tried += fmt::format("\n  {}: no skybake_oiio_module_v2 (a module of another skybake version)", path);
       continue;
     }
     module = entry();
     return *module;
   }
-  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (PNG previews, glTF "
-                                "textures, galleries): rebuild skybake, or set SKYBAKE_MODULE_DIR to the folder "
-                                "holding it; tried:{}", tried));
+  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (the gallery, cloud "
+                                "weather and formation images): it is built when OpenImageIO is installed "
+                                "(apt-get install libopenimageio-dev, then rebuild skybake), or set "
+                                "SKYBAKE_MODULE_DIR to the folder holding it; tried:{}", tried));
 }
 
 }  // namespace skybake

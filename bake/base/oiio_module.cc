@@ -1,4 +1,4 @@
-// libskybake_oiio.so: PNG encoding and the gallery's contact sheet through
+// libskybake_oiio.so: the gallery's contact sheet and image reading through
 // OpenImageIO (see oiio_module.h for why this is a module of its own).
 #include "skybake/base/oiio_module.h"
 
@@ -12,23 +12,6 @@
 
 namespace skybake {
 namespace {
-
-bool EncodePng(int width, int height, const uint8_t* rgb, std::vector<unsigned char>& png, std::string& error) {
-  auto out = OIIO::ImageOutput::create("png");
-  if (!out) {
-    error = "OpenImageIO has no PNG writer: " + OIIO::geterror();
-    return false;
-  }
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", "sRGB");
-  spec.attribute("Software", "skybake " SKYBAKE_VERSION);
-  OIIO::Filesystem::IOVecOutput proxy(png);
-  out->set_ioproxy(&proxy);
-  bool ok = out->open("preview.png", spec) && out->write_image(OIIO::TypeDesc::UINT8, rgb);
-  ok = out->close() && ok;
-  if (!ok) error = out->geterror();
-  return ok;
-}
 
 bool ComposeSheet(const std::vector<SheetCell>& cells, const SheetLayout& l, std::vector<uint8_t>& rgb, int& width,
                   int& height, std::string& error) {
@@ -101,11 +84,11 @@ bool ReadImage(const std::string& path, int& width, int& height, int& channels, 
   return ok;
 }
 
-const OiioModule kModule = {EncodePng, ComposeSheet, ReadImage};
+const OiioModule kModule = {ComposeSheet, ReadImage};
 
 }  // namespace
 }  // namespace skybake
 
-extern "C" __attribute__((visibility("default"))) const skybake::OiioModule* skybake_oiio_module() {
+extern "C" __attribute__((visibility("default"))) const skybake::OiioModule* skybake_oiio_module_v2() {
   return &skybake::kModule;
 }

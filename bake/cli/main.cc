@@ -30,6 +30,7 @@
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "skybake/tools/accuracy.h"
 #include "skybake/input/config.h"
@@ -119,7 +120,7 @@ struct BakeArgs {
   std::string frames;    // --frames FIRST:LAST, empty: every frame
   std::string shard;     // --shard I/N, empty: no split
   ShaderSwitches shaders;  // from the environment (main)
-  std::string engine;    // --engine NAME: output.engine
+  std::vector<std::string> engines;  // --engine NAME[,NAME...], repeatable: output.engine
   bool usd = false;      // --usd: usd.enabled
   // From the environment (main, ReadEnvironment): the loader's driver
   // choice, lavapipe's thread count, the default star catalogue.
@@ -138,7 +139,12 @@ std::vector<std::string> StyleOverrides(const BakeArgs& args) {
     overrides.push_back(fmt::format("render.cube_size={}", args.size));
     overrides.push_back(fmt::format("render.latlong_height={}", args.size));
   }
-  if (!args.engine.empty()) overrides.push_back("output.engine=" + args.engine);
+  if (!args.engines.empty()) {
+    // Every preset named, in the order given, as one TOML string.
+    std::string list;
+    for (const std::string& name : args.engines) list += (list.empty() ? "" : ",") + name;
+    overrides.push_back("output.engine=\"" + list + "\"");
+  }
   if (args.usd) overrides.push_back("usd.enabled=true");
   return overrides;
 }
@@ -489,10 +495,23 @@ void AddBakeCommands(CLI::App& app, Cli& cli) {
   {
     std::string engines;
     for (const std::string& name : EngineNames()) engines += (engines.empty() ? "" : "|") + name;
-    cli.bake->add_option("--engine", cli.args.engine,
-                     "Also write the files one engine loads the right way up (output.engine; docs/engines.md)")
+    cli.bake->add_option("--engine", cli.args.engines,
+                     "Also write the files these engines load the right way up, all from the same render: one "
+                     "name, a list separated by commas, or the option repeated (output.engine; docs/engines.md)")
         ->type_name(engines)
-        ->check(CLI::IsMember(EngineNames()));
+        ->allow_extra_args(false)
+        ->check(CLI::Validator(
+            [](std::string& value) -> std::string {
+              // Each name of a list separated by commas is a preset.
+              const std::vector<std::string> names = EngineNames();
+              for (const std::string& name : SplitEngineList(value))
+                if (std::find(names.begin(), names.end(), name) == names.end())
+                  return fmt::format("'{}' is not an engine preset: give one or more of {{{}}}, separated by "
+                                     "commas or as --engine repeated",
+                                     name, fmt::join(names, ","));
+              return std::string();
+            },
+            "ENGINE[,ENGINE...]"));
   }
   cli.bake->add_flag("--usd", cli.args.usd,
                      "Also write NAME.usda, a USD layer: a DomeLight of the latlong EXRs and DistantLights for the "

@@ -212,11 +212,7 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
   v.Bool("output.latlong", o.latlong);
   v.Bool("output.preview", o.preview);
   v.FileNames("output.face_names", o.face_names, 6);
-  v.Choice("output.engine", o.engine,
-           {{"none", std::string("none")}, {"unity", std::string("unity")}, {"unreal", std::string("unreal")},
-            {"godot", std::string("godot")}, {"blender", std::string("blender")},
-            {"threejs", std::string("threejs")}, {"babylon", std::string("babylon")},
-            {"filament", std::string("filament")}, {"exrenvmap", std::string("exrenvmap")}});
+  v.Engines("output.engine", o.engine);
 
   v.Bool("preview.auto_exposure", s.preview.auto_exposure);
   v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
@@ -452,6 +448,38 @@ class StyleReader : public TomlReader {
       return;
     }
     out = text;
+  }
+
+  // output.engine: "none", or preset names separated by commas, each once;
+  // kept as the names joined by commas, in the order given.
+  void Engines(const char* path, std::string& out) {
+    const toml::node* node = Find(path);
+    if (!node) return;
+    std::vector<std::string> names = {"none"};
+    for (const std::string& name : EngineNames()) names.push_back(name);
+    const std::string choices = JoinNames(names) + " (or several presets separated by commas)";
+    if (!node->is_string()) {
+      Error(node, path, fmt::format("expected one of {}, got {}", choices, TomlTypeName(*node)));
+      return;
+    }
+    const std::vector<std::string> list = SplitEngineList(node->as_string()->get());
+    std::vector<std::string> kept;
+    for (const std::string& name : list) {
+      if (name == "none" && list.size() == 1) {
+        out = "none";
+        return;
+      }
+      if (!FindEnginePreset(name)) {
+        Error(node, path,
+              name == "none" ? fmt::format("'none' cannot be given with other presets: '{}'",
+                                           node->as_string()->get())
+                             : fmt::format("'{}' is not one of {}", name, choices));
+        return;
+      }
+      if (std::find(kept.begin(), kept.end(), name) == kept.end()) kept.push_back(name);
+    }
+    out.clear();
+    for (const std::string& name : kept) out += (out.empty() ? "" : ",") + name;
   }
 
   // Any string (a path).
@@ -789,6 +817,7 @@ class StyleWriter {
   }
   void FileName(const char* path, std::string& v) { Put(path, v); }
   void Text(const char* path, std::string& v) { Put(path, v); }
+  void Engines(const char* path, std::string& v) { Put(path, v); }
   void Preset(const char* path, std::string& name, QualitySettings&, CloudQuality&) { Put(path, name); }
   void Uint(const char* path, uint32_t& v) { Put(path, int64_t(v)); }
   void Vector(const char* path, glm::dvec3& v, const Range&) { Put(path, toml::array{v.x, v.y, v.z}); }

@@ -1,5 +1,6 @@
 #include "skybake/input/engine_preset.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
@@ -153,6 +154,28 @@ const EnginePreset* FindEnginePreset(const std::string& name) {
   return nullptr;
 }
 
+std::vector<std::string> SplitEngineList(const std::string& engine) {
+  std::vector<std::string> names;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = engine.find(',', start);
+    std::string name = engine.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    const size_t first = name.find_first_not_of(" \t"), last = name.find_last_not_of(" \t");
+    names.push_back(first == std::string::npos ? std::string() : name.substr(first, last - first + 1));
+    if (comma == std::string::npos) return names;
+    start = comma + 1;
+  }
+}
+
+std::vector<const EnginePreset*> EnginePresetsOf(const std::string& engine) {
+  std::vector<const EnginePreset*> presets;
+  for (const std::string& name : SplitEngineList(engine)) {
+    const EnginePreset* preset = FindEnginePreset(name);
+    if (preset && std::find(presets.begin(), presets.end(), preset) == presets.end()) presets.push_back(preset);
+  }
+  return presets;
+}
+
 std::vector<EngineImage> EngineImages(const EnginePreset& preset, int n, int h) {
   const Layout l = LayoutOf(preset.name);
   const glm::dmat3 to_skybake = glm::transpose(l.lookup);  // a signed permutation's inverse
@@ -186,31 +209,42 @@ std::vector<EngineImage> EngineImages(const EnginePreset& preset, int n, int h) 
   return images;
 }
 
+namespace {
+
+// BASE_ENGINE_SUFFIX`number`.exr of each of `preset`'s images, in EngineImages order.
+void AppendPresetFileNames(const EnginePreset& preset, const std::string& basename, const std::string& number,
+                           std::vector<std::string>& names) {
+  const std::string stem = basename + "_" + preset.name + "_";
+  for (const std::string& face : preset.faces) names.push_back(stem + face + number + ".exr");
+  if (preset.latlong) names.push_back(stem + "latlong" + number + ".exr");
+  if (preset.cube_strip) names.push_back(stem + "cube" + number + ".exr");
+}
+
+}  // namespace
+
 std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name, int number_width) {
   std::vector<std::string> names;
-  const EnginePreset* preset = FindEnginePreset(style.output.engine);
-  if (!preset) return names;
   const std::string number = FrameNumberSuffix(number_in_name, number_width);
-  const std::string stem = style.output.basename + "_" + preset->name + "_";
-  for (const std::string& face : preset->faces) names.push_back(stem + face + number + ".exr");
-  if (preset->latlong) names.push_back(stem + "latlong" + number + ".exr");
-  if (preset->cube_strip) names.push_back(stem + "cube" + number + ".exr");
+  for (const EnginePreset* preset : EnginePresetsOf(style.output.engine))
+    AppendPresetFileNames(*preset, style.output.basename, number, names);
   return names;
 }
 
 std::optional<std::string> EngineStyleError(const SkyStyle& style) {
-  const EnginePreset* preset = FindEnginePreset(style.output.engine);
-  if (!preset) return std::nullopt;
-  // BASE_FACE.exr of the bake's own faces must not be one of the preset's files.
+  // BASE_FACE.exr of the bake's own faces must not be one of a preset's files.
   auto folded = [](std::string s) {
     for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
     return s;
   };
-  for (const std::string& engine_file : EngineFileNames(style, 0))
-    for (const std::string& face : style.output.face_names)
-      if (style.output.faces && folded(style.output.basename + "_" + face + ".exr") == folded(engine_file))
-        return fmt::format("face name '{}' makes {}, a file of the {} preset: choose another face name", face,
-                           engine_file, preset->name);
+  for (const EnginePreset* preset : EnginePresetsOf(style.output.engine)) {
+    std::vector<std::string> files;
+    AppendPresetFileNames(*preset, style.output.basename, FrameNumberSuffix(0), files);
+    for (const std::string& engine_file : files)
+      for (const std::string& face : style.output.face_names)
+        if (style.output.faces && folded(style.output.basename + "_" + face + ".exr") == folded(engine_file))
+          return fmt::format("face name '{}' makes {}, a file of the {} preset: choose another face name", face,
+                             engine_file, preset->name);
+  }
   return std::nullopt;
 }
 

@@ -1,7 +1,7 @@
 #include "skybake/output/exr_io.h"
+#include "skybake/output/png_io.h"
 
 #include "exr_deflate.h"
-#include "skybake/base/oiio_module.h"
 
 #include <atomic>
 #include <chrono>
@@ -324,12 +324,14 @@ std::string EncodeExr(const std::string& path, const RgbaImage& image, const Exr
 }
 
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb) {
-  // Encoded in memory by the OpenImageIO module, then written like every other file.
-  std::vector<unsigned char> encoded;
-  std::string error;
-  if (!LoadOiioModule().encode_png(width, height, rgb.data(), encoded, error))
-    throw OutputError(fmt::format("cannot encode {}: {}", path, error));
-  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(encoded.data()), encoded.size()));
+  // Encoded in memory by libpng, then written like every other file.
+  std::string encoded;
+  try {
+    encoded = EncodePngRgb8(width, height, rgb);
+  } catch (const OutputError& e) {
+    throw OutputError(fmt::format("cannot encode {}: {}", path, e.what()));
+  }
+  WriteFileAtomically(path, encoded);
   return encoded.size();
 }
 

@@ -1,10 +1,14 @@
 # Blender's own check of a latlong as a World texture (tests/engine_blender_test.cc):
-#   blender -b --factory-startup --python blender_sun_check.py -- SCENE.glb LATLONG.exr OUT_DIR
+#   blender -b --factory-startup --python blender_sun_check.py -- SCENE.glb LATLONG.exr OUT_DIR [TURN_DEG]
 # Imports the scene with Blender's glTF importer, sets LATLONG as the World's
 # Environment Texture with the default mapping, hides the scene's dome (its
 # UVs are skybake's own) and renders, with Cycles (no denoiser), a 3-degree
 # camera along the imported sun light's direction and turned 90, 180 and 270
-# degrees about Blender's vertical (+Z). Prints one line:
+# degrees about Blender's vertical (+Z). With TURN_DEG the texture's lookup
+# is turned about +Z by that angle first, as docs/engines.md tells a user to
+# turn an OpenEXR latlong: a Texture Coordinate node's Generated output (the
+# view direction, for a World) through a Mapping node (Point, Rotation Z =
+# TURN_DEG) into the Environment Texture's Vector. Prints one line:
 #   RESULT {"sun": [x, y, z], "radiance": [r0, r90, r180, r270]}
 # with the mean of each render (linear, the EXR's values).
 import json
@@ -19,7 +23,9 @@ numpy.bool = bool  # Debian 12's Blender 3.4 glTF importer uses np.bool, gone fr
 import bpy
 import mathutils
 
-scene_path, latlong_path, out_dir = sys.argv[sys.argv.index("--") + 1:][:3]
+args = sys.argv[sys.argv.index("--") + 1:]
+scene_path, latlong_path, out_dir = args[:3]
+turn_deg = float(args[3]) if len(args) > 3 else None
 bpy.ops.wm.read_factory_settings(use_empty=True)
 bpy.ops.import_scene.gltf(filepath=scene_path)
 suns = [o for o in bpy.data.objects if o.type == "LIGHT" and o.data.type == "SUN"]
@@ -40,6 +46,13 @@ texture = nodes.new("ShaderNodeTexEnvironment")
 texture.image = bpy.data.images.load(latlong_path)
 texture.interpolation = "Closest"
 world.node_tree.links.new(texture.outputs["Color"], nodes["Background"].inputs["Color"])
+if turn_deg is not None:
+    coordinates = nodes.new("ShaderNodeTexCoord")
+    mapping = nodes.new("ShaderNodeMapping")
+    mapping.vector_type = "POINT"
+    mapping.inputs["Rotation"].default_value = (0.0, 0.0, math.radians(turn_deg))
+    world.node_tree.links.new(coordinates.outputs["Generated"], mapping.inputs["Vector"])
+    world.node_tree.links.new(mapping.outputs["Vector"], texture.inputs["Vector"])
 
 camera_data = bpy.data.cameras.new("probe")
 camera_data.angle = math.radians(3.0)

@@ -99,7 +99,14 @@ batch_script() {  # $1 folder: the batch script of that case
 # --- Set-up ------------------------------------------------------------------
 [ -x "$BUILD/skybake" ] || fail "$BUILD/skybake is missing: build first"
 [ "$(id -u)" = 0 ] || fail "the Slurm daemons run as root here: run the test as root (as .ci/test does)"
-export PATH=$BUILD:$PATH SKYBAKE_VULKAN_VALIDATION=1
+# skybake as a farm node has it: from its Debian packages (cpack in the build
+# folder, unpacked with dpkg -x; the machine's own packages are not touched),
+# on the PATH of the submission and of the jobs.
+(cd "$tmp" && cpack --config "$BUILD/CPackConfig.cmake" -B "$tmp/debs" >"$tmp/cpack.log" 2>&1) ||
+  { cat "$tmp/cpack.log"; fail "cpack could not build the packages"; }
+for deb in "$tmp"/debs/*.deb; do dpkg -x "$deb" "$tmp/package" || fail "dpkg -x $deb"; done
+export PATH=$tmp/package/usr/bin:$PATH SKYBAKE_VULKAN_VALIDATION=1
+[ "$(command -v skybake)" = "$tmp/package/usr/bin/skybake" ] || fail "the packaged skybake is not the one on the PATH"
 ln -s "$SRC/configs" "$work/configs"
 # FRAMES frames of the README's day from 06:00, evenly spread over its 14.5 hours.
 step_min=$((870 / FRAMES))

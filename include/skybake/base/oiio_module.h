@@ -2,8 +2,10 @@
 //
 // Linking OpenImageIO pulls in some 260 shared libraries whose start-up
 // costs about 0.3 s per process on the 2-core machine (docs/performance.md),
-// more than the whole W1 budget's share for it; a bake that writes no PNG
-// never loads them. The module is built beside the binaries
+// more than the whole W1 budget's share for it. A bake loads them only for
+// what needs OpenImageIO: the gallery's contact sheet (its labels) and cloud
+// weather or formation images; PNGs are written with libpng
+// (output/png_io.h). The module is built beside the binaries
 // (libskybake_oiio.so) and found from SetOiioModuleDir (main: SKYBAKE_MODULE_DIR) or the directory of
 // the running executable.
 #pragma once
@@ -27,8 +29,6 @@ struct SheetLayout {
 
 // The module's entry points; each returns false with a message in `error`.
 struct OiioModule {
-  bool (*encode_png)(int width, int height, const uint8_t* rgb, std::vector<unsigned char>& png,
-                     std::string& error);
   bool (*compose_sheet)(const std::vector<SheetCell>& cells, const SheetLayout& layout, std::vector<uint8_t>& rgb,
                         int& width, int& height, std::string& error);
   // Any 2D image OpenImageIO reads (EXR, PNG, ...): its first subimage as
@@ -48,5 +48,8 @@ void SetOiioModuleDir(const std::string& dir);
 
 }  // namespace skybake
 
-// The module's one exported symbol.
-extern "C" const skybake::OiioModule* skybake_oiio_module();
+// The module's one exported symbol. Its name carries the version of
+// OiioModule's layout: a change of the struct renames it, so a binary never
+// calls into a module of another layout (an older libskybake_oiio.so left
+// beside it is passed over, with the name in the error).
+extern "C" const skybake::OiioModule* skybake_oiio_module_v2();

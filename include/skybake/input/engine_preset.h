@@ -48,17 +48,27 @@ const std::vector<EnginePreset>& EnginePresets();
 std::vector<std::string> EngineNames();  // "unity", "unreal", ...
 const EnginePreset* FindEnginePreset(const std::string& name);
 
+// The names of an `output.engine` value: "none" (no preset), or one or more
+// preset names separated by commas ("threejs,babylon"; `--engine` repeated
+// or given a list), spaces around a name ignored, in the order given.
+std::vector<std::string> SplitEngineList(const std::string& engine);
+// The presets `engine` (an `output.engine` value the style check accepted)
+// names, in its order, each once; empty for "none". Every preset's files come
+// from the same frame's renderer (engine_files.h).
+std::vector<const EnginePreset*> EnginePresetsOf(const std::string& engine);
+
 // The images of `preset` for a bake of face size `cube_size` and latlong
 // height `latlong_height` (the latlong is 2h x h).
 std::vector<EngineImage> EngineImages(const EnginePreset& preset, int cube_size, int latlong_height);
 
 // The file names of a frame's engine images (FrameNumberSuffix numbering),
-// in EngineImages order; empty when no preset is set.
+// preset by preset in EnginePresetsOf order, each in EngineImages order;
+// empty when no preset is set.
 std::vector<std::string> EngineFileNames(const SkyStyle& style, int number_in_name,
                                          int number_width = kFrameNumberMinDigits);
 
-// What is wrong with the style's preset and the rest of its outputs (a face
-// name that is one of the preset's files), or nothing.
+// What is wrong with the style's presets and the rest of its outputs (a face
+// name that is one of a preset's files), or nothing.
 std::optional<std::string> EngineStyleError(const SkyStyle& style);
 
 // A manifest's engine file of a frame: BASE_ENGINE_SUFFIX.NNNN.exr for a

@@ -63,7 +63,12 @@ enum class DomeShape { kSphere, kHemisphere };
 struct GltfSettings {
   bool enabled = true;              // write name.gltf (+ .bin) and name.glb
   DomeShape dome = DomeShape::kSphere;
-  double radius_m = 1000.0;         // horizontal radius of the dome
+  // Horizontal radius of the dome. Within every client's default camera
+  // range from where that camera starts: Blender's startup camera clips at
+  // 100 m and stands 11.3 m from the origin, three.js's PerspectiveCamera at
+  // 2000 m, Babylon.js's cameras at 10000 m (docs/engines.md, "The dome and
+  // the clients' default cameras").
+  double radius_m = 50.0;
   double flattening = 0.0;          // 0: round; f: vertical radius = (1 - f) * radius_m
   int segments = 64;                // around the horizon; half as many rings pole to pole
   bool image_based_light = false;   // EXT_lights_image_based from ibl.specular (gltf_ibl.h)

@@ -79,7 +79,7 @@ uint64_t WriteExr(const std::string& path, const RgbaImage& image, const ExrWrit
 // when the size is unchanged.
 void SetExrThreads(int threads);
 
-// Writes an 8-bit sRGB PNG through OpenImageIO.
+// Writes an 8-bit sRGB PNG (EncodePngRgb8: libpng, png_io.h).
 uint64_t WritePng(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb);
 
 // Writes `bytes` to a temporary file beside `path`, syncs it and renames it

@@ -14,19 +14,22 @@
 
 namespace skybake {
 
-// The size of each image of the style's preset (EngineImages order) at the
-// style's render.cube_size and render.latlong_height: faces N x N, a latlong
-// 2H x H, a cube strip N x 6N; empty without a preset. For `skybake plan`
-// and the resource estimate (budget.cc), without the directions.
+// The size of each image of the style's presets (EnginePresetsOf, each in
+// EngineImages order) at the style's render.cube_size and
+// render.latlong_height: faces N x N, a latlong 2H x H, a cube strip N x 6N;
+// empty without a preset. For `skybake plan` and the resource estimate
+// (budget.cc), without the directions.
 struct EngineImageSize {
-  std::string suffix;
+  std::string suffix;  // ENGINE_SUFFIX: "threejs_px", "blender_latlong", ...
   int width = 0, height = 0;
 };
 std::vector<EngineImageSize> PlanEngineImages(const SkyStyle& style);
 
-// Renders the images of the style's preset (EngineImages) at the frame's
-// Sun: every texel along its direction, sun disc included as in the bake's
-// other files.
+// Renders the images of the style's presets (EnginePresetsOf, each in
+// EngineImages order) at the frame's Sun with the frame's renderer (its
+// LUTs, its sky): every texel along its direction, sun disc included as in
+// the bake's other files. Several presets' images are the same render along
+// their own directions.
 std::vector<RgbaImage> RenderEngineImages(SkyRenderer& renderer, const glm::dvec3& sun, const SkyStyle& style);
 
 // The half-float scale of a frame's engine files: the bake's own
@@ -41,8 +44,9 @@ double EngineFileScale(double max_value, double bake_scale, PixelType pixel_type
 
 // Encodes and writes them as EXRs named `names` (EngineFileNames) in
 // `out_dir`, with the frame's options `exr` (provenance; the scale of
-// EngineFileScale, in each file's skybake:scale) and the preset's
-// attributes (skybake:engine, skybake:engine_mapping, envmap).
+// EngineFileScale over each preset's own images, in each file's
+// skybake:scale) and each preset's attributes (skybake:engine,
+// skybake:engine_mapping, envmap).
 std::vector<BakedFile> WriteEngineFiles(const SkyStyle& style, const std::vector<RgbaImage>& images,
                                         const ExrWriteOptions& exr, const std::string& out_dir,
                                         const std::vector<std::string>& names);

@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# The Debian package, as a farm node gets it (ctest deb_package, label
+# package): cpack builds the .debs from BUILD_DIR, their Depends must be
+# satisfiable here (dpkg --dry-run -i: nothing is installed), the packages
+# are unpacked into a temporary root (dpkg -x), and the skybake they hold
+# bakes the default style they hold, with the module found beside its own
+# install; then `cmake --install` into a prefix that cannot be written must
+# stop with a clear message and install nothing.
+#   bash tests/package/deb_test.sh BUILD_DIR
+set -euo pipefail
+build="$(cd "$1" && pwd)"
+work="$(mktemp -d "${TMPDIR:-/tmp}/skybake-deb.XXXXXX")"
+trap 'rm -rf "$work"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+# 1. The packages.
+(cd "$work" && cpack --config "$build/CPackConfig.cmake" -B "$work/packages" >"$work/cpack.log" 2>&1) ||
+  { cat "$work/cpack.log"; fail "cpack"; }
+tool=$(ls "$work"/packages/skybake_*.deb 2>/dev/null | head -1)
+[ -n "$tool" ] || { ls -l "$work/packages"; fail "no skybake_*.deb"; }
+echo "package: $(basename "$tool") ($(stat -c %s "$tool") bytes)"
+depends=$(dpkg-deb -f "$tool" Depends)
+echo "Depends: $depends"
+# The libraries the binary links (dpkg-shlibdeps) and the Vulkan driver it needs at run time.
+for lib in libvulkan1 libopenexr libdeflate0 libpng16-16 libzstd1 libssl3 libnova libstdc++6 mesa-vulkan-drivers; do
+  case "$depends" in *"$lib"*) ;; *) fail "Depends lacks $lib" ;; esac
+done
+case "$depends" in *openimageio*) fail "the tool's package depends on OpenImageIO" ;; esac
+dpkg-deb -c "$tool" | awk '{print $6}' > "$work/contents"
+for f in ./usr/bin/skybake ./usr/share/skybake/configs/default.toml ./usr/share/doc/skybake/README.md; do
+  grep -qx "$f" "$work/contents" || fail "$f is not in the package"
+done
+module=$(ls "$work"/packages/skybake-oiio_*.deb 2>/dev/null | head -1 || true)
+if [ -n "$module" ]; then
+  echo "package: $(basename "$module"), Depends: $(dpkg-deb -f "$module" Depends)"
+  case "$(dpkg-deb -f "$module" Depends)" in *libopenimageio*) ;; *) fail "the module's package lacks libopenimageio" ;; esac
+fi
+dpkg --dry-run -i "$tool" ${module:+"$module"} >"$work/dpkg.log" 2>&1 || { cat "$work/dpkg.log"; fail "dpkg -i would fail"; }
+
+# 2. Unpacked into a root of its own: a bake with what the package holds.
+for deb in "$tool" ${module:+"$module"}; do dpkg -x "$deb" "$work/root"; done
+"$work/root/usr/bin/skybake" --version
+(cd "$work" && "$work/root/usr/bin/skybake" bake "$work/root/usr/share/skybake/configs/default.toml" --size 16 -q \
+   --vulkan-validation --out "$work/out") || fail "the packaged skybake did not bake"
+for f in sky_px.exr sky_latlong.exr sky_latlong.png sky.glb manifest.json; do
+  [ -s "$work/out/$f" ] || fail "the bake wrote no $f"
+done
+grep -q '"complete": true' "$work/out/manifest.json" || fail "manifest not complete"
+if [ -n "$module" ]; then
+  # The gallery needs the module: found beside the packaged binary's install.
+  mkdir -p "$work/styles" && cp "$work/root/usr/share/skybake/configs/default.toml" "$work/styles/"
+  # (The loader's log names the module it opened: the package's, not the build tree's.)
+  LD_DEBUG=files "$work/root/usr/bin/skybake" gallery "$work/styles" --size 8 -q --out "$work/gallery" \
+    >"$work/gallery.log" 2>&1 || { tail -20 "$work/gallery.log"; fail "the packaged gallery did not run"; }
+  [ -s "$work/gallery/gallery.png" ] || fail "no gallery.png"
+  grep -q "file=$work/root/usr/lib/[a-z0-9_/-]*skybake/libskybake_oiio.so" "$work/gallery.log" ||
+    { grep libskybake_oiio "$work/gallery.log" | head -3; fail "the gallery did not load the packaged module"; }
+fi
+
+# 3. An install prefix that cannot be written: a clear error, nothing installed.
+touch "$work/plain-file"
+if cmake --install "$build" --prefix "$work/plain-file/skybake" >"$work/install.log" 2>&1; then
+  fail "cmake --install into a prefix under a regular file succeeded"
+fi
+grep -q "cannot install skybake into $work/plain-file/skybake" "$work/install.log" ||
+  { cat "$work/install.log"; fail "no clear message"; }
+grep -q "Installing:" "$work/install.log" && fail "something was installed"
+[ ! -e "$work/plain-file/skybake" ] || fail "the prefix was created"
+sed -n 's/^ *\(CMake Error.*\|cannot install.*\)$/\1/p' "$work/install.log" | head -3
+echo "deb package: OK"
