@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The Debian package, as a farm node gets it (ctest deb_package, label
+# The Debian packages, as a farm node gets them (ctest deb_package, label
 # package): cpack builds the .debs from BUILD_DIR, their Depends must be
 # satisfiable here (dpkg --dry-run -i: nothing is installed), the packages
 # are unpacked into a temporary root (dpkg -x), and the skybake they hold
@@ -35,10 +35,26 @@ if [ -n "$module" ]; then
   echo "package: $(basename "$module"), Depends: $(dpkg-deb -f "$module" Depends)"
   case "$(dpkg-deb -f "$module" Depends)" in *libopenimageio*) ;; *) fail "the module's package lacks libopenimageio" ;; esac
 fi
-dpkg --dry-run -i "$tool" ${module:+"$module"} >"$work/dpkg.log" 2>&1 || { cat "$work/dpkg.log"; fail "dpkg -i would fail"; }
+python_deb=$(ls "$work"/packages/python3-skybake_*.deb 2>/dev/null | head -1 || true)
+if [ -f "$build/CMakeCache.txt" ] && grep -q '^SKYBAKE_PYTHON_MINOR:INTERNAL=' "$build/CMakeCache.txt"; then
+  [ -n "$python_deb" ] || fail "the build has the Python module but cpack made no python3-skybake package"
+fi
+if [ -n "$python_deb" ]; then
+  py_depends=$(dpkg-deb -f "$python_deb" Depends)
+  echo "package: $(basename "$python_deb"), Depends: $py_depends"
+  for dep in "skybake (=" "python3 (>= 3." "python3 (<< 3." python3-numpy; do
+    case "$py_depends" in *"$dep"*) ;; *) fail "python3-skybake's Depends lack $dep" ;; esac
+  done
+  # Where Debian's python3 looks (/usr/lib/python3/dist-packages), not the /usr/local layout.
+  dpkg-deb -c "$python_deb" | awk '{print $6}' > "$work/python_contents"
+  grep -q '^\./usr/lib/python3/dist-packages/skybake\.cpython-3[0-9]*-[a-z0-9_-]*\.so$' "$work/python_contents" ||
+    { dpkg-deb -c "$python_deb"; fail "the module is not in /usr/lib/python3/dist-packages"; }
+fi
+dpkg --dry-run -i "$tool" ${module:+"$module"} ${python_deb:+"$python_deb"} >"$work/dpkg.log" 2>&1 ||
+  { cat "$work/dpkg.log"; fail "dpkg -i would fail"; }
 
 # 2. Unpacked into a root of its own: a bake with what the package holds.
-for deb in "$tool" ${module:+"$module"}; do dpkg -x "$deb" "$work/root"; done
+for deb in "$tool" ${module:+"$module"} ${python_deb:+"$python_deb"}; do dpkg -x "$deb" "$work/root"; done
 "$work/root/usr/bin/skybake" --version
 (cd "$work" && "$work/root/usr/bin/skybake" bake "$work/root/usr/share/skybake/configs/default.toml" --size 16 -q \
    --vulkan-validation --out "$work/out") || fail "the packaged skybake did not bake"
@@ -55,6 +71,22 @@ if [ -n "$module" ]; then
   [ -s "$work/gallery/gallery.png" ] || fail "no gallery.png"
   grep -q "file=$work/root/usr/lib/[a-z0-9_/-]*skybake/libskybake_oiio.so" "$work/gallery.log" ||
     { grep libskybake_oiio "$work/gallery.log" | head -3; fail "the gallery did not load the packaged module"; }
+fi
+
+if [ -n "$python_deb" ]; then
+  # The packaged module, imported by Debian's python3 from the package's folder alone, bakes.
+  (cd "$work" && PYTHONPATH="$work/root/usr/lib/python3/dist-packages" SKYBAKE_VULKAN_VALIDATION=1 /usr/bin/python3 - \
+     "$work/root/usr/share/skybake/configs/default.toml" "$work/py_out" "$work/root" <<'PY'
+import sys
+import skybake
+assert skybake.__file__.startswith(sys.argv[3] + "/usr/lib/python3/dist-packages/"), skybake.__file__
+result = skybake.bake(skybake.load_style(sys.argv[1]), out=sys.argv[2], size=16, arrays=True)
+frame = result.frames[0]
+assert frame.latlong.shape == (16, 32, 3), frame.latlong.shape
+assert result.manifest["complete"] is True
+print("python3-skybake:", skybake.__version__, "baked", len(result.frames), "frame, sun at %.1f deg" % frame.sun_elevation_deg)
+PY
+  ) || fail "the packaged Python module did not bake"
 fi
 
 # 3. An install prefix that cannot be written: a clear error, nothing installed.
