@@ -36,24 +36,6 @@ double CompassAzimuthFromLibnova(double libnova_azimuth_deg) { return Wrap360(li
 
 namespace {
 
-// libnova caches its nutation (and the solar series built on it) by Julian
-// day and reuses a value for a nearby day, so a result depends on the calls
-// before it at the 1e-10 level. Computing each at a day far away first
-// makes the next call at `julian_day_ut` compute afresh: a frame's stars
-// and Moon are then the same whichever frames were computed before it (a
-// shard of a sequence gives the unsharded bake's bytes). The lunar series
-// keeps no cache (ln_get_lunar_geo_posn at a day gives the same bits
-// whatever was computed before); its equatorial place reads the nutation.
-void ResetLibnovaCaches(double julian_day_ut) {
-  const double far = julian_day_ut + 400.0;
-  ln_nutation nutation{};
-  ln_get_nutation(far, &nutation);
-  ln_equ_posn equatorial{};
-  ln_get_solar_equ_coords(far, &equatorial);
-  ln_lnlat_posn ecliptic{};
-  ln_get_solar_ecl_coords(far, &ecliptic);
-}
-
 // Meeus eq. 13.3 and 13.4: equatorial (RA, Dec) from ecliptic (lambda,
 // beta) with the obliquity eps, all in radians; RA in (-pi, pi].
 void EquatorialFromEcliptic(double lambda, double beta, double eps, double& ra, double& dec) {

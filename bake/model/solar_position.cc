@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <libnova/julian_day.h>
+#include <libnova/nutation.h>
 #include <libnova/precession.h>
 #include <libnova/solar.h>
 #include <libnova/transform.h>
@@ -27,6 +28,24 @@ int DaysInMonth(int year, int month) {
   if (month < 1 || month > 12) return 0;
   bool leap = (year % 4 == 0 && year % 100 != 0) || year % 400 == 0;
   return kDays[month - 1] + (month == 2 && leap ? 1 : 0);
+}
+
+// libnova caches its nutation (and the solar series built on it) by Julian
+// day and reuses a value for a nearby day, so a result depends on the calls
+// before it at the 1e-10 level. Computing each at a day far away first
+// makes the next call at `julian_day_ut` compute afresh: a frame's Sun, stars
+// and Moon are then the same whichever frames were computed before it (a
+// shard of a sequence gives the unsharded bake's bytes). The lunar series
+// keeps no cache (ln_get_lunar_geo_posn at a day gives the same bits
+// whatever was computed before); its equatorial place reads the nutation.
+void ResetLibnovaCaches(double julian_day_ut) {
+  const double far = julian_day_ut + 400.0;
+  ln_nutation nutation{};
+  ln_get_nutation(far, &nutation);
+  ln_equ_posn equatorial{};
+  ln_get_solar_equ_coords(far, &equatorial);
+  ln_lnlat_posn ecliptic{};
+  ln_get_solar_ecl_coords(far, &ecliptic);
 }
 
 double JulianDayUt(const CivilTime& time) {
@@ -53,6 +72,7 @@ SolarPosition ComputeSolarPosition(const CivilTime& time, const GeoLocation& pla
   // example 25.b, 1992-10-13: RA 0.1 deg too large, the precession of 7.8
   // years), so they are precessed to the equinox of date before the
   // horizontal transform, which uses the sidereal time of date.
+  ResetLibnovaCaches(result.julian_day_ut);
   ln_equ_posn equatorial_j2000{};
   ln_get_solar_equ_coords(result.julian_day_ut, &equatorial_j2000);
   ln_equ_posn equatorial{};

@@ -110,9 +110,6 @@ def test_dict_style_bakes_as_its_toml(in_source, tmp_path):
     assert b.frames[0].illuminance_lux > 0
 
 
-@pytest.mark.xfail(strict=True, reason="libnova's nutation and solar series are cached by day and the sun's "
-                   "position (model/solar_position.cc) does not reset them as the Moon's does (input/astronomy.cc): "
-                   "a second load in one process differs at the 1e-10 degree level")
 def test_sun_positions_do_not_depend_on_earlier_ones(schedule_path, tmp_path):
     """The same schedule gives the same sun positions whatever was computed before it in the process."""
     first = skybake.load_schedule(str(schedule_path)).frames

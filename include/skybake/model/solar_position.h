@@ -49,6 +49,11 @@ struct SolarPosition {
 // Julian day (UT) of a civil time.
 double JulianDayUt(const CivilTime& time);
 
+// Makes libnova's next nutation and solar computation at `julian_day_ut`
+// compute afresh instead of reusing a cached nearby day (solar_position.cc):
+// positions then do not depend on what was computed before them.
+void ResetLibnovaCaches(double julian_day_ut);
+
 // The Sun's geometric position at `time` seen from `place`.
 SolarPosition ComputeSolarPosition(const CivilTime& time, const GeoLocation& place);
 
