@@ -59,9 +59,9 @@ const OiioModule& LoadOiioModule() {
       tried += fmt::format("\n  {}: {}", path, ::dlerror());
       continue;
     }
-    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v2"));
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v3"));
     if (!entry) {
-      tried += fmt::format("\n  {}: no skybake_oiio_module_v2 (a module of another skybake version)", path);
+      tried += fmt::format("\n  {}: no skybake_oiio_module_v3 (a module of another skybake version)", path);
       continue;
     }
     module = entry();
