@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/types.h>
@@ -116,6 +117,38 @@ TEST(FileDoor, AKeptReadIsTheFirstRead) {
   EXPECT_EQ(ReadKept(dir + "/absent.json", 100, again), "no such file");
   testing::WriteFile(dir, "absent.json", "late");
   EXPECT_EQ(ReadKept(dir + "/absent.json", 100, again), "no such file");
+  fs::remove_all(dir);
+}
+
+// An image a key names: a FIFO or a device is refused unread; an 8000 x
+// 8000 PNG of zeros (a small file) is refused from its header, before its
+// pixels (64 Mi samples as floats, 256 MiB) are decoded; a small image reads.
+TEST(FileDoor, ImagesAreCheckedFromTheirHeaderBeforeDecoding) {
+  const std::string dir = testing::FreshTempDir("door_images");
+  ASSERT_EQ(::mkfifo((dir + "/fifo.png").c_str(), 0600), 0);
+  fs::create_symlink("/dev/zero", dir + "/zero.png");
+  int width = 0, height = 0, channels = 0;
+  std::vector<float> pixels;
+  EXPECT_EQ(ReadImageFile(dir + "/fifo.png", width, height, channels, pixels),
+            "is a FIFO (named pipe), not a regular file");
+  EXPECT_EQ(ReadImageFile(dir + "/zero.png", width, height, channels, pixels), "is a device, not a regular file");
+  auto write_png = [&](const std::string& name, int w, int h, int c) {
+    const std::vector<uint8_t> zeros(size_t(w) * h * c, 0);
+    auto out = OIIO::ImageOutput::create(dir + "/" + name);
+    ASSERT_TRUE(out && out->open(dir + "/" + name, OIIO::ImageSpec(w, h, c, OIIO::TypeDesc::UINT8)));
+    ASSERT_TRUE(out->write_image(OIIO::TypeDesc::UINT8, zeros.data()));
+    out->close();
+  };
+  write_png("huge.png", 8000, 8000, 4);
+  EXPECT_LT(fs::file_size(dir + "/huge.png"), uint64_t(4) << 20) << "a small file";
+  EXPECT_EQ(ReadImageFile(dir + "/huge.png", width, height, channels, pixels),
+            "cannot read it as an image (8000 x 8000 texels of 4 channels, more than the 67108864 samples an input "
+            "image may have (4096 x 4096 x 4))");
+  EXPECT_TRUE(pixels.empty()) << "nothing decoded";
+  write_png("small.png", 8, 4, 3);
+  EXPECT_EQ(ReadImageFile(dir + "/small.png", width, height, channels, pixels), "");
+  EXPECT_EQ(width * height * channels, 96);
+  EXPECT_EQ(pixels.size(), 96u);
   fs::remove_all(dir);
 }
 

@@ -13,7 +13,6 @@
 #include <fmt/format.h>
 
 #include "skybake/base/errors.h"
-#include "skybake/base/oiio_module.h"
 
 namespace skybake {
 namespace {
@@ -197,14 +196,6 @@ std::string ReadFolderFile(const std::string& dir, const std::string& name, uint
   return ReadAll(fd, max_bytes, bytes);
 }
 
-std::string ReadImageFile(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels) {
-  std::shared_ptr<const std::string> bytes;
-  if (std::string problem = ReadKept(path, kMaxImageFileBytes, bytes); !problem.empty()) return problem;
-  std::string error;
-  if (!LoadOiioModule().read_image(path, *bytes, kMaxImageSamples, width, height, channels, pixels, error))
-    return "cannot read it as an image (" + error + ")";
-  return "";
-}
 
 std::string RegularFileSize(const std::string& path, uint64_t& size) {
   int fd = -1;
