@@ -83,7 +83,7 @@ TEST(ConfigTest, AllErrorsAreReportedAtOnce) {
       "pixel_type = \"double\"\n",
       "bad.toml");
   EXPECT_EQ(Messages(r), (std::vector<std::string>{
-                "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range (0, inf)",
+                "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range [1, 1000000]",
                 "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)",
                 "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]",
                 "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'"}));

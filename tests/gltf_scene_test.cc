@@ -1,13 +1,20 @@
 // The skydome mesh and the sun node: geometry checked against OpenEXR's
 // latlong mapping and glTF's light convention.
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <vector>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <OpenEXR/ImfEnvmap.h>
 
+#include "skybake/output/exr_io.h"
 #include "skybake/output/gltf_scene.h"
+#include "test_support.h"
 
 namespace skybake {
 namespace {
@@ -104,6 +111,41 @@ TEST(GltfScene, SunNodeShinesAwayFromTheSun) {
     EXPECT_LT(glm::length(light_travel + sun), 1e-9);
     EXPECT_NEAR(glm::length(q), 1.0, 1e-12);
   }
+}
+
+// Frames whose animation times differ in double but round to one float32
+// (seconds apart, 10,000 hours in): the sampler's times are still strictly
+// increasing, as glTF requires, each spaced to the next float32 after the
+// key before it; distinct float32 times are kept as they are.
+TEST(GltfScene, AnimationTimesAreStrictlyIncreasingInFloat32) {
+  const std::string dir = testing::FreshTempDir("gltf_times");
+  WritePng(dir + "/sky.png", 4, 2, std::vector<uint8_t>(4 * 2 * 3, 128));
+  SceneDescription scene;
+  scene.name = "sky";
+  scene.out_dir = dir;
+  scene.texture_file = "sky.png";
+  scene.texture_width = 4;
+  scene.texture_height = 2;
+  for (double t : {10000.0, 10000.0001, 10000.0002, 10000.0003, 10001.0}) {
+    SceneSun sun;
+    sun.time_s = t;
+    sun.illuminance_lux = 1000.0;
+    scene.suns.push_back(sun);
+  }
+  ASSERT_EQ(float(10000.0), float(10000.0003)) << "the case needs times equal in float32";
+  WriteGltfScene(scene);
+  const nlohmann::json gltf = nlohmann::json::parse(std::ifstream(dir + "/sky.gltf"));
+  const nlohmann::json& input = gltf["accessors"][gltf["animations"][0]["samplers"][0]["input"].get<int>()];
+  const nlohmann::json& view = gltf["bufferViews"][input["bufferView"].get<int>()];
+  ASSERT_EQ(input["count"].get<int>(), 5);
+  const std::string bin = testing::ReadFileBytes(dir + "/sky.bin");
+  std::vector<float> times(5);
+  std::memcpy(times.data(), bin.data() + view.value("byteOffset", size_t(0)), 5 * sizeof(float));
+  EXPECT_EQ(times[0], 10000.0f);
+  for (int k = 1; k < 4; ++k) EXPECT_EQ(times[k], std::nextafter(times[k - 1], HUGE_VALF)) << "key " << k;
+  EXPECT_EQ(times[4], 10001.0f) << "a distinct time is kept";
+  EXPECT_EQ(input["max"][0].get<float>(), 10001.0f);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -13,7 +13,9 @@
 #include <thread>
 #include <vector>
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/file.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -241,6 +243,43 @@ TEST(OutputLockTest, OverlappingClaimsAreRefusedDisjointOnesCoexist) {
   fs::remove_all(dir);
 }
 
+// The folder's mutex held by a stopped process (here: this test, holding
+// its flock): a claimer waits a bounded time, then exit 6 naming the
+// holder's pid and host as the mutex file gives them; the wait is set by
+// SKYBAKE_LOCK_WAIT_SECONDS, a bad value being a usage error.
+TEST(OutputLockTest, AHeldMutexIsWaitedForABoundedTimeThenNamed) {
+  const std::string dir = FreshTempDir("lockwait");
+  const int held = ::open((dir + "/.skybake.lock").c_str(), O_RDWR | O_CREAT, 0644);
+  ASSERT_GE(held, 0);
+  ASSERT_EQ(::flock(held, LOCK_EX), 0);
+  const std::string holder = "pid 4242\nhost farm-node-7\x1b[2J\n";
+  ASSERT_EQ(::write(held, holder.data(), holder.size()), ssize_t(holder.size()));
+  try {
+    OutputLock never = OutputLock::Claim(dir, {"sky_px.exr"}, 0.05);
+    ADD_FAILURE() << "the mutex was taken while held";
+  } catch (const OutputLockedError& e) {
+    EXPECT_EQ(e.exit_code(), 6);
+    EXPECT_NE(std::string(e.what()).find("/.skybake.lock has been held for more than 0.05 s by pid 4242 on "
+                                         "farm-node-7\\x1b[2J: that skybake is stopped or hung"),
+              std::string::npos)
+        << e.what();
+  }
+  CommandRun bake = RunSkybake("bake '" + Style() + "' --size 8 -q --out '" + dir + "'", "SKYBAKE_LOCK_WAIT_SECONDS=0");
+  EXPECT_EQ(bake.exit_code, 6) << bake.output;
+  EXPECT_NE(bake.output.find("held for more than 0 s by pid 4242 on farm-node-7"), std::string::npos) << bake.output;
+  for (const char* bad : {"nan", "-1", "1e9", "soon"}) {
+    CommandRun refused =
+        RunSkybake("bake '" + Style() + "' --size 8 -q --out '" + dir + "'", std::string("SKYBAKE_LOCK_WAIT_SECONDS=") + bad);
+    EXPECT_EQ(refused.exit_code, 2) << bad << ": " << refused.output;
+  }
+  // Released: the next claim proceeds and leaves the holder's name behind.
+  ::close(held);
+  OutputLock taken = OutputLock::Claim(dir, {"sky_px.exr"}, 0.05);
+  EXPECT_FALSE(fs::exists(dir + "/sky_px.exr"));
+  taken = OutputLock();
+  fs::remove_all(dir);
+}
+
 // Twenty frames of 64^3 take a few seconds: long enough to meet them.
 std::string SlowSequenceBake(const std::string& schedule, const std::string& out, const std::string& extra = "") {
   return "bake '" + Style() + "' --schedule '" + schedule + "' --size 48 -q --out '" + out + "' " + extra;
@@ -288,6 +327,33 @@ int WaitExit(pid_t pid) {
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
+// --out swapped for a link while a sequence runs (the folder renamed away,
+// a link to another folder put at its name, between frames 1 and 2 at the
+// frame boundary the product stops at): the later frames land in the folder
+// the bake locked and holds open, never in the link's target.
+TEST(SafeOutputs, OutSwappedForALinkMidSequenceDoesNotRedirectLaterFrames) {
+  const std::string root = FreshTempDir("outswap");
+  const std::string schedule =
+      WriteFile(root, "three.toml", "[schedule]\nsun = { elevation_deg = [10, 20, 30], azimuth_deg = 135 }\n");
+  const std::string out = root + "/out";
+  ::setenv("SKYBAKE_STOP_AFTER_FRAME", "1", 1);
+  const pid_t child = Spawn("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out + "'");
+  ::unsetenv("SKYBAKE_STOP_AFTER_FRAME");
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, WUNTRACED), child);
+  ASSERT_TRUE(WIFSTOPPED(status)) << "the bake stops itself after frame 1";
+  fs::rename(out, root + "/locked");
+  fs::create_directories(root + "/elsewhere");
+  fs::create_directory_symlink(root + "/elsewhere", out);
+  ::kill(child, SIGCONT);
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  EXPECT_TRUE(FileNames(root + "/elsewhere").empty()) << "nothing lands in the link's target";
+  const std::set<std::string> locked = FileNames(root + "/locked");
+  for (const char* name : {"sky_px.0001.exr", "sky_px.0002.exr", "sky_px.0003.exr"})
+    EXPECT_TRUE(locked.count(name)) << name << " is in the folder the bake locked";
+  fs::remove_all(root);
+}
+
 // Two bakes of the same files into one folder: the second, even with
 // --force, stops before any GPU work with exit 6 naming the first; the first
 // completes with every file matching its manifest.
@@ -311,7 +377,11 @@ TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
   CommandRun second = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
   EXPECT_EQ(second.exit_code, 6) << second.output;
   EXPECT_NE(second.output.find(fmt::format("(pid {} on ", first)), std::string::npos) << second.output;
-  EXPECT_NE(second.output.find(" bake "), std::string::npos) << "names the other's command: " << second.output;
+  // The other's command and part, not its paths (a claim is read by all
+  // who share the folder).
+  EXPECT_NE(second.output.find(": skybake bake), which writes"), std::string::npos)
+      << "names the other's command: " << second.output;
+  EXPECT_EQ(second.output.find("--schedule"), std::string::npos) << "no arguments but the part: " << second.output;
   ASSERT_EQ(WaitExit(first), 0);
   nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
   EXPECT_TRUE(manifest["complete"].get<bool>());
@@ -472,6 +542,23 @@ TEST(SafeOutputs, GalleryNeedsForceAndNeverWritesThroughALink) {
   EXPECT_EQ(ReadFileBytes(root + "/victim"), "victim");
   EXPECT_TRUE(fs::is_regular_file(fs::symlink_status(out + "/gallery.png")));
   EXPECT_EQ(ReadFileBytes(out + "/gallery.png"), sheet);
+
+  // A link planted at a style's folder (out/b -> a folder outside --out) is
+  // refused, not followed, even with --force: nothing lands in its target;
+  // a file there is refused alike.
+  fs::remove_all(out + "/b");
+  fs::create_directories(root + "/elsewhere");
+  fs::create_directory_symlink(root + "/elsewhere", out + "/b");
+  CommandRun planted = RunSkybake(gallery + " --force");
+  EXPECT_EQ(planted.exit_code, 6) << planted.output;
+  EXPECT_NE(planted.output.find("'" + out + "/b' is a symbolic link, not a folder"), std::string::npos)
+      << planted.output;
+  EXPECT_TRUE(FileNames(root + "/elsewhere").empty()) << "nothing written through the link";
+  fs::remove(out + "/b");
+  std::ofstream(out + "/b") << "a file";
+  CommandRun file = RunSkybake(gallery + " --force");
+  EXPECT_EQ(file.exit_code, 6) << file.output;
+  EXPECT_NE(file.output.find("'" + out + "/b' is a file, not a folder"), std::string::npos) << file.output;
   fs::remove_all(root);
 }
 

@@ -264,6 +264,26 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
        "frame 1: '-X' is not the face of the frame's face file 1 (+X: +X, -X, +Y, -Y, +Z, -Z in that order)"},
       {"face label missing", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][2].erase("face"); },
        "no 'face'"},
+      // Values skybake never writes (the style's ranges): exit 8 naming the
+      // entry and the frame, never a scene of infinities or a 2^31-frame loop.
+      {"gltf radius huge", "0001-0001", [](nlohmann::json& m) { m["gltf"]["radius_m"] = 1e308; },
+       "'radius_m' is 1e+308, not a number in [0.001, 100000000]"},
+      {"sun illuminance huge", "0002-0002", [](nlohmann::json& m) { m["frames"][0]["sun"]["illuminance_lux"] = 1e300; },
+       "frame 2: 'illuminance_lux' is 1e+300, not a number in [0, 1000000000000]"},
+      {"sun direction huge", "0002-0002", [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][0] = -1e308; },
+       "frame 2: 'direction'[0] is -1e+308, not a number in [-1, 1]"},
+      {"denormal sun radius", "0001-0001",
+       [](nlohmann::json& m) { m["frames"][0]["sun"]["angular_radius_rad"] = 5e-324; },
+       "frame 1: 'angular_radius_rad' is 5e-324, not a number in [1e-06, 0.5]"},
+      {"sun elevation of the wrong type", "0001-0001",
+       [](nlohmann::json& m) { m["frames"][0]["sun"]["elevation_deg"] = "high"; },
+       "frame 1: 'elevation_deg' has the wrong type"},
+      {"animation time negative", "0002-0002", [](nlohmann::json& m) { m["frames"][0]["animation_time_s"] = -1.0; },
+       "frame 2: 'animation_time_s' is -1.0, not a number in [0, 10000000]"},
+      {"part of 2^31 frames", "0001-0001", [](nlohmann::json& m) { m["part"]["last_frame"] = 2147483647; },
+       "'last_frame' is 2147483647, not an integer in [1, 10099999]"},
+      {"exposure huge", "0001-0001", [](nlohmann::json& m) { m["exposure_ev100"] = 1e308; },
+       "'exposure_ev100' is 1e+308, not a number in [-100, 100]"},
       {"texture of another frame", "0001-0001",
        [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "sky_latlong.0001.png"; },
        "gltf.texture.file 'sky_latlong.0001.png' of the shard manifests in "},
@@ -303,6 +323,20 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
                               "/manifest.shard-0002-0002.json, is not a regular file (links are not followed)"),
               std::string::npos)
         << run.output;
+  }
+  // A dangling link planted at the merged manifest's name is a file there:
+  // refused without --force (exit 6), the link left as it was.
+  {
+    const std::string dir = root + "/case";
+    fs::remove_all(dir);
+    fs::copy(parts, dir);
+    fs::create_symlink(root + "/nowhere/manifest.json", dir + "/manifest.json");
+    CommandRun run = RunSkybake("merge-manifest '" + dir + "'");
+    EXPECT_EQ(run.exit_code, 6) << run.output;
+    EXPECT_NE(run.output.find(dir + "/manifest.json already exists: pass --force to replace it"), std::string::npos)
+        << run.output;
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(dir + "/manifest.json")));
+    EXPECT_FALSE(fs::exists(root + "/nowhere"));
   }
   // Two face files of part 1 swapped on disk and in its manifest, sizes and
   // checksums with them: every name is a face name and each part is

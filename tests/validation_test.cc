@@ -35,8 +35,78 @@ const std::string kDeepKey = [] {
   return text + " = 1\n";
 }();
 
+// A quoted key of 20,000 dotted parts (40 KB) where skybake splits keys at
+// the dots: a `--set` key, a schedule frame's `set`, a ramp and a rate. Each
+// part cost a copy of the whole key before the part limit applied to them
+// (gigabytes and minutes at 50,000 parts); now refused before any split.
+std::string ManyPartKey() {
+  std::string key = "sun";
+  for (int i = 0; i < 20000; ++i) key += ".a";
+  return key;
+}
+const std::string kManyPartSet = "--set " + ManyPartKey() + "=1";
+const std::string kManyPartFrameSet = "[schedule]\n[[schedule.frames]]\nelevation_deg = 10\nazimuth_deg = 135\nset = { \"" +
+                                      ManyPartKey() + "\" = 1 }\n";
+const std::string kManyPartRamp =
+    "[schedule]\nsun = { elevation_deg = [0, 10], azimuth_deg = 135 }\n[schedule.ramp]\n\"" + ManyPartKey() +
+    "\" = [0, 1]\n";
+const std::string kManyPartRate =
+    "[schedule]\ndate = 2013-05-27\nlatitude_deg = 42.4\nlongitude_deg = -76.5\nutc_offset_hours = -4.0\n"
+    "times = [09:00:00, 10:00:00]\n"
+    "[schedule.per_hour]\n\"" + ManyPartKey() +
+    "\" = 1\n";
+
 // clang-format off
 const BadInput kBadInputs[] = {
+    // Finite but extreme values per key family (1e308, denormals): refused by
+    // check with the key's range (configs/default.toml), never an internal
+    // error after the GPU work.
+    {"AtmosphereRadiusHuge", "[atmosphere]\nbottom_radius_km = 1e308\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:20: atmosphere.bottom_radius_km: 1e+308 is out of range [1, 1000000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"AtmosphereScaleHeightDenormal", "[atmosphere.rayleigh]\nscale_height_km = 5e-324\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:19: atmosphere.rayleigh.scale_height_km: 5e-324 is out of range [0.001, 1000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"AtmosphereMieScatteringHuge", "[atmosphere.mie]\nscattering_per_km = [1e308, 0, 0]\nextinction_per_km = [1e308, 0, 0]\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:22: atmosphere.mie.scattering_per_km[0]: 1e+308 is out of range [0, 1000]\n"
+         "skybake: error: style.toml:3:22: atmosphere.mie.extinction_per_km[0]: 1e+308 is out of range [0, 1000]\n"
+         "skybake: 2 errors; nothing was baked\n"},
+    {"SunAzimuthHuge", "[sun]\nazimuth_deg = 1e308\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:15: sun.azimuth_deg: 1e+308 is out of range [-100000, 100000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SunRadiusDenormal", "[sun]\nangular_radius_rad = 1e-310\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:22: sun.angular_radius_rad: 1e-310 is out of range [1e-06, 0.5]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SunIrradianceHuge", "[sun]\nirradiance = 1e300\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:14: sun.irradiance: 1e+300 is out of range [0, 10000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"EffectsStrengthHuge", "[effects]\nsun_disc_strength = 1e308\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:21: effects.sun_disc_strength: 1e+308 is out of range [0, 1000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SceneDomeRadiusHuge", "[gltf]\nradius_m = 1e308\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: gltf.radius_m: 1e+308 is out of range [0.001, 100000000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SceneDomeRadiusDenormal", "[gltf]\nradius_m = 4.9e-324\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:12: gltf.radius_m: 5e-324 is out of range [0.001, 100000000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"PreviewEv100Huge", "[preview]\nev100 = -1e308\n", nullptr, "", 3,
+         "skybake: error: style.toml:2:9: preview.ev100: -1e+308 is out of range [-50, 50]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetExtremeValue", "", nullptr, "--set atmosphere.top_radius_km=1.7976931348623157e308", 3,
+         "skybake: error: --set atmosphere.top_radius_km=1.7976931348623157e308:1:5: atmosphere.top_radius_km: 1.7976931348623157e+308 is out of range [1, 1000000]\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"SetKeyOfManyParts", "", nullptr, kManyPartSet.c_str(), 3,
+         "skybake: error: --set: sun.(...): the key has more than 64 dotted parts (skybake's keys have at most 5, e.g. atmosphere.rayleigh.scale_height_km): give a style key\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleFrameSetKeyOfManyParts", "", kManyPartFrameSet.c_str(), "", 3,
+         "skybake: error: schedule.toml:5:40017: schedule.frames[0].set.sun.(...): a style key of more than 64 dotted parts: skybake's keys have at most 5, e.g. \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRampKeyOfManyParts", "", kManyPartRamp.c_str(), "", 3,
+         "skybake: error: schedule.toml:4:40009: schedule.ramp.sun.(...): a style key of more than 64 dotted parts: skybake's keys have at most 5, e.g. \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
+    {"ScheduleRateKeyOfManyParts", "", kManyPartRate.c_str(), "", 3,
+         "skybake: error: schedule.toml:8:40009: schedule.per_hour.sun.(...): a style key of more than 64 dotted parts: skybake's keys have at most 5, e.g. \"atmosphere.mie.g\"\n"
+         "skybake: 1 error; nothing was baked\n"},
     {"UnknownKeyWithSuggestion", R"toml([sun]
 elevaton_deg = 10
 )toml",
@@ -71,13 +141,13 @@ cube_size = 16.5
 bottom_radius_km = -6360.0
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:20: atmosphere.bottom_radius_km: -6360 is out of range (0, inf)\n"
+         "skybake: error: style.toml:2:20: atmosphere.bottom_radius_km: -6360 is out of range [1, 1000000]\n"
          "skybake: 1 error; nothing was baked\n"},
     {"NegativeScaleHeight", R"toml([atmosphere.rayleigh]
 scale_height_km = -8.0
 )toml",
      nullptr, "", 3,
-         "skybake: error: style.toml:2:19: atmosphere.rayleigh.scale_height_km: -8 is out of range (0, inf)\n"
+         "skybake: error: style.toml:2:19: atmosphere.rayleigh.scale_height_km: -8 is out of range [0.001, 1000]\n"
          "skybake: 1 error; nothing was baked\n"},
     {"TopRadiusNotAboveBottom", R"toml([atmosphere]
 bottom_radius_km = 6360.0
@@ -534,6 +604,23 @@ TEST(BadInputs, SizeOutsideTheCommandLineRangeIsAUsageError) {
 
 // A budget of nan compared false with every estimate and switched the
 // check off; inf, 0 and negatives are no budget either.
+// A name with an escape sequence (a style file named to clear the screen)
+// is printed escaped, in what succeeds as in errors.
+TEST(BadInputs, EscapeSequencesInNamesAreNotPrintedRaw) {
+  const std::string dir = testing::FreshTempDir("escaped_name");
+  const std::string name = "sky\x1b[2J\x07.toml";
+  std::ofstream(dir + "/" + name) << "[sun]\nelevation_deg = 10\n";
+  testing::CommandRun ok = testing::RunSkybake("check '" + name + "'", "cd '" + dir + "' &&");
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  EXPECT_NE(ok.output.find("\nsky\\x1b[2J\\x07.toml: ok\n"), std::string::npos) << ok.output;
+  EXPECT_EQ(ok.output.find('\x1b'), std::string::npos) << ok.output;
+  testing::CommandRun bad = testing::RunSkybake("check '" + name + "' --set sun.elevation_deg=100", "cd '" + dir + "' &&");
+  EXPECT_EQ(bad.exit_code, 3) << bad.output;
+  EXPECT_EQ(bad.output.find('\x1b'), std::string::npos) << bad.output;
+  EXPECT_EQ(bad.output.find('\x07'), std::string::npos) << bad.output;
+  fs::remove_all(dir);
+}
+
 TEST(BadInputs, BudgetsAreFiniteNumbersAboveZero) {
   const std::string style = testing::SourceDir() + "/configs/default.toml";
   for (const char* option : {"--max-memory-mib", "--max-frame-seconds"}) {

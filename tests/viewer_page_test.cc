@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <glm/glm.hpp>
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <nlohmann/json.hpp>
 
 #include "skybake/pipeline/test_pattern.h"
@@ -180,6 +181,52 @@ TEST(ViewerPageTest, EmbedSizeMustBeFinite) {
     EXPECT_NE(r.output.find("expected a finite number at or above 0"), std::string::npos) << r.output;
   }
   EXPECT_FALSE(std::filesystem::exists(dir + "/view.html"));
+}
+
+// Names a manifest lists are checked by the one check of listed names and
+// opened through the door: a name leaving the folder is exit 8 before any
+// file is opened; a link, a FIFO or a link to a device at a plain name is
+// refused unread (exit 5); nothing outside the folder reaches the page.
+TEST(ViewerPageTest, HostileManifestNamesAndFilesAreRefused) {
+  namespace fs = std::filesystem;
+  const std::string root = testing::FreshTempDir("view_hostile");
+  const std::string secret = testing::WriteFile(root, "secret.exr", "SECRET-BYTES");
+  const std::string dir = root + "/bake";
+  fs::create_directories(dir);
+  ASSERT_EQ(::mkfifo((dir + "/fifo.exr").c_str(), 0600), 0);
+  fs::create_symlink(secret, dir + "/link.exr");
+  fs::create_symlink("/dev/zero", dir + "/zero.exr");
+  testing::WriteFile(dir, "text.exr", "not an EXR");
+  struct Case {
+    const char* name;
+    int exit_code;
+    const char* message;
+  };
+  for (const Case& c : {Case{"../secret.exr", 8, "'../secret.exr' is not a plain file name of the manifest's folder"},
+                        Case{"/etc/passwd", 8, "'/etc/passwd' is not a plain file name of the manifest's folder"},
+                        Case{"sub/x.exr", 8, "'sub/x.exr' is not a plain file name of the manifest's folder"},
+                        Case{"x\\u001b[2J.exr", 8, "'x\\x1b[2J.exr' is not a plain file name"},
+                        Case{"link.exr", 5, "link.exr': it is a symbolic link, which is not followed here"},
+                        Case{"zero.exr", 5, "zero.exr': it is a symbolic link, which is not followed here"},
+                        Case{"fifo.exr", 5, "fifo.exr': it is a FIFO (named pipe), not a regular file"},
+                        Case{"text.exr", 5, "text.exr' is not an OpenEXR file"}}) {
+    SCOPED_TRACE(c.name);
+    testing::WriteFile(dir, "manifest.json",
+                       std::string(R"({"frames": [{"frame": 1, "files": [{"kind": "latlong", "file": ")") + c.name +
+                           "\"}]}]}");
+    testing::CommandRun r = testing::RunSkybake("view " + dir);
+    EXPECT_EQ(r.exit_code, c.exit_code) << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir + "/view.html"));
+  }
+  // The manifest itself as a link is not followed either.
+  fs::remove(dir + "/manifest.json");
+  testing::WriteFile(root, "elsewhere.json", R"({"frames": []})");
+  fs::create_symlink(root + "/elsewhere.json", dir + "/manifest.json");
+  testing::CommandRun r = testing::RunSkybake("view " + dir);
+  EXPECT_EQ(r.exit_code, 5) << r.output;
+  EXPECT_NE(r.output.find("manifest.json': it is a symbolic link"), std::string::npos) << r.output;
+  fs::remove_all(root);
 }
 
 }  // namespace

@@ -14,6 +14,8 @@
 #include "skybake/base/errors.h"
 #include "skybake/base/oiio_module.h"
 
+#include "skybake/base/file_door.h"
+
 namespace skybake {
 
 namespace {
@@ -59,9 +61,9 @@ const OiioModule& LoadOiioModule() {
       tried += fmt::format("\n  {}: {}", path, ::dlerror());
       continue;
     }
-    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v2"));
+    auto entry = reinterpret_cast<const OiioModule* (*)()>(::dlsym(handle, "skybake_oiio_module_v3"));
     if (!entry) {
-      tried += fmt::format("\n  {}: no skybake_oiio_module_v2 (a module of another skybake version)", path);
+      tried += fmt::format("\n  {}: no skybake_oiio_module_v3 (a module of another skybake version)", path);
       continue;
     }
     module = entry();
@@ -71,6 +73,17 @@ const OiioModule& LoadOiioModule() {
                                 "weather and formation images): it is built when OpenImageIO is installed "
                                 "(apt-get install libopenimageio-dev, then rebuild skybake), or set "
                                 "SKYBAKE_MODULE_DIR to the folder holding it; tried:{}", tried));
+}
+
+// The door's image read (file_door.h): the bytes kept by ReadKept, decoded by
+// the module from memory.
+std::string ReadImageFile(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels) {
+  std::shared_ptr<const std::string> bytes;
+  if (std::string problem = ReadKept(path, kMaxImageFileBytes, bytes); !problem.empty()) return problem;
+  std::string error;
+  if (!LoadOiioModule().read_image(path, *bytes, kMaxImageSamples, width, height, channels, pixels, error))
+    return "cannot read it as an image (" + error + ")";
+  return "";
 }
 
 }  // namespace skybake

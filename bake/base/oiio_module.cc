@@ -62,9 +62,11 @@ bool ComposeSheet(const std::vector<SheetCell>& cells, const SheetLayout& l, std
   return true;
 }
 
-bool ReadImage(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels,
-               std::string& error) {
-  auto in = OIIO::ImageInput::open(path);
+bool ReadImage(const std::string& name, const std::string& bytes, uint64_t max_samples, int& width, int& height,
+               int& channels, std::vector<float>& pixels, std::string& error) {
+  OIIO::Filesystem::IOMemReader reader(const_cast<char*>(bytes.data()), bytes.size());
+  OIIO::ImageSpec config;
+  auto in = OIIO::ImageInput::open(name, &config, &reader);
   if (!in) {
     error = OIIO::geterror();
     return false;
@@ -72,6 +74,15 @@ bool ReadImage(const std::string& path, int& width, int& height, int& channels, 
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.depth > 1) {
     error = "a 3D image (depth " + std::to_string(spec.depth) + "); expected a 2D image";
+    return false;
+  }
+  // From the header, before decoding: a small file may declare a huge image.
+  const uint64_t samples = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0)) *
+                           uint64_t(std::max(spec.nchannels, 0));
+  if (samples > max_samples) {
+    error = std::to_string(spec.width) + " x " + std::to_string(spec.height) + " texels of " +
+            std::to_string(spec.nchannels) + " channels, more than the " + std::to_string(max_samples) +
+            " samples an input image may have (4096 x 4096 x 4)";
     return false;
   }
   width = spec.width;
@@ -89,6 +100,6 @@ const OiioModule kModule = {ComposeSheet, ReadImage};
 }  // namespace
 }  // namespace skybake
 
-extern "C" __attribute__((visibility("default"))) const skybake::OiioModule* skybake_oiio_module_v2() {
+extern "C" __attribute__((visibility("default"))) const skybake::OiioModule* skybake_oiio_module_v3() {
   return &skybake::kModule;
 }

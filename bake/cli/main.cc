@@ -172,7 +172,7 @@ bool LoadBake(const BakeArgs& args, LoadedBake& bake) {
   }
   if (!args.quiet)
     for (const ConfigError& w : bake.config.warnings)
-      std::fprintf(stderr, "skybake: warning: %s\n", w.Format().c_str());
+      std::fprintf(stderr, "skybake: warning: %s\n", Printable(w.Format()).c_str());
   // A schedule makes a sequence: every frame's style is resolved and checked
   // before any GPU work.
   bake.schedule_path = args.schedule_path;
@@ -248,10 +248,10 @@ int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstim
   std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
               largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
   if (bake.schedule)
-    std::printf("%s with %s: ok, %zu frames\n", args.style_path.c_str(), bake.schedule_path.c_str(),
+    std::printf("%s with %s: ok, %zu frames\n", Printable(args.style_path).c_str(), Printable(bake.schedule_path).c_str(),
                 bake.schedule->frames.size());
   else
-    std::printf("%s: ok\n", args.style_path.c_str());
+    std::printf("%s: ok\n", Printable(args.style_path).c_str());
   return kExitOk;
 }
 
@@ -259,7 +259,7 @@ int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstim
 // manifest's and timings'.
 void PrintFiles(const std::vector<BakedFile>& files) {
   for (const BakedFile& f : files)
-    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), Printable(f.path).c_str(), (unsigned long long)f.bytes);
 }
 
 // The bake's options from the command line (and the environment main read).
@@ -353,10 +353,10 @@ int RunBake(const BakeArgs& args, Mode mode, ProgressReport* progress = nullptr)
 int RunMergeManifest(const MergeOptions& options) {
   // Check every part, then write the scene and manifest.json.
   MergeResult result = MergeShardManifests(options);
-  for (const std::string& part : result.parts) std::printf("part      %s\n", part.c_str());
+  for (const std::string& part : result.parts) std::printf("part      %s\n", Printable(part).c_str());
   for (const BakedFile& f : result.scene_files)
-    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), f.path.c_str(), (unsigned long long)f.bytes);
-  std::printf("manifest  %s  %d frames from %zu part%s\n", result.manifest_path.c_str(), result.frames,
+    std::printf("%s  %s  %llu bytes\n", f.kind.c_str(), Printable(f.path).c_str(), (unsigned long long)f.bytes);
+  std::printf("manifest  %s  %d frames from %zu part%s\n", Printable(result.manifest_path).c_str(), result.frames,
               result.parts.size(), result.parts.size() == 1 ? "" : "s");
   return kExitOk;
 }
@@ -372,7 +372,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   // Parse and validate every style first: nothing is baked if one is wrong.
   std::vector<std::string> styles = StyleFilesIn(gallery.styles_dir);
   if (styles.empty()) {
-    std::fprintf(stderr, "skybake: error: no .toml styles in %s\n", gallery.styles_dir.c_str());
+    std::fprintf(stderr, "skybake: error: no .toml styles in %s\n", Printable(gallery.styles_dir).c_str());
     return kExitUsage;
   }
   std::vector<ConfigError> errors;
@@ -399,7 +399,7 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
     options.bake.progress = [&done, &styles](const StageReport& s) {
       if (s.name != "preview") return;
       std::fprintf(stderr, "skybake: gallery %zu/%zu %s (%s)\n", done + 1, styles.size(),
-                   styles[done].c_str(), s.detail.c_str());
+                   Printable(styles[done]).c_str(), Printable(s.detail).c_str());
       ++done;
     };
   }
@@ -407,8 +407,8 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
 
   // Report: every style with its principles, then the sheet.
   for (const GalleryEntry& e : result.entries)
-    std::printf("style    %-24s %s\n", e.name.c_str(), e.principles.c_str());
-  std::printf("gallery  %s\n", result.contact_sheet.c_str());
+    std::printf("style    %-24s %s\n", Printable(e.name).c_str(), Printable(e.principles).c_str());
+  std::printf("gallery  %s\n", Printable(result.contact_sheet).c_str());
   if (result.validation_messages > 0) {
     std::fprintf(stderr, "skybake: error: the Vulkan validation layer reported %d messages\n",
                  result.validation_messages);
@@ -652,11 +652,11 @@ int RunCommand(Cli& cli) {
   if (cli.gallery->parsed()) return RunGallery(cli.gallery_args, cli.args);
   if (cli.view->parsed()) {
     if (const char* three = std::getenv("SKYBAKE_THREE_DIR")) cli.view_options.three_dir = three;
-    std::printf("%s\n", WriteViewPage(cli.view_options).c_str());
+    std::printf("%s\n", Printable(WriteViewPage(cli.view_options)).c_str());
     return kExitOk;
   }
   if (cli.testpattern->parsed()) {
-    for (const std::string& path : WriteTestPattern(cli.pattern)) std::printf("%s\n", path.c_str());
+    for (const std::string& path : WriteTestPattern(cli.pattern)) std::printf("%s\n", Printable(path).c_str());
     return kExitOk;
   }
   if (cli.merge->parsed()) {
@@ -697,7 +697,7 @@ int RunReportingErrors(Cli& cli) {
     return kExitOutput;
   } catch (const std::exception& e) {
     if (first_error.empty()) first_error = std::string("internal error: ") + e.what();
-    std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", e.what());
+    std::fprintf(stderr, "skybake: internal error: %s (please report it)\n", Printable(e.what()).c_str());
     return kExitInternal;
   }
 }

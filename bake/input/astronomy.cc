@@ -18,6 +18,7 @@
 #include <libnova/transform.h>
 #include <nlohmann/json.hpp>
 
+#include "skybake/base/file_door.h"
 #include "skybake/input/config.h"
 
 namespace skybake {
@@ -54,14 +55,16 @@ SkyDirection FromLibnovaHorizontal(const ln_hrz_posn& h) {
 }  // namespace
 
 std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = fmt::format("cannot read the star catalogue {}: give night.star_catalogue the path of a d3-celestial "
+  // Through the door (file_door.h): a regular file, capped, read once per
+  // process, so every frame of a bake draws the same stars.
+  std::shared_ptr<const std::string> bytes;
+  if (const std::string problem = ReadKept(path, kMaxCatalogueBytes, bytes); !problem.empty()) {
+    error = fmt::format("cannot read the star catalogue {}: it {}: give night.star_catalogue the path of a d3-celestial "
                         "stars.*.json (bash .ci/setup installs configs/stars/node_modules/d3-celestial/data/stars.8.json)",
-                        EscapedText(path));
+                        EscapedText(path), problem == "no such file" ? "does not exist" : problem);
     return std::nullopt;
   }
-  nlohmann::json doc = nlohmann::json::parse(in, nullptr, false);
+  nlohmann::json doc = nlohmann::json::parse(*bytes, nullptr, false);
   if (doc.is_discarded() || !doc.is_object() || !doc.contains("features") || !doc["features"].is_array()) {
     error = fmt::format("{} is not a d3-celestial star file (a GeoJSON FeatureCollection with \"features\"): give "
                         "night.star_catalogue a stars.6.json, stars.8.json or stars.14.json of d3-celestial",

@@ -28,6 +28,7 @@
 #include <glm/glm.hpp>
 #include <toml++/toml.h>
 
+#include "skybake/base/file_door.h"
 #include "toml_reader.h"
 
 namespace skybake {
@@ -35,13 +36,9 @@ namespace {
 
 // --------------------------------------------------------------- ranges
 
-constexpr double kInf = HUGE_VAL;
-constexpr Range kPositive{0.0, kInf, true, true};
-constexpr Range kNonNegative{0.0, kInf, false, true};
 constexpr Range kUnit{0.0, 1.0, false, false};
 constexpr Range kOpenUnitSymmetric{-1.0, 1.0, true, true};
 constexpr Range kElevation{-90.0, 90.0, false, false};
-constexpr Range kSunRadius{0.0, 0.5, true, false};
 constexpr Range kNoiseThreshold{-1.0, 1.0, false, true};
 constexpr Range kShapeRadius{0.0, 90.0, true, false};
 constexpr Range kAzimuth{-360.0, 360.0, false, false};
@@ -54,6 +51,30 @@ constexpr Range kCloudDistance{1.0, 2000.0, false, false};
 constexpr Range kCloudPanoramaScale{0.0, 4.0, false, false};
 constexpr Range kIblLodBias{-4.0, 4.0, false, false};
 constexpr Range kIblFullSamplesRoughness{0.0, 1.0, false, false};
+
+// The physical keys' ranges (configs/default.toml states them): wide enough
+// for any planet and any sky a style can mean, narrow enough that every
+// product the renderer forms stays finite in float32 (about 3.4e38) and no
+// division meets a denormal. A planet from a 1 km moonlet to a 10^6 km
+// giant (Jupiter: 69,911 km; hard_cases_test bakes 1 km and 10^5 km); an
+// observer up to 10,000 km; coefficients
+// up to 1000 per km (fog of 3 m visibility is about 1300 per km of
+// extinction, Koschmieder 3.912 / V); scale heights and widths from 1 m to
+// 1000 km; the Sun's disc from 1e-6 rad (a point) to 0.5 rad, its
+// irradiance up to 1e4 W m^-2 nm^-1 (about 5000 times Earth's);
+// artistic multipliers and the night floor up to 1000.
+constexpr Range kPlanetRadiusKm{1.0, 1e6, false, false};
+constexpr Range kObserverAltitudeM{0.0, 1e7, false, false};
+constexpr Range kPerKm{0.0, 1e3, false, false};
+constexpr Range kHeightKm{1e-3, 1e3, false, false};
+constexpr Range kPeakAltitudeKm{0.0, 1e3, false, false};
+constexpr Range kSunRadiusRad{1e-6, 0.5, false, false};
+constexpr Range kSunAzimuth{-1e5, 1e5, false, false};
+constexpr Range kIrradiance{0.0, 1e4, false, false};
+constexpr Range kMultiplier{0.0, 1e3, false, false};
+constexpr Range kEv100{-50.0, 50.0, false, false};    // moonless night about -10, snow in sunlight about 16
+constexpr Range kViewerPosition{-1e6, 1e6, false, false};  // within the largest dome
+constexpr Range kGltfRadiusM{1e-3, 1e8, false, false};  // finite in float32 with its vertices' products
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -81,19 +102,19 @@ bool IsSafeFileName(const std::string& name) { return IsPlainFileName(name); }
 template <class Visitor>
 void VisitAtmosphere(SkyStyle& s, Visitor& v) {
   AtmosphereParams& a = s.atmosphere;
-  v.Real("atmosphere.bottom_radius_km", a.bottom_radius_km, kPositive);
-  v.Real("atmosphere.top_radius_km", a.top_radius_km, kPositive);
-  v.Real("atmosphere.observer_altitude_m", a.observer_altitude_m, kNonNegative);
+  v.Real("atmosphere.bottom_radius_km", a.bottom_radius_km, kPlanetRadiusKm);
+  v.Real("atmosphere.top_radius_km", a.top_radius_km, kPlanetRadiusKm);
+  v.Real("atmosphere.observer_altitude_m", a.observer_altitude_m, kObserverAltitudeM);
   v.Triple("atmosphere.ground_albedo", a.ground_albedo, kUnit);
-  v.Triple("atmosphere.rayleigh.scattering_per_km", a.rayleigh_scattering_per_km, kNonNegative);
-  v.Real("atmosphere.rayleigh.scale_height_km", a.rayleigh_scale_height_km, kPositive);
-  v.Triple("atmosphere.mie.scattering_per_km", a.mie_scattering_per_km, kNonNegative);
-  v.Triple("atmosphere.mie.extinction_per_km", a.mie_extinction_per_km, kNonNegative);
-  v.Real("atmosphere.mie.scale_height_km", a.mie_scale_height_km, kPositive);
+  v.Triple("atmosphere.rayleigh.scattering_per_km", a.rayleigh_scattering_per_km, kPerKm);
+  v.Real("atmosphere.rayleigh.scale_height_km", a.rayleigh_scale_height_km, kHeightKm);
+  v.Triple("atmosphere.mie.scattering_per_km", a.mie_scattering_per_km, kPerKm);
+  v.Triple("atmosphere.mie.extinction_per_km", a.mie_extinction_per_km, kPerKm);
+  v.Real("atmosphere.mie.scale_height_km", a.mie_scale_height_km, kHeightKm);
   v.Real("atmosphere.mie.g", a.mie_g, kOpenUnitSymmetric);
-  v.Triple("atmosphere.ozone.absorption_per_km", a.ozone_absorption_per_km, kNonNegative);
-  v.Real("atmosphere.ozone.peak_altitude_km", a.ozone_peak_altitude_km, kNonNegative);
-  v.Real("atmosphere.ozone.half_width_km", a.ozone_half_width_km, kPositive);
+  v.Triple("atmosphere.ozone.absorption_per_km", a.ozone_absorption_per_km, kPerKm);
+  v.Real("atmosphere.ozone.peak_altitude_km", a.ozone_peak_altitude_km, kPeakAltitudeKm);
+  v.Real("atmosphere.ozone.half_width_km", a.ozone_half_width_km, kHeightKm);
 }
 
 // The Sun: where it is, its disc and irradiance.
@@ -101,9 +122,9 @@ template <class Visitor>
 void VisitSun(SkyStyle& s, Visitor& v) {
   AtmosphereParams& a = s.atmosphere;
   v.Real("sun.elevation_deg", s.sun.elevation_deg, kElevation);
-  v.Real("sun.azimuth_deg", s.sun.azimuth_deg, kAnyFinite);
-  v.Real("sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadius);
-  v.Triple("sun.irradiance", a.solar_irradiance, kNonNegative);
+  v.Real("sun.azimuth_deg", s.sun.azimuth_deg, kSunAzimuth);
+  v.Real("sun.angular_radius_rad", a.sun_angular_radius_rad, kSunRadiusRad);
+  v.Triple("sun.irradiance", a.solar_irradiance, kIrradiance);
   v.Real("sun.limb_darkening_u", a.limb_darkening_u, kUnit);
 }
 
@@ -115,11 +136,11 @@ void VisitEffects(SkyStyle& s, Visitor& v) {
   v.Bool("effects.ground", s.effects.ground);
   v.Bool("effects.mie", s.effects.mie);
   v.Bool("effects.ozone", s.effects.ozone);
-  v.Real("effects.multiple_scattering_strength", s.effects.multiple_scattering_strength, kNonNegative);
-  v.Real("effects.sun_disc_strength", s.effects.sun_disc_strength, kNonNegative);
+  v.Real("effects.multiple_scattering_strength", s.effects.multiple_scattering_strength, kMultiplier);
+  v.Real("effects.sun_disc_strength", s.effects.sun_disc_strength, kMultiplier);
   v.Bool("effects.night_dimming", s.effects.night_dimming);
   v.Real("effects.night_dimming_strength", s.effects.night_dimming_strength, kUnit);
-  v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kNonNegative);
+  v.Real("effects.night_sky_luminance_cd_m2", s.effects.night_sky_luminance_cd_m2, kMultiplier);
 }
 
 template <class Visitor>
@@ -215,7 +236,7 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
   v.Engines("output.engine", o.engine);
 
   v.Bool("preview.auto_exposure", s.preview.auto_exposure);
-  v.Real("preview.ev100", s.preview.ev100, kAnyFinite);
+  v.Real("preview.ev100", s.preview.ev100, kEv100);
 }
 
 // AOAS (Shen, Mallett, Shkurko 2019): the aesthetic principles.
@@ -225,10 +246,10 @@ void VisitAoas(SkyStyle& s, Visitor& v) {
   v.Uint("aoas.seed", x.seed);
   v.Bool("skydome.enabled", x.skydome.enabled);
   v.Real("skydome.radius", x.skydome.radius, kDomeRadius);
-  v.Vector("skydome.viewer_position", x.skydome.viewer_position, kAnyFinite);
+  v.Vector("skydome.viewer_position", x.skydome.viewer_position, kViewerPosition);
   v.Bool("hue.enabled", x.hue.enabled);
   v.Color("hue.color", x.hue.color);
-  v.Triple("hue.rayleigh_per_km", x.hue.rayleigh_per_km, kNonNegative);
+  v.Triple("hue.rayleigh_per_km", x.hue.rayleigh_per_km, kPerKm);
   v.Real("hue.strength", x.hue.strength, kUnit);
   v.Bool("ambiguity.enabled", x.ambiguity.enabled);
   v.Real("ambiguity.l_pt", x.ambiguity.l_pt, kUnit);  // 0: no perturbation (pruned)
@@ -274,7 +295,7 @@ void VisitGltf(SkyStyle& s, Visitor& v) {
   GltfSettings& g = s.gltf;
   v.Bool("gltf.enabled", g.enabled);
   v.Choice("gltf.dome", g.dome, {{"sphere", DomeShape::kSphere}, {"hemisphere", DomeShape::kHemisphere}});
-  v.Real("gltf.radius_m", g.radius_m, kPositive);
+  v.Real("gltf.radius_m", g.radius_m, kGltfRadiusM);
   v.Real("gltf.flattening", g.flattening, kFlattening);
   v.Int("gltf.segments", g.segments, 8, 1024);
   v.Bool("gltf.image_based_light", g.image_based_light);
@@ -1020,6 +1041,14 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
          "[schedule.ramp] or a frame's set");
     return;
   }
+  if (KeyHasTooManyParts(key)) {
+    // Refused before the key is split (the key named by its first part).
+    fail(fmt::format("the key has more than {} dotted parts (skybake's keys have at most 5, e.g. "
+                     "atmosphere.rayleigh.scale_height_km): give a style key",
+                     kMaxKeyParts));
+    errors.back().key = key.substr(0, key.find('.')) + ".(...)";
+    return;
+  }
   if (DeepKey(value)) {
     fail(fmt::format("the value nests more than {} dotted key parts: give a plain value", kMaxKeyParts));
     return;
@@ -1056,15 +1085,16 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
   toml::table* table = &root;
   std::string_view path = key;
   size_t dot;
+  // An empty table located at the argument, copied for each part made.
+  const toml::table made_in = toml::parse("t = {}", name);
+  const toml::table& made = *made_in.get("t")->as_table();
   while ((dot = path.find('.')) != std::string_view::npos) {
     std::string_view part = path.substr(0, dot);
     if (part.empty()) {
       fail("empty part in the key path (two dots, or a leading dot): e.g. --set sun.elevation_deg=10");
       return;
     }
-    toml::table made_in = toml::parse("t = {}", name);
-    toml::table made = std::move(*made_in.get("t")->as_table());
-    auto [it, inserted] = table->insert(toml::key(part, region_at(key.size() - path.size())), std::move(made));
+    auto [it, inserted] = table->insert(toml::key(part, region_at(key.size() - path.size())), toml::table(made));
     if (!it->second.is_table()) {
       fail(fmt::format("'{}' is not a table", part));
       return;
@@ -1453,6 +1483,13 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   return result;
 }
 
+bool KeyHasTooManyParts(std::string_view key) {
+  size_t parts = 1;
+  for (size_t at = key.find('.'); at != std::string_view::npos; at = key.find('.', at + 1))
+    if (++parts > kMaxKeyParts) return true;
+  return false;
+}
+
 std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string& name) {
   std::optional<toml::source_position> at = DeepKey(text);
   if (!at) return std::nullopt;
@@ -1471,43 +1508,23 @@ std::optional<ConfigError> ReadInputFile(const std::string& path, const char* wh
   ConfigError e;
   e.file = path;
   e.key = "(file)";
-  struct stat st {};
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) {
+  // Through the door (file_door.h): non-blocking, a regular file, capped
+  // whatever the size says (a file in /proc says 0).
+  const std::string problem = ReadRegularFile(path, kMaxInputBytes, FileLinks::kFollow, text);
+  if (problem.empty()) return std::nullopt;
+  if (problem == "no such file" || problem.rfind("cannot be opened", 0) == 0 || problem.rfind("cannot be read (no", 0) == 0)
     e.message = fmt::format("cannot open the {} file: check the path", what);
-    return e;
-  }
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    e.message = S_ISDIR(st.st_mode) ? fmt::format("is a directory: give a {} TOML file", what)
-                                    : fmt::format("is not a regular file (a device, a pipe or a socket): give a {} "
-                                                  "TOML file", what);
-    return e;
-  }
-  // Read up to the limit, whatever the size says (a file in /proc says 0).
-  text.clear();
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      e.message = fmt::format("cannot read the {} file: {}", what, std::strerror(errno));
-      ::close(fd);
-      return e;
-    }
-    if (n == 0) break;
-    text.append(buffer, size_t(n));
-    if (text.size() > kMaxInputBytes) {
-      ::close(fd);
-      e.message = fmt::format("is larger than {} MiB, the limit of a style or schedule file (a schedule of "
-                              "100,000 frames listed one by one is under 8 MiB): give a {} TOML file",
-                              kMaxInputBytes >> 20, what);
-      text.clear();
-      return e;
-    }
-  }
-  ::close(fd);
-  return std::nullopt;
+  else if (problem == "is a directory, not a file")
+    e.message = fmt::format("is a directory: give a {} TOML file", what);
+  else if (problem.find("not a regular file") != std::string::npos)
+    e.message = fmt::format("is not a regular file (a device, a pipe or a socket): give a {} TOML file", what);
+  else if (problem.find("MiB") != std::string::npos)
+    e.message = fmt::format("is larger than {} MiB, the limit of a style or schedule file (a schedule of "
+                            "100,000 frames listed one by one is under 8 MiB): give a {} TOML file",
+                            kMaxInputBytes >> 20, what);
+  else
+    e.message = fmt::format("the {} file {}", what, problem);
+  return e;
 }
 
 ConfigResult LoadSkyStyle(const std::string& path, const std::vector<std::string>& overrides) {

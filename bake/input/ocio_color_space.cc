@@ -3,9 +3,12 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <sstream>
 
 #include <OpenColorIO/OpenColorIO.h>
 #include <fmt/format.h>
+
+#include "skybake/base/file_door.h"
 
 namespace skybake {
 namespace {
@@ -57,22 +60,22 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
   ColorSpaceLookup r;
   // A config is a small text file: not a FIFO, a device or a folder that
   // OpenColorIO would block on or read without end.
-  std::error_code error;
-  const std::filesystem::file_status status = std::filesystem::status(path, error);
-  if (error || !std::filesystem::is_regular_file(status) ||
-      std::filesystem::file_size(path, error) > kMaxConfigBytes || error) {
+  // Through the door (file_door.h): a regular file, capped, read once.
+  std::shared_ptr<const std::string> bytes;
+  if (const std::string problem = ReadKept(path, kMaxConfigBytes, bytes); !problem.empty()) {
     r.error = fmt::format("'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
-                          "cannot be read: {}",
-                          name, BuiltinColorSpaceNames(), path,
-                          error ? error.message()
-                                : std::filesystem::is_regular_file(status)
-                                      ? fmt::format("over {} MiB", kMaxConfigBytes >> 20)
-                                      : std::string("not a regular file"));
+                          "cannot be read: it {}",
+                          name, BuiltinColorSpaceNames(), path, problem);
     return r;
   }
   OCIO::ConstConfigRcPtr config;
   try {
-    config = OCIO::Config::CreateFromFile(path.c_str());
+    std::istringstream stream(*bytes);
+    OCIO::ConfigRcPtr read = OCIO::Config::CreateFromStream(stream)->createEditableCopy();
+    // Its LUTs' search paths are relative to the config's folder, as
+    // CreateFromFile would set.
+    read->setWorkingDir(std::filesystem::absolute(path).parent_path().string().c_str());
+    config = read;
   } catch (const OCIO::Exception& e) {
     r.error = fmt::format("'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
                           "cannot be read: {}",

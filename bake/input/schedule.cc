@@ -125,8 +125,15 @@ class ScheduleReader : public TomlReader {
     bool ok = !key.empty() && key.front() != '.' && key.back() != '.' && key.find("..") == std::string::npos;
     for (char c : key)
       ok = ok && ((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '.');
-    if (!ok)
+    if (!ok) {
       Error(&node, where, fmt::format("'{}' is not a style key: use a dotted key such as \"atmosphere.mie.g\"", key));
+    } else if (KeyHasTooManyParts(key)) {
+      // Refused here, once, before any frame's style splits it at the dots.
+      Error(&node, where.substr(0, where.size() - key.size()) + key.substr(0, key.find('.')) + ".(...)",
+            fmt::format("a style key of more than {} dotted parts: skybake's keys have at most 5, e.g. "
+                        "\"atmosphere.mie.g\"", kMaxKeyParts));
+      ok = false;
+    }
     return ok;
   }
 

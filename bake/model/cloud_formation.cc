@@ -11,7 +11,7 @@
 
 #include <fmt/format.h>
 
-#include "skybake/base/oiio_module.h"
+#include "skybake/base/file_door.h"
 #include "skybake/model/clouds.h"
 
 namespace skybake {
@@ -23,14 +23,10 @@ namespace {
 
 // Reads the image and checks it against the formation: "" or what is wrong.
 std::string LoadMask(const std::string& path, const CloudFormation& f, CloudMask* mask) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return "no such file";
-  if (!std::filesystem::is_regular_file(path, ec)) return "not a regular file";
   int width = 0, height = 0, channels = 0;
   std::vector<float> pixels;
-  std::string error;
-  if (!LoadOiioModule().read_image(path, width, height, channels, pixels, error))
-    return "cannot read it as an image (" + error + ")";
+  // Through the door (file_door.h): a regular file, read once per bake.
+  if (std::string problem = ReadImageFile(path, width, height, channels, pixels); !problem.empty()) return problem;
   if (channels < 3)
     return fmt::format("{} channel{}; a mask needs 3 or 4 (R humidity, G phase readiness, B extinction)", channels,
                        channels == 1 ? "" : "s");

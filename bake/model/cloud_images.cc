@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "skybake/base/oiio_module.h"
+#include "skybake/base/file_door.h"
 #include "skybake/model/clouds.h"
 
 namespace skybake {
@@ -20,12 +20,11 @@ struct LoadedImage {
 
 // "" when the image loads and has 1, 3 or 4 channels; else what is wrong.
 std::string LoadImage(const std::string& path, LoadedImage& image) {
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return "no such file";
-  if (!std::filesystem::is_regular_file(path, ec)) return "not a regular file";
-  std::string error;
-  if (!LoadOiioModule().read_image(path, image.width, image.height, image.channels, image.pixels, error))
-    return "cannot read it as an image (" + error + ")";
+  // Through the door (file_door.h): a regular file, read once per bake,
+  // its size checked from its header.
+  if (std::string problem = ReadImageFile(path, image.width, image.height, image.channels, image.pixels);
+      !problem.empty())
+    return problem;
   if (image.width < 1 || image.height < 1) return "the image is empty";
   if (image.channels != 1 && image.channels != 3 && image.channels != 4)
     return fmt::format("{} channels; expected 1 (coverage) or 3/4 (R = coverage)", image.channels);

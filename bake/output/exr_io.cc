@@ -1,9 +1,12 @@
 #include "skybake/output/exr_io.h"
+#include "skybake/base/file_door.h"
 #include "skybake/output/png_io.h"
 
 #include "exr_deflate.h"
 
 #include <atomic>
+#include <functional>
+#include <map>
 #include <chrono>
 #include <cerrno>
 #include <cfloat>
@@ -105,15 +108,37 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes) {
 void WriteFileAtomically(const std::string& path, const std::function<void(const ByteSink&)>& produce) {
   std::string temporary;
   bool created = false;
+  std::function<void()> remove_temporary = [&] { ::unlink(temporary.c_str()); };
   auto fail = [&](const char* what, int error, int fd) {
     if (fd >= 0) ::close(fd);
-    if (created) ::unlink(temporary.c_str());
+    if (created) remove_temporary();
     throw OutputError(fmt::format("cannot write {} ({} {}: {}){}", path, what, temporary, std::strerror(error),
                                   WriteFix(error)));
   };
-  int fd = CreateExclusiveFile(temporary, path);
+  // In a held folder (file_door.h) relative to its descriptor: the
+  // folder the bake locked, whatever its name points to now.
+  const std::filesystem::path target(path);
+  const int dir_fd = HeldFolder(target.parent_path().string());
+  const std::string name = target.filename().string();
+  std::string temporary_name;
+  auto unlink_temporary = [&] {
+    if (dir_fd >= 0) ::unlinkat(dir_fd, temporary_name.c_str(), 0);
+    else ::unlink(temporary.c_str());
+  };
+  int fd = -1;
+  if (dir_fd >= 0) {
+    for (int attempt = 0;; ++attempt) {
+      temporary = TemporaryPathFor(path);
+      temporary_name = std::filesystem::path(temporary).filename().string();
+      fd = ::openat(dir_fd, temporary_name.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+      if (fd >= 0 || errno != EEXIST || attempt == 16) break;
+    }
+  } else {
+    fd = CreateExclusiveFile(temporary, path);
+  }
   if (fd < 0) fail("creating", errno, -1);
   created = true;
+  remove_temporary = unlink_temporary;
   const ByteSink write = [&](std::string_view bytes) {
     for (size_t done = 0; done < bytes.size();) {
       ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
@@ -128,16 +153,18 @@ void WriteFileAtomically(const std::string& path, const std::function<void(const
     throw;  // from `write`: the descriptor is closed and the temporary removed
   } catch (...) {
     ::close(fd);
-    ::unlink(temporary.c_str());
+    unlink_temporary();
     throw;
   }
   // On disk before the rename, so that even a power cut leaves the old file
   // or the whole new one.
   if (::fsync(fd) != 0) fail("syncing", errno, fd);
   if (::close(fd) != 0) fail("closing", errno, -1);
-  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+  const int renamed = dir_fd >= 0 ? ::renameat(dir_fd, temporary_name.c_str(), dir_fd, name.c_str())
+                                  : std::rename(temporary.c_str(), path.c_str());
+  if (renamed != 0) {
     int error = errno;
-    ::unlink(temporary.c_str());
+    unlink_temporary();
     throw OutputError(fmt::format("cannot move {} into place: {}", path, std::strerror(error)));
   }
 }

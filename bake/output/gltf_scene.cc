@@ -1,4 +1,6 @@
 #include "skybake/output/gltf_scene.h"
+
+#include "skybake/base/file_door.h"
 #include "skybake/output/gltf_ibl.h"
 
 #include <algorithm>
@@ -162,27 +164,13 @@ int AddMeshNode(tinygltf::Model& model, const std::string& name, tinygltf::Primi
   return int(model.nodes.size()) - 1;
 }
 
-// The texture PNG: a regular file, never read through a link.
+// The texture PNG through the door (file_door.h): a regular file of the
+// folder, never read through a link; at most 1 GiB (a 16384 x 8192 RGB PNG
+// stored raw is 384 MiB).
 std::string ReadFile(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_NONBLOCK | O_CLOEXEC);
-  struct stat st {};
-  if (fd < 0 || ::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    if (fd >= 0) ::close(fd);
-    throw OutputError(fmt::format("cannot read {} for the glTF scene: not a regular file", path));
-  }
   std::string bytes;
-  char buffer[1 << 16];
-  for (;;) {
-    const ssize_t n = ::read(fd, buffer, sizeof buffer);
-    if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      ::close(fd);
-      throw OutputError(fmt::format("cannot read {} for the glTF scene: {}", path, std::strerror(errno)));
-    }
-    if (n == 0) break;
-    bytes.append(buffer, size_t(n));
-  }
-  ::close(fd);
+  if (const std::string problem = ReadRegularFile(path, uint64_t(1) << 30, FileLinks::kRefuse, bytes); !problem.empty())
+    throw OutputError(fmt::format("cannot read {} for the glTF scene: it {}", path, problem));
   return bytes;
 }
 
@@ -347,7 +335,14 @@ struct RotationKeys {
 RotationKeys AddRotationKeys(tinygltf::Model& model, const std::vector<SceneSun>& keys) {
   std::vector<float> times, rotations;
   for (const SceneSun& k : keys) {
-    times.push_back(float(k.time_s));
+    // glTF wants a sampler's times strictly increasing; distinct times in
+    // double can round to one float32 (frames seconds apart a year in,
+    // hours_from_start near 1e4): such a key is spaced to the next float
+    // after its predecessor (a shift of at most a few float32 ulps, about
+    // 1e-3 h a year in), never dropped or refused.
+    float t = float(k.time_s);
+    if (!times.empty() && !(t > times.back())) t = std::nextafter(times.back(), HUGE_VALF);
+    times.push_back(t);
     const glm::dquat q = SunNodeRotation(k.direction);
     rotations.insert(rotations.end(), {float(q.x), float(q.y), float(q.z), float(q.w)});
   }

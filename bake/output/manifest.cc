@@ -1,4 +1,6 @@
 #include "skybake/output/manifest.h"
+
+#include "skybake/base/file_door.h"
 #include "skybake/output/sha256.h"
 
 #include <algorithm>
@@ -166,33 +168,66 @@ class Reader {
     if (v.size() != 3) Fail(fmt::format("'{}' is not 3 numbers", key));
     return {v[0], v[1], v[2]};
   }
-  Rgb RgbOf(const json& object, const char* key) const {
-    glm::dvec3 v = Vector(object, key);
-    return {v.x, v.y, v.z};
-  }
   ShRgb Sh(const json& object, const char* key) const {
     std::vector<std::vector<double>> rows = Get<std::vector<std::vector<double>>>(object, key);
     ShRgb sh{};
     if (rows.size() != sh.size()) Fail(fmt::format("'{}' is not {} rows", key, sh.size()));
     for (size_t i = 0; i < sh.size(); ++i) {
       if (rows[i].size() != 3) Fail(fmt::format("'{}' row {} is not 3 numbers", key, i));
+      for (double v : rows[i])
+        if (!(std::abs(v) <= 1e15)) Fail(fmt::format("'{}' row {} has {}, not a number in [-1e15, 1e15]", key, i, v));
       sh[i] = {rows[i][0], rows[i][1], rows[i][2]};
     }
     return sh;
   }
+  // Frame numbers as a schedule gives them: from 1 to 9,999,999 +
+  // 100,000 frames, a sequence of at most 100,000 (schedule.h).
   FrameRange Range(const json& object, const char* key) const {
     const json& r = Get<json>(object, key);
-    FrameRange range{Int(r, "first_frame"), Int(r, "last_frame")};
+    FrameRange range{int(Integer(r, "first_frame", 1, kMaxFrameNumber)), int(Integer(r, "last_frame", 1, kMaxFrameNumber))};
     if (range.last < range.first) Fail(fmt::format("'{}' ends before it starts", key));
+    if (int64_t(range.last) - range.first >= kMaxSequenceFrames)
+      Fail(fmt::format("'{}' spans more than the {} frames of a sequence", key, kMaxSequenceFrames));
     return range;
   }
-  [[noreturn]] void Fail(const std::string& what) const {
-    throw ManifestError(fmt::format("{}: {}: not a skybake manifest, or one from another version", path_, what));
+  // A finite number in [lo, hi]: the values skybake writes for the key (the
+  // style's ranges, configs/default.toml, and what follows from them).
+  double Real(const json& object, const char* key, double lo, double hi) const {
+    const json& v = Get<json>(object, key);
+    if (!v.is_number()) Fail(fmt::format("'{}' has the wrong type", key));
+    const double x = v.get<double>();
+    if (!(x >= lo && x <= hi)) Fail(fmt::format("'{}' is {}, not a number in [{}, {}]", key, v.dump(), lo, hi));
+    return x;
   }
+  glm::dvec3 Bounded(const json& object, const char* key, double lo, double hi) const {
+    const glm::dvec3 v = Vector(object, key);
+    for (int i = 0; i < 3; ++i)
+      if (!(v[i] >= lo && v[i] <= hi))
+        Fail(fmt::format("'{}'[{}] is {}, not a number in [{}, {}]", key, i, v[i], lo, hi));
+    return v;
+  }
+  [[noreturn]] void Fail(const std::string& what) const {
+    throw ManifestError(
+        fmt::format("{}: {}{}: not a skybake manifest, or one from another version", path_, where_, what));
+  }
+  // What an error names before the entry: "frame 12: " while a frame is read.
+  void At(std::string where) const { where_ = std::move(where); }
+
+  static constexpr int64_t kMaxFrameNumber = 9999999 + 100000;
+  static constexpr int64_t kMaxSequenceFrames = 100000;
 
  private:
   std::string path_;
+  mutable std::string where_;
 };
+
+// The ranges of the numbers a manifest records (Reader::Real): a sun or
+// Moon up to 1e12 lux (10^4 W m^-2 nm^-1 of irradiance, the style's
+// largest, is about 10^9 lux), SH coefficients up to 1e15, times up to 1e7
+// (hours of a schedule or frame indices), EV100 within [-100, 100].
+constexpr double kMaxLux = 1e12;
+constexpr double kMaxSh = 1e15;
+constexpr double kMaxTime = 1e7;
 
 // The largest file a manifest may list: 2^53 bytes (8 PiB), the integers a
 // JSON number holds exactly in every reader.
@@ -241,6 +276,16 @@ json SharedPart(json manifest) {
                                   path, where, EscapedText(name), expected));
 }
 
+}  // namespace
+
+bool IsListedNameOk(const std::string& name) { return FolderNameProblem(name).empty() && IsPlainFileName(name); }
+
+void CheckListedName(const std::string& manifest_path, const std::string& where, const std::string& name) {
+  if (!IsListedNameOk(name)) FailName(manifest_path, where, name, "a plain file name of the manifest's folder");
+}
+
+namespace {
+
 bool EndsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
@@ -263,7 +308,7 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
     const size_t m = stem.rfind("_specular_m");
     const bool level_ok = m != std::string::npos && m > 0 && m + 11 < stem.size() &&
                           stem.find_first_not_of("0123456789", m + 11) == std::string::npos;
-    if (stage > 3 || !IsPlainFileName(file.file) || !face_ok || !level_ok)
+    if (stage > 3 || !IsListedNameOk(file.file) || !face_ok || !level_ok)
       FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE_specular_mLEVEL_FACE{})",
                                                    file.kind, number_in_name, tail));
     const std::string b = stem.substr(0, m);
@@ -280,7 +325,7 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
   std::string stem;
   for (const char* ext : {".exr", ".ktx2"})
     if (stem.empty() && EndsWith(file.file, number + ext)) stem = file.file.substr(0, file.file.size() - number.size() - std::strlen(ext));
-  if (stage > 3 || !IsPlainFileName(file.file) || stem.empty())
+  if (stage > 3 || !IsListedNameOk(file.file) || stem.empty())
     FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
   // An EXR specular level: strip its _mLEVEL.
   if (file.kind == "ibl_specular" && EndsWith(file.file, ".exr")) {
@@ -305,8 +350,8 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
 // in that order, one BASE per frame; the scene is NAME.gltf, NAME.bin, NAME.glb; the texture a PNG.
 void CheckNames(const std::string& path, const Manifest& m) {
   std::map<std::string, std::string> face_names;  // "+X" -> "px": the same in every frame
-  if (!IsPlainFileName(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
-  if (!IsPlainFileName(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
+  if (!IsListedNameOk(m.gltf.name)) FailName(path, "gltf.name", m.gltf.name, "a plain file name");
+  if (!IsListedNameOk(m.gltf.texture_file) || !EndsWith(m.gltf.texture_file, ".png"))
     FailName(path, "gltf.texture.file", m.gltf.texture_file, "a plain file name of a PNG in the folder");
   // Every frame number of a sequence has its width (FrameNumberWidth).
   const int number_width = FrameNumberWidth(m.sequence ? m.sequence->last : 0);
@@ -318,7 +363,7 @@ void CheckNames(const std::string& path, const Manifest& m) {
     int stage = 0;  // 0 faces, 1 cube, 2 latlong, 3 IBL, 4 png, 5 done: the order files are written in
     auto stem_of = [&](const ManifestFile& file, const char* ext, const char* what) {
       const std::string tail = number + ext;
-      if (!IsPlainFileName(file.file) || !EndsWith(file.file, tail) || file.file.size() == tail.size())
+      if (!IsListedNameOk(file.file) || !EndsWith(file.file, tail) || file.file.size() == tail.size())
         FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (...{})", what,
                                                      f.number, tail));
       return file.file.substr(0, file.file.size() - tail.size());
@@ -353,7 +398,7 @@ void CheckNames(const std::string& path, const Manifest& m) {
       } else if (file.kind == "engine") {
         // BASE_ENGINE_SUFFIX.NNNN.exr (engine_preset.h), after the IBL files.
         const std::optional<std::string> b = EngineFileBase(file.file, f.number, number_width);
-        if (stage > 4 || !IsPlainFileName(file.file) || !b || b->empty())
+        if (stage > 4 || !IsListedNameOk(file.file) || !b || b->empty())
           FailName(path, where, file.file, fmt::format("an engine preset's file skybake names for frame {} "
                                                        "(BASE_ENGINE_SUFFIX{}.exr)", f.number, number));
         if (!base.empty() && *b != base)
@@ -411,7 +456,7 @@ void CheckNames(const std::string& path, const Manifest& m) {
   }
   static const std::map<std::string, std::string> kSceneExtension = {
       {"gltf", ".gltf"}, {"gltf_bin", ".bin"}, {"glb", ".glb"}, {"gltf_ground", "_ground.png"}};
-  if (m.usd.enabled && !IsPlainFileName(m.usd.name)) FailName(path, "usd.name", m.usd.name, "a plain file name");
+  if (m.usd.enabled && !IsListedNameOk(m.usd.name)) FailName(path, "usd.name", m.usd.name, "a plain file name");
   for (const ManifestFile& file : m.scene) {
     if (file.kind == "usd" && m.usd.enabled && file.file == m.usd.name + ".usda") continue;
     auto it = kSceneExtension.find(file.kind);
@@ -468,16 +513,17 @@ namespace {
 
 MoonRecord MoonOf(const Reader& r, const json& moon) {
   MoonRecord mr;
-  mr.direction = r.Vector(moon, "direction");
-  mr.elevation_deg = r.Get<double>(moon, "elevation_deg");
-  mr.azimuth_deg = r.Get<double>(moon, "azimuth_deg");
-  mr.phase_angle_deg = r.Get<double>(moon, "phase_angle_deg");
-  mr.illuminated_fraction = r.Get<double>(moon, "illuminated_fraction");
-  mr.bright_limb_deg = r.Get<double>(moon, "bright_limb_deg");
-  mr.angular_radius_rad = r.Get<double>(moon, "angular_radius_rad");
-  mr.top_illuminance_lux = r.Get<double>(moon, "top_illuminance_lux");
-  mr.illuminance_lux = r.Get<double>(moon, "illuminance_lux");
-  mr.irradiance = r.RgbOf(moon, "irradiance");
+  mr.direction = r.Bounded(moon, "direction", -1.0, 1.0);
+  mr.elevation_deg = r.Real(moon, "elevation_deg", -90.0, 90.0);
+  mr.azimuth_deg = r.Real(moon, "azimuth_deg", -360.0, 360.0);
+  mr.phase_angle_deg = r.Real(moon, "phase_angle_deg", -360.0, 360.0);
+  mr.illuminated_fraction = r.Real(moon, "illuminated_fraction", 0.0, 1.0);
+  mr.bright_limb_deg = r.Real(moon, "bright_limb_deg", -360.0, 360.0);
+  mr.angular_radius_rad = r.Real(moon, "angular_radius_rad", 0.0, 0.5);
+  mr.top_illuminance_lux = r.Real(moon, "top_illuminance_lux", 0.0, kMaxLux);
+  mr.illuminance_lux = r.Real(moon, "illuminance_lux", 0.0, kMaxLux);
+  const glm::dvec3 moon_irradiance = r.Bounded(moon, "irradiance", 0.0, kMaxLux);
+  mr.irradiance = {moon_irradiance.x, moon_irradiance.y, moon_irradiance.z};
   mr.light = r.Get<bool>(moon, "light");
   return mr;
 }
@@ -485,22 +531,26 @@ MoonRecord MoonOf(const Reader& r, const json& moon) {
 ManifestFrame FrameOf(const Reader& r, const json& f) {
   ManifestFrame frame;
   frame.number = r.Int(f, "frame");
+  r.At(fmt::format("frame {}: ", frame.number));
   frame.style_sha256 = r.Get<std::string>(f, "style_sha256");
   if (f.contains("time") && !f["time"].is_null()) frame.time = r.Get<std::string>(f, "time");
-  frame.hours_from_start = r.Get<double>(f, "hours_from_start");
-  frame.animation_time_s = r.Get<double>(f, "animation_time_s");
+  frame.hours_from_start = r.Real(f, "hours_from_start", 0.0, kMaxTime);
+  frame.animation_time_s = r.Real(f, "animation_time_s", 0.0, kMaxTime);
   const json& sun = r.Get<json>(f, "sun");
-  frame.sun_elevation_deg = r.Get<double>(sun, "elevation_deg");
-  frame.sun_azimuth_deg = r.Get<double>(sun, "azimuth_deg");
-  frame.sun_direction = r.Vector(sun, "direction");
-  frame.sun_illuminance_lux = r.Get<double>(sun, "illuminance_lux");
-  frame.sun_irradiance = r.RgbOf(sun, "irradiance");
-  if (sun.contains("angular_radius_rad")) frame.sun_angular_radius_rad = r.Get<double>(sun, "angular_radius_rad");
+  frame.sun_elevation_deg = r.Real(sun, "elevation_deg", -90.0, 90.0);
+  frame.sun_azimuth_deg = r.Real(sun, "azimuth_deg", -1e5, 1e5);
+  frame.sun_direction = r.Bounded(sun, "direction", -1.0, 1.0);
+  frame.sun_illuminance_lux = r.Real(sun, "illuminance_lux", 0.0, kMaxLux);
+  const glm::dvec3 irradiance = r.Bounded(sun, "irradiance", 0.0, kMaxLux);  // output units x sr
+  frame.sun_irradiance = {irradiance.x, irradiance.y, irradiance.z};
+  if (sun.contains("angular_radius_rad"))
+    frame.sun_angular_radius_rad = r.Real(sun, "angular_radius_rad", 1e-6, 0.5);
   frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
   frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
   if (f.contains("moon")) frame.moon = MoonOf(r, r.Get<json>(f, "moon"));
   frame.files = FilesOf(r, r.Get<json>(f, "files"));
   if (f.contains("cloud_shadow")) frame.cloud_shadow = CloudShadowFromJson(f["cloud_shadow"]);
+  r.At("");
   return frame;
 }
 
@@ -509,8 +559,8 @@ ManifestScene SceneOf(const Reader& r, const json& gltf) {
   scene.enabled = r.Get<bool>(gltf, "enabled");
   scene.name = r.Get<std::string>(gltf, "name");
   scene.dome.dome = r.Get<std::string>(gltf, "dome") == "hemisphere" ? DomeShape::kHemisphere : DomeShape::kSphere;
-  scene.dome.radius_m = r.Get<double>(gltf, "radius_m");
-  scene.dome.flattening = r.Get<double>(gltf, "flattening");
+  scene.dome.radius_m = r.Real(gltf, "radius_m", 1e-3, 1e8);  // the style's gltf.radius_m
+  scene.dome.flattening = r.Real(gltf, "flattening", 0.0, std::nextafter(1.0, 0.0));
   scene.dome.segments = int(r.Integer(gltf, "segments", 3, 4096));
   scene.dome.enabled = scene.enabled;
   const json& texture = r.Get<json>(gltf, "texture");
@@ -522,10 +572,20 @@ ManifestScene SceneOf(const Reader& r, const json& gltf) {
 
 }  // namespace
 
+// A manifest's text through the door (file_door.h): a regular file, not a
+// link, at most kMaxManifestBytes (100,000 frames of all outputs are about
+// 300 MiB).
+constexpr uint64_t kMaxManifestBytes = uint64_t(1) << 30;
+
+std::string ManifestBytes(const std::string& path) {
+  std::string bytes;
+  if (const std::string problem = ReadRegularFile(path, kMaxManifestBytes, FileLinks::kRefuse, bytes); !problem.empty())
+    throw ManifestSyntaxError(fmt::format("cannot read {}: it {}", EscapedText(path), problem));
+  return bytes;
+}
+
 Manifest ReadManifest(const std::string& path, ManifestNames names) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ManifestSyntaxError(fmt::format("cannot read {}", path));
-  json j = json::parse(in, nullptr, false);
+  json j = json::parse(ManifestBytes(path), nullptr, false);
   Reader r(path);
   if (j.is_discarded() || !j.is_object())
     throw ManifestSyntaxError(
@@ -538,10 +598,10 @@ Manifest ReadManifest(const std::string& path, ManifestNames names) {
   m.schedule = r.Get<std::string>(j, "schedule");
   m.sequence_sha256 = r.Get<std::string>(j, "sequence_sha256");
   m.units = r.Get<std::string>(j, "units");
-  m.exposure_ev100 = r.Get<double>(j, "exposure_ev100");
+  m.exposure_ev100 = r.Real(j, "exposure_ev100", -100.0, 100.0);
   m.exposure_source = r.Get<std::string>(j, "exposure_source");
   m.texture_frame = r.Int(j, "texture_frame");
-  m.half_scale = r.Get<double>(j, "half_scale");
+  m.half_scale = r.Real(j, "half_scale", 1e-30, 1e30);
   m.gltf = SceneOf(r, r.Get<json>(j, "gltf"));
   if (j.contains("usd")) {
     const json& usd = r.Get<json>(j, "usd");
@@ -668,14 +728,14 @@ std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir
         {written.gltf_path, "gltf"}, {written.bin_path, "gltf_bin"}, {written.glb_path, "glb"}};
     if (scene.ground) files.push_back({(fs::path(out_dir) / scene.ground_texture_file).string(), "gltf_ground"});
     for (auto [path, kind] : files) {
-      scene_files.push_back({path, kind, fs::file_size(path), Sha256OfFile(path)});
+      scene_files.push_back({path, kind, WrittenFileSize(path), Sha256OfFile(path)});
       manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
                                 scene_files.back().sha256});
     }
   }
   if (manifest.usd.enabled && !manifest.frames.empty()) {
     const std::string path = WriteUsdLayer(UsdLayerOf(manifest, out_dir));
-    scene_files.push_back({path, "usd", fs::file_size(path), Sha256OfFile(path)});
+    scene_files.push_back({path, "usd", WrittenFileSize(path), Sha256OfFile(path)});
     manifest.scene.push_back({fs::path(path).filename().string(), "usd", scene_files.back().bytes,
                               scene_files.back().sha256});
   }
@@ -753,8 +813,7 @@ MergeParts ReadMergeParts(const MergeOptions& options) {
                                     options.dir));
   for (const std::string& path : p.paths) {
     Manifest m = ReadManifest(path);
-    std::ifstream in(path, std::ios::binary);
-    p.parts.emplace_back(std::move(m), SharedPart(json::parse(in)));
+    p.parts.emplace_back(std::move(m), SharedPart(json::parse(ManifestBytes(path))));
   }
   p.order.resize(p.parts.size());
   for (size_t i = 0; i < p.order.size(); ++i) p.order[i] = i;
@@ -904,7 +963,8 @@ MergeResult MergeShardManifests(const MergeOptions& options) {
   const OutputLock lock = OutputLock::Claim(options.dir, outputs);
   if (!options.force) {
     for (const std::string& name : outputs)
-      if (fs::exists(dir / name, ec))
+      // A link counts as a file, a dangling one too (exists() follows it).
+      if (fs::exists(fs::symlink_status(dir / name, ec)))
         throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", (dir / name).string()));
   }
 

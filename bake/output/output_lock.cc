@@ -1,10 +1,16 @@
 #include "skybake/output/output_lock.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <set>
+#include <thread>
+#include <vector>
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -13,7 +19,9 @@
 
 #include <fmt/format.h>
 
+#include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/base/file_door.h"
 
 namespace skybake {
 namespace {
@@ -27,19 +35,36 @@ constexpr const char* kClaimHeader = "skybake output lock\n";
 // 40-byte names are 36 MB; anything larger is not a claim of ours.
 constexpr off_t kMaxClaimBytes = off_t(256) << 20;
 
+// `text` with control characters escaped, for a message (EscapedText
+// without its quotes).
+std::string EscapedName(std::string_view text) {
+  const std::string quoted = EscapedText(text);
+  return quoted.substr(1, quoted.size() - 2);
+}
+
+// The program, its subcommand and the part it bakes ("skybake bake --shard
+// 2/4"), not the whole command line: a claim is read by whoever shares the
+// folder, and the other arguments may name private paths.
 std::string ProcessCommandLine() {
-  std::string command;
+  std::vector<std::string> args(1);
   if (FILE* f = std::fopen("/proc/self/cmdline", "rb")) {
     char buffer[4096];
-    size_t n = std::fread(buffer, 1, sizeof buffer, f);
+    const size_t n = std::fread(buffer, 1, sizeof buffer, f);
     std::fclose(f);
     for (size_t i = 0; i < n; ++i) {
-      const unsigned char c = static_cast<unsigned char>(buffer[i]);
-      command += c == 0 ? ' ' : (c < 0x20 || c == 0x7f) ? '?' : char(c);
+      if (buffer[i] == 0) args.emplace_back();
+      else args.back() += buffer[i];
     }
   }
-  while (!command.empty() && command.back() == ' ') command.pop_back();
-  return command;
+  std::string command = fs::path(args[0]).filename().string();
+  if (args.size() > 1 && !args[1].empty() && args[1][0] != '-') command += " " + args[1];
+  for (size_t i = 2; i < args.size(); ++i) {
+    if ((args[i] == "--shard" || args[i] == "--frames") && i + 1 < args.size())
+      command += " " + args[i] + " " + args[i + 1];
+    else if (args[i].rfind("--shard=", 0) == 0 || args[i].rfind("--frames=", 0) == 0)
+      command += " " + args[i];
+  }
+  return EscapedName(command);
 }
 
 std::string HostName() {
@@ -101,12 +126,29 @@ std::string ReadAll(int fd) {
 
 bool LockingUnsupported(int error) { return error == ENOLCK || error == EOPNOTSUPP || error == ENOSYS; }
 
+// What the mutex file says of its holder ("pid N\nhost H\n", written by
+// the holder once it has the lock), as "pid N on H"; "an unknown process"
+// when it says nothing (a holder from before the file said so, or one
+// between taking the lock and writing).
+std::string MutexHolder(int fd) {
+  char buffer[512] = {};
+  const ssize_t n = ::pread(fd, buffer, sizeof buffer - 1, 0);
+  Claim holder;
+  const std::string text = std::string(kClaimHeader) + std::string(buffer, n > 0 ? size_t(n) : 0) + "command \nnames 0\n";
+  if (!ParseClaim(text, holder) || holder.pid.empty()) return "an unknown process";
+  return fmt::format("pid {} on {}", EscapedName(holder.pid), EscapedName(holder.host));
+}
+
 // The folder's short-lived mutex: `.skybake.lock`, flock'd; the file is
 // removed by its holder before unlocking, so a waiter that then gets the
 // lock on the removed file tries again on a new one. -1 when the file
-// system has no flock (a warning says so).
-int LockFolder(const std::string& dir) {
+// system has no flock (a warning says so). Held for as long as one process
+// reads the claims (milliseconds): a wait beyond `wait_seconds` means its
+// holder is stopped or hung, and is refused with OutputLockedError naming
+// the holder.
+int LockFolder(const std::string& dir, double wait_seconds) {
   const std::string path = (fs::path(dir) / kMutexName).string();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(wait_seconds);
   for (;;) {
     int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK, 0644);
     if (fd < 0) FailLock(dir, "opening", errno);
@@ -116,7 +158,21 @@ int LockFolder(const std::string& dir) {
       FailLock(dir, "checking", EINVAL);
     }
     int rc;
-    while ((rc = ::flock(fd, LOCK_EX)) != 0 && errno == EINTR) {
+    // Polled, not blocked on: a blocking flock has no timeout. From 1 ms,
+    // doubling to 50 ms between tries.
+    auto pause = std::chrono::milliseconds(1);
+    while ((rc = ::flock(fd, LOCK_EX | LOCK_NB)) != 0 && (errno == EINTR || errno == EWOULDBLOCK)) {
+      if (errno == EINTR) continue;
+      if (std::chrono::steady_clock::now() >= deadline) {
+        const std::string holder = MutexHolder(fd);
+        ::close(fd);
+        throw OutputLockedError(fmt::format(
+            "{}/{} has been held for more than {} s by {}: that skybake is stopped or hung; end it, or choose "
+            "another --out (SKYBAKE_LOCK_WAIT_SECONDS sets the wait)",
+            dir, kMutexName, wait_seconds, holder));
+      }
+      std::this_thread::sleep_for(pause);
+      pause = std::min(pause * 2, std::chrono::milliseconds(50));
     }
     if (rc != 0) {
       const int error = errno;
@@ -128,7 +184,14 @@ int LockFolder(const std::string& dir) {
       }
       FailLock(dir, "locking", error);
     }
-    if (::lstat(path.c_str(), &named) == 0 && named.st_dev == held.st_dev && named.st_ino == held.st_ino) return fd;
+    if (::lstat(path.c_str(), &named) == 0 && named.st_dev == held.st_dev && named.st_ino == held.st_ino) {
+      // Who holds it, for a waiter's message (best effort: a waiter copes
+      // with an empty file).
+      const std::string holder = fmt::format("pid {}\nhost {}\n", ::getpid(), HostName());
+      if (::ftruncate(fd, 0) == 0 && ::pwrite(fd, holder.data(), holder.size(), 0) < 0) {
+      }
+      return fd;
+    }
     ::close(fd);  // removed or replaced while we waited: take the new one
   }
 }
@@ -145,8 +208,24 @@ bool IsLockFileName(const std::string& file_name) {
   return file_name == kMutexName || file_name.compare(0, std::strlen(kClaimPrefix), kClaimPrefix) == 0;
 }
 
+double MutexWaitSeconds() {
+  const char* text = std::getenv("SKYBAKE_LOCK_WAIT_SECONDS");
+  if (!text || !*text) return kDefaultMutexWaitSeconds;
+  char* end = nullptr;
+  const double seconds = std::strtod(text, &end);
+  if (*end != '\0' || !std::isfinite(seconds) || seconds < 0.0 || seconds > 86400.0)
+    throw UsageError(fmt::format("SKYBAKE_LOCK_WAIT_SECONDS='{}' is not a number of seconds in [0, 86400]: "
+                                 "give e.g. 30, or unset it (default {} s)",
+                                 EscapedName(text), kDefaultMutexWaitSeconds));
+  return seconds;
+}
+
 OutputLock OutputLock::Claim(const std::string& dir, const std::vector<std::string>& names) {
-  const int mutex = LockFolder(dir);
+  return Claim(dir, names, MutexWaitSeconds());
+}
+
+OutputLock OutputLock::Claim(const std::string& dir, const std::vector<std::string>& names, double wait_seconds) {
+  const int mutex = LockFolder(dir, wait_seconds);
   if (mutex < 0) return OutputLock();
   struct Unlock {
     const std::string& dir;
@@ -193,10 +272,18 @@ OutputLock OutputLock::Claim(const std::string& dir, const std::vector<std::stri
   const std::string temporary = fs::path(TemporaryPathFor((fs::path(dir) / kMutexName).string())).filename().string();
   const std::string claim_path =
       (fs::path(dir) / (kClaimPrefix + temporary.substr(std::strlen("..skybake.lock.tmp")))).string();
-  int fd = ::open(claim_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  // Readable by the owner and group only (farm users who share a folder
+  // share a group); the umask may narrow it further.
+  int fd = ::open(claim_path.c_str(), O_RDWR | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0640);
   if (fd < 0) FailLock(dir, "creating a claim in", errno);
   lock.path_ = claim_path;
   lock.fd_ = fd;
+  // The folder itself, held with the lock to the end (file_door.h): the
+  // bake's outputs are written relative to it.
+  const int dir_fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir_fd < 0) FailLock(dir, "opening the folder of", errno);
+  HoldFolder(dir, dir_fd);
+  lock.dir_ = dir;
   if (::flock(fd, LOCK_EX | LOCK_NB) != 0) FailLock(dir, "locking a claim in", errno);
   std::string text = kClaimHeader;
   text += fmt::format("pid {}\nhost {}\ncommand {}\nnames {}\n", ::getpid(), HostName(), ProcessCommandLine(),
@@ -211,9 +298,11 @@ OutputLock OutputLock::Claim(const std::string& dir, const std::vector<std::stri
   return lock;
 }
 
-OutputLock::OutputLock(OutputLock&& other) noexcept : fd_(other.fd_), path_(std::move(other.path_)) {
+OutputLock::OutputLock(OutputLock&& other) noexcept
+    : fd_(other.fd_), path_(std::move(other.path_)), dir_(std::move(other.dir_)) {
   other.fd_ = -1;
   other.path_.clear();
+  other.dir_.clear();
 }
 
 OutputLock& OutputLock::operator=(OutputLock&& other) noexcept {
@@ -221,8 +310,10 @@ OutputLock& OutputLock::operator=(OutputLock&& other) noexcept {
     Release();
     fd_ = other.fd_;
     path_ = std::move(other.path_);
+    dir_ = std::move(other.dir_);
     other.fd_ = -1;
     other.path_.clear();
+    other.dir_.clear();
   }
   return *this;
 }
@@ -234,6 +325,8 @@ void OutputLock::Release() {
   ::unlink(path_.c_str());
   ::close(fd_);
   fd_ = -1;
+  if (!dir_.empty()) ReleaseFolder(dir_);
+  dir_.clear();
 }
 
 }  // namespace skybake

@@ -1,6 +1,9 @@
 #include "skybake/output/sha256.h"
 
-#include <fstream>
+#include <cerrno>
+#include <cstring>
+
+#include <unistd.h>
 #include <memory>
 #include <vector>
 
@@ -8,6 +11,7 @@
 #include <openssl/evp.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/base/file_door.h"
 
 namespace skybake {
 namespace {
@@ -35,14 +39,25 @@ class Sha256 {
 }  // namespace
 
 std::string Sha256OfFile(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw OutputError(fmt::format("cannot read {} to checksum it", path));
+  // Through the door (file_door.h): a regular file, not a link (every file
+  // checksummed is one of a bake's folder), read in chunks.
+  int fd = -1;
+  if (const std::string problem = OpenRegularFile(path, FileLinks::kRefuse, fd); !problem.empty())
+    throw OutputError(fmt::format("cannot read {} to checksum it: it {}", path, problem));
   Sha256 sha;
   std::vector<char> chunk(1 << 16);
-  while (in) {
-    in.read(chunk.data(), std::streamsize(chunk.size()));
-    if (in.gcount() > 0) sha.Update(chunk.data(), size_t(in.gcount()));
+  for (;;) {
+    const ssize_t n = ::read(fd, chunk.data(), chunk.size());
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      const int error = errno;
+      ::close(fd);
+      throw OutputError(fmt::format("cannot read {} to checksum it: {}", path, std::strerror(error)));
+    }
+    if (n == 0) break;
+    sha.Update(chunk.data(), size_t(n));
   }
+  ::close(fd);
   return sha.HexDigest();
 }
 

@@ -1,10 +1,16 @@
 #include "skybake/pipeline/gallery.h"
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+
+#include <sys/stat.h>
 
 #include <fmt/format.h>
 
+#include "skybake/base/file_door.h"
+#include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
 #include "skybake/output/output_lock.h"
 #include "skybake/base/oiio_module.h"
@@ -20,6 +26,25 @@ constexpr int kNameSize = 17;
 constexpr int kDetailSize = 12;
 constexpr const char* kNameFont = "DejaVuSans-Bold";
 constexpr const char* kDetailFont = "DejaVuSans";
+
+// OUT/NAME, a style's folder in the gallery: made here, and refused when
+// the name is taken by anything but a folder; a link planted there (to a
+// folder outside --out) is not followed. OUT itself is the user's and may
+// be a link.
+std::string StyleFolder(const std::string& out_dir, const std::string& name) {
+  const std::string dir = (std::filesystem::path(out_dir) / name).string();
+  if (!FolderNameProblem(name).empty())
+    throw OutputError(fmt::format("{} cannot be a style's folder in the gallery: rename the style file", EscapedText(dir)));
+  if (::mkdir(dir.c_str(), 0777) != 0 && errno != EEXIST)
+    throw OutputError(fmt::format("cannot make the folder {} ({}): choose a writable --out", EscapedText(dir),
+                                  std::strerror(errno)));
+  struct stat st {};
+  if (::lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+    throw OutputExistsError(fmt::format("{} is {}, not a folder: the gallery writes each style into a folder of "
+                                        "--out; remove it, or choose another --out",
+                                        EscapedText(dir), S_ISLNK(st.st_mode) ? "a symbolic link" : "a file"));
+  return dir;
+}
 
 }  // namespace
 
@@ -107,7 +132,7 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
     ConfigResult config = LoadSkyStyle(path, overrides);
     if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
     BakeOptions bake = options.bake;
-    bake.out_dir = (std::filesystem::path(options.out_dir) / name).string();  // preview + manifest
+    bake.out_dir = StyleFolder(options.out_dir, name);  // preview + manifest
     // A style with its own [schedule] (a date, a time and a place: the
     // night styles) is baked at its schedule's first frame, as a sequence of
     // that one frame.

@@ -1,5 +1,7 @@
 #include "manifest_builder.h"
 
+#include "skybake/base/file_door.h"
+
 #include <algorithm>
 #include <filesystem>
 
@@ -78,8 +80,7 @@ void ManifestBuilder::Write(bool complete) {
   m.complete = complete;
   WriteJsonWithSpools(result_.manifest_path, ManifestText(m), {{"frames", &spool_}});
   ++result_.manifest_writes;
-  std::error_code ec;
-  result_.manifest_bytes_written += std::filesystem::file_size(result_.manifest_path, ec);
+  result_.manifest_bytes_written += WrittenFileSize(result_.manifest_path);
 }
 
 std::vector<BakedFile> ManifestBuilder::WriteSceneAndManifest() {

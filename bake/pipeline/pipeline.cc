@@ -8,6 +8,8 @@
 //   manifest_builder.cc the manifest as frames are done
 #include "skybake/pipeline/pipeline.h"
 
+#include "skybake/base/file_door.h"
+
 #include <algorithm>
 #include <csignal>
 #include <cstdio>
@@ -196,11 +198,11 @@ void FinishBake(const RenderPlan& plan, const BakeOptions& options, ManifestBuil
       timer.Finish("glTF", fmt::format("{} ({} sun key{}), .glb", scene_files.front().path, manifest.frames(),
                                        manifest.frames() == 1 ? "" : "s"));
   }
-  result.files.push_back({result.manifest_path, "manifest", std::filesystem::file_size(result.manifest_path), ""});
+  result.files.push_back({result.manifest_path, "manifest", WrittenFileSize(result.manifest_path), ""});
   timer.Finish("manifest", result.manifest_path);
   const std::string timings_path = OutputPath(options, TimingsFileName(plan.part));
   WriteTimings(result, options.out_dir, SecondsSince(bake_start), timings_path, timer.spools());
-  result.files.push_back({timings_path, "timings", std::filesystem::file_size(timings_path), ""});
+  result.files.push_back({timings_path, "timings", WrittenFileSize(timings_path), ""});
 }
 
 BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {

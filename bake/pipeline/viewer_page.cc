@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -11,9 +12,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfInputFile.h>
 
+#include "skybake/base/file_door.h"
+#include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/output/manifest.h"
 #include "skybake/pipeline/pipeline.h"
 
 namespace skybake {
@@ -22,13 +27,47 @@ namespace {
 namespace fs = std::filesystem;
 using json = nlohmann::json;
 
+// A file of three.js (links followed: an npm install links packages).
 std::string Slurp(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw OutputError(fmt::format("cannot read {}", path.string()));
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
+  std::string bytes;
+  if (const std::string problem = ReadRegularFile(path.string(), uint64_t(64) << 20, FileLinks::kFollow, bytes);
+      !problem.empty())
+    throw OutputError(fmt::format("cannot read {}: it {}", path.string(), problem));
+  return bytes;
 }
+
+// A file of the bake's folder through the door (file_door.h): a name a
+// manifest lists, checked by the one check of listed names (manifest.h),
+// opened in `dir` without following a link, a regular file (a FIFO or a
+// device is refused unread) of at most kMaxShownBytes.
+constexpr uint64_t kMaxShownBytes = uint64_t(1) << 30;  // a 16384 x 8192 RGBA float EXR is 2 GiB; the half scale 512 MiB
+
+std::string FolderFile(const fs::path& dir, const std::string& name, const std::string& manifest = "") {
+  if (!manifest.empty()) CheckListedName(manifest, "frames[].files[].file", name);
+  std::string bytes;
+  if (const std::string problem = ReadFolderFile(dir.string(), name, kMaxShownBytes, bytes); !problem.empty())
+    throw OutputError(fmt::format("cannot read {}: it {}: bake the folder again", EscapedText((dir / name).string()),
+                                  problem));
+  return bytes;
+}
+
+// The data window's size of an OpenEXR file held in memory.
+class MemoryStream : public Imf::IStream {
+ public:
+  explicit MemoryStream(const std::string& bytes) : Imf::IStream("memory"), bytes_(bytes) {}
+  bool read(char c[], int n) override {
+    if (n < 0 || at_ + uint64_t(n) > bytes_.size()) throw std::runtime_error("the file ends early");
+    std::memcpy(c, bytes_.data() + at_, size_t(n));
+    at_ += uint64_t(n);
+    return at_ < bytes_.size();
+  }
+  uint64_t tellg() override { return at_; }
+  void seekg(uint64_t pos) override { at_ = pos; }
+
+ private:
+  const std::string& bytes_;
+  uint64_t at_ = 0;
+};
 
 std::string Base64(const std::string& bytes) {
   static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -246,6 +285,7 @@ if (test) {
 struct Frame {
   std::string file, type, label;
   double scale = 1.0;
+  std::string manifest;  // the manifest that names the file, "" for a file found in the folder
 };
 
 // What the page shows: each frame's latlong, and the bake's exposure.
@@ -260,7 +300,7 @@ struct ShownFrames {
 ShownFrames ManifestFrames(const fs::path& manifest_path) {
   ShownFrames shown;
   double half_scale = 1.0;
-  json m = json::parse(Slurp(manifest_path), nullptr, false);
+  json m = json::parse(FolderFile(manifest_path.parent_path(), manifest_path.filename().string()), nullptr, false);
   if (m.is_discarded() || !m.is_object())
     throw OutputError(fmt::format("{} is not valid JSON: bake the folder again", manifest_path.string()));
   if (m.contains("exposure_ev100") && m["exposure_ev100"].is_number()) {
@@ -276,6 +316,7 @@ ShownFrames ManifestFrames(const fs::path& manifest_path) {
       if ((kind == "preview" || kind == "gltf_texture") && frame.file.empty()) frame = {name, "png", "", 1.0};
     }
     if (frame.file.empty()) continue;
+    frame.manifest = manifest_path.string();
     const int number = f.value("frame", 0);
     frame.label = number > 0 ? fmt::format("frame {}", number) : "the bake";
     if (f.contains("time") && f["time"].is_string()) frame.label += ", " + f["time"].get<std::string>();
@@ -296,7 +337,7 @@ ShownFrames FolderLatlongs(const fs::path& dir) {
   }
   std::sort(names.begin(), names.end());
   ShownFrames shown;
-  for (const std::string& n : names) shown.frames.push_back({n, "exr", n, 1.0});
+  for (const std::string& n : names) shown.frames.push_back({n, "exr", n, 1.0, ""});
   return shown;
 }
 
@@ -307,7 +348,7 @@ json FrameEntries(const std::vector<Frame>& frames, const fs::path& dir, double 
   json list = json::array();
   double embedded_bytes = 0.0;
   for (const Frame& f : frames) {
-    const std::string data = Slurp(dir / f.file);
+    const std::string data = FolderFile(dir, f.file, f.manifest);
     embedded_bytes += double(data.size());
     const bool embed = list.empty() || embedded_bytes <= embed_mib * 1024.0 * 1024.0;
     int width = 0, height = 0;
@@ -316,10 +357,16 @@ json FrameEntries(const std::vector<Frame>& frames, const fs::path& dir, double 
       for (int i = 16; i < 20; ++i) width = (width << 8) | uint8_t(data[size_t(i)]);
       for (int i = 20; i < 24; ++i) height = (height << 8) | uint8_t(data[size_t(i)]);
     } else {
-      Imf::InputFile in((dir / f.file).string().c_str());
-      const Imath::Box2i window = in.header().dataWindow();
-      width = window.max.x - window.min.x + 1;
-      height = window.max.y - window.min.y + 1;
+      try {
+        MemoryStream stream(data);
+        Imf::InputFile in(stream);
+        const Imath::Box2i window = in.header().dataWindow();
+        width = window.max.x - window.min.x + 1;
+        height = window.max.y - window.min.y + 1;
+      } catch (const std::exception& e) {
+        throw OutputError(fmt::format("{} is not an OpenEXR file ({}): bake the folder again",
+                                      EscapedText((dir / f.file).string()), e.what()));
+      }
     }
     json entry = {{"type", f.type}, {"label", f.label}, {"scale", f.scale}, {"width", width}, {"height", height}};
     if (embed)

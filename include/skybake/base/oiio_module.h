@@ -31,10 +31,14 @@ struct SheetLayout {
 struct OiioModule {
   bool (*compose_sheet)(const std::vector<SheetCell>& cells, const SheetLayout& layout, std::vector<uint8_t>& rgb,
                         int& width, int& height, std::string& error);
-  // Any 2D image OpenImageIO reads (EXR, PNG, ...): its first subimage as
-  // floats, channels interleaved, values as stored (no colour conversion).
-  bool (*read_image)(const std::string& path, int& width, int& height, int& channels, std::vector<float>& pixels,
-                     std::string& error);
+  // Any 2D image OpenImageIO reads from memory (EXR, PNG, TIFF, ...): the
+  // file's `bytes` (read through the door, file_door.h; `name`, its path,
+  // picks the format), its first subimage as floats, channels interleaved,
+  // values as stored (no colour conversion). Refused from its header, before
+  // any pixel is decoded, when width x height x channels exceeds
+  // `max_samples`.
+  bool (*read_image)(const std::string& name, const std::string& bytes, uint64_t max_samples, int& width,
+                     int& height, int& channels, std::vector<float>& pixels, std::string& error);
 };
 
 // Loads the module once (thread-safe); throws OutputError naming the file
@@ -52,4 +56,4 @@ void SetOiioModuleDir(const std::string& dir);
 // OiioModule's layout: a change of the struct renames it, so a binary never
 // calls into a module of another layout (an older libskybake_oiio.so left
 // beside it is passed over, with the name in the error).
-extern "C" const skybake::OiioModule* skybake_oiio_module_v2();
+extern "C" const skybake::OiioModule* skybake_oiio_module_v3();

@@ -78,5 +78,12 @@ std::optional<ConfigError> ReadInputFile(const std::string& path, const char* wh
 // The error for a key of more than kMaxKeyParts parts in `text`, located.
 std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string& name);
 
+// Whether the dotted key `key` ("a.b.c": 3 parts) has more than
+// kMaxKeyParts parts; stops counting at the first part beyond, so a key of
+// any length costs at most kMaxKeyParts + 1 dot searches. The one check of a
+// `--set` key and of a quoted key in a schedule's `set`, `ramp` or
+// `per_hour` ("a.b.c" = 1), both of which skybake splits at the dots.
+bool KeyHasTooManyParts(std::string_view key);
+
 
 }  // namespace skybake

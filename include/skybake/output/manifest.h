@@ -134,6 +134,15 @@ class ManifestSyntaxError : public ManifestError {
   using ManifestError::ManifestError;
 };
 
+// The one check of a name read from a manifest, by every command that opens
+// one (view, gallery, merge-manifest, --resume): a plain file name directly
+// inside the manifest's folder (FolderNameProblem of file_door.h, and
+// IsPlainFileName: no '/', no '..', not absolute, no control character).
+// Throws ManifestError (exit 8) naming `manifest_path`, `where` (the entry)
+// and the name, escaped.
+void CheckListedName(const std::string& manifest_path, const std::string& where, const std::string& name);
+bool IsListedNameOk(const std::string& name);
+
 // Whether ReadManifest checks the names it reads against the ones skybake
 // gives (kUnchecked: the caller compares them with the exact names of its
 // own bake, as --resume does, before opening anything under them).

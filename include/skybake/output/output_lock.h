@@ -16,6 +16,9 @@
 //    OutputLockedError (exit code 6) naming the other process and the first
 //    shared file; a claim of other names (another part's frames and part
 //    manifest) proceeds.
+//  - The mutex is waited for at most a bounded time (SKYBAKE_LOCK_WAIT_SECONDS,
+//    default 60 s), then OutputLockedError (exit 6) names its holder's pid
+//    and host, which the holder writes into `.skybake.lock`.
 //  - Links are never followed: the lock files are opened with O_NOFOLLOW.
 #pragma once
 
@@ -32,13 +35,22 @@ class OutputLockedError : public OutputExistsError {
   using OutputExistsError::OutputExistsError;
 };
 
+// How long a claimer waits for the folder's mutex, which its holder keeps
+// for the milliseconds of reading the claims: 60 s is a stopped or hung
+// holder (a claim of 100,000 frames, 36 MB, is read in well under 1 s).
+inline constexpr double kDefaultMutexWaitSeconds = 60.0;
+
 class OutputLock {
  public:
   OutputLock() = default;
   // Claims `names` (plain file names) in the existing folder `dir`. Throws
   // OutputLockedError on an overlap with a live claim, OutputError when the
   // folder cannot hold a lock file (not writable).
+  // The folder's mutex is waited for at most SKYBAKE_LOCK_WAIT_SECONDS
+  // (default kDefaultMutexWaitSeconds); then OutputLockedError names its
+  // holder (pid and host).
   static OutputLock Claim(const std::string& dir, const std::vector<std::string>& names);
+  static OutputLock Claim(const std::string& dir, const std::vector<std::string>& names, double wait_seconds);
   OutputLock(OutputLock&& other) noexcept;
   OutputLock& operator=(OutputLock&& other) noexcept;
   OutputLock(const OutputLock&) = delete;
@@ -51,6 +63,7 @@ class OutputLock {
   void Release();
   int fd_ = -1;
   std::string path_;
+  std::string dir_;  // the folder held (file_door.h) while the claim lives
 };
 
 // True for the names of the lock's own files (`.skybake.lock`,
