@@ -702,7 +702,8 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
       {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4},
       {SPEC_CLOUD_FORMATION, 80, 4}};
   VkSpecializationInfo specialization{21, entries, sizeof(values), &values};
-  return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
+  return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization,
+                               context_.pipeline_cache());
 }
 
 void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,

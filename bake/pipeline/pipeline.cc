@@ -51,11 +51,26 @@ void CheckDeviceLimits(const RenderPlan& plan, VulkanContext& context) {
 }
 
 // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
-void PreparePipelines(const SkyStyle& first, RendererCache& renderers, StageTimer& timer, BakeResult& result) {
+// The persistent pipeline cache's part in the pipelines stage (gpu/pipeline_cache.h).
+std::string PipelineCacheReport(const PipelineCacheStatus& s) {
+  if (!s.enabled) return "pipeline cache off";
+  std::string report = s.loaded ? fmt::format("pipeline cache hit ({} bytes)", s.loaded_bytes)
+                       : s.ignored_because.empty() ? "pipeline cache empty"
+                                                   : "pipeline cache ignored: " + s.ignored_because;
+  if (s.saved) report += fmt::format(", saved ({} bytes)", s.saved_bytes);
+  if (!s.save_error.empty()) report += ", not saved: " + s.save_error;
+  return report;
+}
+
+void PreparePipelines(const SkyStyle& first, RendererCache& renderers, VulkanContext& context, StageTimer& timer,
+                      BakeResult& result) {
   {
     const RenderCounters& c = renderers.Main(first).counters();
-    timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants", c.pipelines,
-                                          c.variant_pipelines));
+    // Saved now, so that a bake that fails later still leaves it; pipelines
+    // made later (a twilight frame's, the IBL's) are saved at the end.
+    context.SavePipelineCache();
+    timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants; {}", c.pipelines,
+                                          c.variant_pipelines, PipelineCacheReport(context.pipeline_cache_status())));
   }
   renderers.Main(first).PrecomputeLuts();
   for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
@@ -234,7 +249,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
 
   RendererCache renderers(context, result, options.shaders);
   std::unique_ptr<IblBaker> ibl_baker;
-  PreparePipelines(plan.first(), renderers, timer, result);
+  PreparePipelines(plan.first(), renderers, context, timer, result);
 
   // Exposure and half-float scale: the sequence's, before any file is written.
   BakeExposure exposure = ChooseSequenceExposure(plan, renderers, timer);
