@@ -650,6 +650,7 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
   args.shaders.texel_views = !EnvIs("SKYBAKE_TEXEL_VIEWS", "0");
   args.shaders.formation_read_always = EnvIs("SKYBAKE_FORMATION_READ", "1");
+  args.shaders.twilight_skip = !EnvIs("SKYBAKE_TWILIGHT_SKIP", "0");
 }
 
 int RunCommand(Cli& cli) {

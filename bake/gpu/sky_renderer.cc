@@ -539,6 +539,8 @@ void SkyRenderer::BindOutput(const Buffer& target) {
   bound_output_ = target.buffer;
 }
 
+bool SkyRenderer::MarchesTwilight(const glm::dvec3& sun) const { return MarchesTwilightBand(sun); }
+
 bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
   const double below = TwilightSunElevationDeg(quality_) * M_PI / 180.0;
   if (aoas_switches_.skydome || output_directions_ || !(below > 0.0) || !(sun.y < std::sin(below))) return false;
@@ -1074,7 +1076,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
   BindOutput(target);
   // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
-  const bool twilight = MarchesTwilightBand(sun);
+  const bool twilight = twilight_march_allowed_ && MarchesTwilightBand(sun);
   // With every cloud band in the Earth's shadow the clouds march without the Sun's light.
   const bool shadowed_clouds = CloudsInEarthShadow(sun);
   // A Sun too low for the light volume (CloudLightVolumeForSun): every light sample marched.

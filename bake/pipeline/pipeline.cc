@@ -31,6 +31,7 @@
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/render_plan.h"
 #include "stage_timer.h"
+#include "twilight_skip.h"
 
 namespace skybake {
 namespace {
@@ -91,6 +92,7 @@ struct FrameStages {
   NightSkyRenderer* night_renderer;
   const PreviousBake& previous;
   const BakeExposure& exposure;
+  const TwilightSkip& twilight_skip;  // frames whose views render without the twilight march
   StageTimer& timer;
 };
 
@@ -132,7 +134,10 @@ bool BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
   SkyRenderer& renderer = s.renderers.Main(style, plan.CloudTimeSeconds(), plan.sun);
   RenderedViews rendered;
   if (!verified) {
+    // The views alone without the march when it cannot show (twilight_skip.h).
+    renderer.set_twilight_march(!s.twilight_skip.frames.count(plan.number));
     rendered = renderer.RenderInPlace(plan.sun, plan.views, style.output.sun == SunOutput::kMap);
+    renderer.set_twilight_march(true);
     for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
   }
   std::optional<FrameNight> night;
@@ -254,6 +259,11 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   // Exposure and half-float scale: the sequence's, before any file is written.
   BakeExposure exposure = ChooseSequenceExposure(plan, renderers, timer);
   result.half_scale = exposure.half_scale;
+  // Twilight frames that would round to 0 at that scale, marched or not: not marched (twilight_skip.h).
+  const TwilightSkip twilight_skip = options.shaders.twilight_skip
+                                         ? ChooseTwilightSkips(plan, renderers, exposure.half_scale, night != nullptr)
+                                         : TwilightSkip();
+  if (twilight_skip.probed > 0) timer.Finish("twilight probe", twilight_skip.report);
   std::filesystem::create_directories(options.out_dir);
 
   // Frames: rendered in order, each one's files written beside the next
@@ -261,7 +271,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   ManifestBuilder manifest(plan, options, exposure, result);
   FrameWriter writer(plan, options, timer, exposure, manifest, result);
   FrameStages stages{plan,     options, context,  renderers,  ibl_baker, night.get(),
-                     night_renderer ? &*night_renderer : nullptr, previous, exposure, timer};
+                     night_renderer ? &*night_renderer : nullptr, previous, exposure, twilight_skip, timer};
   const int frame_count = int(std::count_if(plan.frames.begin(), plan.frames.end(),
                                              [&](const FramePlan& f) { return plan.Bakes(f); }));
   int frame_index = 0;
