@@ -1,6 +1,7 @@
-// Twilight frames whose march cannot show (pipeline/twilight_skip.h): a
-// sequence's deep twilight frames render without the twilight band march
-// when their probe says the march would not change their half floats, the
+// Twilight frames whose march cannot show (pipeline/twilight_skip.h; the
+// CLI's SKYBAKE_TWILIGHT_SKIP=1): a sequence's deep twilight frames render
+// without the twilight band march when their probe says the march would
+// not change their half floats, the
 // bake says which, and their files match those of the marched bake to
 // within one half-float step (the frames above are byte for byte the same).
 #include <cmath>
@@ -50,10 +51,10 @@ times = [03:00:00, 03:15:00, 12:00:00]
 )");
   const std::string common = testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule +
                              " --size 96 --set output.cube_strip=false";
-  const testing::CommandRun skipped = testing::RunSkybake("bake " + common + " --force --out " + dir + "/skipped");
+  const testing::CommandRun skipped = testing::RunSkybake("bake " + common + " --force --out " + dir + "/skipped", "SKYBAKE_TWILIGHT_SKIP=1");
   ASSERT_EQ(skipped.exit_code, 0) << skipped.output;
   const testing::CommandRun marched =
-      testing::RunSkybake("bake " + common + " --force --out " + dir + "/marched", "SKYBAKE_TWILIGHT_SKIP=0");
+      testing::RunSkybake("bake " + common + " --force --out " + dir + "/marched");
   ASSERT_EQ(marched.exit_code, 0) << marched.output;
   EXPECT_EQ(marched.output.find("twilight probe"), std::string::npos) << marched.output;
   // The probe runs from the lowest Sun up and stops at the first frame the march changes.
@@ -86,9 +87,13 @@ times = [03:00:00, 03:15:00, 12:00:00]
       EXPECT_LE(HalfStepsApart(a, b), 1.0) << file << " (" << line << ")";
     }
   }
-  // The plan says the march is probed.
+  // The plan says the march is probed; without SKYBAKE_TWILIGHT_SKIP=1 (the CLI's default) it does not.
+  EXPECT_EQ(testing::RunSkybake("plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule)
+                .output.find("probed at the exposure stage"),
+            std::string::npos);
   const testing::CommandRun plan =
-      testing::RunSkybake("plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule);
+      testing::RunSkybake("plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule,
+                          "SKYBAKE_TWILIGHT_SKIP=1");
   EXPECT_NE(plan.output.find("probed at the exposure stage"), std::string::npos) << plan.output;
 }
 

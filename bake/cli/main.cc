@@ -650,7 +650,9 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
   args.shaders.texel_views = !EnvIs("SKYBAKE_TEXEL_VIEWS", "0");
   args.shaders.formation_read_always = EnvIs("SKYBAKE_FORMATION_READ", "1");
-  args.shaders.twilight_skip = !EnvIs("SKYBAKE_TWILIGHT_SKIP", "0");
+  // Off unless asked for: on W2 it leaves one frame of 24 unmarched and costs more than that frame (probes,
+  // and 224 MiB more peak memory; docs/performance.md, "Today").
+  args.shaders.twilight_skip = EnvIs("SKYBAKE_TWILIGHT_SKIP", "1");
 }
 
 int RunCommand(Cli& cli) {

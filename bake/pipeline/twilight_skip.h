@@ -1,4 +1,7 @@
-// Twilight frames whose march cannot show (private to the pipeline layer).
+// Twilight frames whose march cannot show (private to the pipeline layer;
+// the CLI runs it only with SKYBAKE_TWILIGHT_SKIP=1: on W2 it leaves one
+// frame of 24 unmarched, and its probes cost more CPU time than that frame
+// saves and add about 220 MiB of peak memory, docs/performance.md "Today").
 //
 // A sequence's half-float files hold every value times the sequence's half
 // scale (exposure.h), to 11 significant bits: a half-float step is 2^-10 of

@@ -54,8 +54,8 @@ struct ShaderSwitches {
   // SKYBAKE_FORMATION_READ=1: the cloud pipelines keep a formation's density read (SPEC_CLOUD_FORMATION)
   // even when no layer has one, as the generic build did
   bool formation_read_always = false;
-  // SKYBAKE_TWILIGHT_SKIP=0: every twilight frame marched, even one whose half-float views the march would
-  // not change (pipeline/twilight_skip.h)
+  // Twilight frames whose half-float views the march would not change go unmarched (pipeline/twilight_skip.h);
+  // the CLI turns it on only with SKYBAKE_TWILIGHT_SKIP=1 (its probes cost more than they save on W2)
   bool twilight_skip = true;
 };
 
