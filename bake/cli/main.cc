@@ -126,6 +126,7 @@ struct BakeArgs {
   // choice, lavapipe's thread count, the default star catalogue.
   std::string software_driver_selection;
   std::string lavapipe_threads;  // LP_NUM_THREADS main set, or ""
+  std::string pipeline_cache_folder;  // PipelineCacheFolder, or "" when SKYBAKE_PIPELINE_CACHE=0
   std::string star_catalogue = DefaultStarCataloguePath();
   std::optional<int> stop_after_frame;  // $SKYBAKE_STOP_AFTER_FRAME: BakeOptions::stop_after_frame (farm tests)
 };
@@ -272,6 +273,7 @@ void SetDeviceOptions(const BakeArgs& args, BakeOptions& options) {
   options.vulkan.validation = args.validation;
   options.vulkan.software_driver_selection = args.software_driver_selection;
   options.vulkan.lavapipe_threads = args.lavapipe_threads;
+  options.vulkan.pipeline_cache_folder = args.pipeline_cache_folder;
   options.shaders = args.shaders;
   options.star_catalogue = args.star_catalogue;
   options.stop_after_frame = args.stop_after_frame;
@@ -615,6 +617,16 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
 // Single-threaded still: the only point where the environment may change.
 // The Vulkan loader reads VK_LOADER_DRIVERS_SELECT when the first instance
 // is made, so the driver choice is set here, before any Vulkan call.
+// The persistent pipeline cache's folder (gpu/pipeline_cache.h): the XDG
+// Base Directory's user cache, $XDG_CACHE_HOME/skybake or ~/.cache/skybake;
+// "" (no cache) with SKYBAKE_PIPELINE_CACHE=0 or with neither variable set.
+std::string PipelineCacheFolder() {
+  if (EnvIs("SKYBAKE_PIPELINE_CACHE", "0")) return "";
+  if (const char* xdg = std::getenv("XDG_CACHE_HOME"); xdg && *xdg == '/') return std::string(xdg) + "/skybake";
+  if (const char* home = std::getenv("HOME"); home && *home) return std::string(home) + "/.cache/skybake";
+  return "";
+}
+
 void ReadEnvironment(BakeArgs& args) {
   EnvironmentVariables variables;
   for (const std::string& name : DriverEnvironmentVariableNames())
@@ -630,6 +642,7 @@ void ReadEnvironment(BakeArgs& args) {
     args.star_catalogue = catalogue;
   if (const char* stop = std::getenv("SKYBAKE_STOP_AFTER_FRAME"); stop && *stop)
     args.stop_after_frame = std::atoi(stop);
+  args.pipeline_cache_folder = PipelineCacheFolder();
   args.validation = args.validation || EnvFlag("SKYBAKE_VULKAN_VALIDATION");
   args.shaders.generic = EnvIs("SKYBAKE_GENERIC_SHADERS", "1");
   args.shaders.sun_disc_pass = !EnvIs("SKYBAKE_SUN_DISC_PASS", "0");
@@ -637,6 +650,9 @@ void ReadEnvironment(BakeArgs& args) {
   args.shaders.twilight_rows = !EnvIs("SKYBAKE_TWILIGHT_ROWS", "0");
   args.shaders.texel_views = !EnvIs("SKYBAKE_TEXEL_VIEWS", "0");
   args.shaders.formation_read_always = EnvIs("SKYBAKE_FORMATION_READ", "1");
+  // Off unless asked for: on W2 it leaves one frame of 24 unmarched and costs more than that frame (probes,
+  // and 224 MiB more peak memory; docs/performance.md, "Today").
+  args.shaders.twilight_skip = EnvIs("SKYBAKE_TWILIGHT_SKIP", "1");
 }
 
 int RunCommand(Cli& cli) {

@@ -308,7 +308,8 @@ IblBaker::IblBaker(VulkanContext& context) : context_(context) {
     const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, 2, sizeof(gpu::IblPush));
     set_layout_ = layouts.set;
     pipeline_layout_ = layouts.pipeline;
-    pipeline_ = CreateComputePipeline(device, kIblPrefilterSpv, sizeof(kIblPrefilterSpv), pipeline_layout_);
+    pipeline_ = CreateComputePipeline(device, kIblPrefilterSpv, sizeof(kIblPrefilterSpv), pipeline_layout_, nullptr,
+                                      context_.pipeline_cache());
 
     // Trilinear, clamped at the face edges (Vulkan filters across cube faces).
     VkSamplerCreateInfo sampler_info{VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO};

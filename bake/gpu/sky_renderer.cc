@@ -539,6 +539,8 @@ void SkyRenderer::BindOutput(const Buffer& target) {
   bound_output_ = target.buffer;
 }
 
+bool SkyRenderer::MarchesTwilight(const glm::dvec3& sun) const { return MarchesTwilightBand(sun); }
+
 bool SkyRenderer::MarchesTwilightBand(const glm::dvec3& sun) const {
   const double below = TwilightSunElevationDeg(quality_) * M_PI / 180.0;
   if (aoas_switches_.skydome || output_directions_ || !(below > 0.0) || !(sun.y < std::sin(below))) return false;
@@ -702,7 +704,8 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
       {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4},
       {SPEC_CLOUD_FORMATION, 80, 4}};
   VkSpecializationInfo specialization{21, entries, sizeof(values), &values};
-  return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization);
+  return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization,
+                               context_.pipeline_cache());
 }
 
 void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
@@ -1073,7 +1076,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
   BindOutput(target);
   // At twilight the low sky is ray-marched (quality.twilight_march_band_deg).
-  const bool twilight = MarchesTwilightBand(sun);
+  const bool twilight = twilight_march_allowed_ && MarchesTwilightBand(sun);
   // With every cloud band in the Earth's shadow the clouds march without the Sun's light.
   const bool shadowed_clouds = CloudsInEarthShadow(sun);
   // A Sun too low for the light volume (CloudLightVolumeForSun): every light sample marched.

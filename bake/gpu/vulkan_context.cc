@@ -322,7 +322,10 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
     device_info.pEnabledFeatures = &features;
     VK_CHECK(vkCreateDevice(physical_device_, &device_info, nullptr, &device_));
     vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+    pipeline_cache_ =
+        std::make_unique<PipelineCache>(device_, properties_, options.pipeline_cache_folder, BuildShaderDigest());
   } catch (...) {
+    if (device_) vkDestroyDevice(device_, nullptr);
     if (messenger_) {
       auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
           vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
@@ -334,6 +337,8 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
 }
 
 VulkanContext::~VulkanContext() {
+  if (pipeline_cache_) pipeline_cache_->Save();
+  pipeline_cache_.reset();
   if (device_) vkDestroyDevice(device_, nullptr);
   if (messenger_) {
     auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
@@ -385,7 +390,7 @@ ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayout
 }
 
 VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t bytes, VkPipelineLayout layout,
-                                 const VkSpecializationInfo* specialization) {
+                                 const VkSpecializationInfo* specialization, VkPipelineCache cache) {
   VkShaderModuleCreateInfo module_info{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
   module_info.codeSize = bytes;
   module_info.pCode = code;
@@ -399,7 +404,7 @@ VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t b
   info.stage.pSpecializationInfo = specialization;
   info.layout = layout;
   VkPipeline pipeline;
-  VkResult result = vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &info, nullptr, &pipeline);
+  VkResult result = vkCreateComputePipelines(device, cache, 1, &info, nullptr, &pipeline);
   vkDestroyShaderModule(device, module, nullptr);
   VK_CHECK(result);
   return pipeline;

@@ -199,7 +199,7 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
 // directions, docs/accuracy.md) are ray-marched by a sky pass of their own
 // pipeline, unless the Sun is too low for any sunlit air to be in view.
 void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first, const SkyStyle& pruned,
-                      PassPlan& plan) {
+                      const ShaderSwitches& shaders, PassPlan& plan) {
   const QualitySettings& q = first.quality;
   const double band = q.twilight_march_band_deg;
   const double below = TwilightSunElevationDeg(q);
@@ -223,10 +223,18 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
   const double night_deg = SunlitAirDepressionDeg(a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
                                                   a.sun_angular_radius_rad);
+  // A sequence's frames whose half-float views the march would not change
+  // are not marched; which ones needs renders (pipeline/twilight_skip.h).
+  const bool probed = shaders.twilight_skip && frames.size() > 1 && first.output.pixel_type == PixelType::kHalf &&
+                      !first.night.Any() && ActiveCloudLayers(pruned.clouds).empty();
+  const std::string skip =
+      probed ? ", less those it changes by under a quarter of a half-float step (probed at the exposure stage)" : "";
   plan.passes.push_back({"twilight band march", extent,
                          night_deg >= 180.0
-                             ? fmt::format("frames with the Sun below {:g} deg (sunlit air in view from space)", below)
-                             : fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg", below, night_deg),
+                             ? fmt::format("frames with the Sun below {:g} deg (sunlit air in view from space){}",
+                                           below, skip)
+                             : fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg{}", below,
+                                           night_deg, skip),
                          runs,
                          texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
 }
@@ -441,7 +449,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   plan.atmospheres = DistinctAtmospheres(frames);
   // The passes in the order they run; medium samples over the bake.
   PlanSkyPasses(first, pruned, plan);
-  PlanTwilightBand(frames, first, pruned, plan);
+  PlanTwilightBand(frames, first, pruned, shaders, plan);
   const bool disc_pass = PlansSunDiscPass(first, pruned, shaders);
   if (disc_pass) plan.passes.push_back({"sun disc", "near the Sun", "once per frame", plan.frames, 0.0});
   // The spectral mode (spectral_sky.h): the passes so far run once per group of three bins.

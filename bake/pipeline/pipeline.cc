@@ -33,6 +33,7 @@
 #include "skybake/pipeline/pass_plan.h"
 #include "skybake/pipeline/render_plan.h"
 #include "stage_timer.h"
+#include "twilight_skip.h"
 
 namespace skybake {
 namespace {
@@ -53,11 +54,26 @@ void CheckDeviceLimits(const RenderPlan& plan, VulkanContext& context) {
 }
 
 // Pipelines and LUTs: built for the first frame, rebuilt only on atmosphere changes.
-void PreparePipelines(const SkyStyle& first, RendererCache& renderers, StageTimer& timer, BakeResult& result) {
+// The persistent pipeline cache's part in the pipelines stage (gpu/pipeline_cache.h).
+std::string PipelineCacheReport(const PipelineCacheStatus& s) {
+  if (!s.enabled) return "pipeline cache off";
+  std::string report = s.loaded ? fmt::format("pipeline cache hit ({} bytes)", s.loaded_bytes)
+                       : s.ignored_because.empty() ? "pipeline cache empty"
+                                                   : "pipeline cache ignored: " + s.ignored_because;
+  if (s.saved) report += fmt::format(", saved ({} bytes)", s.saved_bytes);
+  if (!s.save_error.empty()) report += ", not saved: " + s.save_error;
+  return report;
+}
+
+void PreparePipelines(const SkyStyle& first, RendererCache& renderers, VulkanContext& context, StageTimer& timer,
+                      BakeResult& result) {
   {
     const RenderCounters& c = renderers.Main(first).counters();
-    timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants", c.pipelines,
-                                          c.variant_pipelines));
+    // Saved now, so that a bake that fails later still leaves it; pipelines
+    // made later (a twilight frame's, the IBL's) are saved at the end.
+    context.SavePipelineCache();
+    timer.Finish("pipelines", fmt::format("{} compute pipelines, {} from built-in shader variants; {}", c.pipelines,
+                                          c.variant_pipelines, PipelineCacheReport(context.pipeline_cache_status())));
   }
   renderers.Main(first).PrecomputeLuts();
   for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
@@ -78,6 +94,7 @@ struct FrameStages {
   NightSkyRenderer* night_renderer;
   const PreviousBake& previous;
   const BakeExposure& exposure;
+  const TwilightSkip& twilight_skip;  // frames whose views render without the twilight march
   StageTimer& timer;
 };
 
@@ -119,7 +136,10 @@ bool BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
   SkyRenderer& renderer = s.renderers.Main(style, plan.CloudTimeSeconds(), plan.sun);
   RenderedViews rendered;
   if (!verified) {
+    // The views alone without the march when it cannot show (twilight_skip.h).
+    renderer.set_twilight_march(!s.twilight_skip.frames.count(plan.number));
     rendered = renderer.RenderInPlace(plan.sun, plan.views, style.output.sun == SunOutput::kMap);
+    renderer.set_twilight_march(true);
     for (const PassTiming& t : renderer.last_timings()) frame.gpu_passes.push_back(t);
   }
   std::optional<FrameNight> night;
@@ -236,11 +256,16 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
 
   RendererCache renderers(context, result, options.shaders);
   std::unique_ptr<IblBaker> ibl_baker;
-  PreparePipelines(plan.first(), renderers, timer, result);
+  PreparePipelines(plan.first(), renderers, context, timer, result);
 
   // Exposure and half-float scale: the sequence's, before any file is written.
   BakeExposure exposure = ChooseSequenceExposure(plan, renderers, timer);
   result.half_scale = exposure.half_scale;
+  // Twilight frames that would round to 0 at that scale, marched or not: not marched (twilight_skip.h).
+  const TwilightSkip twilight_skip = options.shaders.twilight_skip
+                                         ? ChooseTwilightSkips(plan, renderers, exposure.half_scale, night != nullptr)
+                                         : TwilightSkip();
+  if (twilight_skip.probed > 0) timer.Finish("twilight probe", twilight_skip.report);
   std::filesystem::create_directories(options.out_dir);
 
   // Frames: rendered in order, each one's files written beside the next
@@ -248,7 +273,7 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   ManifestBuilder manifest(plan, options, exposure, result);
   FrameWriter writer(plan, options, timer, exposure, manifest, result);
   FrameStages stages{plan,     options, context,  renderers,  ibl_baker, night.get(),
-                     night_renderer ? &*night_renderer : nullptr, previous, exposure, timer};
+                     night_renderer ? &*night_renderer : nullptr, previous, exposure, twilight_skip, timer};
   const int frame_count = int(std::count_if(plan.frames.begin(), plan.frames.end(),
                                              [&](const FramePlan& f) { return plan.Bakes(f); }));
   int frame_index = 0;

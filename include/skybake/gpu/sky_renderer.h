@@ -54,6 +54,9 @@ struct ShaderSwitches {
   // SKYBAKE_FORMATION_READ=1: the cloud pipelines keep a formation's density read (SPEC_CLOUD_FORMATION)
   // even when no layer has one, as the generic build did
   bool formation_read_always = false;
+  // Twilight frames whose half-float views the march would not change go unmarched (pipeline/twilight_skip.h);
+  // the CLI turns it on only with SKYBAKE_TWILIGHT_SKIP=1 (its probes cost more than they save on W2)
+  bool twilight_skip = true;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
@@ -194,6 +197,14 @@ class SkyRenderer {
 
   const std::vector<PassTiming>& last_timings() const { return timings_; }
   const RenderCounters& counters() const { return counters_; }
+  // Whether the renders that follow may march the twilight band (on unless
+  // switched off here): the bake switches it off for the views of a frame
+  // whose every texel rounds to 0 in half floats either way
+  // (pipeline/twilight_skip.h), and on again after them.
+  void set_twilight_march(bool on) { twilight_march_allowed_ = on; }
+  bool twilight_march_allowed() const { return twilight_march_allowed_; }
+  // Whether a frame with this Sun would march the twilight band (with the march allowed).
+  bool MarchesTwilight(const glm::dvec3& sun) const;
   // Whether the shaders read through the texel views (SPEC_TEXEL_VIEWS).
   bool reads_texel_views() const { return texel_views_whole_; }
 
@@ -386,6 +397,7 @@ class SkyRenderer {
   VkPipeline shadowed_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the Sun's light (CloudsInEarthShadow)
   VkPipeline marched_light_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the light volume
   bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
+  bool twilight_march_allowed_ = true;                   // set_twilight_march
   bool twilight_rows_ = true;                            // ShaderSwitches::twilight_rows
   bool texel_views_allowed_ = true;                      // ShaderSwitches::texel_views
   bool formation_read_always_ = false;                   // ShaderSwitches::formation_read_always

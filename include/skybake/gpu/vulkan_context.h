@@ -18,6 +18,7 @@
 #include <vulkan/vulkan.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/gpu/pipeline_cache.h"
 
 namespace skybake {
 
@@ -108,9 +109,11 @@ ComputeLayouts CreateComputeLayouts(VkDevice device, const VkDescriptorSetLayout
                                     uint32_t binding_count, uint32_t push_bytes);
 
 // A compute pipeline of SPIR-V `code` (`bytes` long, entry point "main")
-// with `layout` and optional specialization constants; the caller destroys it.
+// with `layout` and optional specialization constants, through `cache` when
+// given (VulkanContext::pipeline_cache()); the caller destroys it.
 VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t bytes, VkPipelineLayout layout,
-                                 const VkSpecializationInfo* specialization = nullptr);
+                                 const VkSpecializationInfo* specialization = nullptr,
+                                 VkPipelineCache cache = VK_NULL_HANDLE);
 
 struct VulkanOptions {
   int device_index = -1;      // -1: choose the best usable device
@@ -122,6 +125,10 @@ struct VulkanOptions {
   // The LP_NUM_THREADS main set (LavapipeThreadCount), or "" when it set
   // none; reported with the device when the device is lavapipe.
   std::string lavapipe_threads;
+  // The folder of the persistent pipeline cache (pipeline_cache.h), or ""
+  // for none: main gives $XDG_CACHE_HOME/skybake or ~/.cache/skybake unless
+  // SKYBAKE_PIPELINE_CACHE=0; tests and the library's other users give none.
+  std::string pipeline_cache_folder;
 };
 
 class VulkanContext {
@@ -145,6 +152,17 @@ class VulkanContext {
   // known period): GPU pass times are reported only then.
   bool SupportsTimestamps() const;
 
+  // The pipeline cache every pipeline is created through (VK_NULL_HANDLE
+  // without a folder), what it did, and saving it (also done by the
+  // destructor; never throws).
+  VkPipelineCache pipeline_cache() const { return pipeline_cache_ ? pipeline_cache_->handle() : VK_NULL_HANDLE; }
+  PipelineCacheStatus pipeline_cache_status() const {
+    return pipeline_cache_ ? pipeline_cache_->status() : PipelineCacheStatus();
+  }
+  void SavePipelineCache() {
+    if (pipeline_cache_) pipeline_cache_->Save();
+  }
+
   // Number of validation messages (warnings and errors) seen so far.
   int validation_message_count() const { return validation_messages_; }
   const std::vector<std::string>& validation_messages() const { return messages_; }
@@ -162,6 +180,7 @@ class VulkanContext {
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
   VkPhysicalDevice physical_device_ = VK_NULL_HANDLE;
   VkDevice device_ = VK_NULL_HANDLE;
+  std::unique_ptr<PipelineCache> pipeline_cache_;  // destroyed before the device
   VkQueue queue_ = VK_NULL_HANDLE;
   uint32_t queue_family_ = 0;
   VkPhysicalDeviceProperties properties_{};
