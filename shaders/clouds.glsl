@@ -210,6 +210,19 @@ float SampleMap(int first, int n, vec2 uv) {
   return mix(a, b, f.y);
 }
 
+// Nearest-voxel reads of an n^3 volume and of an n^2 map (the texel that
+// holds the point), wrapping: one load where the trilinear read takes 8.
+float SampleVolumeNearest(int first, int n, vec3 uvw) {
+  ivec3 i = min(ivec3(fract(uvw) * float(n)), ivec3(n - 1));
+  return CloudNoise(first + (i.z * n + i.y) * n + i.x);
+}
+float SampleMapNearest(int first, int n, vec2 uv) {
+  ivec2 i = min(ivec2(fract(uv) * float(n)), ivec2(n - 1));
+  return CloudNoise(first + i.y * n + i.x);
+}
+
+#include "cloud_weather.glsl"
+
 // ---------------------------------------------------------------- density
 
 // The height profile: 0 below `stops.x`, rising to 1 at `stops.y`, 1 up to
@@ -229,9 +242,8 @@ float LayerExtinction(int l, vec2 xz, float h, bool detail) {
   if (hf <= 0.0 || hf >= 1.0) return 0.0;
   float profile = HeightProfile(layer.profile, hf);
   float coverage_key = layer.weather.x;
-  // Wind moves the whole layer (shear: more with height).
-  vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
-  vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
+  // Wind and the non-repeating warp (cloud_weather.glsl).
+  CloudPlace place = CloudPlaceOf(layer, xz, h);
   float d;
   if (kCloudFormation && layer.weather.w > 1.5) {
     // A formation's whole density (cloud_formation.h): its volume, x and y
@@ -239,23 +251,23 @@ float LayerExtinction(int l, vec2 xz, float h, bool detail) {
     // centres at the bottom and the top: clamped, not wrapped).
     float n = float(gpu_clouds.resolution.x);
     d = SampleVolume(layer.noise.x, gpu_clouds.resolution.x,
-                     vec3(weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), weather_uv.y));
+                     vec3(place.weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), place.weather_uv.y));
   } else {
-    float weather = SampleMap(layer.noise.z, gpu_clouds.resolution.z, weather_uv);
+    float weather = CloudWeatherAt(layer, place, false);
     // Local coverage: coverage 0.5 is the weather map as it is, 0 none, 1 all.
     float coverage = clamp(2.0 * coverage_key - 1.0 + weather, 0.0, 1.0);
     // Schneider 2015: remap(shape x profile, 1 - coverage, 1) x coverage; the
     // shape is at most 1, so where the profile alone is below 1 - coverage
     // there is no cloud and no volume is read.
     if (coverage <= 0.0 || profile <= 1.0 - coverage) return 0.0;
-    float shape = SampleVolume(layer.noise.x, gpu_clouds.resolution.x, vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y);
+    float shape = SampleVolume(layer.noise.x, gpu_clouds.resolution.x, CloudShapeUvw(layer, place, h - layer.shell.x));
     float base = mix(1.0, shape, layer.shape.x) * profile;
     d = clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage;
   }
   if (d <= 0.0) return 0.0;
   float lift = h - layer.shell.x;
   if (detail && layer.shape.z > 0.0) {
-    float n = SampleVolume(layer.noise.y, gpu_clouds.resolution.y, vec3(q.x, lift, q.y) * layer.shape.w);
+    float n = SampleVolume(layer.noise.y, gpu_clouds.resolution.y, CloudDetailUvw(layer, place, lift));
     // Wispy at the base (inverted noise), billowy above (Schneider 2015).
     float modifier = mix(1.0 - n, n, clamp(hf * 5.0, 0.0, 1.0));
     float threshold = 0.35 * layer.shape.z * modifier;
@@ -305,15 +317,22 @@ float LayerCloudMargin(int l, vec2 xz, float h) {
   bool inside = hf > 0.0 && hf < 1.0;
   if (kCloudFormation && layer.weather.w > 1.5) return inside ? 1.0 : -1.0;
   float profile = HeightProfile(layer.profile, hf);
-  vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
-  vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
+  CloudPlace place = CloudPlaceOf(layer, xz, h);
   int first = CloudSkipFirst(l);
   int nw = gpu_clouds.resolution.z, ns = gpu_clouds.resolution.x;
   bool edge = false;
-  ivec2 wcell = CloudSkipCell(vec3(weather_uv, 0.0), nw, edge).xy;  // z: mid-cell, never an edge
+  ivec2 wcell = CloudSkipCell(vec3(place.weather_uv, 0.0), nw, edge).xy;  // z: mid-cell, never an edge
   float weather = CloudNoise(first + wcell.y * nw + wcell.x);
+  if (place.three_reads) {
+    // The weather of the three reads grows with each (CloudWeatherOfReads):
+    // of the cells' maxima it bounds the weather of any point in all three.
+    ivec2 wcell2 = CloudSkipCell(vec3(place.weather_uv2, 0.0), nw, edge).xy;
+    ivec2 wcell3 = CloudSkipCell(vec3(place.weather_uv3, 0.0), nw, edge).xy;
+    weather = CloudWeatherOfReads(weather, CloudNoise(first + wcell2.y * nw + wcell2.x),
+                                  CloudNoise(first + wcell3.y * nw + wcell3.x));
+  }
   float coverage = clamp(2.0 * layer.weather.x - 1.0 + weather, 0.0, 1.0);
-  ivec3 cell = CloudSkipCell(vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y, ns, edge);
+  ivec3 cell = CloudSkipCell(CloudShapeUvw(layer, place, h - layer.shell.x), ns, edge);
   float shape = CloudNoise(first + nw * nw + (cell.z * ns + cell.y) * ns + cell.x);
   float base = mix(1.0, shape, layer.shape.x) * profile;
   if (edge) return inside ? 1.0 : -1.0;
@@ -438,17 +457,6 @@ float CloudRayToAltitude(IN(AtmosphereParameters) atm, float r0, float h0, float
   return -r0 * mu + branch * sqrt(max(disc, 0.0));
 }
 
-// Nearest-voxel reads of an n^3 volume and of an n^2 map (the texel that
-// holds the point), wrapping: one load where the trilinear read takes 8.
-float SampleVolumeNearest(int first, int n, vec3 uvw) {
-  ivec3 i = min(ivec3(fract(uvw) * float(n)), ivec3(n - 1));
-  return CloudNoise(first + (i.z * n + i.y) * n + i.x);
-}
-float SampleMapNearest(int first, int n, vec2 uv) {
-  ivec2 i = min(ivec2(fract(uv) * float(n)), ivec2(n - 1));
-  return CloudNoise(first + i.y * n + i.x);
-}
-
 // LayerExtinction without the detail erosion (the light march's density),
 // its volumes and weather map read at the nearest voxel: the light march's
 // far samples (CloudOpticalDepthToSun), where a step is about a voxel long
@@ -457,18 +465,16 @@ float LayerLightExtinctionNearest(int l, vec2 xz, float h) {
   GpuCloudLayer layer = gpu_clouds.layers[l];
   float hf = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
   float profile = HeightProfile(layer.profile, hf);
-  vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
-  vec2 weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
+  CloudPlace place = CloudPlaceOf(layer, xz, h);
   float d;
   if (kCloudFormation && layer.weather.w > 1.5) {
     float n = float(gpu_clouds.resolution.x);
     d = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x,
-                            vec3(weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), weather_uv.y));
+                            vec3(place.weather_uv.x, clamp(hf, 0.5 / n, 1.0 - 0.5 / n), place.weather_uv.y));
   } else {
-    float weather = SampleMapNearest(layer.noise.z, gpu_clouds.resolution.z, weather_uv);
+    float weather = CloudWeatherAt(layer, place, true);
     float coverage = clamp(2.0 * layer.weather.x - 1.0 + weather, 0.0, 1.0);
-    float shape = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x,
-                                      vec3(q.x, h - layer.shell.x, q.y) * layer.shape.y);
+    float shape = SampleVolumeNearest(layer.noise.x, gpu_clouds.resolution.x, CloudShapeUvw(layer, place, h - layer.shell.x));
     float base = mix(1.0, shape, layer.shape.x) * profile;
     d = coverage > 0.0 ? clamp((base - (1.0 - coverage)) / coverage, 0.0, 1.0) * coverage : 0.0;
   }

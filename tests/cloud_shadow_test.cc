@@ -148,10 +148,11 @@ coverage = 0.5
 shape_size_m = 4000
 detail_size_m = 400
 weather_size_m = 8000
+tiling = true
 )";
 
-// A map whose extent is a whole number of every tile (8 km: 2 shape tiles,
-// 20 detail tiles, 1 weather tile) repeats: the map one extent east is the
+// A map of a tiling layer (`tiling = true`) whose extent is a whole number
+// of every tile (8 km: 2 shape tiles, 20 detail tiles, 1 weather tile) repeats: the map one extent east is the
 // same map, and the map half an extent east is this one rolled by half its
 // width, so its middle (where this map's east and west edges meet) is as
 // continuous as the rest. An extent of 7 km does not tile.
@@ -159,6 +160,10 @@ TEST(CloudShadow, TilingMapWrapsWithoutASeam) {
   const SkyStyle style = Style(kNoisy);
   EXPECT_TRUE(CloudShadowTiles(PrunedStyle(style).clouds, 8000.0));
   EXPECT_FALSE(CloudShadowTiles(PrunedStyle(style).clouds, 7000.0));
+  // The same layer read through the non-repeating warp (the default) never tiles.
+  SkyStyle free_style = style;
+  free_style.clouds.layers[0].tiling = false;
+  EXPECT_FALSE(CloudShadowTiles(PrunedStyle(free_style).clouds, 8000.0));
   std::unique_ptr<SkyRenderer> r = RendererOf(style);
   CloudShadowSettings s{.enabled = true, .resolution = 64, .extent_m = 8000.0};
   const glm::dvec3 sun = Sun(50.0);

@@ -94,10 +94,12 @@ detail_size_m = 300
 wind_m_s = [10.0, -5.0]
 shear_m_s_per_km = [2.0, 0.0]
 weather_size_m = 20000
+tiling = true
 )");
   ASSERT_EQ(s.clouds.layers.size(), 1u);
   const CloudLayer& l = s.clouds.layers[0];
   EXPECT_EQ(l.type, CloudType::kCustom);
+  EXPECT_TRUE(l.tiling);
   EXPECT_EQ(l.profile[3], 0.9);
   EXPECT_EQ(l.wind_m_s[1], -5.0);
   EXPECT_FALSE(l.seed.has_value());
@@ -108,6 +110,15 @@ weather_size_m = 20000
   EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.y, 0.5f);   // 5 m/s south
   EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.z, 0.2f);   // 2 m/s per km x 100 s
   EXPECT_FLOAT_EQ(in.uniform.layers[0].shell.z, 20.0f);        // 0.02 /m = 20 /km
+  // A tiling layer reads its tiles as they are (no warp: weather_origin.zw
+  // 0); by default the warp of the 20 km weather tile and three weather reads.
+  EXPECT_EQ(in.uniform.layers[0].weather_origin.z, 0.0f);
+  EXPECT_EQ(in.uniform.layers[0].weather_origin.w, 0.0f);
+  CloudSettings free_clouds = s.clouds;
+  free_clouds.layers[0].tiling = false;
+  const CloudInputs free_in = ToCloudInputs(free_clouds, s.aoas.seed, "", 100.0);
+  EXPECT_FLOAT_EQ(free_in.uniform.layers[0].weather_origin.z, 20.0f);
+  EXPECT_EQ(free_in.uniform.layers[0].weather_origin.w, 1.0f);
   // The resolved style records the layer, so a bake says what it used.
   EXPECT_NE(s.resolved_toml.find("[[cloud_layer]]"), std::string::npos) << s.resolved_toml;
   SkyStyle again = Style(s.resolved_toml);
@@ -171,6 +182,8 @@ TEST(CloudStyle, BadLayersAreLocated) {
                   "cloud_layer[0].profile: [0.5, 0.1, 0.2, 0.3]: expected"));
   EXPECT_TRUE(has(Errors("[[cloud_layer]]\ncolour = 3\n"), "cloud_layer[0].colour: unknown key 'colour'"));
   EXPECT_TRUE(has(Errors("[[cloud_layer]]\nwind_m_s = [1.0]\n"), "cloud_layer[0].wind_m_s: expected [east, north]"));
+  EXPECT_TRUE(has(Errors("[[cloud_layer]]\ntiling = 1\n"),
+                  "clouds_test.toml:2:10: cloud_layer[0].tiling: expected true or false"));
   std::string five;
   for (int i = 0; i < 5; ++i) five += fmt::format("[[cloud_layer]]\naltitude_m = {}\n", 1000 * i);
   e = Errors(five);
@@ -269,7 +282,8 @@ TEST(CloudPass, PrunedLayerIsByteIdenticalToNoLayer) {
   testing::ExpectNoValidationMessages();
 }
 
-// Wind moves the clouds by wind x time and nothing else: after exactly one
+// Wind moves the clouds by wind x time and nothing else: for a layer that
+// tiles (`tiling = true`), after exactly one
 // tile period of every noise (8 km at 80 m/s in 100 s) the sky is the same
 // to float rounding; after half of it, it differs; two renders of the same
 // time give the same bytes.
@@ -282,6 +296,7 @@ coverage = 0.5
 weather_size_m = 8000
 shape_size_m = 4000
 detail_size_m = 400
+tiling = true
 wind_m_s = [80.0, 0.0]
 )");
   const glm::dvec3 sun = Sun(30.0);

@@ -700,7 +700,10 @@ class StyleReader : public TomlReader {
         else if (k == "detail_amount") number(value, key_path, kUnit, layer.detail_amount);
         else if (k == "detail_size_m") number(value, key_path, kNoiseSize, layer.detail_size_m);
         else if (k == "weather_size_m") number(value, key_path, kWeatherSize, layer.weather_size_m);
-        else if (k == "wind_m_s") numbers(value, key_path, kWind, layer.wind_m_s.data(), 2, "[east, north] in m/s");
+        else if (k == "tiling") {
+          if (!value.is_boolean()) ok = false, Error(&value, key_path, "expected true or false");
+          else layer.tiling = value.as_boolean()->get();
+        } else if (k == "wind_m_s") numbers(value, key_path, kWind, layer.wind_m_s.data(), 2, "[east, north] in m/s");
         else if (k == "shear_m_s_per_km")
           numbers(value, key_path, kShear, layer.shear_m_s_per_km.data(), 2, "[east, north] in m/s per km");
         else if (k == "weather_extent_m")
@@ -746,7 +749,7 @@ class StyleReader : public TomlReader {
           Error(&value, key_path,
                 fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
                             "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
-                            "wind_m_s, shear_m_s_per_km, seed, weather_size_m, weather_image, weather_extent_m, "
+                            "wind_m_s, shear_m_s_per_km, seed, weather_size_m, tiling, weather_image, weather_extent_m, "
                             "weather_origin_m, formation)",
                             k));
         }
@@ -883,6 +886,7 @@ class StyleWriter {
       t.insert("shear_m_s_per_km", toml::array{l.shear_m_s_per_km[0], l.shear_m_s_per_km[1]});
       if (l.seed) t.insert("seed", int64_t(*l.seed));
       t.insert("weather_size_m", l.weather_size_m);
+      if (l.tiling) t.insert("tiling", true);
       if (l.formation.enabled) t.insert("formation", CloudFormationToml(l.formation));
       if (!l.weather_image.empty()) {
         t.insert("weather_image", l.weather_image);

@@ -26,6 +26,9 @@ std::string Vec3(const std::array<double, 3>& v) { return fmt::format("{:.9g} {:
 
 bool CloudShadowTiles(const CloudSettings& clouds, double extent_m) {
   for (const CloudLayer& l : ActiveCloudLayers(clouds)) {
+    // A layer read through the non-periodic warp never repeats
+    // (shaders/cloud_weather.glsl); a formation's is not warped.
+    if (!l.tiling && !l.formation.enabled) return false;
     std::array<double, 2> weather = {l.weather_size_m, l.weather_size_m};
     if (l.formation.enabled) weather = l.formation.size_m;
     else if (!l.weather_image.empty()) weather = l.weather_extent_m;

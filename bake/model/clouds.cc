@@ -338,13 +338,18 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
                           q.shape_resolution);
     } else if (l.weather_image.empty()) {
       o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};
-      o.weather_origin = {0.0f, 0.0f, 0.0f, 0.0f};
+      // z: the warp's weather tile (km; 0 when the layer tiles), w: the
+      // weather read three times through it (shaders/cloud_weather.glsl).
+      o.weather_origin = {0.0f, 0.0f, l.tiling ? 0.0f : float(l.weather_size_m * 1e-3), l.tiling ? 0.0f : 1.0f};
     } else {
       // The image's north-west corner (row 0, column 0) at world x = west
       // edge, z = -(north edge).
       o.weather = {float(l.coverage), float(1e3 / l.weather_extent_m[0]), float(1e3 / l.weather_extent_m[1]), 1.0f};
+      // The image as placed; only the shape is warped (z), by the warp of
+      // the layer's weather_size_m.
       o.weather_origin = {float(l.weather_origin_m[0] * 1e-3),
-                          float(-(l.weather_origin_m[1] + l.weather_extent_m[1]) * 1e-3), 0.0f, 0.0f};
+                          float(-(l.weather_origin_m[1] + l.weather_extent_m[1]) * 1e-3),
+                          l.tiling ? 0.0f : float(l.weather_size_m * 1e-3), 0.0f};
       const std::vector<float> map = ReadWeatherImage(ResolvePath(l.weather_image, style_dir), q.weather_resolution);
       in.weather_images.insert(in.weather_images.end(), map.begin(), map.end());
     }

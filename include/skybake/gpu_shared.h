@@ -196,7 +196,9 @@ SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
                         // (or a formation's coverage); 2 = also a formation's whole density, its volume in
                         // the shape volume's place (cloud_formation.h)
   vec4 wind_offset;     // xy: world x, z moved by the wind at the bottom, km; zw: more per km of height (shear), km/km
-  vec4 weather_origin;  // xy: world x, z of the weather map's corner, km; zw: unused
+  vec4 weather_origin;  // xy: world x, z of the weather map's corner, km; z: the non-repeating warp's weather
+                        // tile, km (0: the layer tiles); w: 1 = the weather read three times through the warp
+                        // (shaders/cloud_weather.glsl)
   ivec4 noise;          // x, y, z: first float of the shape volume, detail volume, weather map; w: seed
 };
 

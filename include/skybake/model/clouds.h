@@ -60,6 +60,11 @@ struct CloudLayer {
   std::optional<uint32_t> seed;  // aoas.seed when unset
   // Weather map: procedural tiling noise of this extent, or an image.
   double weather_size_m = 30000.0;  // edge of one tile of the procedural weather map
+  // false (default): the shape, detail and procedural weather are read
+  // through a non-periodic domain warp (shaders/cloud_weather.glsl), so the
+  // layer never repeats; true: they repeat with their tile sizes (a cloud
+  // shadow map of whole tiles then wraps without a seam, CloudShadowTiles).
+  bool tiling = false;
   std::string weather_image;        // EXR or PNG; R = coverage (0..1); "" = procedural
   std::array<double, 2> weather_extent_m = {30000.0, 30000.0};  // [east, north] size of the image
   std::array<double, 2> weather_origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner
