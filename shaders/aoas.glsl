@@ -167,6 +167,35 @@ vec3 PerturbationOffset(IN(AoasParameters) aoas, vec3 fragment) {
   return offset * (aoas.l_pt * aoas.dome_radius);
 }
 
+// The perturbed view `perturbed` (unit) kept on the side of the horizon that
+// the unperturbed view `view` (unit) is on, both before the skydome's turn
+// to the zenith, `apex` the local zenith there. The horizon is the cosine
+// mu_h = -sqrt(1 - (r_bottom / r)^2) of the observer at `altitude` (km; 0 on
+// the ground): a view with mu = apex . view < mu_h meets the ground. The
+// perturbation's change of mu, delta, is scaled by d^2 / (d^2 + delta^2),
+// d = |mu_view - mu_h|: |delta| d^2 / (d^2 + delta^2) <= d / 2 < d, so the
+// view never crosses the horizon, and far from it (d >> |delta|) the
+// perturbation is kept whole (factor 1 - (delta / d)^2). The azimuthal part
+// of the perturbation is kept everywhere. Ground texels then show ground and
+// sky texels sky, as without ambiguity (issue 50, item 6).
+vec3 KeepPerturbedViewOnSide(IN(AtmosphereParameters) atm, vec3 view, vec3 perturbed, vec3 apex,
+                             Real altitude) {
+  Real r = atm.bottom_radius + altitude;
+  Real ratio = atm.bottom_radius / r;
+  Real mu_h = -sqrt(max(1.0 - ratio * ratio, 0.0));
+  Real mu_view = dot(view, apex);
+  Real mu_perturbed = dot(perturbed, apex);
+  Real d = abs(mu_view - mu_h);
+  Real delta = mu_perturbed - mu_view;
+  Real denom = d * d + delta * delta;
+  if (denom <= 0.0) return view;
+  Real mu = clamp(mu_view + delta * (d * d / denom), -1.0, 1.0);
+  vec3 across = perturbed - apex * mu_perturbed;
+  Real across_len = length(across);
+  if (across_len < 1e-6) return perturbed;  // at the zenith or nadir, far from the horizon
+  return apex * mu + across * (sqrt(max(1.0 - mu * mu, 0.0)) / across_len);
+}
+
 // ---------------------------------------------------------------- cloud complexity (eq. 7-8)
 
 // Cloud amount in [0, 1] from eq. 7, noise = Perlin(P^s_f, S_noise): the
@@ -308,14 +337,16 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
   }
   // Without the skydome and the perturbation, eq. 1 gives back w exactly.
   vec3 view = w;
+  vec3 apex = SkydomeApexDirection(viewer);
   if (aoas.skydome || aoas.ambiguity) {
-    vec3 perturbed = fragment;
-    if (aoas.ambiguity) perturbed = fragment + PerturbationOffset(aoas, fragment);
-    view = SkydomeViewDirection(perturbed, viewer);
+    view = SkydomeViewDirection(fragment, viewer);
+    if (aoas.ambiguity) {
+      vec3 perturbed = SkydomeViewDirection(fragment + PerturbationOffset(aoas, fragment), viewer);
+      view = KeepPerturbedViewOnSide(earth, view, perturbed, apex, earth.observer_altitude);
+    }
   }
   vec3 sun_local = sun;
   if (aoas.skydome) {
-    vec3 apex = SkydomeApexDirection(viewer);
     view = RotateApexToZenith(view, apex);
     sun_local = RotateApexToZenith(sun, apex);
   }

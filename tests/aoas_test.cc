@@ -819,5 +819,80 @@ TEST(AoasStylesTest, GalleryCommandExitCodesAndSheet) {
     EXPECT_NE(output.find(std::filesystem::path(style).stem().string()), std::string::npos) << style;
 }
 
+// ------------------------------------------------------------------ the horizon under ambiguity
+
+TEST(AoasAmbiguityTest, PerturbedViewNeverCrossesTheHorizon) {
+  // KeepPerturbedViewOnSide in double: views within 10 deg of the horizon,
+  // perturbations of up to 0.3 rad, observers on the ground and at 10 km
+  // (horizon 3.2 deg down): the kept view is on the unperturbed view's side,
+  // unit, and far from the horizon the perturbation is kept nearly whole.
+  f64::AtmosphereParameters atm{};
+  atm.bottom_radius = 6360.0;
+  atm.top_radius = 6460.0;
+  std::mt19937 rng(50);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const f64::vec3 up(0.0, 1.0, 0.0);
+  int crossings = 0;
+  for (double altitude : {0.0, 10.0}) {
+    const double r = atm.bottom_radius + altitude;
+    const double mu_h = -std::sqrt(1.0 - (atm.bottom_radius / r) * (atm.bottom_radius / r));
+    for (int i = 0; i < 20000; ++i) {
+      double mu = mu_h + 0.17 * unit(rng), phi = M_PI * unit(rng);
+      f64::vec3 view(std::sqrt(1.0 - mu * mu) * std::cos(phi), mu, std::sqrt(1.0 - mu * mu) * std::sin(phi));
+      f64::vec3 perturbed = f64::normalize(view + f64::vec3(unit(rng), unit(rng), unit(rng)) * 0.3);
+      f64::vec3 kept = f64::KeepPerturbedViewOnSide(atm, view, perturbed, up, altitude);
+      EXPECT_NEAR(f64::length(kept), 1.0, 1e-12);
+      if ((kept.y < mu_h) != (mu < mu_h)) ++crossings;
+    }
+  }
+  EXPECT_EQ(crossings, 0);
+  // 60 deg up, a 0.05 change of mu: kept to within 1% of itself.
+  f64::vec3 view(0.5, std::sqrt(0.75), 0.0);
+  f64::vec3 perturbed = f64::normalize(f64::vec3(0.45, std::sqrt(0.75) + 0.05, 0.02));
+  f64::vec3 kept = f64::KeepPerturbedViewOnSide(atm, view, perturbed, up, 0.0);
+  EXPECT_NEAR(kept.y - view.y, perturbed.y - view.y, 0.01 * std::abs(perturbed.y - view.y));
+}
+
+TEST(AoasAmbiguityTest, HorizonIsAsCleanAsWithoutAmbiguity) {
+  // Measure: the count of texels of a 256 x 128 latlong (observer on the
+  // ground, where the ground seen below the horizon is one radiance, the
+  // ground at the observer's feet) whose side flips: a texel centred below
+  // the horizon that does not show the ground's radiance (within 1e-4
+  // relative), or one above it that does. Bound: 0, as the same style with
+  // the ambiguity off. Before the perturbation was kept on its side of the
+  // horizon, ambiguous_yellow (l_pt 0.1) flipped texels within about 6 deg
+  // of the horizon.
+  const int width = 256, height = 128;
+  const ViewRequest view{MAPPING_LATLONG, width, height, 0};
+  const std::vector<glm::dvec3> directions = ViewDirections(view);
+  for (const char* name : {"ambiguous_yellow", "coral_cartoony", "red_yellow_dystopian"}) {
+    SCOPED_TRACE(name);
+    const std::string path = testing::SourceDir() + "/configs/styles/" + name + ".toml";
+    ConfigResult on = LoadSkyStyle(path, {"quality.view_steps=16"});
+    ConfigResult off = LoadSkyStyle(path, {"quality.view_steps=16", "ambiguity.enabled=false"});
+    ASSERT_TRUE(on.ok() && off.ok());
+    ASSERT_EQ(on.style.atmosphere.observer_altitude_m, 0.0);
+    const std::vector<float> with = RenderGpu(on.style, {view})[0], without = RenderGpu(off.style, {view})[0];
+    // The ground's radiance: the first texel of the bottom row without ambiguity.
+    const size_t ground_index = size_t(height - 1) * width;
+    auto count_flips = [&](const std::vector<float>& image) {
+      int flips = 0;
+      for (size_t i = 0; i < directions.size(); ++i) {
+        bool shows_ground = true;
+        for (int c = 0; c < 3; ++c) {
+          double g = without[4 * ground_index + c];
+          if (std::abs(image[4 * i + c] - g) > 1e-4 * std::max(std::abs(g), 1e-6)) shows_ground = false;
+        }
+        if (shows_ground != (directions[i].y < 0.0)) ++flips;
+      }
+      return flips;
+    };
+    const int flips_without = count_flips(without), flips_with = count_flips(with);
+    RecordProperty(std::string(name) + "_flips", std::to_string(flips_with));
+    EXPECT_EQ(flips_without, 0);
+    EXPECT_EQ(flips_with, 0);
+  }
+}
+
 }  // namespace
 }  // namespace skybake
