@@ -55,8 +55,8 @@ struct ShaderSwitches {
   // even when no layer has one, as the generic build did
   bool formation_read_always = false;
   // Twilight frames whose half-float views the march would not change go unmarched (pipeline/twilight_skip.h);
-  // the CLI turns it on only with SKYBAKE_TWILIGHT_SKIP=1 (its probes cost more than they save on W2)
-  bool twilight_skip = true;
+  // off unless asked for (the CLI: SKYBAKE_TWILIGHT_SKIP=1): its probes cost more than they save on W2
+  bool twilight_skip = false;
 };
 
 // Whether the sun disc is added by a pass of its own over the texels near
