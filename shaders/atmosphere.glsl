@@ -644,18 +644,30 @@ InScattering IntegrateInScattering(IN(AtmosphereParameters) atm, IN(SkyRay) ray,
   int granule = simpson ? 2 : 1;
   Real t_split = 0.0;
   if (n >= 2 * granule) t_split = UmbraExitDistance(atm, ray);
-  if (t_split <= 0.0)
-    return IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, 0.0, ray.t_max, n, result);
-  Real fraction = t_split / ray.t_max;
-  if (atm.step_distribution == STEPS_QUADRATIC) fraction = sqrt(fraction);
-  // At most half the steps in the shadow: a ray nearly parallel to the
-  // shadow's axis leaves it far out, where the unsplit mapping has only a
-  // step or two left for the lit part and its penumbra.
-  int n_shadow = int(floor(fraction * Real(n / granule) + 0.5)) * granule;
-  n_shadow = clamp(n_shadow, granule, (n / (2 * granule)) * granule);
-  result = IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, 0.0, t_split, n_shadow, result);
-  return IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, t_split, ray.t_max, n - n_shadow,
-                                      result);
+  // One segment [0, t_max] with n steps, or two split at t_split. The
+  // segments go through one call in a loop: the compiler inlines each call
+  // of the integrator (every rule), so a second and third call site would
+  // copy it (the sky-view LUT shader's SPIR-V, docs/performance.md).
+  int n_first = n;
+  Real t_first = ray.t_max;
+  if (t_split > 0.0) {
+    Real fraction = t_split / ray.t_max;
+    if (atm.step_distribution == STEPS_QUADRATIC) fraction = sqrt(fraction);
+    // At most half the steps in the shadow: a ray nearly parallel to the
+    // shadow's axis leaves it far out, where the unsplit mapping has only a
+    // step or two left for the lit part and its penumbra.
+    n_first = int(floor(fraction * Real(n / granule) + 0.5)) * granule;
+    n_first = clamp(n_first, granule, (n / (2 * granule)) * granule);
+    t_first = t_split;
+  }
+  int segments = t_split > 0.0 ? 2 : 1;
+  for (int k = 0; k < segments; ++k) {
+    Real t_a = k == 0 ? 0.0 : t_first;
+    Real t_b = k == 0 ? t_first : ray.t_max;
+    int steps = k == 0 ? n_first : n - n_first;
+    result = IntegrateInScatteringSegment(atm, ray, rayleigh_phase, mie_phase, t_a, t_b, steps, result);
+  }
+  return result;
 }
 
 // Radiance of the sunlit Lambertian ground at the end of a ray that hits it,
