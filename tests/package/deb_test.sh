@@ -5,7 +5,8 @@
 # are unpacked into a temporary root (dpkg -x), and the skybake they hold
 # bakes the default style they hold, with the module found beside its own
 # install; then `cmake --install` into a prefix that cannot be written must
-# stop with a clear message and install nothing.
+# stop with a clear message and install nothing; last, as root, the packages
+# are installed with dpkg -i, bake from /usr/bin/skybake, and are purged.
 #   bash tests/package/deb_test.sh BUILD_DIR
 set -euo pipefail
 build="$(cd "$1" && pwd)"
@@ -99,4 +100,36 @@ grep -q "cannot install skybake into $work/plain-file/skybake" "$work/install.lo
 grep -q "Installing:" "$work/install.log" && fail "something was installed"
 [ ! -e "$work/plain-file/skybake" ] || fail "the prefix was created"
 sed -n 's/^ *\(CMake Error.*\|cannot install.*\)$/\1/p' "$work/install.log" | head -3
+# 4. Installed on this machine as a farm node installs it (dpkg -i), a bake from /usr/bin/skybake,
+#    then purged (dpkg --purge) with nothing left behind. As root only, and only where no skybake is
+#    installed already: the test never replaces or removes a skybake it did not install.
+if [ "$(id -u)" != 0 ]; then
+  echo "dpkg -i: not tried (not root); the packages were checked unpacked above"
+elif dpkg-query -W -f='${Status}' skybake 2>/dev/null | grep -q "ok installed" || [ -e /usr/bin/skybake ]; then
+  echo "dpkg -i: not tried: a skybake is installed here already (/usr/bin/skybake), and the test does not replace it"
+else
+  names="skybake${module:+ skybake-oiio}${python_deb:+ python3-skybake}"
+  trap 'dpkg --purge $names >/dev/null 2>&1 || true; rm -rf "$work"' EXIT
+  dpkg -i "$tool" ${module:+"$module"} ${python_deb:+"$python_deb"} >"$work/dpkg_install.log" 2>&1 ||
+    { cat "$work/dpkg_install.log"; fail "dpkg -i"; }
+  /usr/bin/skybake --version
+  (cd "$work" && /usr/bin/skybake bake /usr/share/skybake/configs/default.toml --size 16 -q --vulkan-validation \
+     --out "$work/installed_out") || fail "the installed skybake did not bake"
+  [ -s "$work/installed_out/sky_latlong.exr" ] || fail "the installed skybake wrote no sky_latlong.exr"
+  if [ -n "$python_deb" ]; then
+    (cd "$work" && /usr/bin/python3 -c 'import skybake; assert skybake.__file__.startswith("/usr/lib/python3/dist-packages/")') ||
+      fail "Debian's python3 does not import the installed module"
+  fi
+  # --purge: a package with maintainer scripts (ldconfig for the module) stays "rc" after -r alone.
+  dpkg --purge $names >"$work/dpkg_remove.log" 2>&1 || { cat "$work/dpkg_remove.log"; fail "dpkg --purge"; }
+  trap 'rm -rf "$work"' EXIT
+  for f in /usr/bin/skybake /usr/share/skybake /usr/lib/skybake /usr/share/doc/skybake; do
+    [ ! -e "$f" ] || fail "dpkg --purge left $f"
+  done
+  ls /usr/lib/python3/dist-packages/skybake.* >/dev/null 2>&1 && fail "dpkg --purge left the Python module"
+  for name in $names; do
+    dpkg-query -W -f='${db:Status-Abbrev}' "$name" 2>/dev/null | grep -q . && fail "dpkg still knows $name after --purge"
+  done
+  echo "dpkg -i $names, a bake from /usr/bin/skybake, dpkg --purge: nothing left"
+fi
 echo "deb package: OK"
