@@ -208,41 +208,34 @@ TEST_F(Shard, MergeRefusesMissingFramesAndPartsOfAnotherBake) {
 // range; anything else is exit 8, before any file under such a name is
 // opened (no size of a file outside the folder is ever shown) and with
 // nothing written.
-TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
-  const std::string root = FreshTempDir("hostile");
-  const std::string schedule = root + "/two.toml";
-  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n";
-  const std::string parts = root + "/parts";
-  for (const char* shard : {"1/2", "2/2"}) {
-    CommandRun run = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + parts +
-                                "' --shard " + shard);
-    ASSERT_EQ(run.exit_code, 0) << run.output;
-  }
-  std::ofstream(root + "/secret.png") << "secret";
-  using Edit = std::function<void(nlohmann::json&)>;
-  struct Case {
-    const char* name;
-    const char* part;  // the manifest edited
-    Edit edit;
-    std::string message;  // expected in the output
-  };
+// An edit of a shard manifest that merge-manifest must refuse (exit 8).
+struct ManifestEdit {
+  const char* name;
+  const char* part;  // the manifest edited
+  std::function<void(nlohmann::json&)> edit;
+  std::string message;  // expected in the output
+};
+
+// Names from the manifests that would leave the folder or name another
+// file, and values skybake never writes.
+std::vector<ManifestEdit> HostileManifestEdits() {
   auto file = [](int n) { return [n](nlohmann::json& m) -> nlohmann::json& { return m["frames"][0]["files"][n]["file"]; }; };
-  const std::vector<Case> cases = {
+  return {
       {"gltf name escapes", "0001-0001", [](nlohmann::json& m) { m["gltf"]["name"] = "../evil"; },
        "gltf.name: '../evil' is not a plain file name"},
       {"gltf name absolute", "0001-0001", [](nlohmann::json& m) { m["gltf"]["name"] = "/tmp/evil"; },
        "gltf.name: '/tmp/evil' is not a plain file name"},
       {"texture escapes", "0002-0002", [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "../secret.png"; },
        "gltf.texture.file: '../secret.png' is not a plain file name of a PNG in the folder"},
-      {"frame file escapes", "0001-0001", [&](nlohmann::json& m) { file(0)(m) = "../../../etc/passwd"; },
+      {"frame file escapes", "0001-0001", [file](nlohmann::json& m) { file(0)(m) = "../../../etc/passwd"; },
        "frame 1: '../../../etc/passwd' is not the face file skybake names for frame 1 (....0001.exr)"},
-      {"frame file absolute", "0001-0001", [&](nlohmann::json& m) { file(6)(m) = "/etc/passwd"; },
+      {"frame file absolute", "0001-0001", [file](nlohmann::json& m) { file(6)(m) = "/etc/passwd"; },
        "frame 1: '/etc/passwd' is not the cube strip file skybake names for frame 1"},
-      {"frame file in a sub-folder", "0001-0001", [&](nlohmann::json& m) { file(7)(m) = "sub/sky_latlong.0001.exr"; },
+      {"frame file in a sub-folder", "0001-0001", [file](nlohmann::json& m) { file(7)(m) = "sub/sky_latlong.0001.exr"; },
        "frame 1: 'sub/sky_latlong.0001.exr' is not the latlong file skybake names for frame 1"},
-      {"frame file with a newline", "0001-0001", [&](nlohmann::json& m) { file(1)(m) = "sky_nx.0001.exr\nX"; },
+      {"frame file with a newline", "0001-0001", [file](nlohmann::json& m) { file(1)(m) = "sky_nx.0001.exr\nX"; },
        "frame 1: 'sky_nx.0001.exr\\nX' is not the face file skybake names for frame 1"},
-      {"another frame's file", "0001-0001", [&](nlohmann::json& m) { file(7)(m) = "sky_latlong.0002.exr"; },
+      {"another frame's file", "0001-0001", [file](nlohmann::json& m) { file(7)(m) = "sky_latlong.0002.exr"; },
        "frame 1: 'sky_latlong.0002.exr' is not the latlong file skybake names for frame 1 (....0001.exr)"},
       {"kind swapped", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][6]["kind"] = "latlong"; },
        "frame 1: 'sky_cube.0001.exr' is not the latlong file skybake names for frame 1 (BASE_latlong.0001)"},
@@ -288,7 +281,21 @@ TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
        [](nlohmann::json& m) { m["gltf"]["texture"]["file"] = "sky_latlong.0001.png"; },
        "gltf.texture.file 'sky_latlong.0001.png' of the shard manifests in "},
   };
-  for (const Case& c : cases) {
+}
+
+TEST(ShardManifest, MergeRefusesNamesAndValuesTheBakeWouldNotWrite) {
+  const std::string root = FreshTempDir("hostile");
+  const std::string schedule = root + "/two.toml";
+  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n";
+  const std::string parts = root + "/parts";
+  for (const char* shard : {"1/2", "2/2"}) {
+    CommandRun run = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + parts +
+                                "' --shard " + shard);
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+  }
+  std::ofstream(root + "/secret.png") << "secret";
+  const std::vector<ManifestEdit> cases = HostileManifestEdits();
+  for (const ManifestEdit& c : cases) {
     SCOPED_TRACE(c.name);
     const std::string dir = root + "/case";
     fs::remove_all(dir);
