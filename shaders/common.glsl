@@ -46,7 +46,7 @@ layout(std140, set = 0, binding = BINDING_AOAS) uniform AoasBlock {
 // uniform values that decide a branch ("inlined uniforms") and keeps every
 // variant while the pipeline lives, so a sequence's new Sun every frame cost
 // an LLVM compile and about 1 MiB that was never given back. Storage-buffer
-// values are never inlined. (docs/performance.md, "Long sequences".)
+// values are never inlined. (docs/performance_history.md, "Long sequences".)
 layout(std430, set = 0, binding = BINDING_DISPATCH) readonly buffer DispatchBuffer {
   SkyPush dispatch_constants[];
 };

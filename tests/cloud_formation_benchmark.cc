@@ -1,5 +1,5 @@
 // What the cloud-formation automaton and the cloud shadow map cost per
-// frame (docs/performance.md "Cloud formation and shadow map"):
+// frame (docs/performance_history.md "Cloud formation and shadow map"):
 //   - one automaton step of a 64 x 64 x 8 lattice (CPU, one thread);
 //   - a frame of configs/styles/afternoon_buildup.toml at the end of its
 //     schedule (18:00, step 20 + 6 h x 20 = 140) simulated from step 0, as

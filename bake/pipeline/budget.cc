@@ -120,7 +120,7 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
 // manifest entries and timings stay on disk, json_spool.h): what is left is
 // what the glTF scene needs of a frame and the scene's texts at the end:
 // 3.1 KiB a frame while 10,000 frames bake, 26.1 KiB a frame to the end of
-// the bake (tests/benchmark/long_sequence.py, docs/performance.md "Long
+// the bake (tests/benchmark/long_sequence.py, docs/performance_history.md "Long
 // sequences"), which kStreamedFrameBytes bounds.
 constexpr double kFrameRecordBytes = 64.0 * 1024.0;
 constexpr double kFileRecordBytes = 6.0 * 1024.0;

@@ -10,7 +10,7 @@
 # cropped to them: a strip to measure noise on at less cost.
 #
 # Run by `tests/benchmark/performance.py --blender-clouds`, which times the
-# whole process and measures the noise (docs/performance.md, "W3 against
+# whole process and measures the noise (docs/performance_history.md, "W3 against
 # Blender Cycles"). Blender units are metres, Z is up.
 #
 # The scene is W3's (configs/benchmark/w3.toml):

@@ -5,7 +5,7 @@ over N frames. Prints, per N, the wall time, the peak RSS, the memory the
 frames after the first tenth added per frame (sampled from /proc while the
 bake runs: to its end, and while frames are baked), the folder's size and
 the progress manifests' writes (from timings.json). Out of ctest;
-docs/performance.md "Long sequences" quotes it.
+docs/performance_history.md "Long sequences" quotes it.
 
   python3 tests/benchmark/long_sequence.py --frames 100,1000,10000 \
       --set quality.sky_view_lut=false

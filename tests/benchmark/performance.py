@@ -14,7 +14,7 @@ blender_sky.py) renders the same frames in the same run when it is installed.
     python3 tests/benchmark/performance.py --only-ibl [--reps 5] [--skybake-before OLD/skybake]
     python3 tests/benchmark/performance.py --blender-clouds --work DIR [--reps-w3 3] [--sun-elevation 45] [--reuse-blender]
 
---blender-clouds: W3 against Blender Cycles (docs/performance.md, "W3
+--blender-clouds: W3 against Blender Cycles (docs/performance_history.md, "W3
 against Blender Cycles"): skybake's W3 as a 2048 x 1024 float latlong alone
 and with its usual outputs, then tests/benchmark/blender_clouds.py at 16 and
 64 samples (two 16-sample renders with different seeds), the noise of each

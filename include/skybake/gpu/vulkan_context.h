@@ -94,7 +94,7 @@ std::string SoftwareDriverSelection(const DriverEnvironment& environment);
 // or empty in `environment`): twice `hardware_threads`, or "" to leave it.
 // Lavapipe's own default, one thread per core, leaves cores idle between
 // its work items; twice as many keep them busy, with the same user CPU time
-// and the same bytes in every file (docs/performance.md, "Lavapipe
+// and the same bytes in every file (docs/performance_history.md, "Lavapipe
 // threads"). Lavapipe caps the count at its own maximum. "" also when
 // `hardware_threads` is 0 (unknown) or the user's value is set.
 std::string LavapipeThreadCount(const EnvironmentVariables& environment, unsigned hardware_threads);
