@@ -1,5 +1,7 @@
 #include "skybake/model/envmap.h"
 
+#include <cmath>
+
 #include <glm/geometric.hpp>
 #include <OpenEXR/ImfEnvmap.h>
 
@@ -21,8 +23,8 @@ std::vector<glm::dvec3> CubeStripDirections(int n) {
         Imath::V2f pif{float(px), float(py)};
         Imath::V2f pixel = Imf::CubeMap::pixelPosition(f, window, pif);
         Imath::V3f d = Imf::CubeMap::direction(f, window, pif);
-        int x = int(pixel.x + 0.5f);
-        int y = int(pixel.y + 0.5f);
+        const int x = int(std::lround(pixel.x));
+        const int y = int(std::lround(pixel.y));
         directions[size_t(y) * n + x] = glm::normalize(glm::dvec3(d.x, d.y, d.z));
       }
     }
