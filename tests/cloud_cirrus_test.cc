@@ -6,7 +6,9 @@
 //   it, whichever way the wind blows; a stratocumulus layer of the same
 //   noise is within 1.5 times either way (the measure sees isotropy too);
 // - the ice phase integrates to 1 over the sphere and its asymmetry
-//   parameter is the cited 0.75 (Baum et al. 2011);
+//   parameter is the cited 0.75 (Baum et al. 2011), and the render uses it:
+//   the same cloud lit through it is brighter near the Sun and darker 90 deg
+//   from it than through the water phase;
 // - configs/styles/cirrus_uncinus.toml is thin: its vertical optical depth
 //   stays within the thin-to-opaque cirrus range 0.03-3 (Sassen and Cho 1992)
 //   and its transmittance is never below exp(-3);
@@ -26,6 +28,8 @@
 #include "skybake/input/config.h"
 #include "skybake/model/cloud_shadow.h"
 #include "skybake/model/clouds.h"
+#include "skybake/model/atmosphere.h"
+#include "skybake/model/view.h"
 #include "skybake/model/shared_glsl.h"
 #include "skybake/model/tonemap.h"
 #include "skybake/pipeline/pass_plan.h"
@@ -138,6 +142,63 @@ TEST(Cirrus, IcePhaseIsNormalisedWithTheCitedAsymmetry) {
   }
   // Forward of sideways, as ice: the forward peak far above 90 deg.
   EXPECT_GT(glsl::IceCrystalPhase(1.0, 1.0), 100.0 * glsl::IceCrystalPhase(0.0, 1.0));
+}
+
+// The render uses the ice phase: a cirrus layer with streak_ratio 1 and no
+// shear reads its noise where a custom layer of the cirrus profile does (the
+// squeeze by 1 along east is exact in float), so the two differ by the
+// phase alone. Near the Sun the ice phase's forward lobe (g = 0.75) is
+// brighter than the water phase's (g = 0.25); 90 deg from it, darker (at
+// single scattering, 0.0145 against 0.0471 sr^-1).
+std::vector<float> LatlongOf(const std::string& layer_keys, std::vector<glm::dvec3>& directions, glm::dvec3& sun) {
+  const std::string toml = R"(
+[quality]
+preset = "draft"
+[sun]
+elevation_deg = 40.0
+azimuth_deg = 180.0
+[aoas]
+seed = 31
+[[cloud_layer]]
+altitude_m = 8500.0
+thickness_m = 500.0
+coverage = 0.7
+density_per_m = 0.004
+shape_size_m = 5000.0
+wind_m_s = [30.0, 0.0]
+)" + layer_keys;
+  ConfigResult r = ParseSkyStyle(toml, "cloud_cirrus_test.toml");
+  EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].Format());
+  const SkyStyle style = PrunedStyle(r.style);
+  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                       OutputScale(style.output.units), false,
+                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                       ToCloudInputs(style.clouds, style.aoas.seed, "", 0.0));
+  sun = SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg);
+  const ViewRequest view{MAPPING_LATLONG, 256, 128, 0};
+  directions = ViewDirections(view);
+  std::vector<float> image = renderer.Render(sun, {view}, false)[0];
+  testing::ExpectNoValidationMessages();
+  return image;
+}
+
+TEST(Cirrus, TheRenderLightsCirrusThroughTheIcePhase) {
+  std::vector<glm::dvec3> directions;
+  glm::dvec3 sun;
+  const std::vector<float> ice = LatlongOf("type = \"cirrus\"\nstreak_ratio = 1.0\n", directions, sun);
+  const std::vector<float> water = LatlongOf("type = \"custom\"\nprofile = [0.0, 0.35, 0.65, 1.0]\n", directions, sun);
+  double near_ice = 0.0, near_water = 0.0, side_ice = 0.0, side_water = 0.0;
+  for (size_t i = 0; i < directions.size(); ++i) {
+    if (directions[i].y < 0.1) continue;  // the sky above the horizon haze
+    const double angle_deg = std::acos(std::clamp(glm::dot(directions[i], sun), -1.0, 1.0)) * 180.0 / M_PI;
+    const double a = ice[4 * i + 1], b = water[4 * i + 1];  // green
+    if (angle_deg < 15.0) near_ice += a, near_water += b;
+    if (angle_deg > 80.0 && angle_deg < 100.0) side_ice += a, side_water += b;
+  }
+  std::printf("ice over water phase, same cloud: within 15 deg of the Sun %.3f, 80-100 deg from it %.3f\n",
+              near_ice / near_water, side_ice / side_water);
+  EXPECT_GT(near_ice, 1.2 * near_water);
+  EXPECT_LT(side_ice, side_water);
 }
 
 TEST(Cirrus, TheCirrusStyleIsThin) {
