@@ -250,6 +250,12 @@ TEST(Cirrus, StreakRatioIsReadAndChecked) {
   ConfigResult low = ParseSkyStyle(base + "streak_ratio = 0.5\n", "a.toml");
   ASSERT_FALSE(low.ok());
   EXPECT_NE(low.errors[0].Format().find("streak_ratio"), std::string::npos) << low.errors[0].Format();
+  // The resolved style (the manifest's) keeps it, and reads back the same.
+  EXPECT_NE(ok.style.resolved_toml.find("streak_ratio = 12"), std::string::npos) << ok.style.resolved_toml;
+  ConfigResult again = ParseSkyStyle(ok.style.resolved_toml, "resolved.toml");
+  ASSERT_TRUE(again.ok()) << again.errors[0].Format();
+  EXPECT_EQ(again.style.clouds.layers[0].streak_ratio, 12.0);
+  EXPECT_EQ(again.style.resolved_toml, ok.style.resolved_toml);
   ConfigResult wrong_type = ParseSkyStyle("[[cloud_layer]]\ntype = \"cumulus\"\nstreak_ratio = 4.0\n", "a.toml");
   ASSERT_FALSE(wrong_type.ok());
   EXPECT_NE(wrong_type.errors[0].Format().find("needs type = \"cirrus\""), std::string::npos)

@@ -896,6 +896,7 @@ class StyleWriter {
       if (l.seed) t.insert("seed", int64_t(*l.seed));
       t.insert("weather_size_m", l.weather_size_m);
       if (l.tiling) t.insert("tiling", true);
+      if (l.type == CloudType::kCirrus) t.insert("streak_ratio", l.streak_ratio);
       if (l.formation.enabled) t.insert("formation", CloudFormationToml(l.formation));
       if (!l.weather_image.empty()) {
         t.insert("weather_image", l.weather_image);
