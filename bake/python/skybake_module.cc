@@ -34,6 +34,7 @@
 
 #include "build_commit.h"
 #include "exr_arrays.h"
+#include "ktx2_arrays.h"
 #include "skybake/base/errors.h"
 #include "skybake/base/oiio_module.h"
 #include "skybake/gpu/vulkan_context.h"
@@ -576,6 +577,9 @@ struct PyFrame {
   py::object cube = py::none();
   py::dict faces;
   py::dict engine;
+  py::dict ibl;                                   // every IBL file's texels, by file name
+  py::list ibl_specular;                          // the prefiltered levels, (6, N, N, 3) each
+  py::object ibl_irradiance = py::none();         // (6, N, N, 3)
   double render_seconds = 0.0;
 };
 
@@ -627,20 +631,76 @@ py::array_t<float> ArrayOf(const RgbImage& image) {
   return a;
 }
 
-bool IsExr(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".exr") == 0; }
+bool EndsWith(const std::string& path, const char* suffix) {
+  const size_t n = std::strlen(suffix);
+  return path.size() > n && path.compare(path.size() - n, n, suffix) == 0;
+}
+bool IsExr(const std::string& path) { return EndsWith(path, ".exr"); }
+bool IsIbl(const BakedFile& f) { return f.kind == "ibl_specular" || f.kind == "ibl_irradiance" || f.kind == "ibl_dfg"; }
 
-// The EXRs of a frame read back (without the GIL), by file.
-std::map<std::string, RgbImage> ReadFrameExrs(const std::vector<FrameResult>& frames) {
-  std::map<std::string, RgbImage> images;
+// The images of a frame's files read back (without the GIL), by file: its
+// EXRs, and the mip levels of its IBL KTX2s.
+struct FrameImages {
+  std::map<std::string, RgbImage> exrs;
+  std::map<std::string, std::vector<Ktx2Level>> ktx2s;
+};
+
+FrameImages ReadFrameImages(const std::vector<FrameResult>& frames) {
+  FrameImages images;
   py::gil_scoped_release release;
   for (const FrameResult& frame : frames)
-    for (const BakedFile& f : frame.files)
-      if ((f.kind == "latlong" || f.kind == "face" || f.kind == "cube" || f.kind == "engine") && IsExr(f.path))
-        images.emplace(f.path, ReadExrRgb(f.path));
+    for (const BakedFile& f : frame.files) {
+      const bool map = f.kind == "latlong" || f.kind == "face" || f.kind == "cube" || f.kind == "engine" || IsIbl(f);
+      if (map && IsExr(f.path)) images.exrs.emplace(f.path, ReadExrRgb(f.path));
+      else if (IsIbl(f) && EndsWith(f.path, ".ktx2")) images.ktx2s.emplace(f.path, ReadKtx2Rgb(f.path));
+    }
   return images;
 }
 
-PyFrame FrameOf(const FrameResult& f, std::map<std::string, RgbImage>* images) {
+// An IBL cube EXR (six faces stacked from the top, ibl_files.cc) as (6, N, N, 3).
+py::array_t<float> CubeOfStacked(const RgbImage& image) {
+  const size_t n = size_t(image.width);
+  py::array_t<float> a({size_t(6), n, n, size_t(3)});
+  std::memcpy(a.mutable_data(), image.rgb.data(), image.rgb.size() * sizeof(float));
+  return a;
+}
+
+// A KTX2's mip levels: (6, N, N, 3) per level of a cube, (N, N, 3) of an image.
+py::list LevelsOf(const std::vector<Ktx2Level>& levels) {
+  py::list list;
+  for (const Ktx2Level& l : levels) {
+    const size_t n = size_t(l.size);
+    py::array_t<float> a = l.faces == 6 ? py::array_t<float>({size_t(6), n, n, size_t(3)})
+                                        : py::array_t<float>({n, n, size_t(3)});
+    std::memcpy(a.mutable_data(), l.rgb.data(), l.rgb.size() * sizeof(float));
+    list.append(a);
+  }
+  return list;
+}
+
+// Frame.ibl, .ibl_specular and .ibl_irradiance: every IBL file by name; the levels
+// and irradiance from the EXRs when written, else from the KTX2s.
+void IblArraysOf(const FrameResult& f, const FrameImages& images, PyFrame& frame) {
+  py::list exr_levels;
+  for (const BakedFile& file : f.files) {
+    if (!IsIbl(file)) continue;
+    const py::str name(std::filesystem::path(file.path).filename().string());
+    if (auto exr = images.exrs.find(file.path); exr != images.exrs.end()) {
+      py::array_t<float> array = file.kind == "ibl_dfg" ? ArrayOf(exr->second) : CubeOfStacked(exr->second);
+      frame.ibl[name] = array;
+      if (file.kind == "ibl_specular") exr_levels.append(array);  // listed level 0 first (IblFileNames)
+      else if (file.kind == "ibl_irradiance") frame.ibl_irradiance = array;
+    } else if (auto ktx2 = images.ktx2s.find(file.path); ktx2 != images.ktx2s.end()) {
+      py::list levels = LevelsOf(ktx2->second);
+      frame.ibl[name] = levels;
+      if (file.kind == "ibl_specular" && frame.ibl_specular.empty() && exr_levels.empty()) frame.ibl_specular = levels;
+      else if (file.kind == "ibl_irradiance" && frame.ibl_irradiance.is_none()) frame.ibl_irradiance = levels[0];
+    }
+  }
+  if (!exr_levels.empty()) frame.ibl_specular = exr_levels;
+}
+
+PyFrame FrameOf(const FrameResult& f, const FrameImages* images) {
   PyFrame frame;
   frame.number = f.number;
   if (f.time) frame.time = py::str(f.time->Iso8601());
@@ -656,14 +716,15 @@ PyFrame FrameOf(const FrameResult& f, std::map<std::string, RgbImage>* images) {
   frame.render_seconds = f.render_seconds;
   if (images) {
     for (const BakedFile& file : f.files) {
-      auto it = images->find(file.path);
-      if (it == images->end()) continue;
+      auto it = images->exrs.find(file.path);
+      if (it == images->exrs.end() || IsIbl(file)) continue;
       py::array_t<float> array = ArrayOf(it->second);
       if (file.kind == "latlong" && frame.latlong.is_none()) frame.latlong = array;
       else if (file.kind == "cube") frame.cube = array;
       else if (file.kind == "face") frame.faces[py::str(std::filesystem::path(file.path).filename().string())] = array;
       else if (file.kind == "engine") frame.engine[py::str(std::filesystem::path(file.path).filename().string())] = array;
     }
+    IblArraysOf(f, *images, frame);
   }
   return frame;
 }
@@ -795,8 +856,8 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
   report.End(kExitOk, "");
 
   // The result: frames, files, the manifest as a dict, arrays when asked.
-  std::map<std::string, RgbImage> images;
-  if (arrays) images = ReadFrameExrs(result.frames);
+  FrameImages images;
+  if (arrays) images = ReadFrameImages(result.frames);
   PyBake baked;
   baked.out = out;
   baked.manifest_path = result.manifest_path;
@@ -918,6 +979,18 @@ void RegisterTypes(py::module_& m) {
       .def_readonly("engine", &PyFrame::engine,
                     "With arrays=True and an engine preset: each of its EXRs' texels (the engine's own layout; "
                     "docs/engines.md), numpy float32 (H, W, 3), by file name.")
+      .def_readonly("ibl", &PyFrame::ibl,
+                    "With arrays=True and an IBL bake: every IBL file's texels by file name, as the file stores them "
+                    "(times its skybake:scale): a cube EXR (a specular level, the irradiance) as numpy float32 (6, N, "
+                    "N, 3), faces +X -X +Y -Y +Z -Z (Vulkan order), rows from the top; the DFG EXR as (N, N, 3); a "
+                    "KTX2 as a list of its mip levels, level 0 first, each (6, N, N, 3) for a cube, (N, N, 3) for "
+                    "the DFG table.")
+      .def_readonly("ibl_specular", &PyFrame::ibl_specular,
+                    "With arrays=True and ibl.specular: the GGX-prefiltered levels, level 0 (roughness 0) first, "
+                    "each numpy float32 (6, N, N, 3), from the EXRs when written, else the KTX2's mip levels; else [].")
+      .def_readonly("ibl_irradiance", &PyFrame::ibl_irradiance,
+                    "With arrays=True and ibl.irradiance: the irradiance map E(n) / pi, numpy float32 (6, N, N, 3), "
+                    "from the EXR when written, else the KTX2; else None.")
       .def_readonly("render_seconds", &PyFrame::render_seconds, "The frame's render time, s.")
       .def("__repr__", [](const PyFrame& f) {
         return fmt::format("<skybake.Frame {} sun {:.2f} deg>", f.number, f.sun_elevation_deg);
@@ -985,8 +1058,9 @@ void RegisterFunctions(py::module_& m) {
         "progress(event) receives each --progress-json event as a dict (start, stage, frame_start, frame_end with "
         "frame, of, seconds_per_frame, eta_s; end); returning False or raising cancels the bake (Cancel, or what "
         "it raised, is raised here), leaving the folder as a killed bake leaves it. vulkan_validation: the "
-        "Khronos validation layer, any message raises VulkanError. arrays: read each frame's EXRs back as numpy "
-        "arrays (Frame.latlong, .faces, .cube). The GIL is released while the bake runs. Returns a Bake.");
+        "Khronos validation layer, any message raises VulkanError. arrays: read each frame's EXRs and IBL KTX2s "
+        "back as numpy arrays (Frame.latlong, .faces, .cube, .engine, .ibl, .ibl_specular, .ibl_irradiance). The "
+        "GIL is released while the bake runs. Returns a Bake.");
 }
 
 }  // namespace

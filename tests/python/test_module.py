@@ -177,9 +177,87 @@ def test_engine_arrays_are_the_files_texels(in_source, tmp_path):
                                   read_with_oiiotool(tmp_path / "out" / "sky_blender_latlong.exr"))
 
 
+# A small IBL bake: two specular levels, the irradiance and the DFG table, as EXRs and KTX2s.
+IBL = ["ibl.specular=true", "ibl.irradiance=true", "ibl.dfg_lut=true", "ibl.size=16", "ibl.samples=16",
+       "ibl.irradiance_size=8", "ibl.irradiance_samples=16", "ibl.dfg_size=8", "ibl.dfg_samples=16", "ibl.ktx2=true"]
+
+
+def read_small_values_with_oiiotool(exr, tmp_path):
+    """read_with_oiiotool exact for every half float, subnormals too (--dumpdata prints 9 decimals):
+    OpenImageIO scales the texels by 2^24 into a float EXR first (every half is then a whole number)."""
+    scaled = tmp_path / f"scaled_{exr.name}"
+    subprocess.run(["oiiotool", str(exr), "--mulc", str(2 ** 24), "-d", "float", "-o", str(scaled)], check=True)
+    return read_with_oiiotool(scaled) / np.float32(2 ** 24)
+
+
+def read_ktx2_with_ktx_parse(source_dir, ktx2, tmp_path):
+    """npm ktx-parse's reading of a KTX2 (tests/viewer/ktx2_dump.mjs, zstd undone by the zstd
+    command): each mip level's texels as RGB float32, (faces, N, N, 3), decoded here with numpy."""
+    prefix = tmp_path / ktx2.name
+    run = subprocess.run(["node", "ktx2_dump.mjs", str(ktx2), str(prefix)], cwd=source_dir / "tests" / "viewer",
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    info = json.loads(run.stdout)
+    faces = info["faceCount"]
+    levels = []
+    for i in range(info["levelCount"]):
+        n = max(1, info["pixelWidth"] >> i)
+        raw = (tmp_path / f"{ktx2.name}.level{i}").read_bytes()
+        if info["vkFormat"] == 97:  # R16G16B16A16_SFLOAT
+            rgb = np.frombuffer(raw, dtype="<f2").reshape(faces, n, n, 4)[..., :3].astype(np.float32)
+        else:
+            assert info["vkFormat"] == 123  # E5B9G9R9_UFLOAT_PACK32: mantissa 2^(exponent - 15 - 9)
+            v = np.frombuffer(raw, dtype="<u4").reshape(faces, n, n)
+            scale = np.ldexp(1.0, (v >> 27).astype(np.int32) - 24)
+            rgb = np.stack([((v >> (9 * c)) & 0x1FF) * scale for c in range(3)], axis=-1).astype(np.float32)
+        levels.append(rgb if faces == 6 else rgb[0])
+    return levels
+
+
+@pytest.mark.parametrize("ktx2", [["ibl.ktx2_zstd_level=3"], ["ibl.ktx2_format=\"e5b9g9r9\"", "ibl.exr=false"]],
+                         ids=["rgba16f_zstd", "e5b9g9r9_without_exr"])
+def test_ibl_arrays_are_the_files_texels(in_source, source_dir, tmp_path, ktx2):
+    """Every IBL file's texels (EXRs read back by OpenImageIO, KTX2 mip levels by npm ktx-parse);
+    .ibl_specular and .ibl_irradiance from the EXRs when written, else from the KTX2s."""
+    result = skybake.bake(skybake.load_style(STYLE, IBL + ktx2), out=str(tmp_path / "out"), size=SIZE, arrays=True,
+                          vulkan_validation=True)
+    frame = result.frames[0]
+    ibl_files = [pathlib.Path(f.path) for f in frame.files if f.kind.startswith("ibl_")]
+    with_exr = "ibl.exr=false" not in ktx2
+    assert sorted(frame.ibl) == sorted(p.name for p in ibl_files) and len(ibl_files) == (7 if with_exr else 3)
+    for path in ibl_files:
+        array = frame.ibl[path.name]
+        if path.suffix == ".exr":
+            texels = read_small_values_with_oiiotool(path, tmp_path)
+            if path.name != "sky_dfg.exr":
+                n = texels.shape[1]
+                texels = texels.reshape(6, n, n, 3)  # six faces stacked from the top
+            assert array.dtype == np.float32
+            np.testing.assert_array_equal(array, texels)
+        else:
+            levels = read_ktx2_with_ktx_parse(source_dir, path, tmp_path)
+            assert len(array) == len(levels)
+            for got, read in zip(array, levels):
+                assert got.dtype == np.float32
+                np.testing.assert_array_equal(got, read)
+    assert [level.shape for level in frame.ibl_specular] == [(6, 16, 16, 3), (6, 8, 8, 3)]
+    assert frame.ibl_irradiance.shape == (6, 8, 8, 3)
+    if with_exr:
+        assert frame.ibl_specular[1] is frame.ibl["sky_specular_m1.exr"]
+        assert frame.ibl_irradiance is frame.ibl["sky_irradiance.exr"]
+    else:
+        assert frame.ibl_specular[1] is frame.ibl["sky_specular.ktx2"][1]
+        assert frame.ibl_irradiance is frame.ibl["sky_irradiance.ktx2"][0]
+    # The maps are of a daylit sky: positive; the irradiance is smoother than level 0.
+    assert frame.ibl_irradiance.min() > 0 and frame.ibl_specular[0].min() > 0
+    assert frame.ibl_irradiance.std() < frame.ibl_specular[0].std()
+
+
 def test_without_arrays_no_images_are_read(in_source, tmp_path):
-    result = skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE)
-    assert result.frames[0].latlong is None and result.frames[0].faces == {}
+    result = skybake.bake(skybake.load_style(STYLE, IBL), out=str(tmp_path / "out"), size=SIZE)
+    frame = result.frames[0]
+    assert frame.latlong is None and frame.faces == {} and frame.ibl == {}
+    assert frame.ibl_specular == [] and frame.ibl_irradiance is None
 
 
 def test_moon_and_lights_are_the_manifests(in_source, tmp_path):
