@@ -287,10 +287,26 @@ struct TomlWriter {
 
   static std::string Join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
+  // A datetime.date, .time or .datetime as a TOML local date, local time,
+  // local or offset date-time (a schedule's `date`, `times`): its isoformat.
+  std::optional<std::string> DateOrTime(py::handle v, const std::string& key) {
+    py::module_ datetime = py::module_::import("datetime");
+    const bool is_datetime = py::isinstance(v, datetime.attr("datetime"));
+    const bool is_time = py::isinstance(v, datetime.attr("time"));
+    if (!is_datetime && !is_time && !py::isinstance(v, datetime.attr("date"))) return std::nullopt;
+    if (is_time && !v.attr("tzinfo").is_none()) {
+      Fail(key, "a time with a time zone has no TOML form: give a naive datetime.time (the schedule's "
+                "utc_offset_hours places it)");
+      return "0";
+    }
+    return v.attr("isoformat")().cast<std::string>();
+  }
+
   // A value, inline (arrays and tables of arrays as inline arrays and tables).
   std::string Value(py::handle v, const std::string& key) {
     if (PyBool_Check(v.ptr())) return v.ptr() == Py_True ? "true" : "false";
     if (py::isinstance<py::str>(v)) return TomlString(v.cast<std::string>());
+    if (std::optional<std::string> when = DateOrTime(v, key)) return *when;
     if (PyLong_Check(v.ptr()) || (PyIndex_Check(v.ptr()) && !PyFloat_Check(v.ptr())))
       return std::string(py::str(py::int_(py::reinterpret_borrow<py::object>(v))));
     if (PyFloat_Check(v.ptr()) || py::hasattr(v, "__float__")) {
@@ -320,7 +336,8 @@ struct TomlWriter {
       }
       return out + "]";
     }
-    Fail(key, fmt::format("{} cannot be written as TOML: give a bool, int, float, str, list or dict",
+    Fail(key, fmt::format("{} cannot be written as TOML: give a bool, int, float, str, list, dict, or a "
+                          "datetime.date, time or datetime",
                           std::string(py::str(py::type::of(v).attr("__name__")))));
     return "0";
   }
@@ -364,7 +381,9 @@ struct PyStyle {
     all.insert(all.end(), extra.begin(), extra.end());
     return text ? ParseSkyStyle(*text, source, all) : LoadSkyStyle(source, all);
   }
-  bool has_inline_schedule() const { return !text && FileHasSchedule(source); }
+  // An inline [schedule] table, as the CLI reads one from a style file: in
+  // the file, or in the text of a dict or text style.
+  bool has_inline_schedule() const { return text ? TextHasSchedule(*text, source) : FileHasSchedule(source); }
 };
 
 PyStyle MakeStyle(std::string source, std::optional<std::string> text, std::vector<std::string> overrides) {
@@ -382,6 +401,14 @@ PySchedule LoadScheduleOrThrow(const std::string& path) {
   ScheduleResult loaded = LoadSchedule(path);
   if (!loaded.ok()) ThrowConfigErrors(loaded.errors);
   return {std::move(loaded.schedule)};
+}
+
+// A style's inline schedule (has_inline_schedule), named as the style.
+PySchedule InlineScheduleOrThrow(const PyStyle& style) {
+  if (!style.text) return LoadScheduleOrThrow(style.source);
+  ScheduleResult parsed = ParseSchedule(*style.text, style.source);
+  if (!parsed.ok()) ThrowConfigErrors(parsed.errors);
+  return {std::move(parsed.schedule)};
 }
 
 py::dict FrameOfSchedule(const ScheduleFrame& f) {
@@ -414,7 +441,7 @@ LoadedBake Load(const PyStyle& style, const PySchedule* schedule, const std::vec
   if (!bake.config.ok()) ThrowConfigErrors(bake.config.errors);
   bake.warnings = bake.config.warnings;
   if (schedule) bake.schedule = schedule->schedule;
-  else if (style.has_inline_schedule()) bake.schedule = LoadScheduleOrThrow(style.source).schedule;
+  else if (style.has_inline_schedule()) bake.schedule = InlineScheduleOrThrow(style).schedule;
   if (bake.schedule) {
     bake.schedule_path = bake.schedule->source_path;
     std::vector<std::string> all = style.overrides;
@@ -916,7 +943,8 @@ void RegisterTypes(py::module_& m) {
           "warnings", [](const PyStyle& s) { return Locations(s.config.warnings); },
           "Not errors: the style bakes, but likely not as meant (Location tuples).")
       .def_property_readonly("has_schedule", &PyStyle::has_inline_schedule,
-                             "Whether the style file has an inline [schedule] table (bake() then bakes a sequence).")
+                             "Whether the style (a file, dict or text) has an inline [schedule] table (bake() then "
+                             "bakes a sequence).")
       .def(
           "with_overrides",
           [](const PyStyle& s, const std::vector<std::string>& more) {
@@ -1017,7 +1045,8 @@ void RegisterFunctions(py::module_& m) {
         py::kw_only(), py::arg("name") = py::none(),
         "Loads and validates a style: `source` is a TOML file's path, or a dict of style keys (nested dicts are "
         "tables: {'sun': {'elevation_deg': 10}}), written as TOML and read exactly as a file, named `name` "
-        "(default '<dict>') in errors and provenance. `overrides` are 'key.path=toml_value' assignments, as the "
+        "(default '<dict>') in errors and provenance; a [schedule] table in it (dates and times as datetime.date and "
+        "datetime.time) makes a sequence, as in a file. `overrides` are 'key.path=toml_value' assignments, as the "
         "CLI's --set. Raises StyleError with every located error.");
   m.def(
       "parse_style",

@@ -134,6 +134,44 @@ def test_dict_style_sequence_bakes_as_its_file(in_source, tmp_path):
     assert_same_folders(tmp_path / "file", tmp_path / "dict")
 
 
+def test_dict_style_inline_schedule_bakes_as_the_cli(cli, tmp_path):
+    """A dict with a [schedule] table is a sequence, as a style file with one is to the CLI: the
+    schedule's date and times as datetime objects (TOML dates and times), a ramp; the same bytes."""
+    import datetime
+    path = tmp_path / "inline.toml"
+    path.write_text('[atmosphere.mie]\ng = 0.7\n'
+                    '[schedule]\nfirst_frame = 1\ndate = 2013-05-27\nlatitude_deg = 42.44337\n'
+                    'longitude_deg = -76.48163\nutc_offset_hours = -4.0\ntimes = [07:00:00, 12:30:00]\n'
+                    '[schedule.ramp]\n"atmosphere.mie.g" = [0.7, 0.85]\n')
+    from_dict = skybake.load_style(
+        {"atmosphere": {"mie": {"g": 0.7}},
+         "schedule": {"first_frame": 1, "date": datetime.date(2013, 5, 27), "latitude_deg": 42.44337,
+                      "longitude_deg": -76.48163, "utc_offset_hours": -4.0,
+                      "times": [datetime.time(7, 0), datetime.time(12, 30)],
+                      "ramp": {"atmosphere.mie.g": [0.7, 0.85]}}}, name=str(path))
+    assert from_dict.has_schedule and skybake.load_style(str(path)).has_schedule
+    assert skybake.parse_style(path.read_text()).has_schedule
+    assert not skybake.load_style({"atmosphere": {"mie": {"g": 0.7}}}).has_schedule
+    run = cli("bake", path, "--size", SIZE, "--out", tmp_path / "cli", "--vulkan-validation", "-q")
+    assert run.returncode == 0, run.stderr
+    result = skybake.bake(from_dict, out=str(tmp_path / "py"), size=SIZE, vulkan_validation=True)
+    assert [f.number for f in result.frames] == [1, 2]
+    assert [f.time for f in result.frames] == ["2013-05-27T07:00:00-04:00", "2013-05-27T12:30:00-04:00"]
+    assert len({frame["style_sha256"] for frame in result.manifest["frames"]}) == 2
+    assert_same_folders(tmp_path / "cli", tmp_path / "py")
+    # plan and check read it as the CLI does.
+    assert skybake.plan(from_dict) == cli("plan", path).stdout
+    # An inline schedule's mistakes are StyleErrors at their key, nothing baked.
+    bad = {"schedule": {"date": "2013-05-27", "times": [datetime.time(7, 0)]}}
+    with pytest.raises(skybake.StyleError) as raised:
+        skybake.bake(skybake.load_style(bad, name="bad"), out=str(tmp_path / "bad"), size=SIZE)
+    assert ("bad", "schedule.date") in [(x.file, x.key) for x in raised.value.errors]
+    assert not (tmp_path / "bad").exists()
+    with pytest.raises(skybake.StyleError) as raised:
+        skybake.load_style({"schedule": {"times": [datetime.time(7, tzinfo=datetime.timezone.utc)]}})
+    assert [x.key for x in raised.value.errors] == ["schedule.times[0]"]
+
+
 # === Arrays: the files' texels.
 
 def read_with_oiiotool(exr):
