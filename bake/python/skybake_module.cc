@@ -36,6 +36,7 @@
 #include "exr_arrays.h"
 #include "ktx2_arrays.h"
 #include "skybake/base/errors.h"
+#include "skybake/base/file_door.h"
 #include "skybake/base/oiio_module.h"
 #include "skybake/gpu/vulkan_context.h"
 #include "skybake/input/config.h"
@@ -387,6 +388,7 @@ struct PyStyle {
 };
 
 PyStyle MakeStyle(std::string source, std::optional<std::string> text, std::vector<std::string> overrides) {
+  const KeptReadScope kept;  // the OpenColorIO config as it is now (file_door.h)
   PyStyle style{std::move(source), std::move(text), std::move(overrides), {}};
   style.config = style.With({});
   if (!style.config.ok()) ThrowConfigErrors(style.config.errors);
@@ -437,7 +439,8 @@ struct LoadedBake {
 LoadedBake Load(const PyStyle& style, const PySchedule* schedule, const std::vector<std::string>& extra) {
   const Environment& env = ReadEnvironment();
   LoadedBake bake;
-  bake.config = extra.empty() ? style.config : style.With(extra);
+  // Parsed again, so that its inputs (an OpenColorIO config) are as they are now.
+  bake.config = style.With(extra);
   if (!bake.config.ok()) ThrowConfigErrors(bake.config.errors);
   bake.warnings = bake.config.warnings;
   if (schedule) bake.schedule = schedule->schedule;
@@ -770,6 +773,7 @@ PyStyle LoadStyle(py::object source, const std::vector<std::string>& overrides, 
 }
 
 py::list Check(const PyStyle& style, const PySchedule* schedule, double max_memory_mib, double max_frame_seconds) {
+  const KeptReadScope kept;
   LoadedBake bake = Load(style, schedule, {});
   BakeOptions options;
   options.max_memory_mib = max_memory_mib;
@@ -779,6 +783,7 @@ py::list Check(const PyStyle& style, const PySchedule* schedule, double max_memo
 }
 
 py::dict Estimate(const PyStyle& style, const PySchedule* schedule, std::optional<int> size) {
+  const KeptReadScope kept;
   LoadedBake bake = Load(style, schedule, ExtraOverrides(size, std::nullopt, false));
   ResourceEstimate largest;
   for (const SkyStyle& s : bake.Styles()) {
@@ -795,6 +800,7 @@ py::dict Estimate(const PyStyle& style, const PySchedule* schedule, std::optiona
 
 std::string Plan(const PyStyle& style, const PySchedule* schedule, std::optional<int> size,
                  const std::optional<std::string>& frames, const std::optional<std::string>& shard) {
+  const KeptReadScope kept;
   const Environment& env = ReadEnvironment();
   LoadedBake bake = Load(style, schedule, ExtraOverrides(size, std::nullopt, false));
   const std::optional<FrameRange> part = SelectPart(bake, frames, shard);
@@ -816,6 +822,10 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
             double max_memory_mib, double max_frame_seconds, const std::optional<std::string>& frames,
             const std::optional<std::string>& shard, const std::optional<std::string>& engine, bool usd) {
   const Environment& env = ReadEnvironment();
+  // Every input (star catalogue, OpenColorIO config, weather and mask
+  // images) read once in this bake, as the files are now: a bake after an
+  // edit sees the edit (file_door.h, KeptReadScope).
+  const KeptReadScope kept;
   // The progress events from the start, as --progress-json's: an error
   // found before the bake ends them too, with its exit code.
   PythonProgress report(progress);

@@ -315,6 +315,35 @@ def test_moon_and_lights_are_the_manifests(in_source, tmp_path):
     assert frame.sh_with_sun.tolist() == record["sh_irradiance_with_sun"]
 
 
+# === Inputs read again by each bake.
+
+def test_a_bake_after_an_edit_reads_the_edited_inputs(in_source, source_dir, tmp_path):
+    """Each call reads its input files as they are then (one bake still reads each once): an
+    OpenColorIO config edited between two bakes in one process changes the second bake's maps.
+    The edit halves the matrix of "Linear P3-D65" (XYZ to P3): the maps halve."""
+    config = tmp_path / "config.ocio"
+    original = (source_dir / "tests" / "colour" / "ocio" / "test_config.ocio").read_text()
+    config.write_text(original)
+    overrides = ['output.color_space="Linear P3-D65"', f'output.ocio_config="{config}"']
+    first = skybake.bake(skybake.load_style(STYLE, overrides), out=str(tmp_path / "first"), size=SIZE, arrays=True)
+    matrix = "matrix: [2.493496911941425, -0.9313836179191239, -0.40271078445071684, 0, -0.8294889695615747, " \
+             "1.7626640603183463, 0.023624685841943577, 0, 0.03584583024378447, -0.07617238926804182, " \
+             "0.9568845240076872, 0, 0, 0, 0, 1]"
+    assert matrix in original
+    halved = "matrix: [" + ", ".join(repr(float(v) * 0.5) if i not in (3, 7, 11, 15) else v
+                                     for i, v in enumerate(matrix[len("matrix: ["):-1].split(", "))) + "]"
+    config.write_text(original.replace(matrix, halved))
+    style = skybake.load_style(STYLE, overrides)
+    second = skybake.bake(style, out=str(tmp_path / "second"), size=SIZE, arrays=True)
+    a, b = first.frames[0].latlong, second.frames[0].latlong
+    assert a.min() > 0 and not np.array_equal(a, b)
+    np.testing.assert_allclose(b, 0.5 * a, rtol=2 ** -10)  # half floats: 11 significant bits
+    # The style loaded after the edit holds the edited matrix too; bake() re-reads.
+    config.write_text(original)
+    third = skybake.bake(style, out=str(tmp_path / "third"), size=SIZE, arrays=True)
+    np.testing.assert_array_equal(third.frames[0].latlong, a)
+
+
 # === Errors: the CLI's exit codes and located messages.
 
 def test_style_file_errors_are_located_as_the_cli_gives_them(cli, tmp_path):
