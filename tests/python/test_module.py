@@ -371,6 +371,51 @@ def test_dict_with_wrong_types(tmp_path):
     assert sorted(x.key for x in raised.value.errors) == ["render.cube_size[1]", "sun.elevation_deg"]
 
 
+def test_bad_input_raises_the_clis_errors_and_writes_nothing(cli, in_source, tmp_path):
+    """The issue's bad input, from Python as from the command: a dict of wrong types, an unknown
+    colour space (dict, override and file), a USD layer that cannot be written; each the CLI's
+    exit code and located message, and nothing written."""
+    # A dict of wrong types: the messages of the same keys in a file, at their keys.
+    style_file = tmp_path / "wrong.toml"
+    style_file.write_text('[sun]\nelevation_deg = "high"\n[render]\ncube_size = 12.5\n')
+    with pytest.raises(skybake.StyleError) as from_dict:
+        skybake.load_style({"sun": {"elevation_deg": "high"}, "render": {"cube_size": 12.5}}, name=str(style_file))
+    run = cli("check", style_file)
+    assert run.returncode == from_dict.value.exit_code == 3
+    assert sorted(x.key for x in from_dict.value.errors) == ["render.cube_size", "sun.elevation_deg"]
+    for x in from_dict.value.errors:
+        assert f": {x.key}: {x.message}" in run.stderr
+
+    # An unknown colour space: the names there are, at output.color_space; nothing baked.
+    run = cli("bake", STYLE, "--size", SIZE, "--set", 'output.color_space="P4"', "--out", tmp_path / "cli")
+    assert run.returncode == 3 and not (tmp_path / "cli").exists()
+    for style in [lambda: skybake.load_style({"output": {"color_space": "P4"}}),
+                  lambda: skybake.load_style(STYLE, ['output.color_space="P4"'])]:
+        with pytest.raises(skybake.StyleError) as raised:
+            skybake.bake(style(), out=str(tmp_path / "py"), size=SIZE)
+        assert raised.value.exit_code == 3
+        [error] = raised.value.errors
+        assert error.key == "output.color_space"
+        assert "'P4' is not one of 'rec709', 'acescg', 'aces2065-1', 'rec2020', 'xyz'" in error.message
+        assert f"output.color_space: {error.message}" in run.stderr
+    assert not (tmp_path / "py").exists()
+
+    # A USD layer that cannot be written (a folder at its name): exit code 5 before any file.
+    for name in ["cli", "py"]:
+        (tmp_path / "usd" / name / "sky.usda").mkdir(parents=True)
+    run = cli("bake", STYLE, "--size", SIZE, "--usd", "--out", tmp_path / "usd" / "cli")
+    with pytest.raises(skybake.OutputError) as raised:
+        skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "usd" / "py"), size=SIZE, usd=True)
+    assert run.returncode == raised.value.exit_code == 5
+    message = str(raised.value)
+    assert message == f"{tmp_path / 'usd' / 'py'}/sky.usda is a directory: an output file cannot replace it; " \
+                      "move it away, or choose another --out"
+    assert run.stderr == "skybake: error: " + message.replace("/py/", "/cli/") + "\n"
+    for name in ["cli", "py"]:
+        assert [p.name for p in (tmp_path / "usd" / name).iterdir()] == ["sky.usda"]
+        assert list((tmp_path / "usd" / name / "sky.usda").iterdir()) == []
+
+
 def test_dict_values_as_toml():
     """numpy scalars are numbers; strings keep quotes, backslashes and newlines (the error quotes
     the value read back); a dict equals the TOML text of the same keys."""
