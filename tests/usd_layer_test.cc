@@ -391,6 +391,24 @@ TEST(UsdLayerTest, EveryColourSpaceNamesTheDomeTexturesSpace) {
     EXPECT_EQ(name->value(), space);
   }
 
+  // A space of an OpenColorIO config keeps the config's name.
+  {
+    const std::string dir = root + "/config";
+    const testing::CommandRun bake = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 --usd -q --vulkan-validation "
+        "--set 'output.color_space=\"Linear P3-D65\"' --set 'output.ocio_config=\"" + testing::SourceDir() +
+        "/tests/colour/ocio/test_config.ocio\"' --out " + dir);
+    ASSERT_EQ(bake.exit_code, 0) << bake.output;
+    const json report = ReadWithTinyUsdz(dir);
+    ASSERT_TRUE(report.is_object());
+    ASSERT_EQ(report.value("ok", false), true) << report.dump();
+    EXPECT_TRUE(report["layer_loaded"].get<bool>()) << report["layer_error"];
+    EXPECT_TRUE(report["stage_loaded"].get<bool>()) << report["stage_error"];
+    const std::string text = report["text"].get<std::string>();
+    const std::string dome = PrimBlock(text, "def DomeLight \"Dome\"");
+    EXPECT_EQ(ColorSpaceOf(dome, "asset inputs:texture:file"), "Linear P3-D65") << dome;
+  }
+
   // A sequence in ACEScg: the metadata before the texture's time samples.
   const std::string schedule = testing::WriteFile(root, "schedule.toml", R"([schedule]
 first_frame = 1

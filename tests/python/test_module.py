@@ -243,6 +243,17 @@ def read_ktx2_with_ktx_parse(source_dir, ktx2, tmp_path):
         raw = (tmp_path / f"{ktx2.name}.level{i}").read_bytes()
         if info["vkFormat"] == 97:  # R16G16B16A16_SFLOAT
             rgb = np.frombuffer(raw, dtype="<f2").reshape(faces, n, n, 4)[..., :3].astype(np.float32)
+        elif info["vkFormat"] == 122:  # B10G11R11_UFLOAT_PACK32: R 6+5 bits, G 6+5, B 5+5 (exponent bias 15)
+            v = np.frombuffer(raw, dtype="<u4").reshape(faces, n, n)
+
+            def unsigned_float(bits, mantissa_bits):
+                e = (bits >> mantissa_bits).astype(np.int32)
+                m = (bits & ((1 << mantissa_bits) - 1)).astype(np.float64) / (1 << mantissa_bits)
+                assert (e < 31).all()  # no infinity or NaN in a bake's maps
+                return np.where(e == 0, np.ldexp(m, -14), np.ldexp(1.0 + m, e - 15))
+
+            rgb = np.stack([unsigned_float(v & 0x7FF, 6), unsigned_float((v >> 11) & 0x7FF, 6),
+                            unsigned_float(v >> 22, 5)], axis=-1).astype(np.float32)
         else:
             assert info["vkFormat"] == 123  # E5B9G9R9_UFLOAT_PACK32: mantissa 2^(exponent - 15 - 9)
             v = np.frombuffer(raw, dtype="<u4").reshape(faces, n, n)
@@ -252,8 +263,9 @@ def read_ktx2_with_ktx_parse(source_dir, ktx2, tmp_path):
     return levels
 
 
-@pytest.mark.parametrize("ktx2", [["ibl.ktx2_zstd_level=3"], ["ibl.ktx2_format=\"e5b9g9r9\"", "ibl.exr=false"]],
-                         ids=["rgba16f_zstd", "e5b9g9r9_without_exr"])
+@pytest.mark.parametrize("ktx2", [["ibl.ktx2_zstd_level=3"], ["ibl.ktx2_format=\"e5b9g9r9\"", "ibl.exr=false"],
+                                  ["ibl.ktx2_format=\"b10g11r11\"", "ibl.exr=false", "ibl.ktx2_zstd_level=1"]],
+                         ids=["rgba16f_zstd", "e5b9g9r9_without_exr", "b10g11r11_zstd_without_exr"])
 def test_ibl_arrays_are_the_files_texels(in_source, source_dir, tmp_path, ktx2):
     """Every IBL file's texels (EXRs read back by OpenImageIO, KTX2 mip levels by npm ktx-parse);
     .ibl_specular and .ibl_irradiance from the EXRs when written, else from the KTX2s."""
