@@ -151,18 +151,46 @@ std::string ReadRegularFile(const std::string& path, uint64_t max_bytes, FileLin
   return ReadAll(fd, max_bytes, bytes);
 }
 
-std::string ReadKept(const std::string& path, uint64_t max_bytes, std::shared_ptr<const std::string>& bytes) {
+namespace {
+
+// The kept reads, and how many KeptReadScopes are open.
+struct KeptReads {
   struct Kept {
     std::string problem;
     std::shared_ptr<const std::string> bytes;
   };
-  static std::mutex mutex;
-  static std::map<std::string, Kept> kept;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::mutex mutex;
+  std::map<std::string, Kept> kept;
+  int scopes = 0;
+};
+
+KeptReads& TheKeptReads() {
+  static KeptReads* reads = new KeptReads;  // never destroyed: a read may come from a thread at exit
+  return *reads;
+}
+
+}  // namespace
+
+KeptReadScope::KeptReadScope() {
+  KeptReads& k = TheKeptReads();
+  std::lock_guard<std::mutex> lock(k.mutex);
+  if (k.scopes++ == 0) k.kept.clear();
+}
+
+KeptReadScope::~KeptReadScope() {
+  KeptReads& k = TheKeptReads();
+  std::lock_guard<std::mutex> lock(k.mutex);
+  --k.scopes;
+}
+
+std::string ReadKept(const std::string& path, uint64_t max_bytes, std::shared_ptr<const std::string>& bytes) {
+  KeptReads& reads = TheKeptReads();
+  std::lock_guard<std::mutex> lock(reads.mutex);
+  std::map<std::string, KeptReads::Kept>& kept = reads.kept;
   auto it = kept.find(path);
   if (it == kept.end()) {
     auto read = std::make_shared<std::string>();
-    Kept k;
+    KeptReads::Kept k;
     k.problem = ReadRegularFile(path, max_bytes, FileLinks::kFollow, *read);
     if (k.problem.empty()) k.bytes = std::move(read);
     it = kept.emplace(path, std::move(k)).first;

@@ -1317,12 +1317,6 @@ void CheckSceneAndEngine(const SkyStyle& style, StyleChecks& c) {
                 "usd.enabled = false";
     c.errors.push_back(e);
   }
-  if (style.usd.enabled && !style.output.color_space.IsRec709()) {
-    ConfigError e = c.Locate("usd.enabled");
-    e.message = "the USD layer's lights and dome share one colour space, linear Rec.709: set "
-                "output.color_space = \"rec709\", or usd.enabled = false";
-    c.errors.push_back(e);
-  }
   if (std::optional<std::string> engine = EngineStyleError(style)) {
     ConfigError e = c.Locate("output.engine");
     e.message = *engine;

@@ -550,12 +550,17 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
 
 bool FileHasSchedule(const std::string& path) {
   std::string text;
-  if (ReadInputFile(path, "style", text) || DeepKeyError(text, path)) return false;  // LoadSkyStyle reports it
+  if (ReadInputFile(path, "style", text)) return false;  // LoadSkyStyle reports it
+  return TextHasSchedule(text, path);
+}
+
+bool TextHasSchedule(std::string_view toml_text, const std::string& name) {
+  if (DeepKeyError(toml_text, name)) return false;  // the style reader reports it
   try {
-    toml::table root = toml::parse(text, path);
+    toml::table root = toml::parse(toml_text, name);
     return root.contains("schedule");
   } catch (const toml::parse_error&) {
-    return false;  // LoadSkyStyle reports the syntax error
+    return false;  // the style reader reports the syntax error
   }
 }
 

@@ -643,6 +643,7 @@ UsdLayerDescription UsdLayerOf(const Manifest& manifest, const std::string& out_
     if (frame.latlong_file.empty())
       throw OutputError(fmt::format("frame {} has no latlong EXR for the USD layer's dome", f.number));
     frame.texture_scale = ExrSkybakeScale((fs::path(out_dir) / frame.latlong_file).string());
+    frame.color_space = ExrSkybakeColorSpace((fs::path(out_dir) / frame.latlong_file).string());
     frame.time = f.time.value_or("");
     frame.sun_elevation_deg = f.sun_elevation_deg;
     frame.sun_azimuth_deg = f.sun_azimuth_deg;
