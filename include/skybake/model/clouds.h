@@ -100,6 +100,12 @@ CloudQuality CloudQualityPreset(const std::string& name);
 struct CloudSettings {
   std::vector<CloudLayer> layers;
   CloudQuality quality;
+  // The frame's local clock time, seconds since midnight of its date (a
+  // schedule's clock times, local = UTC + utc_offset_hours; set per frame by
+  // ResolveFrameStyles, not a style key): the clock of the layers' formations
+  // (FormationTimeSeconds, cloud_formation.h). None for a single bake and a
+  // schedule without clock times.
+  std::optional<double> local_clock_s;
 };
 
 // The layers a bake renders: those with coverage and density above 0 (the
