@@ -16,6 +16,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "skybake/base/errors.h"
 #include "skybake/model/cloud_formation.h"
 #include "schedule_fixtures.h"
 #include "test_support.h"
@@ -42,6 +43,31 @@ TEST(CloudFormationClock, TimeIsTheClockSinceTheDaysStart) {
       FormationCoverageAt(f, nullptr, 3, FormationTimeSeconds(f, 15.0 * 3600.0, 2.0 * 3600.0), 32);
   EXPECT_EQ(late.map, again.map);
   EXPECT_EQ(late.origin_m, again.origin_m);
+}
+
+// A formation whose lattices a frame reads (cells x (smoothing_steps + 2)
+// steps) exceed the memory budget is refused before anything is written,
+// with the estimate and the keys to lower: 512 x 512 x 64 cells over 66
+// steps, 7 bytes a cell, about 7.4 GiB against the default 4 GiB.
+TEST(CloudFormationClock, LatticesAboveTheMemoryBudgetAreRefusedUpFront) {
+  namespace fs = std::filesystem;
+  const std::string root = testing::FreshTempDir("cloud_formation_budget");
+  const std::string style = testing::WriteFile(root, "style.toml", R"([[cloud_layer]]
+altitude_m = 1500
+thickness_m = 1200
+
+[cloud_layer.formation]
+enabled = true
+cells = [512, 512, 64]
+smoothing_steps = 64
+)");
+  const testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size 16 -q --out '" + root + "/out'");
+  EXPECT_EQ(run.exit_code, int(kExitBudget)) << run.output;
+  EXPECT_NE(run.output.find("MiB of it the cloud formations' lattices"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("lower [cloud_layer.formation] cells or smoothing_steps"), std::string::npos)
+      << run.output;
+  EXPECT_FALSE(fs::exists(root + "/out/manifest.json"));
+  fs::remove_all(root);
 }
 
 // A formation layer with wind, drift and a cloud shadow map; float pixels,
