@@ -210,7 +210,9 @@ struct CloudInputs {
   int layers() const { return uniform.counts.x; }
 };
 // `time_s`: clock time since the sequence's first frame; the wind moves the
-// clouds by wind x time_s (no re-randomising per frame).
+// clouds by wind x time_s (no re-randomising per frame). A layer with a
+// formation runs on the formation's clock instead (FormationTimeSeconds of
+// clouds.local_clock_s, cloud_formation.h): its wind, drift and lattice.
 CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
                           double time_s);
 
