@@ -688,6 +688,9 @@ FrameStyles ResolveFrameStylesOfText(std::string_view text, const std::string& s
       continue;
     }
     styled.style.source_path = style_path;
+    // The formation's clock (cloud_formation.h): the frame's local clock time.
+    if (frame.time)
+      styled.style.clouds.local_clock_s = frame.time->hour * 3600.0 + frame.time->minute * 60.0 + frame.time->second;
     result.styles.push_back(std::move(styled.style));
   }
   return result;

@@ -337,12 +337,15 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
   for (int i = 0; i < count; ++i) {
     const CloudLayer& l = layers[i];
     gpu::GpuCloudLayer& o = g.layers[i];
-    // World x = east, z = -north.
-    const double seconds = time_s;
+    // World x = east, z = -north. A formation's layer moves on the
+    // formation's clock (cloud_formation.h), so that a clock time bakes the
+    // same clouds whichever frame a schedule starts at.
+    const double seconds =
+        l.formation.enabled ? FormationTimeSeconds(l.formation, clouds.local_clock_s, time_s) : time_s;
     o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
                      float(l.shear_m_s_per_km[0] * seconds * 1e-3), float(-l.shear_m_s_per_km[1] * seconds * 1e-3)};
     if (l.formation.enabled) {
-      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, time_s, style_dir, o, in.weather_images,
+      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, seconds, style_dir, o, in.weather_images,
                           q.shape_resolution);
     } else if (l.weather_image.empty()) {
       o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};

@@ -117,6 +117,12 @@ CloudQuality CloudQualityPreset(const std::string& name);
 struct CloudSettings {
   std::vector<CloudLayer> layers;
   CloudQuality quality;
+  // The frame's local clock time, seconds since midnight of its date (a
+  // schedule's clock times, local = UTC + utc_offset_hours; set per frame by
+  // ResolveFrameStyles, not a style key): the clock of the layers' formations
+  // (FormationTimeSeconds, cloud_formation.h). None for a single bake and a
+  // schedule without clock times.
+  std::optional<double> local_clock_s;
 };
 
 // The layers a bake renders: those with coverage and density above 0 (the
@@ -224,7 +230,9 @@ struct CloudInputs {
   int layers() const { return uniform.counts.x; }
 };
 // `time_s`: clock time since the sequence's first frame; the wind moves the
-// clouds by wind x time_s (no re-randomising per frame).
+// clouds by wind x time_s (no re-randomising per frame). A layer with a
+// formation runs on the formation's clock instead (FormationTimeSeconds of
+// clouds.local_clock_s, cloud_formation.h): its wind, drift and lattice.
 CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
                           double time_s);
 
