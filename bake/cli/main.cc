@@ -32,6 +32,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "skybake/base/file_door.h"
 #include "skybake/tools/accuracy.h"
 #include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
@@ -683,10 +684,19 @@ int RunCommand(Cli& cli) {
   // so that a path that cannot be written stops the bake with nothing
   // touched; a live line on a terminal, lines in a log, nothing with -q.
   if (!cli.args.progress_json.empty()) {
-    cli.progress_file = std::fopen(cli.args.progress_json.c_str(), "w");
-    if (!cli.progress_file)
+    // Through the door (file_door.h): a FIFO no process reads is refused,
+    // not waited on.
+    int fd = -1;
+    if (const std::string problem = OpenStreamOutput(cli.args.progress_json, fd); !problem.empty())
+      throw OutputError(fmt::format("--progress-json {} cannot be written: it {}; nothing was baked",
+                                    cli.args.progress_json, problem));
+    cli.progress_file = ::fdopen(fd, "w");
+    if (!cli.progress_file) {
+      const int error = errno;
+      ::close(fd);
       throw OutputError(fmt::format("--progress-json {} cannot be written: {}; nothing was baked",
-                                    cli.args.progress_json, std::strerror(errno)));
+                                    cli.args.progress_json, std::strerror(error)));
+    }
   }
   const ProgressStyle style = cli.args.quiet              ? ProgressStyle::kQuiet
                               : isatty(STDERR_FILENO) == 1 ? ProgressStyle::kLiveLine
