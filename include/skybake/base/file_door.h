@@ -96,6 +96,15 @@ std::string RegularFileSize(const std::string& path, uint64_t& size);
 // naming it when it is gone or not a regular file (the one exception here).
 uint64_t WrittenFileSize(const std::string& path);
 
+// Opens `path` for writing a stream of lines as it happens (--progress-json):
+// a regular file (created or emptied), or where a reader already waits a
+// pipe or a character device (/dev/fd/N of a wrapper's pipe, /dev/null, a
+// terminal). Opened non-blocking, so that a FIFO with no reader is refused at
+// once ("is a FIFO (named pipe) that no process reads") instead of hanging;
+// a directory, a socket or a block device is refused. On success `fd` is a
+// blocking descriptor the caller closes, and "" is returned.
+std::string OpenStreamOutput(const std::string& path, int& fd);
+
 // The caps of inputs that have no size of their own: a star catalogue (the
 // largest d3-celestial file, stars.14.json, is about 16 MiB) and an image
 // file (a 16384 x 16384 RGBA float EXR is 4 GiB uncompressed; a weather map
