@@ -89,6 +89,8 @@ CloudPlace CloudPlaceOf(GpuCloudLayer layer, vec2 xz, float h) {
   CloudPlace p;
   // Wind moves the whole layer (shear: more with height).
   vec2 q = xz - layer.wind_offset.xy - layer.wind_offset.zw * (h - layer.shell.x);
+  // Cirrus: every read below in the frame squeezed along the streaks (cloud_cirrus.glsl).
+  if (kCloudCirrus && layer.streaks.z > 0.0) q = CirrusStreakPosition(layer, q, h);
   p.weather_uv = (q - layer.weather_origin.xy) * layer.weather.yz;
   p.weather_uv2 = p.weather_uv;
   p.weather_uv3 = p.weather_uv;

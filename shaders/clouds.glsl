@@ -45,6 +45,11 @@ layout(constant_id = SPEC_CLOUD_LIGHT_VOLUME) const bool kCloudLightVolume = fal
 // sides of an `if` run on lavapipe, so every density call of a style without
 // a formation paid for that volume's trilinear read too.
 layout(constant_id = SPEC_CLOUD_FORMATION) const bool kCloudFormation = true;
+// Whether some layer is cirrus (GpuCloudLayer.streaks.z > 0, CloudCirrusOn in
+// clouds.h): its noise read along the streaks (cloud_cirrus.glsl) and its
+// samples lit through the ice phase (cloud_ice_phase.glsl). Off, both are
+// compiled out: a style without cirrus runs the shader it ran before.
+layout(constant_id = SPEC_CLOUD_CIRRUS) const bool kCloudCirrus = false;
 
 // ---------------------------------------------------------------- hashing and tiling noise
 
@@ -221,6 +226,7 @@ float SampleMapNearest(int first, int n, vec2 uv) {
   return CloudNoise(first + i.y * n + i.x);
 }
 
+#include "cloud_cirrus.glsl"
 #include "cloud_weather.glsl"
 
 // ---------------------------------------------------------------- density
@@ -449,6 +455,8 @@ float CloudPhase(float cos_theta, float eccentricity) {
   return mix(HenyeyGreenstein(gpu_clouds.phase.y * eccentricity, cos_theta),
              HenyeyGreenstein(gpu_clouds.phase.x * eccentricity, cos_theta), gpu_clouds.phase.z);
 }
+
+#include "cloud_ice_phase.glsl"
 
 // Distance along the ray (r0, mu) to altitude H on the descending (sign
 // -1) or ascending (+1) branch; r_H^2 - r0^2 formed from altitudes.
@@ -925,6 +933,21 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
     float u = (float(i) + 0.5) / float(n);
     vec3 w = CloudSegmentWeights(u);
     vec3 sun_light = kCloudSunLight ? CloudSunLight(atm, sun_segment, w, r, h, ClampCosine(mu_s)) : vec3(0.0);
+    // The layer the sample is in decides albedo, the height factor and the
+    // phase (overlapping layers: the first that has density there).
+    float albedo = gpu_clouds.layers[0].shell.w;
+    float hf = 0.5;
+    bool ice = false;
+    for (int l = 0; l < kCloudLayers; ++l) {
+      GpuCloudLayer layer = gpu_clouds.layers[l];
+      float f = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
+      if (f > 0.0 && f < 1.0) {
+        albedo = layer.shell.w;
+        hf = f;
+        ice = kCloudCirrus && layer.streaks.z > 0.0;
+        break;
+      }
+    }
     vec3 scattered = vec3(0.0);
     if (kCloudSunLight && max(sun_light.x, max(sun_light.y, sun_light.z)) > 0.0) {
       float tau = CloudOpticalDepthToSun(atm, xz, h, mu_s, sun, band_top);
@@ -932,25 +955,13 @@ void MarchCloudSegment(IN(AtmosphereParameters) atm, vec3 view, vec3 sun, IN(Clo
       // optical depth and a phase of eccentricity c^o.
       float a = 1.0, b = 1.0, c = 1.0, sum = 0.0;
       for (int o = 0; o < octaves; ++o) {
-        sum += a * exp(-b * tau) * CloudPhase(cos_theta, c);
+        float phase = (kCloudCirrus && ice) ? IceCrystalPhase(cos_theta, c) : CloudPhase(cos_theta, c);
+        sum += a * exp(-b * tau) * phase;
         a *= gpu_clouds.octave.x;
         b *= gpu_clouds.octave.y;
         c *= gpu_clouds.octave.z;
       }
       scattered = sun_light * sum;
-    }
-    // The layer the sample is in decides albedo and the height factor
-    // (overlapping layers: the first that has density there).
-    float albedo = gpu_clouds.layers[0].shell.w;
-    float hf = 0.5;
-    for (int l = 0; l < kCloudLayers; ++l) {
-      GpuCloudLayer layer = gpu_clouds.layers[l];
-      float f = (h - layer.shell.x) / (layer.shell.y - layer.shell.x);
-      if (f > 0.0 && f < 1.0) {
-        albedo = layer.shell.w;
-        hf = f;
-        break;
-      }
     }
     vec3 source = albedo * (scattered + CloudAmbient(CloudSegmentAt(tables.up, w), CloudSegmentAt(tables.down, w), hf));
     // Hillaire 2016 section 5.6.3: the in-scattering integrated over the step

@@ -84,6 +84,24 @@ void BM_FormationNextFrame(benchmark::State& state) {
 }
 BENCHMARK(BM_FormationNextFrame)->Unit(benchmark::kMillisecond)->Iterations(12);
 
+// The same with the temporal filter over the last hour (smoothing_steps =
+// 20 at 20 steps per hour): each frame smooths 22 lattices instead of 2.
+void BM_FormationNextFrameSmoothed(benchmark::State& state) {
+  SkyStyle style = Afternoon();
+  style.clouds.layers[0].formation.smoothing_steps = int(state.range(0));
+  double hours = 0.0;
+  auto frame = [&] {
+    const CloudInputs in = ToCloudInputs(style.clouds, style.aoas.seed, StyleDir(), hours * 3600.0);
+    benchmark::DoNotOptimize(in.weather_images.data());
+  };
+  frame();
+  for (auto _ : state) {
+    hours += 0.5;
+    frame();
+  }
+}
+BENCHMARK(BM_FormationNextFrameSmoothed)->Arg(0)->Arg(20)->Unit(benchmark::kMillisecond)->Iterations(12);
+
 // With formation.density: the next frame's density volume as well, the
 // smoothed lattice resampled to 64^3 (FormationDensityAt), 30 minutes on
 // from the last frame like BM_FormationNextFrame.

@@ -99,8 +99,9 @@ TEST(FileDoor, SizeIsCapped) {
   fs::remove_all(dir);
 }
 
-// Read once per process: a file changed (or removed) after its first read
-// gives the first bytes again; a problem is kept too.
+// Read once (no scope open: once per process, as the CLI reads): a file
+// changed (or removed) after its first read gives the first bytes again; a
+// problem is kept too.
 TEST(FileDoor, AKeptReadIsTheFirstRead) {
   const std::string dir = testing::FreshTempDir("door_kept");
   const std::string path = testing::WriteFile(dir, "catalogue.json", "first");
@@ -117,6 +118,38 @@ TEST(FileDoor, AKeptReadIsTheFirstRead) {
   EXPECT_EQ(ReadKept(dir + "/absent.json", 100, again), "no such file");
   testing::WriteFile(dir, "absent.json", "late");
   EXPECT_EQ(ReadKept(dir + "/absent.json", 100, again), "no such file");
+  fs::remove_all(dir);
+}
+
+// Scopes (one per Python call): within overlapping scopes a kept read stays
+// the first; the first scope opened after all closed reads the file anew,
+// problem or bytes; bytes handed out before stay valid.
+TEST(FileDoor, AKeptReadScopeStartsAfreshWhenNoneIsOpen) {
+  const std::string dir = testing::FreshTempDir("door_kept_scope");
+  const std::string path = testing::WriteFile(dir, "config.ocio", "first");
+  std::shared_ptr<const std::string> bytes, again;
+  {
+    const KeptReadScope bake;
+    ASSERT_EQ(ReadKept(path, 100, bytes), "");
+    EXPECT_EQ(*bytes, "first");
+    testing::WriteFile(dir, "config.ocio", "second");
+    {
+      const KeptReadScope other_thread;  // overlapping: shares the reads
+      ASSERT_EQ(ReadKept(path, 100, again), "");
+      EXPECT_EQ(*again, "first");
+    }
+    ASSERT_EQ(ReadKept(path, 100, again), "");
+    EXPECT_EQ(*again, "first");
+  }
+  {
+    const KeptReadScope next_bake;
+    ASSERT_EQ(ReadKept(path, 100, again), "");
+    EXPECT_EQ(*again, "second");
+    EXPECT_EQ(*bytes, "first");
+    fs::remove(path);
+  }
+  const KeptReadScope removed;
+  EXPECT_EQ(ReadKept(path, 100, again), "no such file");
   fs::remove_all(dir);
 }
 

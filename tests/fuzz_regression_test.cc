@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include "input_invariants.h"
 #include "parser_invariants.h"
 #include "test_support.h"
 
@@ -29,6 +30,21 @@ TEST(FuzzRegression, EveryRegressionAndSeedHoldsTheInvariants) {
     }
   }
   EXPECT_GE(replayed, 6u);
+}
+
+// The star catalogue reader on the seeds and crashers of inputs_fuzz.
+TEST(FuzzRegression, EveryCatalogueSeedHoldsTheInvariants) {
+  size_t replayed = 0;
+  for (const auto& entry : fs::directory_iterator(testing::SourceDir() + "/tests/fuzz/catalogues")) {
+    if (!entry.is_regular_file() || entry.path().extension() == ".md") continue;
+    std::ifstream in(entry.path(), std::ios::binary);
+    std::stringstream text;
+    text << in.rdbuf();
+    SCOPED_TRACE(entry.path().string());
+    fuzz::CheckCatalogue(text.str());  // aborts, failing the test, if an invariant breaks
+    ++replayed;
+  }
+  EXPECT_GE(replayed, 4u);
 }
 
 }  // namespace

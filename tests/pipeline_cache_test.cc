@@ -6,11 +6,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "skybake/gpu/pipeline_cache.h"
 #include "skybake/gpu/sky_renderer.h"
@@ -159,6 +162,45 @@ TEST(PipelineCacheTest, DamagedOrForeignFilesAreIgnoredSilentlyAndReplaced) {
     std::string why;
     EXPECT_FALSE(DecodePipelineCacheFile(ReadBytes(path), device, why).empty()) << i << ": " << why;
   }
+}
+
+// A shared cache folder others can write: a FIFO or a link to a device at
+// the cache's name is ignored with what it is (not waited on, not read
+// without end, not followed) and replaced by the saved file; a link planted
+// at the temporary's name is not written through.
+TEST(PipelineCacheTest, HostileFilesInASharedFolderAreIgnoredNotFollowed) {
+  const VkPhysicalDeviceProperties& device = testing::Vulkan().properties();
+  const std::string folder = testing::FreshTempDir("pipeline_cache_hostile");
+  const std::string path = folder + "/" + PipelineCacheFileName(device, BuildShaderDigest());
+  struct Planted {
+    std::function<void()> plant;
+    std::string said;
+  };
+  const std::vector<Planted> cases = {
+      {[&] { ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0); }, "it is a FIFO (named pipe), not a regular file"},
+      {[&] { std::filesystem::create_symlink("/dev/zero", path); }, "it is a symbolic link, which is not followed here"},
+  };
+  for (const Planted& c : cases) {
+    std::filesystem::remove(path);
+    c.plant();
+    CachedBake bake(folder);
+    EXPECT_FALSE(bake.context.pipeline_cache_status().loaded);
+    EXPECT_EQ(bake.context.pipeline_cache_status().ignored_because, c.said);
+    bake.context.SavePipelineCache();
+    EXPECT_TRUE(bake.context.pipeline_cache_status().saved) << bake.context.pipeline_cache_status().save_error;
+    EXPECT_TRUE(std::filesystem::is_regular_file(std::filesystem::symlink_status(path))) << c.said;
+  }
+  // The temporary's name (PATH.tmp.PID) is predictable: a link there to a
+  // file of the user's is refused, the file left as it was.
+  std::filesystem::remove(path);
+  const std::string victim = testing::WriteFile(folder, "victim.txt", "keep me");
+  std::filesystem::create_symlink(victim, path + ".tmp." + std::to_string(::getpid()));
+  CachedBake bake(folder);
+  bake.context.SavePipelineCache();
+  EXPECT_FALSE(bake.context.pipeline_cache_status().saved);
+  EXPECT_NE(bake.context.pipeline_cache_status().save_error, "");
+  EXPECT_EQ(testing::ReadFileBytes(victim), "keep me");
+  EXPECT_EQ(bake.context.validation_message_count(), 0);
 }
 
 TEST(PipelineCacheTest, NoFolderNoCache) {

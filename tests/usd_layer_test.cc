@@ -64,12 +64,32 @@ std::string PrimBlock(const std::string& text, const std::string& header) {
   return text.substr(at, end == std::string::npos ? std::string::npos : end - at);
 }
 
-// The value written after `decl = ` in a block, or "" when absent.
+// The value written after `decl = ` in a block, or "" when absent (without
+// the " (" that opens its metadata).
 std::string ValueOf(const std::string& block, const std::string& decl) {
   const size_t at = block.find(decl + " = ");
   if (at == std::string::npos) return "";
   const size_t start = at + decl.size() + 3;
-  return block.substr(start, block.find('\n', start) - start);
+  std::string value = block.substr(start, block.find('\n', start) - start);
+  if (value.size() > 2 && value.compare(value.size() - 2, 2, " (") == 0) value.resize(value.size() - 2);
+  return value;
+}
+
+// The colorSpace metadata of `decl` in a block (after its value, or on a
+// declaration of its own before its time samples), or "" when absent.
+std::string ColorSpaceOf(const std::string& block, const std::string& decl) {
+  static const std::regex kColorSpace(R"(^\s*colorSpace = \"([^"]*)\"\s*$)");
+  for (const std::string& opening : {decl + " (\n", decl + " = "}) {
+    size_t at = block.find(opening);
+    if (at == std::string::npos) continue;
+    const size_t eol = block.find('\n', at);
+    if (opening.back() != '\n' && block.compare(eol - 2, 2, " (") != 0) continue;
+    const size_t next = block.find('\n', eol + 1);
+    std::smatch m;
+    const std::string line = block.substr(eol + 1, next - eol - 1);
+    if (std::regex_match(line, m, kColorSpace)) return m[1];
+  }
+  return "";
 }
 
 // The time samples of `decl` in a block: time code -> value text.
@@ -325,6 +345,106 @@ times = [12:00:00, 16:00:00, 21:00:00]
   }
   EXPECT_EQ(moonlit, 1) << "the night frame (21:00) has the Moon's light, above the horizon";
   fs::remove_all(dir);
+}
+
+// Every output colour space writes a layer: the dome's texture names the
+// EXR's space in USD's colorSpace metadata (the canonical names of USD's
+// colour guide), the lights keep linear Rec.709 colours (colorSpace
+// "lin_rec709_scene", the manifest's irradiance), and the customData says
+// both; TinyUSDZ reads each back. A sequence puts the metadata on a
+// declaration before the texture's time samples.
+TEST(UsdLayerTest, EveryColourSpaceNamesTheDomeTexturesSpace) {
+  const std::string root = testing::FreshTempDir("usd_color_space");
+  const std::vector<std::pair<std::string, std::string>> spaces = {{"rec709", "lin_rec709_scene"},
+                                                                   {"acescg", "lin_ap1_scene"},
+                                                                   {"aces2065-1", "lin_ap0_scene"},
+                                                                   {"rec2020", "lin_rec2020_scene"},
+                                                                   {"xyz", "lin_ciexyzd65_scene"}};
+  for (const auto& [space, token] : spaces) {
+    EXPECT_EQ(UsdColorSpaceToken(space), token);
+    const std::string dir = root + "/" + space;
+    const testing::CommandRun bake = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 --usd -q --vulkan-validation "
+        "--set output.color_space=\"" + space + "\" --out " + dir);
+    ASSERT_EQ(bake.exit_code, 0) << space << ": " << bake.output;
+    const json report = ReadWithTinyUsdz(dir);
+    ASSERT_TRUE(report.is_object());
+    ASSERT_EQ(report.value("ok", false), true) << report.dump();
+    EXPECT_TRUE(report["layer_loaded"].get<bool>()) << space << ": " << report["layer_error"];
+    EXPECT_TRUE(report["stage_loaded"].get<bool>()) << space << ": " << report["stage_error"];
+    const std::string text = report["text"].get<std::string>();
+    const std::string dome = PrimBlock(text, "def DomeLight \"Dome\"");
+    const std::string sun = PrimBlock(text, "def DistantLight \"Sun\"");
+    ASSERT_FALSE(dome.empty() || sun.empty()) << text;
+    EXPECT_EQ(ValueOf(dome, "asset inputs:texture:file"), "@./sky_latlong.exr@") << space;
+    EXPECT_EQ(ColorSpaceOf(dome, "asset inputs:texture:file"), token) << space << "\n" << dome;
+    EXPECT_EQ(ColorSpaceOf(sun, "color3f inputs:color"), "lin_rec709_scene") << space << "\n" << sun;
+    const json manifest = ReadJson(dir + "/manifest.json");
+    ExpectDistantLight(ValueOf(sun, "float inputs:intensity"), ValueOf(sun, "color3f inputs:color"),
+                       manifest["frames"][0]["sun"], space + " sun");
+    EXPECT_NE(text.find("string dome_color_space = \"" + token + "\""), std::string::npos) << space;
+    EXPECT_NE(text.find("string light_color_space = \"lin_rec709_scene\""), std::string::npos) << space;
+    // The EXR the dome names is in that space (its header says so).
+    Imf::InputFile exr((dir + "/sky_latlong.exr").c_str());
+    const auto* name = exr.header().findTypedAttribute<Imf::StringAttribute>("skybake:color_space");
+    ASSERT_NE(name, nullptr);
+    EXPECT_EQ(name->value(), space);
+  }
+
+  // A space of an OpenColorIO config keeps the config's name.
+  {
+    const std::string dir = root + "/config";
+    const testing::CommandRun bake = testing::RunSkybake(
+        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 --usd -q --vulkan-validation "
+        "--set 'output.color_space=\"Linear P3-D65\"' --set 'output.ocio_config=\"" + testing::SourceDir() +
+        "/tests/colour/ocio/test_config.ocio\"' --out " + dir);
+    ASSERT_EQ(bake.exit_code, 0) << bake.output;
+    const json report = ReadWithTinyUsdz(dir);
+    ASSERT_TRUE(report.is_object());
+    ASSERT_EQ(report.value("ok", false), true) << report.dump();
+    EXPECT_TRUE(report["layer_loaded"].get<bool>()) << report["layer_error"];
+    EXPECT_TRUE(report["stage_loaded"].get<bool>()) << report["stage_error"];
+    const std::string text = report["text"].get<std::string>();
+    const std::string dome = PrimBlock(text, "def DomeLight \"Dome\"");
+    EXPECT_EQ(ColorSpaceOf(dome, "asset inputs:texture:file"), "Linear P3-D65") << dome;
+  }
+
+  // A sequence in ACEScg: the metadata before the texture's time samples.
+  const std::string schedule = testing::WriteFile(root, "schedule.toml", R"([schedule]
+first_frame = 1
+[[schedule.frames]]
+elevation_deg = 10.0
+azimuth_deg = 120.0
+[[schedule.frames]]
+elevation_deg = 30.0
+azimuth_deg = 150.0
+)");
+  const std::string out = root + "/sequence";
+  testing::BakeSequence16(testing::SourceDir() + "/configs/default.toml", schedule, out,
+                          "--usd --set output.color_space=\"acescg\"");
+  const json report = ReadWithTinyUsdz(out);
+  ASSERT_TRUE(report.is_object());
+  ASSERT_EQ(report.value("ok", false), true) << report.dump();
+  EXPECT_TRUE(report["layer_loaded"].get<bool>()) << report["layer_error"];
+  EXPECT_TRUE(report["stage_loaded"].get<bool>()) << report["stage_error"];
+  const std::string text = report["text"].get<std::string>();
+  std::printf("TinyUSDZ reads the ACEScg sequence's sky.usda as:\n%s\n", text.c_str());
+  const std::string dome = PrimBlock(text, "def DomeLight \"Dome\"");
+  const std::string sun = PrimBlock(text, "def DistantLight \"Sun\"");
+  EXPECT_EQ(ColorSpaceOf(dome, "asset inputs:texture:file"), "lin_ap1_scene") << dome;
+  EXPECT_EQ(ColorSpaceOf(sun, "color3f inputs:color"), "lin_rec709_scene") << sun;
+  const std::map<int, std::string> textures = SamplesOf(dome, "asset inputs:texture:file");
+  const std::map<int, std::string> colours = SamplesOf(sun, "color3f inputs:color");
+  const std::map<int, std::string> intensities = SamplesOf(sun, "float inputs:intensity");
+  const json manifest = ReadJson(out + "/manifest.json");
+  ASSERT_EQ(manifest["frames"].size(), 2u);
+  for (const json& frame : manifest["frames"]) {
+    const int n = frame["frame"].get<int>();
+    ASSERT_TRUE(textures.count(n) && colours.count(n) && intensities.count(n)) << n << "\n" << text;
+    EXPECT_EQ(textures.at(n), fmt::format("@./sky_latlong.{:04d}.exr@", n));
+    ExpectDistantLight(intensities.at(n), colours.at(n), frame["sun"], fmt::format("frame {} sun", n));
+  }
+  fs::remove_all(root);
 }
 
 // A sequence baked in two shards and merged writes the whole bake's layer,

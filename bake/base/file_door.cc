@@ -144,6 +144,28 @@ std::string OpenRegularFile(const std::string& path, FileLinks links, int& fd) {
   return CheckOpened(opened, fd);
 }
 
+std::string OpenStreamOutput(const std::string& path, int& fd) {
+  fd = -1;
+  if (path.empty()) return "is an empty path";
+  const int opened = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_NONBLOCK | O_CLOEXEC | O_NOCTTY, 0644);
+  if (opened < 0) {
+    const int error = errno;
+    if (error == ENXIO) return "is a FIFO (named pipe) or socket that no process reads";
+    if (error == EISDIR) return "is a directory, not a file";
+    if (error == EACCES) return "cannot be written (no permission)";
+    return fmt::format("cannot be opened for writing ({})", std::strerror(error));
+  }
+  struct stat st {};
+  if (::fstat(opened, &st) != 0 || !(S_ISREG(st.st_mode) || S_ISFIFO(st.st_mode) || S_ISCHR(st.st_mode))) {
+    ::close(opened);
+    return S_ISBLK(st.st_mode) ? "is a block device, not a file" : "is not a regular file, a pipe or a terminal";
+  }
+  const int flags = ::fcntl(opened, F_GETFL);
+  if (flags >= 0) ::fcntl(opened, F_SETFL, flags & ~O_NONBLOCK);
+  fd = opened;
+  return "";
+}
+
 std::string ReadRegularFile(const std::string& path, uint64_t max_bytes, FileLinks links, std::string& bytes) {
   int fd = -1;
   const std::string problem = OpenRegularFile(path, links, fd);
@@ -151,18 +173,46 @@ std::string ReadRegularFile(const std::string& path, uint64_t max_bytes, FileLin
   return ReadAll(fd, max_bytes, bytes);
 }
 
-std::string ReadKept(const std::string& path, uint64_t max_bytes, std::shared_ptr<const std::string>& bytes) {
+namespace {
+
+// The kept reads, and how many KeptReadScopes are open.
+struct KeptReads {
   struct Kept {
     std::string problem;
     std::shared_ptr<const std::string> bytes;
   };
-  static std::mutex mutex;
-  static std::map<std::string, Kept> kept;
-  std::lock_guard<std::mutex> lock(mutex);
+  std::mutex mutex;
+  std::map<std::string, Kept> kept;
+  int scopes = 0;
+};
+
+KeptReads& TheKeptReads() {
+  static KeptReads* reads = new KeptReads;  // never destroyed: a read may come from a thread at exit
+  return *reads;
+}
+
+}  // namespace
+
+KeptReadScope::KeptReadScope() {
+  KeptReads& k = TheKeptReads();
+  std::lock_guard<std::mutex> lock(k.mutex);
+  if (k.scopes++ == 0) k.kept.clear();
+}
+
+KeptReadScope::~KeptReadScope() {
+  KeptReads& k = TheKeptReads();
+  std::lock_guard<std::mutex> lock(k.mutex);
+  --k.scopes;
+}
+
+std::string ReadKept(const std::string& path, uint64_t max_bytes, std::shared_ptr<const std::string>& bytes) {
+  KeptReads& reads = TheKeptReads();
+  std::lock_guard<std::mutex> lock(reads.mutex);
+  std::map<std::string, KeptReads::Kept>& kept = reads.kept;
   auto it = kept.find(path);
   if (it == kept.end()) {
     auto read = std::make_shared<std::string>();
-    Kept k;
+    KeptReads::Kept k;
     k.problem = ReadRegularFile(path, max_bytes, FileLinks::kFollow, *read);
     if (k.problem.empty()) k.bytes = std::move(read);
     it = kept.emplace(path, std::move(k)).first;

@@ -32,6 +32,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "skybake/base/file_door.h"
+#include "skybake/pipeline/formation_budget.h"
 #include "skybake/tools/accuracy.h"
 #include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
@@ -245,9 +247,13 @@ int PrintPlan(const BakeArgs& args, const LoadedBake& bake, const std::optional<
 }
 
 // `skybake check`: the largest estimate per frame, and that the style is ok.
-int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstimate& largest) {
+int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstimate& largest,
+               const FormationEstimate& formation) {
   std::printf("estimate per frame: %.0f MiB of memory (budget %.0f), %.1f s of lavapipe time (budget %.0f)\n",
               largest.memory_mib, args.max_memory_mib, largest.seconds, args.max_frame_seconds);
+  if (!formation.frame.empty())
+    std::printf("cloud formation: %.3g cell updates in its busiest frame (%s), about %.1f s of CPU time\n",
+                formation.cell_updates, formation.frame.c_str(), formation.seconds);
   if (bake.schedule)
     std::printf("%s with %s: ok, %zu frames\n", Printable(args.style_path).c_str(), Printable(bake.schedule_path).c_str(),
                 bake.schedule->frames.size());
@@ -342,8 +348,13 @@ int RunBake(const BakeArgs& args, Mode mode, ProgressReport* progress = nullptr)
                "--force to bake a single style again");
     return kExitUsage;
   }
+  // The cloud formation's host work, frame by frame in the order they bake.
+  const FormationEstimate formation =
+      CheckFormationBudget(bake.schedule ? PlanSequenceBake(bake.frame_styles, *bake.schedule, part)
+                                         : PlanSingleBake(bake.config.style),
+                           options);
   if (mode == Mode::kPlan || args.dry_run) return PrintPlan(args, bake, part);
-  if (mode == Mode::kCheck) return PrintCheck(args, bake, largest);
+  if (mode == Mode::kCheck) return PrintCheck(args, bake, largest, formation);
 
   // Bake: device, pipelines, LUTs, render, files, preview; then report.
   SetBakeOptions(args, part, *progress, options);
@@ -396,6 +407,8 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   options.overrides = args.overrides;
   SetDeviceOptions(args, options.bake);
   options.bake.force = args.force;
+  options.bake.max_memory_mib = args.max_memory_mib;
+  options.bake.max_frame_seconds = args.max_frame_seconds;
   size_t done = 0;
   if (!args.quiet) {
     options.bake.progress = [&done, &styles](const StageReport& s) {
@@ -554,6 +567,15 @@ void AddGalleryCommand(CLI::App& app, Cli& cli) {
       ->check(CLI::Range(1, 16));
   cli.gallery->add_option("--set", cli.args.overrides, "Override a key in every style (repeatable)");
   cli.gallery->add_option("--device", cli.args.device, "Vulkan device index from 'skybake devices'");
+  cli.gallery->add_option("--max-memory-mib", cli.args.max_memory_mib,
+                          "Memory budget per style in MiB; a gallery with a style over it is refused (exit 7) "
+                          "before any is baked")
+      ->capture_default_str()
+      ->check(FinitePositive());
+  cli.gallery->add_option("--max-frame-seconds", cli.args.max_frame_seconds,
+                          "Time budget per style in estimated seconds; as --max-memory-mib")
+      ->capture_default_str()
+      ->check(FinitePositive());
   cli.gallery->add_flag("--force", cli.args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
   cli.gallery->add_flag("--quiet,-q", cli.args.quiet, "No progress lines");
   cli.gallery->add_flag("--vulkan-validation", cli.args.validation, "Load the Khronos validation layer");
@@ -571,6 +593,10 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
       ->capture_default_str()
       ->check(CLI::Range(8, 4096));
   cli.testpattern->add_flag("--force", cli.pattern.force, "Overwrite the pattern's files in --out");
+  cli.testpattern->add_option("--max-memory-mib", cli.pattern.max_memory_mib,
+                              "Memory budget in MiB; a larger pattern is refused (exit 7) before any file")
+      ->capture_default_str()
+      ->check(FinitePositive());
 
   cli.view = app.add_subcommand(
       "view", "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
@@ -683,10 +709,19 @@ int RunCommand(Cli& cli) {
   // so that a path that cannot be written stops the bake with nothing
   // touched; a live line on a terminal, lines in a log, nothing with -q.
   if (!cli.args.progress_json.empty()) {
-    cli.progress_file = std::fopen(cli.args.progress_json.c_str(), "w");
-    if (!cli.progress_file)
+    // Through the door (file_door.h): a FIFO no process reads is refused,
+    // not waited on.
+    int fd = -1;
+    if (const std::string problem = OpenStreamOutput(cli.args.progress_json, fd); !problem.empty())
+      throw OutputError(fmt::format("--progress-json {} cannot be written: it {}; nothing was baked",
+                                    cli.args.progress_json, problem));
+    cli.progress_file = ::fdopen(fd, "w");
+    if (!cli.progress_file) {
+      const int error = errno;
+      ::close(fd);
       throw OutputError(fmt::format("--progress-json {} cannot be written: {}; nothing was baked",
-                                    cli.args.progress_json, std::strerror(errno)));
+                                    cli.args.progress_json, std::strerror(error)));
+    }
   }
   const ProgressStyle style = cli.args.quiet              ? ProgressStyle::kQuiet
                               : isatty(STDERR_FILENO) == 1 ? ProgressStyle::kLiveLine

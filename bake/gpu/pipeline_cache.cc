@@ -1,16 +1,17 @@
 #include "skybake/gpu/pipeline_cache.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 
 #include <fmt/format.h>
 
 #include "shaders/shader_digest.h"
+#include "skybake/base/file_door.h"
 #include "skybake/gpu/vulkan_context.h"
 
 namespace skybake {
@@ -67,11 +68,21 @@ std::string VulkanHeaderMismatch(const uint8_t* payload, size_t size, const VkPh
   return "";
 }
 
-std::vector<uint8_t> ReadFile(const std::string& path, bool& exists) {
-  std::ifstream in(path, std::ios::binary);
-  exists = bool(in);
-  if (!in) return {};
-  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+// 256 MiB: lavapipe's data for every skybake pipeline is a few MiB.
+constexpr uint64_t kMaxPipelineCacheBytes = uint64_t(256) << 20;
+
+// Through the door (file_door.h): a regular file of the folder, not a link;
+// a FIFO, device or link planted in a shared cache folder is ignored with
+// what it is (`problem`), not waited on, read without end or followed.
+std::vector<uint8_t> ReadFile(const std::string& path, bool& exists, std::string& problem) {
+  std::string bytes;
+  problem = ReadRegularFile(path, kMaxPipelineCacheBytes, FileLinks::kRefuse, bytes);
+  exists = problem != "no such file";
+  if (!problem.empty()) {
+    if (exists) problem = "it " + problem;
+    return {};
+  }
+  return std::vector<uint8_t>(bytes.begin(), bytes.end());
 }
 
 }  // namespace
@@ -120,8 +131,11 @@ PipelineCache::PipelineCache(VkDevice device, const VkPhysicalDeviceProperties& 
   status_.enabled = true;
   status_.path = (std::filesystem::path(folder) / PipelineCacheFileName(properties, shader_digest)).string();
   bool exists = false;
-  const std::vector<uint8_t> file = ReadFile(status_.path, exists);
-  if (exists) {
+  std::string problem;
+  const std::vector<uint8_t> file = ReadFile(status_.path, exists, problem);
+  if (exists && !problem.empty()) {
+    status_.ignored_because = problem;
+  } else if (exists) {
     loaded_ = DecodePipelineCacheFile(file, properties, status_.ignored_because);
     status_.loaded = status_.ignored_because.empty();
     status_.loaded_bytes = loaded_.size();
@@ -163,7 +177,10 @@ void PipelineCache::Save() {
   std::error_code ec;
   std::filesystem::create_directories(path.parent_path(), ec);
   const std::vector<uint8_t> file = EncodePipelineCacheFile(data);
-  FILE* out = std::fopen(temp.c_str(), "wb");
+  // Created new, never through a link planted at the temporary's name.
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  FILE* out = fd >= 0 ? ::fdopen(fd, "wb") : nullptr;
+  if (fd >= 0 && !out) ::close(fd);
   bool ok = out && std::fwrite(file.data(), 1, file.size(), out) == file.size() && std::fflush(out) == 0 &&
             ::fsync(::fileno(out)) == 0;
   if (out) ok = std::fclose(out) == 0 && ok;

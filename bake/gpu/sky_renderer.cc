@@ -131,6 +131,7 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   // The light volume (clouds.h, CloudLightVolume) after the noise.
   cloud_light_volume_ = cloud_layers_ > 0 && CloudLightVolumeOn(gpu_clouds_);
   cloud_formation_ = cloud_layers_ > 0 && CloudFormationRead(gpu_clouds_);
+  cloud_cirrus_ = cloud_layers_ > 0 && CloudCirrusOn(gpu_clouds_);
   cloud_noise_buffer_ = CreateBuffer(
       cloud_layers_ > 0
           ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_) + (cloud_light_volume_ ? CloudLightVolumeFloats(gpu_clouds_) : 0)) * 4
@@ -686,6 +687,7 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     VkBool32 sky_view, mie, ozone, night, sun_disc_pass;
     int32_t cloud_layers;
     VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow, texel_views, cloud_formation;
+    VkBool32 cloud_cirrus;
   } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
               output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
               aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
@@ -693,8 +695,8 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
               effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
               twilight_march,               cloud_sun_light, cloud_light_volume,
               cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f, texel_views_whole_,
-              cloud_formation_};
-  const VkSpecializationMapEntry entries[21] = {
+              cloud_formation_,             cloud_cirrus_};
+  const VkSpecializationMapEntry entries[22] = {
       {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
       {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
       {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
@@ -702,8 +704,8 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
       {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
       {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
       {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4},
-      {SPEC_CLOUD_FORMATION, 80, 4}};
-  VkSpecializationInfo specialization{21, entries, sizeof(values), &values};
+      {SPEC_CLOUD_FORMATION, 80, 4},    {SPEC_CLOUD_CIRRUS, 84, 4}};
+  VkSpecializationInfo specialization{22, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization,
                                context_.pipeline_cache());
 }
@@ -1304,6 +1306,7 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
       !same(c.lut, gpu_clouds_.lut) || !same(c.light_volume, gpu_clouds_.light_volume) ||
       (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_) ||
       (cloud_layers_ > 0 && CloudFormationRead(c) != cloud_formation_) ||  // SPEC_CLOUD_FORMATION
+      (cloud_layers_ > 0 && CloudCirrusOn(c) != cloud_cirrus_) ||  // SPEC_CLOUD_CIRRUS
       (c.ground_shadow.x > 0.0f) != (gpu_clouds_.ground_shadow.x > 0.0f))  // kGroundCloudShadow's pipelines
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.

@@ -26,9 +26,13 @@ namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 
+// In [0, 360): a tiny negative angle plus 360 rounds to 360 itself, which
+// is 0 (a star at lon -1e-20 had RA 360; found by crafting inputs_fuzz's
+// seed tests/fuzz/catalogues/ra-tiny-negative.json).
 double Wrap360(double deg) {
   double d = std::fmod(deg, 360.0);
-  return d < 0.0 ? d + 360.0 : d;
+  if (d < 0.0) d += 360.0;
+  return d >= 360.0 ? 0.0 : d;
 }
 
 }  // namespace
@@ -64,7 +68,11 @@ std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::str
                         EscapedText(path), problem == "no such file" ? "does not exist" : problem);
     return std::nullopt;
   }
-  nlohmann::json doc = nlohmann::json::parse(*bytes, nullptr, false);
+  return ParseStarCatalogue(*bytes, path, error);
+}
+
+std::optional<StarCatalogue> ParseStarCatalogue(const std::string& text, const std::string& path, std::string& error) {
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object() || !doc.contains("features") || !doc["features"].is_array()) {
     error = fmt::format("{} is not a d3-celestial star file (a GeoJSON FeatureCollection with \"features\"): give "
                         "night.star_catalogue a stars.6.json, stars.8.json or stars.14.json of d3-celestial",

@@ -65,6 +65,8 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
               });
     } else if (k == "steps_per_hour") {
       number(value, p, 0.0, 3600.0, f.steps_per_hour);
+    } else if (k == "day_start_hour") {
+      number(value, p, 0.0, 24.0, f.day_start_hour);
     } else if (k == "warmup_steps") {
       integer(value, p, 0, 100000, f.warmup_steps);
     } else if (k == "extinction_probability") {
@@ -75,6 +77,8 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
       number(value, p, 0.0, 1.0, f.phase_probability);
     } else if (k == "initial_humidity") {
       number(value, p, 0.0, 1.0, f.initial_humidity);
+    } else if (k == "smoothing_steps") {
+      integer(value, p, 0, 64, f.smoothing_steps);
     } else if (k == "smoothing_cells") {
       integer(value, p, 0, 8, f.smoothing_cells);
     } else if (k == "mask_image") {
@@ -88,8 +92,8 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
     } else {
       error(&value, p,
             fmt::format("unknown key '{}' (a formation has enabled, cells, size_m, origin_m, steps_per_hour, "
-                        "warmup_steps, extinction_probability, humidity_probability, phase_probability, "
-                        "initial_humidity, smoothing_cells, mask_image, mask_layers, mask_layer, "
+                        "day_start_hour, warmup_steps, extinction_probability, humidity_probability, phase_probability, "
+                        "initial_humidity, smoothing_cells, smoothing_steps, mask_image, mask_layers, mask_layer, "
                         "velocity_cells_per_hour, density)",
                         k));
     }
@@ -112,11 +116,13 @@ toml::table CloudFormationToml(const CloudFormation& f) {
   t.insert("origin_m", toml::array{f.origin_m[0], f.origin_m[1]});
   t.insert("steps_per_hour", f.steps_per_hour);
   t.insert("warmup_steps", int64_t(f.warmup_steps));
+  t.insert("day_start_hour", f.day_start_hour);
   t.insert("extinction_probability", f.extinction_probability);
   t.insert("humidity_probability", f.humidity_probability);
   t.insert("phase_probability", f.phase_probability);
   t.insert("initial_humidity", f.initial_humidity);
   t.insert("smoothing_cells", int64_t(f.smoothing_cells));
+  if (f.smoothing_steps > 0) t.insert("smoothing_steps", int64_t(f.smoothing_steps));
   if (!f.mask_image.empty()) {
     t.insert("mask_image", f.mask_image);
     t.insert("mask_layers", int64_t(f.mask_layers));

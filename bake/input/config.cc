@@ -49,6 +49,7 @@ constexpr int kMaxOctaves = 8;
 constexpr Range kFlattening{0.0, 1.0, false, true};
 constexpr Range kCloudDistance{1.0, 2000.0, false, false};
 constexpr Range kCloudPanoramaScale{0.0, 4.0, false, false};
+constexpr Range kStreakRatio{1.0, 50.0, false, false};  // a cirrus layer's streaks, length over width
 constexpr Range kIblLodBias{-4.0, 4.0, false, false};
 constexpr Range kIblFullSamplesRoughness{0.0, 1.0, false, false};
 
@@ -664,6 +665,7 @@ class StyleReader : public TomlReader {
       CloudLayer layer;
       bool ok = true;
       bool has_profile = false;
+      bool has_streak_ratio = false;
       auto number = [&](const toml::node& value, const std::string& key_path, const Range& range, double& to) {
         std::optional<double> v = value.value<double>();
         if (!v || value.is_boolean() || !std::isfinite(*v) || !range.Contains(*v)) {
@@ -700,7 +702,10 @@ class StyleReader : public TomlReader {
         else if (k == "detail_amount") number(value, key_path, kUnit, layer.detail_amount);
         else if (k == "detail_size_m") number(value, key_path, kNoiseSize, layer.detail_size_m);
         else if (k == "weather_size_m") number(value, key_path, kWeatherSize, layer.weather_size_m);
-        else if (k == "tiling") {
+        else if (k == "streak_ratio") {
+          number(value, key_path, kStreakRatio, layer.streak_ratio);
+          has_streak_ratio = true;
+        } else if (k == "tiling") {
           if (!value.is_boolean()) ok = false, Error(&value, key_path, "expected true or false");
           else layer.tiling = value.as_boolean()->get();
         } else if (k == "wind_m_s") numbers(value, key_path, kWind, layer.wind_m_s.data(), 2, "[east, north] in m/s");
@@ -750,9 +755,13 @@ class StyleReader : public TomlReader {
                 fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
                             "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
                             "wind_m_s, shear_m_s_per_km, seed, weather_size_m, tiling, weather_image, weather_extent_m, "
-                            "weather_origin_m, formation)",
+                            "weather_origin_m, formation, streak_ratio)",
                             k));
         }
+      }
+      if (ok && has_streak_ratio && layer.type != CloudType::kCirrus) {
+        ok = false;
+        Error(t.get("streak_ratio"), where + ".streak_ratio", "streak_ratio needs type = \"cirrus\"");
       }
       if (ok && has_profile && layer.type != CloudType::kCustom) {
         ok = false;
@@ -887,6 +896,7 @@ class StyleWriter {
       if (l.seed) t.insert("seed", int64_t(*l.seed));
       t.insert("weather_size_m", l.weather_size_m);
       if (l.tiling) t.insert("tiling", true);
+      if (l.type == CloudType::kCirrus) t.insert("streak_ratio", l.streak_ratio);
       if (l.formation.enabled) t.insert("formation", CloudFormationToml(l.formation));
       if (!l.weather_image.empty()) {
         t.insert("weather_image", l.weather_image);
@@ -1305,12 +1315,6 @@ void CheckSceneAndEngine(const SkyStyle& style, StyleChecks& c) {
     ConfigError e = c.Locate("usd.enabled");
     e.message = "UsdLux lights emit in nits (cd/m^2): the USD layer needs output.units = \"luminance\", or "
                 "usd.enabled = false";
-    c.errors.push_back(e);
-  }
-  if (style.usd.enabled && !style.output.color_space.IsRec709()) {
-    ConfigError e = c.Locate("usd.enabled");
-    e.message = "the USD layer's lights and dome share one colour space, linear Rec.709: set "
-                "output.color_space = \"rec709\", or usd.enabled = false";
     c.errors.push_back(e);
   }
   if (std::optional<std::string> engine = EngineStyleError(style)) {

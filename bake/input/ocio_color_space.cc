@@ -5,6 +5,9 @@
 #include <filesystem>
 #include <sstream>
 
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <OpenColorIO/OpenColorIO.h>
 #include <fmt/format.h>
 
@@ -56,6 +59,72 @@ std::string ConfigSpaceNames(const OCIO::ConstConfigRcPtr& config) {
   return names;
 }
 
+// 64 MiB: a 65^3 .cube LUT, the largest OpenColorIO configs ship, is about
+// 8 MiB of text.
+constexpr uint64_t kMaxLutBytes = uint64_t(64) << 20;
+
+// The LUT files of a transform and of the transforms it groups.
+void CollectLutFiles(const OCIO::ConstTransformRcPtr& t, std::vector<std::string>& files) {
+  if (!t) return;
+  if (auto file = OCIO::DynamicPtrCast<const OCIO::FileTransform>(t)) {
+    if (file->getSrc() && *file->getSrc()) files.push_back(file->getSrc());
+  } else if (auto group = OCIO::DynamicPtrCast<const OCIO::GroupTransform>(t)) {
+    for (int i = 0; i < group->getNumTransforms(); ++i) CollectLutFiles(group->getTransform(i), files);
+  }
+}
+
+// The LUT files a config names (colour spaces, looks, view and named
+// transforms) are files OpenColorIO opens by name when a processor needs
+// them: each one found is checked through the door (file_door.h) first, so
+// that a FIFO, a device, a folder or a huge file at a LUT's name is refused
+// with its name instead of hanging the bake or filling its memory. A LUT not
+// found is left to OpenColorIO, which says so if the conversion needs it.
+// "" or the problem.
+std::string LutFilesProblem(const OCIO::ConstConfigRcPtr& config) {
+  std::vector<std::string> files;
+  for (int i = 0; i < config->getNumColorSpaces(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL); ++i) {
+    auto space = config->getColorSpace(config->getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL,
+                                                                        OCIO::COLORSPACE_ALL, i));
+    if (!space) continue;
+    CollectLutFiles(space->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE), files);
+    CollectLutFiles(space->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE), files);
+  }
+  for (int i = 0; i < config->getNumLooks(); ++i)
+    if (auto look = config->getLook(config->getLookNameByIndex(i))) {
+      CollectLutFiles(look->getTransform(), files);
+      CollectLutFiles(look->getInverseTransform(), files);
+    }
+  for (int i = 0; i < config->getNumViewTransforms(); ++i)
+    if (auto view = config->getViewTransform(config->getViewTransformNameByIndex(i))) {
+      CollectLutFiles(view->getTransform(OCIO::VIEWTRANSFORM_DIR_TO_REFERENCE), files);
+      CollectLutFiles(view->getTransform(OCIO::VIEWTRANSFORM_DIR_FROM_REFERENCE), files);
+    }
+  for (int i = 0; i < config->getNumNamedTransforms(OCIO::NAMEDTRANSFORM_ALL); ++i)
+    if (auto named = config->getNamedTransform(config->getNamedTransformNameByIndex(OCIO::NAMEDTRANSFORM_ALL, i))) {
+      CollectLutFiles(named->getTransform(OCIO::TRANSFORM_DIR_FORWARD), files);
+      CollectLutFiles(named->getTransform(OCIO::TRANSFORM_DIR_INVERSE), files);
+    }
+  for (const std::string& src : files) {
+    std::string resolved;
+    try {
+      resolved = config->getCurrentContext()->resolveFileLocation(src.c_str());
+    } catch (const OCIO::Exception&) {
+      continue;  // not found: OpenColorIO's own message if it is needed
+    }
+    int fd = -1;
+    std::string problem = OpenRegularFile(resolved, FileLinks::kFollow, fd);
+    if (problem.empty()) {
+      struct stat st {};
+      if (::fstat(fd, &st) == 0 && uint64_t(st.st_size) > kMaxLutBytes)
+        problem = fmt::format("is {} bytes, more than the {} MiB a LUT may have", uint64_t(st.st_size),
+                              kMaxLutBytes >> 20);
+      ::close(fd);
+    }
+    if (!problem.empty()) return fmt::format("its LUT file '{}' ({}) {}", src, resolved, problem);
+  }
+  return "";
+}
+
 ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
   ColorSpaceLookup r;
   // A config is a small text file: not a FIFO, a device or a folder that
@@ -80,6 +149,18 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
     r.error = fmt::format("'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
                           "cannot be read: {}",
                           name, BuiltinColorSpaceNames(), path, e.what());
+    return r;
+  }
+  std::string lut_problem;
+  try {
+    lut_problem = LutFilesProblem(config);
+  } catch (const OCIO::Exception& e) {
+    lut_problem = fmt::format("its transforms cannot be listed ({})", e.what());
+  }
+  if (const std::string& problem = lut_problem; !problem.empty()) {
+    r.error = fmt::format("the OpenColorIO config {} cannot be used: {}; give the LUT as a regular file of at "
+                          "most {} MiB, or a config that does not name it",
+                          path, problem, kMaxLutBytes >> 20);
     return r;
   }
   if (!config->getColorSpace(name.c_str())) {

@@ -550,12 +550,17 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
 
 bool FileHasSchedule(const std::string& path) {
   std::string text;
-  if (ReadInputFile(path, "style", text) || DeepKeyError(text, path)) return false;  // LoadSkyStyle reports it
+  if (ReadInputFile(path, "style", text)) return false;  // LoadSkyStyle reports it
+  return TextHasSchedule(text, path);
+}
+
+bool TextHasSchedule(std::string_view toml_text, const std::string& name) {
+  if (DeepKeyError(toml_text, name)) return false;  // the style reader reports it
   try {
-    toml::table root = toml::parse(text, path);
+    toml::table root = toml::parse(toml_text, name);
     return root.contains("schedule");
   } catch (const toml::parse_error&) {
-    return false;  // LoadSkyStyle reports the syntax error
+    return false;  // the style reader reports the syntax error
   }
 }
 
@@ -683,6 +688,9 @@ FrameStyles ResolveFrameStylesOfText(std::string_view text, const std::string& s
       continue;
     }
     styled.style.source_path = style_path;
+    // The formation's clock (cloud_formation.h): the frame's local clock time.
+    if (frame.time)
+      styled.style.clouds.local_clock_s = frame.time->hour * 3600.0 + frame.time->minute * 60.0 + frame.time->second;
     result.styles.push_back(std::move(styled.style));
   }
   return result;

@@ -189,14 +189,16 @@ std::string FormationKey(const CloudFormation& f, const CloudMask* mask, uint32_
          fmt::format(" {}", f.warmup_steps);
 }
 
+// The lattices of consecutive steps, from `first`.
 struct CachedFormation {
-  uint64_t step = 0;
-  CloudLattice lattice;
+  uint64_t first = 0;
+  std::vector<CloudLattice> window;
 };
 
 }  // namespace
 
-CloudLattice SimulateFormation(const CloudFormation& f, const CloudMask* mask, uint32_t seed, uint64_t steps) {
+std::vector<CloudLattice> SimulateFormationSteps(const CloudFormation& f, const CloudMask* mask, uint32_t seed,
+                                                 uint64_t first, uint64_t last) {
   static std::mutex mutex;
   static std::map<std::string, CachedFormation> cache;
   const std::string key = FormationKey(f, mask, seed);
@@ -204,23 +206,31 @@ CloudLattice SimulateFormation(const CloudFormation& f, const CloudMask* mask, u
   {
     std::lock_guard<std::mutex> lock(mutex);
     auto it = cache.find(key);
-    if (it != cache.end() && it->second.step <= steps) state = it->second;
+    if (it != cache.end() && !it->second.window.empty() && it->second.first <= first) state = it->second;
   }
-  if (state.lattice.Cells() == 0) state = {0, InitialFormation(f, mask, seed)};
-  // The thresholds change only with the mask layer (velocity z).
-  const bool moving_mask = mask && f.velocity_cells_per_hour[2] != 0.0;
-  FormationThresholds thresholds = FormationThresholdsAt(f, mask, state.step);
-  for (uint64_t s = state.step; s < steps; ++s) {
-    if (moving_mask) thresholds = FormationThresholdsAt(f, mask, s);
-    StepFormation(state.lattice, thresholds, seed, s);
-  }
-  state.step = steps;
-  {
+  if (state.window.empty()) state = {0, {InitialFormation(f, mask, seed)}};
+  const uint64_t latest = state.first + state.window.size() - 1;
+  std::vector<CloudLattice> out;
+  for (uint64_t s = first; s <= std::min(latest, last); ++s) out.push_back(state.window[s - state.first]);
+  if (last > latest) {
+    // The thresholds change only with the mask layer (velocity z).
+    const bool moving_mask = mask && f.velocity_cells_per_hour[2] != 0.0;
+    FormationThresholds thresholds = FormationThresholdsAt(f, mask, latest);
+    CloudLattice lattice = state.window.back();
+    for (uint64_t s = latest; s < last; ++s) {
+      if (moving_mask) thresholds = FormationThresholdsAt(f, mask, s);
+      StepFormation(lattice, thresholds, seed, s);
+      if (s + 1 >= first) out.push_back(lattice);
+    }
     std::lock_guard<std::mutex> lock(mutex);
     if (cache.size() > 16) cache.clear();
-    cache[key] = state;
+    cache[key] = {first, out};
   }
-  return state.lattice;
+  return out;
+}
+
+CloudLattice SimulateFormation(const CloudFormation& f, const CloudMask* mask, uint32_t seed, uint64_t steps) {
+  return SimulateFormationSteps(f, mask, seed, steps, steps).back();
 }
 
 std::vector<float> SmoothFormation(const CloudLattice& l, int r) {
@@ -265,22 +275,61 @@ std::vector<float> ColumnMaximum(const CloudLattice& l, const std::vector<float>
   return column;
 }
 
+// The density at the whole steps around the fractional `step`: at n =
+// floor(step) and, when step is past n, at n + 1 (else empty). Each is
+// SmoothFormation's field, averaged over the steps s - smoothing_steps .. s
+// (those from step 0; one step alone when smoothing_steps is 0).
+struct DensitiesAround {
+  CloudLattice lattice;  // the lattice at n (its size and indexing)
+  std::vector<float> at, next;
+  float w = 0.0f;  // the fraction of the way from n to n + 1
+};
+DensitiesAround DensitiesAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double step) {
+  DensitiesAround d;
+  const uint64_t n = uint64_t(std::floor(step));
+  d.w = float(step - double(n));
+  const uint64_t k = uint64_t(std::max(f.smoothing_steps, 0));
+  const uint64_t first = n >= k ? n - k : 0;
+  const uint64_t last = d.w > 0.0f ? n + 1 : n;
+  const std::vector<CloudLattice> lattices = SimulateFormationSteps(f, mask, seed, first, last);
+  std::vector<std::vector<float>> smoothed;
+  for (const CloudLattice& l : lattices) smoothed.push_back(SmoothFormation(l, f.smoothing_cells));
+  auto mean = [&](uint64_t end) {
+    const uint64_t lo = end >= k ? end - k : 0;
+    std::vector<float> sum = smoothed[lo - first];
+    for (uint64_t s = lo + 1; s <= end; ++s)
+      for (size_t i = 0; i < sum.size(); ++i) sum[i] += smoothed[s - first][i];
+    const float count = float(end - lo + 1);
+    if (count > 1.0f)
+      for (float& v : sum) v /= count;
+    return sum;
+  };
+  d.lattice = lattices[n - first];
+  d.at = mean(n);
+  if (d.w > 0.0f) d.next = mean(n + 1);
+  return d;
+}
+
 }  // namespace
+
+double FormationTimeSeconds(const CloudFormation& f, std::optional<double> local_clock_s, double since_first_s) {
+  if (!local_clock_s) return since_first_s;
+  constexpr double kDay_s = 86400.0;
+  const double t = std::fmod(*local_clock_s - f.day_start_hour * 3600.0, kDay_s);
+  return t < 0.0 ? t + kDay_s : t;
+}
 
 FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int resolution) {
   FormationCoverage out;
   const double hours = std::max(time_s, 0.0) / 3600.0;
   out.step = f.warmup_steps + f.steps_per_hour * hours;
-  const uint64_t n = uint64_t(std::floor(out.step));
-  const float w = float(out.step - double(n));
-  CloudLattice lattice = SimulateFormation(f, mask, seed, n);
-  std::vector<float> column = ColumnMaximum(lattice, SmoothFormation(lattice, f.smoothing_cells));
-  if (w > 0.0f) {
+  const DensitiesAround d = DensitiesAt(f, mask, seed, out.step);
+  std::vector<float> column = ColumnMaximum(d.lattice, d.at);
+  if (d.w > 0.0f) {
     // Linear in time between step n and n + 1.
-    lattice = SimulateFormation(f, mask, seed, n + 1);
-    const std::vector<float> next = ColumnMaximum(lattice, SmoothFormation(lattice, f.smoothing_cells));
-    for (size_t i = 0; i < column.size(); ++i) column[i] += (next[i] - column[i]) * w;
+    const std::vector<float> next = ColumnMaximum(d.lattice, d.next);
+    for (size_t i = 0; i < column.size(); ++i) column[i] += (next[i] - column[i]) * d.w;
   }
   // Bilinear, wrapping, at the map's texel centres; row 0 is the north edge.
   const int nx = f.cells[0], ny = f.cells[1];
@@ -311,15 +360,11 @@ FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* 
 std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int n) {
   const double step = f.warmup_steps + f.steps_per_hour * std::max(time_s, 0.0) / 3600.0;
-  const uint64_t s0 = uint64_t(std::floor(step));
-  const float w = float(step - double(s0));
-  CloudLattice lattice = SimulateFormation(f, mask, seed, s0);
-  std::vector<float> density = SmoothFormation(lattice, f.smoothing_cells);
-  if (w > 0.0f) {
-    lattice = SimulateFormation(f, mask, seed, s0 + 1);
-    const std::vector<float> next = SmoothFormation(lattice, f.smoothing_cells);
-    for (size_t i = 0; i < density.size(); ++i) density[i] += (next[i] - density[i]) * w;
-  }
+  DensitiesAround d = DensitiesAt(f, mask, seed, step);
+  const CloudLattice& lattice = d.lattice;
+  std::vector<float>& density = d.at;
+  if (d.w > 0.0f)
+    for (size_t i = 0; i < density.size(); ++i) density[i] += (d.next[i] - density[i]) * d.w;
   const int nx = lattice.nx, ny = lattice.ny, nz = lattice.nz;
   auto at = [&](int x, int y, int z) {
     return density[lattice.Index(((x % nx) + nx) % nx, ((y % ny) + ny) % ny, std::clamp(z, 0, nz - 1))];
@@ -349,6 +394,13 @@ std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* 
   return volume;
 }
 
+bool FormationShapeWarped(const CloudLayer& layer) {
+  // The whole density (formation.density) reads the detail noise alone.
+  const bool reads_noise =
+      layer.detail_amount > 0.0 || (!layer.formation.density && layer.shape_amount > 0.0);
+  return !layer.tiling && reads_noise;
+}
+
 void ApplyCloudFormation(const CloudLayer& layer, uint32_t seed, int resolution, double time_s,
                          const std::string& style_dir, gpu::GpuCloudLayer& o, std::vector<float>& weather_images,
                          int volume_resolution) {
@@ -363,7 +415,13 @@ void ApplyCloudFormation(const CloudLayer& layer, uint32_t seed, int resolution,
   // As a weather image: row 0, column 0 (the north-west corner) at world
   // x = west edge, z = -(north edge); km.
   o.weather = {float(layer.coverage), float(1e3 / c.extent_m[0]), float(1e3 / c.extent_m[1]), 1.0f};
-  o.weather_origin = {float(c.origin_m[0] * 1e-3), float(-(c.origin_m[1] + c.extent_m[1]) * 1e-3), 0.0f, 0.0f};
+  // z: its shape and detail noise read through the non-repeating warp of
+  // the layer's weather_size_m (cloud_weather.glsl) as a weather image's
+  // are (FormationShapeWarped); the coverage map and the density volume are
+  // read as they are.
+  const bool warped = FormationShapeWarped(layer);
+  o.weather_origin = {float(c.origin_m[0] * 1e-3), float(-(c.origin_m[1] + c.extent_m[1]) * 1e-3),
+                      warped ? float(layer.weather_size_m * 1e-3) : 0.0f, 0.0f};
   weather_images.insert(weather_images.end(), c.map.begin(), c.map.end());
   if (f.density) {
     o.weather.w = 2.0f;

@@ -27,8 +27,9 @@ std::string Vec3(const std::array<double, 3>& v) { return fmt::format("{:.9g} {:
 bool CloudShadowTiles(const CloudSettings& clouds, double extent_m) {
   for (const CloudLayer& l : ActiveCloudLayers(clouds)) {
     // A layer read through the non-periodic warp never repeats
-    // (shaders/cloud_weather.glsl); a formation's is not warped.
-    if (!l.tiling && !l.formation.enabled) return false;
+    // (shaders/cloud_weather.glsl); a formation's coverage or density is
+    // not warped, its noise is (FormationShapeWarped).
+    if (l.formation.enabled ? FormationShapeWarped(l) : !l.tiling) return false;
     std::array<double, 2> weather = {l.weather_size_m, l.weather_size_m};
     if (l.formation.enabled) weather = l.formation.size_m;
     else if (!l.weather_image.empty()) weather = l.weather_extent_m;
@@ -54,11 +55,14 @@ CloudShadowInfo CloudShadowInfoOf(const CloudSettings& clouds, const CloudShadow
   info.tiles = CloudShadowTiles(clouds, s.extent_m);
   for (const CloudLayer& l : ActiveCloudLayers(clouds))
   {
-    std::array<double, 2> offset = {l.wind_m_s[0] * time_s, l.wind_m_s[1] * time_s};
+    // A formation's layer moves on the formation's clock (ToCloudInputs).
+    const double t_s =
+        l.formation.enabled ? FormationTimeSeconds(l.formation, clouds.local_clock_s, time_s) : time_s;
+    std::array<double, 2> offset = {l.wind_m_s[0] * t_s, l.wind_m_s[1] * t_s};
     // A formation's drift (cloud_formation.h) moves its coverage as well.
     if (l.formation.enabled)
       for (int a = 0; a < 2; ++a)
-        offset[a] += l.formation.velocity_cells_per_hour[a] * time_s / 3600.0 * l.formation.size_m[a] /
+        offset[a] += l.formation.velocity_cells_per_hour[a] * t_s / 3600.0 * l.formation.size_m[a] /
                      l.formation.cells[a];
     info.wind_offset_m.push_back(offset);
   }

@@ -276,6 +276,14 @@ gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds) {
     o.profile = {float(l.profile[0]), float(l.profile[1]), float(l.profile[2]), float(l.profile[3])};
     o.shape = {float(l.shape_amount), float(1e3 / l.shape_size_m), float(l.detail_amount),
                float(1e3 / l.detail_size_m)};
+    if (l.type == CloudType::kCirrus) {
+      // World x = east, z = -north; the hook from the shear along the
+      // streaks, (m/s per km) / (m/s) = km^-1.
+      const std::array<double, 2> a = CirrusStreakDirection(l);
+      const double shear_along = l.shear_m_s_per_km[0] * a[0] + l.shear_m_s_per_km[1] * a[1];
+      o.streaks = {float(a[0]), float(-a[1]), float(l.streak_ratio),
+                   float(shear_along / (2.0 * kCirrusFallSpeedM_s))};
+    }
   }
   // range.w: the view march skips empty space (FillCloudSkipMaps).
   g.range = {float(q.max_distance_km), float(std::max(top_km + 1.0, 1.0)), float(q.panorama_scale), 1.0f};
@@ -329,12 +337,15 @@ CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const
   for (int i = 0; i < count; ++i) {
     const CloudLayer& l = layers[i];
     gpu::GpuCloudLayer& o = g.layers[i];
-    // World x = east, z = -north.
-    const double seconds = time_s;
+    // World x = east, z = -north. A formation's layer moves on the
+    // formation's clock (cloud_formation.h), so that a clock time bakes the
+    // same clouds whichever frame a schedule starts at.
+    const double seconds =
+        l.formation.enabled ? FormationTimeSeconds(l.formation, clouds.local_clock_s, time_s) : time_s;
     o.wind_offset = {float(l.wind_m_s[0] * seconds * 1e-3), float(-l.wind_m_s[1] * seconds * 1e-3),
                      float(l.shear_m_s_per_km[0] * seconds * 1e-3), float(-l.shear_m_s_per_km[1] * seconds * 1e-3)};
     if (l.formation.enabled) {
-      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, time_s, style_dir, o, in.weather_images,
+      ApplyCloudFormation(l, l.seed.value_or(aoas_seed), q.weather_resolution, seconds, style_dir, o, in.weather_images,
                           q.shape_resolution);
     } else if (l.weather_image.empty()) {
       o.weather = {float(l.coverage), float(1e3 / l.weather_size_m), float(1e3 / l.weather_size_m), 0.0f};
@@ -367,6 +378,21 @@ size_t CloudLightVolumeFloats(const gpu::GpuClouds& c) {
 
 bool CloudLightVolumeOn(const gpu::GpuClouds& c) {
   return c.counts.x > 0 && c.light_volume.x > 0 && c.resolution.w == 1;
+}
+
+std::array<double, 2> CirrusStreakDirection(const CloudLayer& l) {
+  const double half_km = 0.5 * l.thickness_m * 1e-3;
+  const double east = l.wind_m_s[0] + l.shear_m_s_per_km[0] * half_km;
+  const double north = l.wind_m_s[1] + l.shear_m_s_per_km[1] * half_km;
+  const double speed = std::hypot(east, north);
+  if (speed < 1e-6) return {1.0, 0.0};
+  return {east / speed, north / speed};
+}
+
+bool CloudCirrusOn(const gpu::GpuClouds& c) {
+  for (int l = 0; l < std::min(c.counts.x, CLOUD_MAX_LAYERS); ++l)
+    if (c.layers[l].streaks.z > 0.0f) return true;
+  return false;
 }
 
 bool CloudFormationDensityOn(const gpu::GpuClouds& c) {

@@ -78,5 +78,6 @@ int PerlinPermutation(int i) { return kPerlinPermutation[i]; }
 #include "atmosphere.glsl"
 #include "aoas.glsl"
 #include "envmap.glsl"
+#include "cloud_ice_phase.glsl"
 
 }  // namespace skybake::glsl

@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include <fcntl.h>
@@ -28,11 +27,11 @@
 #define TINYGLTF_NO_INCLUDE_JSON
 #include <tiny_gltf.h>
 
-#include <OpenEXR/ImfRgbaFile.h>
 
 #include "skybake/model/spectrum.h"
 #include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/output/exr_read.h"
 #include "skybake/output/json_spool.h"
 
 namespace skybake {
@@ -620,23 +619,18 @@ WrittenScene WriteGltfScene(const SceneDescription& scene) {
 }
 
 void WriteCloudShadowGroundPng(const std::string& exr_path, const std::string& png_path) {
-  std::vector<uint8_t> rgb;
+  // Through the door (exr_read.h): a FIFO, device or link planted at the
+  // map's name is refused, not waited on or followed.
   int width = 0, height = 0;
-  try {
-    Imf::RgbaInputFile in(exr_path.c_str());
-    const Imath::Box2i window = in.dataWindow();
-    width = window.max.x - window.min.x + 1;
-    height = window.max.y - window.min.y + 1;
-    std::vector<Imf::Rgba> pixels(size_t(width) * height);
-    in.setFrameBuffer(pixels.data() - window.min.x - size_t(window.min.y) * width, 1, size_t(width));
-    in.readPixels(window.min.y, window.max.y);
-    rgb.resize(pixels.size() * 3);
-    for (size_t i = 0; i < pixels.size(); ++i) {
-      const double t = std::clamp(double(float(pixels[i].r)), 0.0, 1.0);
-      rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = uint8_t(std::lround(SrgbEncode(t) * 255.0));
-    }
-  } catch (const std::exception& e) {
-    throw OutputError(fmt::format("{}: cannot read the cloud shadow map for the glTF ground: {}", exr_path, e.what()));
+  std::vector<float> rgba;
+  if (const std::string problem = ReadExrRgba(exr_path, width, height, rgba); !problem.empty())
+    throw OutputError(fmt::format("{}: cannot read the cloud shadow map for the glTF ground: it {}; bake its frame "
+                                  "again",
+                                  exr_path, problem));
+  std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3);
+  for (size_t i = 0; i < size_t(width) * size_t(height); ++i) {
+    const double t = std::clamp(double(rgba[4 * i]), 0.0, 1.0);
+    rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = uint8_t(std::lround(SrgbEncode(t) * 255.0));
   }
   WritePng(png_path, width, height, rgb);
 }

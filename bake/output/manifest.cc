@@ -643,6 +643,7 @@ UsdLayerDescription UsdLayerOf(const Manifest& manifest, const std::string& out_
     if (frame.latlong_file.empty())
       throw OutputError(fmt::format("frame {} has no latlong EXR for the USD layer's dome", f.number));
     frame.texture_scale = ExrSkybakeScale((fs::path(out_dir) / frame.latlong_file).string());
+    frame.color_space = ExrSkybakeColorSpace((fs::path(out_dir) / frame.latlong_file).string());
     frame.time = f.time.value_or("");
     frame.sun_elevation_deg = f.sun_elevation_deg;
     frame.sun_azimuth_deg = f.sun_azimuth_deg;
@@ -881,20 +882,20 @@ void CheckEveryFrameOnce(const MergeParts& p, const FrameRange& sequence, const 
 // A listed file in place, as part `part_path` recorded it for frame `f`.
 void CheckListedFile(const fs::path& dir, const ManifestFile& file, const ManifestFrame& f, const Manifest& part,
                      const std::string& part_path, bool verify_checksums) {
-  std::error_code ec;
   const fs::path path = dir / file.file;  // a plain name (ReadManifest): inside dir
-  // A link is not followed: only a regular file of the folder is read.
-  const fs::file_status status = fs::symlink_status(path, ec);
-  if (fs::exists(status) && !fs::is_regular_file(status))
-    throw ManifestError(fmt::format("{}, listed in {}, is not a regular file (links are not followed): put the "
-                                    "file itself in the folder",
-                                    path.string(), part_path));
-  if (!fs::is_regular_file(status))
+  // Through the door (file_door.h): a link is not followed, and a FIFO or a
+  // device is refused without being opened for long.
+  uint64_t bytes = 0;
+  const std::string problem = RegularFileSize(path.string(), bytes);
+  if (problem == "no such file")
     throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
                                     "{}, or bake them again with --frames {}:{} --resume",
                                     path.string(), part_path, FrameRangeText(*part.part), part.part->first,
                                     part.part->last));
-  const uint64_t bytes = fs::file_size(path);
+  if (!problem.empty())
+    throw ManifestError(fmt::format("{}, listed in {}, {}: put the file itself in the "
+                                    "folder",
+                                    path.string(), part_path, problem));
   if (bytes != file.bytes || (verify_checksums && Sha256OfFile(path.string()) != file.sha256))
     throw ManifestError(fmt::format("{} does not match {} ({}): it is truncated, changed or from another bake; "
                                     "bake frame {} again with --frames {}:{} --resume",

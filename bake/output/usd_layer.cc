@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
@@ -87,10 +88,14 @@ double DomeExposure(double texture_scale) {
 // One attribute: `decl` (type and name) with its value, or in a sequence
 // its time samples at the frame numbers. `values` holds each frame's value
 // text, "" for a frame without a sample.
+// With `color_space`, the attribute carries USD's colorSpace metadata: after
+// a plain value, or on a declaration of its own before the time samples.
 void Attribute(std::string& out, const std::string& indent, const std::string& decl, const UsdLayerDescription& layer,
-               const std::vector<std::string>& values) {
+               const std::vector<std::string>& values, const std::string& color_space = "") {
+  const std::string metadata =
+      color_space.empty() ? "" : " (\n" + indent + "    colorSpace = " + UsdStringLiteral(color_space) + "\n" + indent + ")";
   if (!layer.sequence) {
-    if (!values.front().empty()) out += indent + decl + " = " + values.front() + "\n";
+    if (!values.front().empty()) out += indent + decl + " = " + values.front() + metadata + "\n";
     return;
   }
   std::vector<std::pair<int, std::string>> samples;
@@ -102,9 +107,10 @@ void Attribute(std::string& out, const std::string& indent, const std::string& d
                         std::all_of(samples.begin(), samples.end(),
                                     [&](const auto& s) { return s.second == samples.front().second; });
   if (constant) {
-    out += indent + decl + " = " + samples.front().second + "\n";
+    out += indent + decl + " = " + samples.front().second + metadata + "\n";
     return;
   }
+  if (!metadata.empty()) out += indent + decl + metadata + "\n";
   out += indent + decl + ".timeSamples = {\n";
   for (const auto& [number, v] : samples) out += fmt::format("{}    {}: {},\n", indent, number, v);
   out += indent + "}\n";
@@ -150,10 +156,14 @@ void DistantLight(std::string& out, const UsdLayerDescription& layer, const char
               const UsdDistantKey* k = key(f);
               return k ? Float(k->angular_diameter_deg) : std::string();
             }));
-  Attribute(out, in, "color3f inputs:color", layer, PerFrame(layer, [&](const UsdFrame& f) {
-              const UsdDistantKey* k = key(f);
-              return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
-            }));
+  Attribute(
+      out, in, "color3f inputs:color", layer,
+      PerFrame(layer,
+               [&](const UsdFrame& f) {
+                 const UsdDistantKey* k = key(f);
+                 return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
+               }),
+      UsdColorSpaceToken("rec709"));
   out += in + "float inputs:exposure = 0\n";
   Attribute(out, in, "float inputs:intensity", layer, PerFrame(layer, [&](const UsdFrame& f) {
               const UsdDistantKey* k = key(f);
@@ -189,6 +199,9 @@ void SkyCustomData(std::string& out, const UsdLayerDescription& layer) {
   out += in + "string schedule = " + UsdStringLiteral(layer.schedule) + "\n";
   out += in + "string sequence_sha256 = " + UsdStringLiteral(layer.sequence_sha256) + "\n";
   out += in + "string style = " + UsdStringLiteral(layer.style) + "\n";
+  out += in + "string dome_color_space = " + UsdStringLiteral(UsdColorSpaceToken(layer.frames.front().color_space)) +
+         "\n";
+  out += in + "string light_color_space = " + UsdStringLiteral(UsdColorSpaceToken("rec709")) + "\n";
   out += in + "string units = \"dome: cd/m^2 (nits) = texel x intensity x 2^exposure; distant lights: lux\"\n";
   out += in + "string version = " + UsdStringLiteral(layer.version) + "\n";
   out += "        }\n    }\n";
@@ -198,6 +211,13 @@ void SkyCustomData(std::string& out, const UsdLayerDescription& layer) {
 
 std::string UsdLayerText(const UsdLayerDescription& layer) {
   if (layer.frames.empty()) throw OutputError(fmt::format("{}.usda: a layer of no frames", layer.name));
+  // One colour space for the dome's texture (one colorSpace on its attribute).
+  for (const UsdFrame& f : layer.frames)
+    if (f.color_space != layer.frames.front().color_space)
+      throw OutputError(fmt::format("{}.usda: frame {}'s latlong EXR is in {}, frame {}'s in {}: the dome's texture "
+                                    "has one colour space; bake the frames with one output.color_space",
+                                    layer.name, layer.frames.front().number, layer.frames.front().color_space,
+                                    f.number, f.color_space));
   std::string out = "#usda 1.0\n(\n";
   out += "    defaultPrim = \"Sky\"\n";
   out += "    doc = " + UsdStringLiteral("skybake " + layer.version + " sky: DomeLight (latlong EXR, cd/m^2) and "
@@ -232,7 +252,8 @@ std::string UsdLayerText(const UsdLayerDescription& layer) {
   out += in + "float inputs:intensity = 1\n";
   out += in + "bool inputs:normalize = 0\n";
   Attribute(out, in, "asset inputs:texture:file", layer,
-            PerFrame(layer, [](const UsdFrame& f) { return UsdAssetPathLiteral("./" + f.latlong_file); }));
+            PerFrame(layer, [](const UsdFrame& f) { return UsdAssetPathLiteral("./" + f.latlong_file); }),
+            UsdColorSpaceToken(layer.frames.front().color_space));
   out += in + "token inputs:texture:format = \"latlong\"\n";
   out += "    }\n\n";
   DistantLight(out, layer, "Sun", false);
@@ -248,6 +269,26 @@ std::string WriteUsdLayer(const UsdLayerDescription& layer) {
   const std::string path = (std::filesystem::path(layer.out_dir) / (layer.name + ".usda")).string();
   WriteFileAtomically(path, UsdLayerText(layer));
   return path;
+}
+
+std::string UsdColorSpaceToken(const std::string& skybake_name) {
+  static const std::map<std::string, std::string> kCanonical = {{"rec709", "lin_rec709_scene"},
+                                                                 {"acescg", "lin_ap1_scene"},
+                                                                 {"aces2065-1", "lin_ap0_scene"},
+                                                                 {"rec2020", "lin_rec2020_scene"},
+                                                                 {"xyz", "lin_ciexyzd65_scene"}};
+  const auto it = kCanonical.find(skybake_name);
+  return it == kCanonical.end() ? skybake_name : it->second;
+}
+
+std::string ExrSkybakeColorSpace(const std::string& path) {
+  try {
+    Imf::InputFile in(path.c_str());
+    const Imf::StringAttribute* name = in.header().findTypedAttribute<Imf::StringAttribute>("skybake:color_space");
+    return name && !name->value().empty() ? name->value() : "rec709";
+  } catch (const std::exception& e) {
+    throw OutputError(fmt::format("{}: cannot read its header for the USD layer: {}", path, e.what()));
+  }
 }
 
 double ExrSkybakeScale(const std::string& path) {

@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/pipeline/formation_budget.h"
 
 namespace skybake {
 
@@ -15,6 +16,7 @@ std::string OutputPath(const BakeOptions& options, const std::string& name) {
 OutputLock ClaimOutputs(const RenderPlan& plan, const BakeOptions& options) {
   for (const FramePlan& frame : plan.frames) CheckBudget(*frame.style, options);
   CheckSequenceBudget(plan, options);
+  CheckFormationBudget(plan, options);
   std::error_code ec;
   const std::filesystem::file_status out = std::filesystem::status(options.out_dir, ec);
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))

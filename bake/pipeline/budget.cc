@@ -31,6 +31,19 @@ std::string SpectralAdvice(const SkyStyle& style) {
   return style.quality.wavelengths > kRgbWavelengths ? ", lower quality.wavelengths" : "";
 }
 
+// The cloud formations' lattices a process keeps (cloud_formation.h): per
+// layer with a formation, the smoothing_steps + 2 steps a frame reads (three
+// bytes a cell, SimulateFormationSteps) and their densities smoothed over
+// space (four bytes a cell), MiB.
+double FormationMiB(const SkyStyle& style) {
+  double bytes = 0.0;
+  for (const CloudLayer& l : ActiveCloudLayers(style.clouds)) {
+    const CloudFormation& f = l.formation;
+    if (f.enabled) bytes += (f.smoothing_steps + 2.0) * 7.0 * double(f.cells[0]) * f.cells[1] * f.cells[2];
+  }
+  return bytes / (1024.0 * 1024.0);
+}
+
 }  // namespace
 
 ResourceEstimate EstimateResources(const SkyStyle& style) {
@@ -75,7 +88,7 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   const bool preview = WritesLatlongPng(style);
   const double bytes = 32.0 * texels + 2.0 * 3.0 * channel * largest + (preview ? 22.0 * latlong : 0.0) + luts +
                        (24.0 + 16.0) * engine_texels + engine_growth + spectral_buffers;
-  e.memory_mib = bytes / (1024.0 * 1024.0);
+  e.memory_mib = bytes / (1024.0 * 1024.0) + FormationMiB(style);
   // Samples: the pass plan's count for one frame (each ray-marched texel
   // marches view_steps, times light_steps when the Sun's transmittance is
   // marched too; a sky-view texel is one LUT read; plus the LUTs), each
@@ -95,6 +108,12 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
   };
   if (e.memory_mib > options.max_memory_mib) {
     const auto [need, budget] = pair(e.memory_mib, options.max_memory_mib);
+    if (const double formation = FormationMiB(style); formation > 0.5 * options.max_memory_mib)
+      throw BudgetError(fmt::format(
+          "the bake needs an estimated {} MiB of memory per frame, {:.0f} MiB of it the cloud formations' "
+          "lattices (formation.cells x (smoothing_steps + 2) steps, 7 bytes a cell), above the budget of {} MiB: "
+          "lower [cloud_layer.formation] cells or smoothing_steps, or raise --max-memory-mib (README \"Limits\")",
+          need, formation, budget));
     throw BudgetError(fmt::format(
         "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}{}), above the budget "
         "of {} MiB: lower render.cube_size or render.latlong_height{}, turn off outputs, or raise "

@@ -91,7 +91,9 @@ void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan) {
                          double(s.resolution) * s.resolution * s.steps * bands});
 }
 
-void AddCloudFormationPlan(const SkyStyle& first, const std::vector<double>& hours_from_start, PassPlan& plan) {
+void AddCloudFormationPlan(const std::vector<SkyStyle>& frames, const std::vector<double>& hours_from_start,
+                           PassPlan& plan) {
+  const SkyStyle& first = frames.front();
   bool requested = false;
   for (const CloudLayer& l : first.clouds.layers) requested = requested || l.formation.enabled;
   std::string why_on;
@@ -99,10 +101,14 @@ void AddCloudFormationPlan(const SkyStyle& first, const std::vector<double>& hou
     const CloudFormation& f = l.formation;
     if (!f.enabled) continue;
     // The steps a process simulates: from 0 to the last frame's step, and
-    // the one after it when the frame falls between two.
+    // the one after it when the frame falls between two; on the formation's
+    // clock (cloud_formation.h), from the first frame's local clock time.
     uint64_t steps = 0;
-    for (double h : hours_from_start.empty() ? std::vector<double>{0.0} : hours_from_start) {
-      const double step = f.warmup_steps + f.steps_per_hour * std::max(h, 0.0);
+    for (size_t i = 0; i < std::max<size_t>(hours_from_start.size(), 1); ++i) {
+      const double h = i < hours_from_start.size() ? std::max(hours_from_start[i], 0.0) : 0.0;
+      const std::optional<double> clock = i < frames.size() ? frames[i].clouds.local_clock_s : std::nullopt;
+      const double t_h = FormationTimeSeconds(f, clock, h * 3600.0) / 3600.0;
+      const double step = f.warmup_steps + f.steps_per_hour * t_h;
       steps = std::max(steps, uint64_t(std::floor(step)) + (step > std::floor(step) ? 1 : 0));
     }
     const double cells = double(f.cells[0]) * f.cells[1] * f.cells[2];

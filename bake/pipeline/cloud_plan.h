@@ -30,9 +30,12 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
 
 // Effect "cloud formation" and its CPU step per active layer with a
 // formation: cells per step, and the steps simulated to reach the planned
-// frames' clock times (`hours_from_start`, one per frame; empty: every
-// frame at 0 h), from step 0 (a process, or a --shard / --frames part,
-// simulates from the start). Not medium samples: not in the plan's total.
-void AddCloudFormationPlan(const SkyStyle& first, const std::vector<double>& hours_from_start, PassPlan& plan);
+// frames' times on the formation's clock (FormationTimeSeconds of each of
+// `frames`, whose local clock time it reads, with `hours_from_start`, one
+// per frame; empty: every frame at 0 h), from step 0 (a process, or a
+// --shard / --frames part, simulates from the day's start). Not medium
+// samples: not in the plan's total. `frames` is not empty.
+void AddCloudFormationPlan(const std::vector<SkyStyle>& frames, const std::vector<double>& hours_from_start,
+                           PassPlan& plan);
 
 }  // namespace skybake

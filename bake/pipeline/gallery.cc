@@ -15,7 +15,9 @@
 #include "skybake/output/output_lock.h"
 #include "skybake/base/oiio_module.h"
 #include "skybake/input/schedule.h"
+#include "skybake/pipeline/formation_budget.h"
 #include "skybake/pipeline/night_sky.h"
+#include "skybake/pipeline/render_plan.h"
 
 namespace skybake {
 namespace {
@@ -105,8 +107,51 @@ std::optional<GalleryFrame> GalleryFrameOf(const std::string& path, const std::v
   return frame;
 }
 
+namespace {
+
+// A style's overrides in the gallery: --set, then its latlong preview only.
+std::vector<std::string> GalleryOverrides(const std::string& path, const GalleryOptions& options) {
+  std::vector<std::string> overrides = options.overrides;
+  const std::string name = std::filesystem::path(path).stem().string();
+  for (const std::string& o :
+       {std::string("output.faces=false"), std::string("output.cube_strip=false"),
+        std::string("output.latlong=false"), std::string("output.preview=true"), std::string("gltf.enabled=false"),
+        fmt::format("output.basename=\"{}\"", name), fmt::format("render.latlong_height={}", options.latlong_height)})
+    overrides.push_back(o);
+  return overrides;
+}
+
+// Every style's frame against the budget (BudgetError naming the style)
+// before the first is baked: a gallery is refused whole, not after the
+// styles before the one over budget.
+void CheckGalleryBudgets(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
+  for (const std::string& path : style_paths) {
+    const std::vector<std::string> overrides = GalleryOverrides(path, options);
+    ConfigResult config = LoadSkyStyle(path, overrides);
+    if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
+    std::vector<ConfigError> errors;
+    const std::optional<GalleryFrame> frame = GalleryFrameOf(path, overrides, options.bake.star_catalogue, errors);
+    try {
+      if (frame) {
+        const std::vector<SkyStyle> styles = {frame->style};  // the plan points into it
+        const RenderPlan plan = PlanSequenceBake(styles, frame->schedule, std::nullopt);
+        CheckBudget(frame->style, options.bake);
+        CheckFormationBudget(plan, options.bake);
+      } else {
+        CheckBudget(config.style, options.bake);
+        CheckFormationBudget(PlanSingleBake(config.style), options.bake);
+      }
+    } catch (const BudgetError& e) {
+      throw BudgetError(fmt::format("gallery style {}: {}; nothing was baked", path, e.what()));
+    }
+  }
+}
+
+}  // namespace
+
 GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const GalleryOptions& options) {
   GalleryResult result;
+  CheckGalleryBudgets(style_paths, options);
   std::filesystem::create_directories(options.out_dir);
   // The sheet, like every style's files, is new unless --force; a link at
   // its name counts as a file (it is replaced, never followed). Locked
@@ -120,15 +165,8 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
 
   // Bake each style's latlong preview only.
   for (const std::string& path : style_paths) {
-    std::vector<std::string> overrides = options.overrides;
-    std::string name = std::filesystem::path(path).stem().string();
-    for (const std::string& o :
-         {std::string("output.faces=false"), std::string("output.cube_strip=false"),
-          std::string("output.latlong=false"), std::string("output.preview=true"),
-          std::string("gltf.enabled=false"),
-          fmt::format("output.basename=\"{}\"", name),
-          fmt::format("render.latlong_height={}", options.latlong_height)})
-      overrides.push_back(o);
+    const std::string name = std::filesystem::path(path).stem().string();
+    const std::vector<std::string> overrides = GalleryOverrides(path, options);
     ConfigResult config = LoadSkyStyle(path, overrides);
     if (!config.ok()) throw ConfigFailure(path + " is not a valid style", config.errors);
     BakeOptions bake = options.bake;

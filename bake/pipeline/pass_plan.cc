@@ -469,7 +469,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   AddNightSkyPlan(frames, plan);  // night_sky.h: the host's splat and glow, and what prunes them
   AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
-  AddCloudFormationPlan(first, hours_from_start, plan);  // CPU cell updates, not medium samples
+  AddCloudFormationPlan(frames, hours_from_start, plan);  // CPU cell updates, not medium samples
   PlanIblPasses(first, pruned, plan);
   plan.variant = DescribeVariant(first, pruned, disc_pass, shaders);
   PlanReuse(plan);

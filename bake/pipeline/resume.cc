@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/base/file_door.h"
 #include "skybake/input/config.h"
 #include "skybake/model/envmap.h"
 #include "skybake/output/sha256.h"
@@ -81,12 +82,13 @@ std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous
   index = 0;
   for (const ManifestFile& entry : f.files) {
     std::string path = (std::filesystem::path(out_dir) / expected[index]).string();
-    std::error_code ec;
-    // A link is not followed: only a regular file of the folder is verified.
-    if (!std::filesystem::is_regular_file(std::filesystem::symlink_status(path, ec))) return std::nullopt;
+    // Through the door (file_door.h): only a regular file of the folder is
+    // verified; a link, FIFO or device at the name is baked over, not read.
+    uint64_t bytes = 0;
+    if (!RegularFileSize(path, bytes).empty()) return std::nullopt;
     std::string sha = Sha256OfFile(path);
     if (sha != entry.sha256) return std::nullopt;
-    files.push_back({path, kinds[index], uint64_t(std::filesystem::file_size(path)), sha});
+    files.push_back({path, kinds[index], bytes, sha});
     ++index;
   }
   return files;

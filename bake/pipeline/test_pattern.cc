@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 #include <glm/geometric.hpp>
 
+#include "skybake/base/errors.h"
 #include "skybake/input/engine_preset.h"
 #include "skybake/model/envmap.h"
 #include "skybake/pipeline/pipeline.h"
@@ -118,8 +119,28 @@ glm::dvec3 TestPatternColor(const glm::dvec3& direction) {
   return text ? glm::dvec3(0.0) : TestPatternFaceColor(face);
 }
 
+double TestPatternMemoryMiB(const TestPatternOptions& options) {
+  const double n = options.size;
+  // Six faces, the strip (6N x N) and the latlong (2N x N); the preset's
+  // images by their kinds (the layout of a 1 x 1 pattern).
+  double texels = 14.0 * n * n, largest = 6.0 * n * n;
+  if (const EnginePreset* preset = FindEnginePreset(options.engine))
+    for (const EngineImage& e : EngineImages(*preset, 1, 1)) {
+      const double t = e.kind == "latlong" ? 2.0 * n * n : e.kind == "cube strip" ? 6.0 * n * n : n * n;
+      texels += t;
+      largest = std::max(largest, t);
+    }
+  return (24.0 * texels + 32.0 * largest) / (1024.0 * 1024.0);
+}
+
 std::vector<std::string> WriteTestPattern(const TestPatternOptions& options) {
   const int n = options.size;
+  if (const double mib = TestPatternMemoryMiB(options); !(mib <= options.max_memory_mib))
+    throw BudgetError(fmt::format("testpattern --size {}{} needs an estimated {:.0f} MiB of memory (every image's "
+                                  "directions, the largest image's pixels and file), above the budget of {:.0f} MiB: "
+                                  "lower --size, or raise --max-memory-mib (README \"Limits\"); nothing was written",
+                                  n, options.engine == "none" ? "" : " --engine " + options.engine, mib,
+                                  options.max_memory_mib));
   struct Image {
     std::string name;
     std::vector<glm::dvec3> directions;

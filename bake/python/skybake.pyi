@@ -99,6 +99,16 @@ class Frame:
     @property
     def engine(self) -> dict[str, npt.NDArray[np.float32]]: ...
     @property
+    def ibl(self) -> dict[str, Union[npt.NDArray[np.float32], list[npt.NDArray[np.float32]]]]:
+        """With arrays=True: each IBL file's texels by name; a cube EXR (6, N, N, 3), the DFG EXR (N, N, 3),
+        a KTX2 a list of its mip levels."""
+    @property
+    def ibl_specular(self) -> list[npt.NDArray[np.float32]]:
+        """With arrays=True: the GGX-prefiltered levels, level 0 first, each (6, N, N, 3) (EXRs, else KTX2)."""
+    @property
+    def ibl_irradiance(self) -> Optional[npt.NDArray[np.float32]]:
+        """With arrays=True: the irradiance map E(n) / pi, (6, N, N, 3) (EXR, else KTX2)."""
+    @property
     def render_seconds(self) -> float: ...
 
 class Bake:

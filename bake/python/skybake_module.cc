@@ -34,7 +34,9 @@
 
 #include "build_commit.h"
 #include "exr_arrays.h"
+#include "ktx2_arrays.h"
 #include "skybake/base/errors.h"
+#include "skybake/base/file_door.h"
 #include "skybake/base/oiio_module.h"
 #include "skybake/gpu/vulkan_context.h"
 #include "skybake/input/config.h"
@@ -286,10 +288,26 @@ struct TomlWriter {
 
   static std::string Join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
+  // A datetime.date, .time or .datetime as a TOML local date, local time,
+  // local or offset date-time (a schedule's `date`, `times`): its isoformat.
+  std::optional<std::string> DateOrTime(py::handle v, const std::string& key) {
+    py::module_ datetime = py::module_::import("datetime");
+    const bool is_datetime = py::isinstance(v, datetime.attr("datetime"));
+    const bool is_time = py::isinstance(v, datetime.attr("time"));
+    if (!is_datetime && !is_time && !py::isinstance(v, datetime.attr("date"))) return std::nullopt;
+    if (is_time && !v.attr("tzinfo").is_none()) {
+      Fail(key, "a time with a time zone has no TOML form: give a naive datetime.time (the schedule's "
+                "utc_offset_hours places it)");
+      return "0";
+    }
+    return v.attr("isoformat")().cast<std::string>();
+  }
+
   // A value, inline (arrays and tables of arrays as inline arrays and tables).
   std::string Value(py::handle v, const std::string& key) {
     if (PyBool_Check(v.ptr())) return v.ptr() == Py_True ? "true" : "false";
     if (py::isinstance<py::str>(v)) return TomlString(v.cast<std::string>());
+    if (std::optional<std::string> when = DateOrTime(v, key)) return *when;
     if (PyLong_Check(v.ptr()) || (PyIndex_Check(v.ptr()) && !PyFloat_Check(v.ptr())))
       return std::string(py::str(py::int_(py::reinterpret_borrow<py::object>(v))));
     if (PyFloat_Check(v.ptr()) || py::hasattr(v, "__float__")) {
@@ -319,7 +337,8 @@ struct TomlWriter {
       }
       return out + "]";
     }
-    Fail(key, fmt::format("{} cannot be written as TOML: give a bool, int, float, str, list or dict",
+    Fail(key, fmt::format("{} cannot be written as TOML: give a bool, int, float, str, list, dict, or a "
+                          "datetime.date, time or datetime",
                           std::string(py::str(py::type::of(v).attr("__name__")))));
     return "0";
   }
@@ -363,10 +382,13 @@ struct PyStyle {
     all.insert(all.end(), extra.begin(), extra.end());
     return text ? ParseSkyStyle(*text, source, all) : LoadSkyStyle(source, all);
   }
-  bool has_inline_schedule() const { return !text && FileHasSchedule(source); }
+  // An inline [schedule] table, as the CLI reads one from a style file: in
+  // the file, or in the text of a dict or text style.
+  bool has_inline_schedule() const { return text ? TextHasSchedule(*text, source) : FileHasSchedule(source); }
 };
 
 PyStyle MakeStyle(std::string source, std::optional<std::string> text, std::vector<std::string> overrides) {
+  const KeptReadScope kept;  // the OpenColorIO config as it is now (file_door.h)
   PyStyle style{std::move(source), std::move(text), std::move(overrides), {}};
   style.config = style.With({});
   if (!style.config.ok()) ThrowConfigErrors(style.config.errors);
@@ -381,6 +403,14 @@ PySchedule LoadScheduleOrThrow(const std::string& path) {
   ScheduleResult loaded = LoadSchedule(path);
   if (!loaded.ok()) ThrowConfigErrors(loaded.errors);
   return {std::move(loaded.schedule)};
+}
+
+// A style's inline schedule (has_inline_schedule), named as the style.
+PySchedule InlineScheduleOrThrow(const PyStyle& style) {
+  if (!style.text) return LoadScheduleOrThrow(style.source);
+  ScheduleResult parsed = ParseSchedule(*style.text, style.source);
+  if (!parsed.ok()) ThrowConfigErrors(parsed.errors);
+  return {std::move(parsed.schedule)};
 }
 
 py::dict FrameOfSchedule(const ScheduleFrame& f) {
@@ -409,11 +439,12 @@ struct LoadedBake {
 LoadedBake Load(const PyStyle& style, const PySchedule* schedule, const std::vector<std::string>& extra) {
   const Environment& env = ReadEnvironment();
   LoadedBake bake;
-  bake.config = extra.empty() ? style.config : style.With(extra);
+  // Parsed again, so that its inputs (an OpenColorIO config) are as they are now.
+  bake.config = style.With(extra);
   if (!bake.config.ok()) ThrowConfigErrors(bake.config.errors);
   bake.warnings = bake.config.warnings;
   if (schedule) bake.schedule = schedule->schedule;
-  else if (style.has_inline_schedule()) bake.schedule = LoadScheduleOrThrow(style.source).schedule;
+  else if (style.has_inline_schedule()) bake.schedule = InlineScheduleOrThrow(style).schedule;
   if (bake.schedule) {
     bake.schedule_path = bake.schedule->source_path;
     std::vector<std::string> all = style.overrides;
@@ -576,6 +607,9 @@ struct PyFrame {
   py::object cube = py::none();
   py::dict faces;
   py::dict engine;
+  py::dict ibl;                                   // every IBL file's texels, by file name
+  py::list ibl_specular;                          // the prefiltered levels, (6, N, N, 3) each
+  py::object ibl_irradiance = py::none();         // (6, N, N, 3)
   double render_seconds = 0.0;
 };
 
@@ -627,20 +661,76 @@ py::array_t<float> ArrayOf(const RgbImage& image) {
   return a;
 }
 
-bool IsExr(const std::string& path) { return path.size() > 4 && path.compare(path.size() - 4, 4, ".exr") == 0; }
+bool EndsWith(const std::string& path, const char* suffix) {
+  const size_t n = std::strlen(suffix);
+  return path.size() > n && path.compare(path.size() - n, n, suffix) == 0;
+}
+bool IsExr(const std::string& path) { return EndsWith(path, ".exr"); }
+bool IsIbl(const BakedFile& f) { return f.kind == "ibl_specular" || f.kind == "ibl_irradiance" || f.kind == "ibl_dfg"; }
 
-// The EXRs of a frame read back (without the GIL), by file.
-std::map<std::string, RgbImage> ReadFrameExrs(const std::vector<FrameResult>& frames) {
-  std::map<std::string, RgbImage> images;
+// The images of a frame's files read back (without the GIL), by file: its
+// EXRs, and the mip levels of its IBL KTX2s.
+struct FrameImages {
+  std::map<std::string, RgbImage> exrs;
+  std::map<std::string, std::vector<Ktx2Level>> ktx2s;
+};
+
+FrameImages ReadFrameImages(const std::vector<FrameResult>& frames) {
+  FrameImages images;
   py::gil_scoped_release release;
   for (const FrameResult& frame : frames)
-    for (const BakedFile& f : frame.files)
-      if ((f.kind == "latlong" || f.kind == "face" || f.kind == "cube" || f.kind == "engine") && IsExr(f.path))
-        images.emplace(f.path, ReadExrRgb(f.path));
+    for (const BakedFile& f : frame.files) {
+      const bool map = f.kind == "latlong" || f.kind == "face" || f.kind == "cube" || f.kind == "engine" || IsIbl(f);
+      if (map && IsExr(f.path)) images.exrs.emplace(f.path, ReadExrRgb(f.path));
+      else if (IsIbl(f) && EndsWith(f.path, ".ktx2")) images.ktx2s.emplace(f.path, ReadKtx2Rgb(f.path));
+    }
   return images;
 }
 
-PyFrame FrameOf(const FrameResult& f, std::map<std::string, RgbImage>* images) {
+// An IBL cube EXR (six faces stacked from the top, ibl_files.cc) as (6, N, N, 3).
+py::array_t<float> CubeOfStacked(const RgbImage& image) {
+  const size_t n = size_t(image.width);
+  py::array_t<float> a({size_t(6), n, n, size_t(3)});
+  std::memcpy(a.mutable_data(), image.rgb.data(), image.rgb.size() * sizeof(float));
+  return a;
+}
+
+// A KTX2's mip levels: (6, N, N, 3) per level of a cube, (N, N, 3) of an image.
+py::list LevelsOf(const std::vector<Ktx2Level>& levels) {
+  py::list list;
+  for (const Ktx2Level& l : levels) {
+    const size_t n = size_t(l.size);
+    py::array_t<float> a = l.faces == 6 ? py::array_t<float>({size_t(6), n, n, size_t(3)})
+                                        : py::array_t<float>({n, n, size_t(3)});
+    std::memcpy(a.mutable_data(), l.rgb.data(), l.rgb.size() * sizeof(float));
+    list.append(a);
+  }
+  return list;
+}
+
+// Frame.ibl, .ibl_specular and .ibl_irradiance: every IBL file by name; the levels
+// and irradiance from the EXRs when written, else from the KTX2s.
+void IblArraysOf(const FrameResult& f, const FrameImages& images, PyFrame& frame) {
+  py::list exr_levels;
+  for (const BakedFile& file : f.files) {
+    if (!IsIbl(file)) continue;
+    const py::str name(std::filesystem::path(file.path).filename().string());
+    if (auto exr = images.exrs.find(file.path); exr != images.exrs.end()) {
+      py::array_t<float> array = file.kind == "ibl_dfg" ? ArrayOf(exr->second) : CubeOfStacked(exr->second);
+      frame.ibl[name] = array;
+      if (file.kind == "ibl_specular") exr_levels.append(array);  // listed level 0 first (IblFileNames)
+      else if (file.kind == "ibl_irradiance") frame.ibl_irradiance = array;
+    } else if (auto ktx2 = images.ktx2s.find(file.path); ktx2 != images.ktx2s.end()) {
+      py::list levels = LevelsOf(ktx2->second);
+      frame.ibl[name] = levels;
+      if (file.kind == "ibl_specular" && frame.ibl_specular.empty() && exr_levels.empty()) frame.ibl_specular = levels;
+      else if (file.kind == "ibl_irradiance" && frame.ibl_irradiance.is_none()) frame.ibl_irradiance = levels[0];
+    }
+  }
+  if (!exr_levels.empty()) frame.ibl_specular = exr_levels;
+}
+
+PyFrame FrameOf(const FrameResult& f, const FrameImages* images) {
   PyFrame frame;
   frame.number = f.number;
   if (f.time) frame.time = py::str(f.time->Iso8601());
@@ -656,14 +746,15 @@ PyFrame FrameOf(const FrameResult& f, std::map<std::string, RgbImage>* images) {
   frame.render_seconds = f.render_seconds;
   if (images) {
     for (const BakedFile& file : f.files) {
-      auto it = images->find(file.path);
-      if (it == images->end()) continue;
+      auto it = images->exrs.find(file.path);
+      if (it == images->exrs.end() || IsIbl(file)) continue;
       py::array_t<float> array = ArrayOf(it->second);
       if (file.kind == "latlong" && frame.latlong.is_none()) frame.latlong = array;
       else if (file.kind == "cube") frame.cube = array;
       else if (file.kind == "face") frame.faces[py::str(std::filesystem::path(file.path).filename().string())] = array;
       else if (file.kind == "engine") frame.engine[py::str(std::filesystem::path(file.path).filename().string())] = array;
     }
+    IblArraysOf(f, *images, frame);
   }
   return frame;
 }
@@ -682,6 +773,7 @@ PyStyle LoadStyle(py::object source, const std::vector<std::string>& overrides, 
 }
 
 py::list Check(const PyStyle& style, const PySchedule* schedule, double max_memory_mib, double max_frame_seconds) {
+  const KeptReadScope kept;
   LoadedBake bake = Load(style, schedule, {});
   BakeOptions options;
   options.max_memory_mib = max_memory_mib;
@@ -691,6 +783,7 @@ py::list Check(const PyStyle& style, const PySchedule* schedule, double max_memo
 }
 
 py::dict Estimate(const PyStyle& style, const PySchedule* schedule, std::optional<int> size) {
+  const KeptReadScope kept;
   LoadedBake bake = Load(style, schedule, ExtraOverrides(size, std::nullopt, false));
   ResourceEstimate largest;
   for (const SkyStyle& s : bake.Styles()) {
@@ -707,6 +800,7 @@ py::dict Estimate(const PyStyle& style, const PySchedule* schedule, std::optiona
 
 std::string Plan(const PyStyle& style, const PySchedule* schedule, std::optional<int> size,
                  const std::optional<std::string>& frames, const std::optional<std::string>& shard) {
+  const KeptReadScope kept;
   const Environment& env = ReadEnvironment();
   LoadedBake bake = Load(style, schedule, ExtraOverrides(size, std::nullopt, false));
   const std::optional<FrameRange> part = SelectPart(bake, frames, shard);
@@ -728,6 +822,10 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
             double max_memory_mib, double max_frame_seconds, const std::optional<std::string>& frames,
             const std::optional<std::string>& shard, const std::optional<std::string>& engine, bool usd) {
   const Environment& env = ReadEnvironment();
+  // Every input (star catalogue, OpenColorIO config, weather and mask
+  // images) read once in this bake, as the files are now: a bake after an
+  // edit sees the edit (file_door.h, KeptReadScope).
+  const KeptReadScope kept;
   // The progress events from the start, as --progress-json's: an error
   // found before the bake ends them too, with its exit code.
   PythonProgress report(progress);
@@ -795,8 +893,8 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
   report.End(kExitOk, "");
 
   // The result: frames, files, the manifest as a dict, arrays when asked.
-  std::map<std::string, RgbImage> images;
-  if (arrays) images = ReadFrameExrs(result.frames);
+  FrameImages images;
+  if (arrays) images = ReadFrameImages(result.frames);
   PyBake baked;
   baked.out = out;
   baked.manifest_path = result.manifest_path;
@@ -855,7 +953,8 @@ void RegisterTypes(py::module_& m) {
           "warnings", [](const PyStyle& s) { return Locations(s.config.warnings); },
           "Not errors: the style bakes, but likely not as meant (Location tuples).")
       .def_property_readonly("has_schedule", &PyStyle::has_inline_schedule,
-                             "Whether the style file has an inline [schedule] table (bake() then bakes a sequence).")
+                             "Whether the style (a file, dict or text) has an inline [schedule] table (bake() then "
+                             "bakes a sequence).")
       .def(
           "with_overrides",
           [](const PyStyle& s, const std::vector<std::string>& more) {
@@ -918,6 +1017,18 @@ void RegisterTypes(py::module_& m) {
       .def_readonly("engine", &PyFrame::engine,
                     "With arrays=True and an engine preset: each of its EXRs' texels (the engine's own layout; "
                     "docs/engines.md), numpy float32 (H, W, 3), by file name.")
+      .def_readonly("ibl", &PyFrame::ibl,
+                    "With arrays=True and an IBL bake: every IBL file's texels by file name, as the file stores them "
+                    "(times its skybake:scale): a cube EXR (a specular level, the irradiance) as numpy float32 (6, N, "
+                    "N, 3), faces +X -X +Y -Y +Z -Z (Vulkan order), rows from the top; the DFG EXR as (N, N, 3); a "
+                    "KTX2 as a list of its mip levels, level 0 first, each (6, N, N, 3) for a cube, (N, N, 3) for "
+                    "the DFG table.")
+      .def_readonly("ibl_specular", &PyFrame::ibl_specular,
+                    "With arrays=True and ibl.specular: the GGX-prefiltered levels, level 0 (roughness 0) first, "
+                    "each numpy float32 (6, N, N, 3), from the EXRs when written, else the KTX2's mip levels; else [].")
+      .def_readonly("ibl_irradiance", &PyFrame::ibl_irradiance,
+                    "With arrays=True and ibl.irradiance: the irradiance map E(n) / pi, numpy float32 (6, N, N, 3), "
+                    "from the EXR when written, else the KTX2; else None.")
       .def_readonly("render_seconds", &PyFrame::render_seconds, "The frame's render time, s.")
       .def("__repr__", [](const PyFrame& f) {
         return fmt::format("<skybake.Frame {} sun {:.2f} deg>", f.number, f.sun_elevation_deg);
@@ -944,7 +1055,8 @@ void RegisterFunctions(py::module_& m) {
         py::kw_only(), py::arg("name") = py::none(),
         "Loads and validates a style: `source` is a TOML file's path, or a dict of style keys (nested dicts are "
         "tables: {'sun': {'elevation_deg': 10}}), written as TOML and read exactly as a file, named `name` "
-        "(default '<dict>') in errors and provenance. `overrides` are 'key.path=toml_value' assignments, as the "
+        "(default '<dict>') in errors and provenance; a [schedule] table in it (dates and times as datetime.date and "
+        "datetime.time) makes a sequence, as in a file. `overrides` are 'key.path=toml_value' assignments, as the "
         "CLI's --set. Raises StyleError with every located error.");
   m.def(
       "parse_style",
@@ -985,8 +1097,9 @@ void RegisterFunctions(py::module_& m) {
         "progress(event) receives each --progress-json event as a dict (start, stage, frame_start, frame_end with "
         "frame, of, seconds_per_frame, eta_s; end); returning False or raising cancels the bake (Cancel, or what "
         "it raised, is raised here), leaving the folder as a killed bake leaves it. vulkan_validation: the "
-        "Khronos validation layer, any message raises VulkanError. arrays: read each frame's EXRs back as numpy "
-        "arrays (Frame.latlong, .faces, .cube). The GIL is released while the bake runs. Returns a Bake.");
+        "Khronos validation layer, any message raises VulkanError. arrays: read each frame's EXRs and IBL KTX2s "
+        "back as numpy arrays (Frame.latlong, .faces, .cube, .engine, .ibl, .ibl_specular, .ibl_irradiance). The "
+        "GIL is released while the bake runs. Returns a Bake.");
 }
 
 }  // namespace

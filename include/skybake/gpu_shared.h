@@ -42,6 +42,7 @@ struct alignas(16) ivec4 { int32_t x, y, z, w; };
 #define SPEC_GROUND_CLOUD_SHADOW 23  // bool: the clouds' shadow on the ground below the horizon (GpuClouds.ground_shadow.x > 0)
 #define SPEC_TEXEL_VIEWS 24          // bool: the reads go through the texel views (off: a buffer has more texels than the device's texel buffers hold)
 #define SPEC_CLOUD_FORMATION 25      // bool: some layer's density is a formation's volume (GpuCloudLayer.weather.w = 2; CloudFormationDensityOn)
+#define SPEC_CLOUD_CIRRUS 31         // bool: some layer is cirrus (GpuCloudLayer.streaks.z > 0; CloudCirrusOn): streaks, ice phase
 
 // Descriptor bindings, all in set 0.
 #define BINDING_ATMOSPHERE 0       // uniform GpuAtmosphere
@@ -200,6 +201,8 @@ SKYBAKE_GPU_STRUCT(GpuCloudLayer) {
                         // tile, km (0: the layer tiles); w: 1 = the weather read three times through the warp
                         // (shaders/cloud_weather.glsl)
   ivec4 noise;          // x, y, z: first float of the shape volume, detail volume, weather map; w: seed
+  vec4 streaks;         // cirrus (shaders/cloud_cirrus.glsl): xy: unit world x, z along the streaks; z: their length
+                        // over their width (0: not cirrus, the water phase); w: the fall streaks' hook, km^-1
 };
 
 SKYBAKE_GPU_STRUCT(GpuClouds) {
@@ -256,8 +259,8 @@ SKYBAKE_GPU_STRUCT(IblPush) {
 };
 
 #ifdef __cplusplus
-static_assert(sizeof(GpuCloudLayer) == 7 * 16, "GpuCloudLayer must be vec4-packed");
-static_assert(sizeof(GpuClouds) == (9 + 8 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
+static_assert(sizeof(GpuCloudLayer) == 8 * 16, "GpuCloudLayer must be vec4-packed");
+static_assert(sizeof(GpuClouds) == (9 + 9 * CLOUD_MAX_LAYERS) * 16, "GpuClouds must be vec4-packed");
 static_assert(sizeof(IblPush) == 7 * 16, "IblPush must be vec4-packed");
 static_assert(sizeof(GpuAtmosphere) == 21 * 16, "GpuAtmosphere must be vec4-packed");
 static_assert(sizeof(SkyPush) == 4 * 16, "SkyPush must be vec4-packed");

@@ -134,6 +134,44 @@ def test_dict_style_sequence_bakes_as_its_file(in_source, tmp_path):
     assert_same_folders(tmp_path / "file", tmp_path / "dict")
 
 
+def test_dict_style_inline_schedule_bakes_as_the_cli(cli, tmp_path):
+    """A dict with a [schedule] table is a sequence, as a style file with one is to the CLI: the
+    schedule's date and times as datetime objects (TOML dates and times), a ramp; the same bytes."""
+    import datetime
+    path = tmp_path / "inline.toml"
+    path.write_text('[atmosphere.mie]\ng = 0.7\n'
+                    '[schedule]\nfirst_frame = 1\ndate = 2013-05-27\nlatitude_deg = 42.44337\n'
+                    'longitude_deg = -76.48163\nutc_offset_hours = -4.0\ntimes = [07:00:00, 12:30:00]\n'
+                    '[schedule.ramp]\n"atmosphere.mie.g" = [0.7, 0.85]\n')
+    from_dict = skybake.load_style(
+        {"atmosphere": {"mie": {"g": 0.7}},
+         "schedule": {"first_frame": 1, "date": datetime.date(2013, 5, 27), "latitude_deg": 42.44337,
+                      "longitude_deg": -76.48163, "utc_offset_hours": -4.0,
+                      "times": [datetime.time(7, 0), datetime.time(12, 30)],
+                      "ramp": {"atmosphere.mie.g": [0.7, 0.85]}}}, name=str(path))
+    assert from_dict.has_schedule and skybake.load_style(str(path)).has_schedule
+    assert skybake.parse_style(path.read_text()).has_schedule
+    assert not skybake.load_style({"atmosphere": {"mie": {"g": 0.7}}}).has_schedule
+    run = cli("bake", path, "--size", SIZE, "--out", tmp_path / "cli", "--vulkan-validation", "-q")
+    assert run.returncode == 0, run.stderr
+    result = skybake.bake(from_dict, out=str(tmp_path / "py"), size=SIZE, vulkan_validation=True)
+    assert [f.number for f in result.frames] == [1, 2]
+    assert [f.time for f in result.frames] == ["2013-05-27T07:00:00-04:00", "2013-05-27T12:30:00-04:00"]
+    assert len({frame["style_sha256"] for frame in result.manifest["frames"]}) == 2
+    assert_same_folders(tmp_path / "cli", tmp_path / "py")
+    # plan and check read it as the CLI does.
+    assert skybake.plan(from_dict) == cli("plan", path).stdout
+    # An inline schedule's mistakes are StyleErrors at their key, nothing baked.
+    bad = {"schedule": {"date": "2013-05-27", "times": [datetime.time(7, 0)]}}
+    with pytest.raises(skybake.StyleError) as raised:
+        skybake.bake(skybake.load_style(bad, name="bad"), out=str(tmp_path / "bad"), size=SIZE)
+    assert ("bad", "schedule.date") in [(x.file, x.key) for x in raised.value.errors]
+    assert not (tmp_path / "bad").exists()
+    with pytest.raises(skybake.StyleError) as raised:
+        skybake.load_style({"schedule": {"times": [datetime.time(7, tzinfo=datetime.timezone.utc)]}})
+    assert [x.key for x in raised.value.errors] == ["schedule.times[0]"]
+
+
 # === Arrays: the files' texels.
 
 def read_with_oiiotool(exr):
@@ -177,9 +215,99 @@ def test_engine_arrays_are_the_files_texels(in_source, tmp_path):
                                   read_with_oiiotool(tmp_path / "out" / "sky_blender_latlong.exr"))
 
 
+# A small IBL bake: two specular levels, the irradiance and the DFG table, as EXRs and KTX2s.
+IBL = ["ibl.specular=true", "ibl.irradiance=true", "ibl.dfg_lut=true", "ibl.size=16", "ibl.samples=16",
+       "ibl.irradiance_size=8", "ibl.irradiance_samples=16", "ibl.dfg_size=8", "ibl.dfg_samples=16", "ibl.ktx2=true"]
+
+
+def read_small_values_with_oiiotool(exr, tmp_path):
+    """read_with_oiiotool exact for every half float, subnormals too (--dumpdata prints 9 decimals):
+    OpenImageIO scales the texels by 2^24 into a float EXR first (every half is then a whole number)."""
+    scaled = tmp_path / f"scaled_{exr.name}"
+    subprocess.run(["oiiotool", str(exr), "--mulc", str(2 ** 24), "-d", "float", "-o", str(scaled)], check=True)
+    return read_with_oiiotool(scaled) / np.float32(2 ** 24)
+
+
+def read_ktx2_with_ktx_parse(source_dir, ktx2, tmp_path):
+    """npm ktx-parse's reading of a KTX2 (tests/viewer/ktx2_dump.mjs, zstd undone by the zstd
+    command): each mip level's texels as RGB float32, (faces, N, N, 3), decoded here with numpy."""
+    prefix = tmp_path / ktx2.name
+    run = subprocess.run(["node", "ktx2_dump.mjs", str(ktx2), str(prefix)], cwd=source_dir / "tests" / "viewer",
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stderr
+    info = json.loads(run.stdout)
+    faces = info["faceCount"]
+    levels = []
+    for i in range(info["levelCount"]):
+        n = max(1, info["pixelWidth"] >> i)
+        raw = (tmp_path / f"{ktx2.name}.level{i}").read_bytes()
+        if info["vkFormat"] == 97:  # R16G16B16A16_SFLOAT
+            rgb = np.frombuffer(raw, dtype="<f2").reshape(faces, n, n, 4)[..., :3].astype(np.float32)
+        elif info["vkFormat"] == 122:  # B10G11R11_UFLOAT_PACK32: R 6+5 bits, G 6+5, B 5+5 (exponent bias 15)
+            v = np.frombuffer(raw, dtype="<u4").reshape(faces, n, n)
+
+            def unsigned_float(bits, mantissa_bits):
+                e = (bits >> mantissa_bits).astype(np.int32)
+                m = (bits & ((1 << mantissa_bits) - 1)).astype(np.float64) / (1 << mantissa_bits)
+                assert (e < 31).all()  # no infinity or NaN in a bake's maps
+                return np.where(e == 0, np.ldexp(m, -14), np.ldexp(1.0 + m, e - 15))
+
+            rgb = np.stack([unsigned_float(v & 0x7FF, 6), unsigned_float((v >> 11) & 0x7FF, 6),
+                            unsigned_float(v >> 22, 5)], axis=-1).astype(np.float32)
+        else:
+            assert info["vkFormat"] == 123  # E5B9G9R9_UFLOAT_PACK32: mantissa 2^(exponent - 15 - 9)
+            v = np.frombuffer(raw, dtype="<u4").reshape(faces, n, n)
+            scale = np.ldexp(1.0, (v >> 27).astype(np.int32) - 24)
+            rgb = np.stack([((v >> (9 * c)) & 0x1FF) * scale for c in range(3)], axis=-1).astype(np.float32)
+        levels.append(rgb if faces == 6 else rgb[0])
+    return levels
+
+
+@pytest.mark.parametrize("ktx2", [["ibl.ktx2_zstd_level=3"], ["ibl.ktx2_format=\"e5b9g9r9\"", "ibl.exr=false"],
+                                  ["ibl.ktx2_format=\"b10g11r11\"", "ibl.exr=false", "ibl.ktx2_zstd_level=1"]],
+                         ids=["rgba16f_zstd", "e5b9g9r9_without_exr", "b10g11r11_zstd_without_exr"])
+def test_ibl_arrays_are_the_files_texels(in_source, source_dir, tmp_path, ktx2):
+    """Every IBL file's texels (EXRs read back by OpenImageIO, KTX2 mip levels by npm ktx-parse);
+    .ibl_specular and .ibl_irradiance from the EXRs when written, else from the KTX2s."""
+    result = skybake.bake(skybake.load_style(STYLE, IBL + ktx2), out=str(tmp_path / "out"), size=SIZE, arrays=True,
+                          vulkan_validation=True)
+    frame = result.frames[0]
+    ibl_files = [pathlib.Path(f.path) for f in frame.files if f.kind.startswith("ibl_")]
+    with_exr = "ibl.exr=false" not in ktx2
+    assert sorted(frame.ibl) == sorted(p.name for p in ibl_files) and len(ibl_files) == (7 if with_exr else 3)
+    for path in ibl_files:
+        array = frame.ibl[path.name]
+        if path.suffix == ".exr":
+            texels = read_small_values_with_oiiotool(path, tmp_path)
+            if path.name != "sky_dfg.exr":
+                n = texels.shape[1]
+                texels = texels.reshape(6, n, n, 3)  # six faces stacked from the top
+            assert array.dtype == np.float32
+            np.testing.assert_array_equal(array, texels)
+        else:
+            levels = read_ktx2_with_ktx_parse(source_dir, path, tmp_path)
+            assert len(array) == len(levels)
+            for got, read in zip(array, levels):
+                assert got.dtype == np.float32
+                np.testing.assert_array_equal(got, read)
+    assert [level.shape for level in frame.ibl_specular] == [(6, 16, 16, 3), (6, 8, 8, 3)]
+    assert frame.ibl_irradiance.shape == (6, 8, 8, 3)
+    if with_exr:
+        assert frame.ibl_specular[1] is frame.ibl["sky_specular_m1.exr"]
+        assert frame.ibl_irradiance is frame.ibl["sky_irradiance.exr"]
+    else:
+        assert frame.ibl_specular[1] is frame.ibl["sky_specular.ktx2"][1]
+        assert frame.ibl_irradiance is frame.ibl["sky_irradiance.ktx2"][0]
+    # The maps are of a daylit sky: positive; the irradiance is smoother than level 0.
+    assert frame.ibl_irradiance.min() > 0 and frame.ibl_specular[0].min() > 0
+    assert frame.ibl_irradiance.std() < frame.ibl_specular[0].std()
+
+
 def test_without_arrays_no_images_are_read(in_source, tmp_path):
-    result = skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "out"), size=SIZE)
-    assert result.frames[0].latlong is None and result.frames[0].faces == {}
+    result = skybake.bake(skybake.load_style(STYLE, IBL), out=str(tmp_path / "out"), size=SIZE)
+    frame = result.frames[0]
+    assert frame.latlong is None and frame.faces == {} and frame.ibl == {}
+    assert frame.ibl_specular == [] and frame.ibl_irradiance is None
 
 
 def test_moon_and_lights_are_the_manifests(in_source, tmp_path):
@@ -197,6 +325,35 @@ def test_moon_and_lights_are_the_manifests(in_source, tmp_path):
     assert frame.illuminance_lux == record["sun"]["illuminance_lux"]
     assert list(frame.sun_direction) == record["sun"]["direction"]
     assert frame.sh_with_sun.tolist() == record["sh_irradiance_with_sun"]
+
+
+# === Inputs read again by each bake.
+
+def test_a_bake_after_an_edit_reads_the_edited_inputs(in_source, source_dir, tmp_path):
+    """Each call reads its input files as they are then (one bake still reads each once): an
+    OpenColorIO config edited between two bakes in one process changes the second bake's maps.
+    The edit halves the matrix of "Linear P3-D65" (XYZ to P3): the maps halve."""
+    config = tmp_path / "config.ocio"
+    original = (source_dir / "tests" / "colour" / "ocio" / "test_config.ocio").read_text()
+    config.write_text(original)
+    overrides = ['output.color_space="Linear P3-D65"', f'output.ocio_config="{config}"']
+    first = skybake.bake(skybake.load_style(STYLE, overrides), out=str(tmp_path / "first"), size=SIZE, arrays=True)
+    matrix = "matrix: [2.493496911941425, -0.9313836179191239, -0.40271078445071684, 0, -0.8294889695615747, " \
+             "1.7626640603183463, 0.023624685841943577, 0, 0.03584583024378447, -0.07617238926804182, " \
+             "0.9568845240076872, 0, 0, 0, 0, 1]"
+    assert matrix in original
+    halved = "matrix: [" + ", ".join(repr(float(v) * 0.5) if i not in (3, 7, 11, 15) else v
+                                     for i, v in enumerate(matrix[len("matrix: ["):-1].split(", "))) + "]"
+    config.write_text(original.replace(matrix, halved))
+    style = skybake.load_style(STYLE, overrides)
+    second = skybake.bake(style, out=str(tmp_path / "second"), size=SIZE, arrays=True)
+    a, b = first.frames[0].latlong, second.frames[0].latlong
+    assert a.min() > 0 and not np.array_equal(a, b)
+    np.testing.assert_allclose(b, 0.5 * a, rtol=2 ** -10)  # half floats: 11 significant bits
+    # The style loaded after the edit holds the edited matrix too; bake() re-reads.
+    config.write_text(original)
+    third = skybake.bake(style, out=str(tmp_path / "third"), size=SIZE, arrays=True)
+    np.testing.assert_array_equal(third.frames[0].latlong, a)
 
 
 # === Errors: the CLI's exit codes and located messages.
@@ -224,6 +381,51 @@ def test_dict_with_wrong_types(tmp_path):
     with pytest.raises(skybake.StyleError) as raised:
         skybake.load_style({"sun": {"elevation_deg": None}, "render": {"cube_size": [1, object()]}})
     assert sorted(x.key for x in raised.value.errors) == ["render.cube_size[1]", "sun.elevation_deg"]
+
+
+def test_bad_input_raises_the_clis_errors_and_writes_nothing(cli, in_source, tmp_path):
+    """The issue's bad input, from Python as from the command: a dict of wrong types, an unknown
+    colour space (dict, override and file), a USD layer that cannot be written; each the CLI's
+    exit code and located message, and nothing written."""
+    # A dict of wrong types: the messages of the same keys in a file, at their keys.
+    style_file = tmp_path / "wrong.toml"
+    style_file.write_text('[sun]\nelevation_deg = "high"\n[render]\ncube_size = 12.5\n')
+    with pytest.raises(skybake.StyleError) as from_dict:
+        skybake.load_style({"sun": {"elevation_deg": "high"}, "render": {"cube_size": 12.5}}, name=str(style_file))
+    run = cli("check", style_file)
+    assert run.returncode == from_dict.value.exit_code == 3
+    assert sorted(x.key for x in from_dict.value.errors) == ["render.cube_size", "sun.elevation_deg"]
+    for x in from_dict.value.errors:
+        assert f": {x.key}: {x.message}" in run.stderr
+
+    # An unknown colour space: the names there are, at output.color_space; nothing baked.
+    run = cli("bake", STYLE, "--size", SIZE, "--set", 'output.color_space="P4"', "--out", tmp_path / "cli")
+    assert run.returncode == 3 and not (tmp_path / "cli").exists()
+    for style in [lambda: skybake.load_style({"output": {"color_space": "P4"}}),
+                  lambda: skybake.load_style(STYLE, ['output.color_space="P4"'])]:
+        with pytest.raises(skybake.StyleError) as raised:
+            skybake.bake(style(), out=str(tmp_path / "py"), size=SIZE)
+        assert raised.value.exit_code == 3
+        [error] = raised.value.errors
+        assert error.key == "output.color_space"
+        assert "'P4' is not one of 'rec709', 'acescg', 'aces2065-1', 'rec2020', 'xyz'" in error.message
+        assert f"output.color_space: {error.message}" in run.stderr
+    assert not (tmp_path / "py").exists()
+
+    # A USD layer that cannot be written (a folder at its name): exit code 5 before any file.
+    for name in ["cli", "py"]:
+        (tmp_path / "usd" / name / "sky.usda").mkdir(parents=True)
+    run = cli("bake", STYLE, "--size", SIZE, "--usd", "--out", tmp_path / "usd" / "cli")
+    with pytest.raises(skybake.OutputError) as raised:
+        skybake.bake(skybake.load_style(STYLE), out=str(tmp_path / "usd" / "py"), size=SIZE, usd=True)
+    assert run.returncode == raised.value.exit_code == 5
+    message = str(raised.value)
+    assert message == f"{tmp_path / 'usd' / 'py'}/sky.usda is a directory: an output file cannot replace it; " \
+                      "move it away, or choose another --out"
+    assert run.stderr == "skybake: error: " + message.replace("/py/", "/cli/") + "\n"
+    for name in ["cli", "py"]:
+        assert [p.name for p in (tmp_path / "usd" / name).iterdir()] == ["sky.usda"]
+        assert list((tmp_path / "usd" / name / "sky.usda").iterdir()) == []
 
 
 def test_dict_values_as_toml():

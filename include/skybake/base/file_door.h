@@ -11,9 +11,12 @@
 //    link planted at the name is refused, not followed.
 //  - At most `max_bytes` are read, whatever the size fstat reports (a file in
 //    /proc reports 0), so a huge or growing file is refused, not slurped.
-//  - A kept read (ReadKept) reads each path once per process and returns the
-//    same bytes for every later read: one bake sees one input, even if the
-//    file changes on disk between its frames.
+//  - A kept read (ReadKept) reads each path once and returns the same bytes
+//    for every later read: one bake sees one input, even if the file changes
+//    on disk between its frames. "Once" is once per process, or, where
+//    KeptReadScopes are used (the Python module: one per call), once per
+//    run of overlapping scopes: a bake after the last one ended reads the
+//    files as they are then.
 //
 // Each function returns "" or the problem as a phrase that completes
 // "PATH: ..." ("is a FIFO, a socket or a device, not a regular file"); the
@@ -40,9 +43,20 @@ std::string OpenRegularFile(const std::string& path, FileLinks links, int& fd);
 // Reads all of `path` (a regular file of at most `max_bytes`) into `bytes`.
 std::string ReadRegularFile(const std::string& path, uint64_t max_bytes, FileLinks links, std::string& bytes);
 
-// ReadRegularFile, links followed, once per process per path: the first
+// ReadRegularFile, links followed, once per path (see above): the first
 // read's bytes (or its problem) are kept and returned for every later one.
 std::string ReadKept(const std::string& path, uint64_t max_bytes, std::shared_ptr<const std::string>& bytes);
+
+// The kept reads of one bake (or check, or style load) in a process that
+// runs many: the first scope to open while none is open forgets every kept
+// read; scopes open at the same time (bakes on two threads) share theirs.
+class KeptReadScope {
+ public:
+  KeptReadScope();
+  ~KeptReadScope();
+  KeptReadScope(const KeptReadScope&) = delete;
+  KeptReadScope& operator=(const KeptReadScope&) = delete;
+};
 
 // Why `name`, read from a manifest (or any file of the folder), cannot be the
 // name of a file directly inside that folder: "" when it can. Refuses the
@@ -81,6 +95,15 @@ std::string RegularFileSize(const std::string& path, uint64_t& size);
 // RegularFileSize of a file skybake has just written; throws OutputError
 // naming it when it is gone or not a regular file (the one exception here).
 uint64_t WrittenFileSize(const std::string& path);
+
+// Opens `path` for writing a stream of lines as it happens (--progress-json):
+// a regular file (created or emptied), or where a reader already waits a
+// pipe or a character device (/dev/fd/N of a wrapper's pipe, /dev/null, a
+// terminal). Opened non-blocking, so that a FIFO with no reader is refused at
+// once ("is a FIFO (named pipe) that no process reads") instead of hanging;
+// a directory, a socket or a block device is refused. On success `fd` is a
+// blocking descriptor the caller closes, and "" is returned.
+std::string OpenStreamOutput(const std::string& path, int& fd);
 
 // The caps of inputs that have no size of their own: a star catalogue (the
 // largest d3-celestial file, stars.14.json, is about 16 MiB) and an image

@@ -357,6 +357,7 @@ class SkyRenderer {
   glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
   bool cloud_light_volume_ = false;  // cloud_pipeline_ reads the light volume (CloudLightVolumeOn)
   bool cloud_formation_ = false;     // the cloud pipelines read a formation's density (CloudFormationRead)
+  bool cloud_cirrus_ = false;        // some layer is cirrus: streaks and the ice phase (SPEC_CLOUD_CIRRUS)
   bool CloudFormationRead(const gpu::GpuClouds& clouds) const;
   bool cloud_light_volume_ready_ = false;
   glm::dvec3 cloud_light_volume_sun_{0.0};  // the sun the light volume holds

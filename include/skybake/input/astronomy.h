@@ -75,6 +75,9 @@ struct StarCatalogue {
 // empty). On failure returns nothing and sets `error` to what is wrong and
 // the fix.
 std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::string& error);
+// The same from the file's text (`path` for messages); what the fuzzer
+// (tests/fuzz/inputs_fuzz.cc) reads.
+std::optional<StarCatalogue> ParseStarCatalogue(const std::string& text, const std::string& path, std::string& error);
 
 // The catalogue night.star_catalogue = "" means unless the command line
 // gives another (main: $SKYBAKE_STAR_CATALOGUE, passed in as

@@ -79,8 +79,10 @@ struct ScheduleResult {
 ScheduleResult LoadSchedule(const std::string& path);
 ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name);
 
-// Whether a TOML file (a style) has an inline [schedule] table.
+// Whether a TOML file (a style) has an inline [schedule] table; and the
+// same of a style's TOML text (a style given as a dict or text in Python).
 bool FileHasSchedule(const std::string& path);
+bool TextHasSchedule(std::string_view toml_text, const std::string& name);
 
 // The `--set` assignments that turn the base style into `frame`'s style:
 // the sun, then ramps and rates (which read their base value from

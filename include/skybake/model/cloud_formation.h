@@ -24,11 +24,21 @@
 //
 // Determinism: the random numbers are a counter-based hash of (seed, step,
 // cell, channel), so the lattice at step n follows from the style, the seed
-// and n alone, on every run and machine; a frame at clock time t (hours
-// since the sequence's first frame) is at step steps_per_hour x t, so
-// --resume, --frames and --shard give the frames of a whole bake byte for
-// byte (a part re-simulates from step 0; a process keeps its last lattice
-// and continues from it when the next frame is later).
+// and n alone, on every run and machine.
+//
+// The clock (FormationTimeSeconds): a frame with a clock time (a schedule's
+// times) is at t = its local clock time minus day_start_hour, in [0, 24) h:
+// the automaton starts afresh every day at day_start_hour on the local clock
+// (UTC + the schedule's utc_offset_hours) of the frame's date, after its
+// warm-up steps, and a frame before that hour belongs to the previous day's
+// run. The state at a clock time is thus a function of that clock time
+// alone, not of where a schedule starts: any two schedules, shards or
+// resumes holding the same clock time bake the same lattice, drift and wind
+// offset for it. A frame is at step warmup_steps + steps_per_hour x t (so
+// at most warmup + 24 x steps_per_hour steps from the origin; a process
+// keeps its last lattice and continues from it when the next frame is
+// later). A frame without a clock time (a single bake, a schedule of sun
+// positions) is at t = hours since the sequence's first frame.
 //
 // Frame and units: lattice x = east, y = north, z = up; sizes in metres,
 // velocity in cells (x, y) and mask layers (z) per hour of clock time.
@@ -36,6 +46,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,7 +63,13 @@ struct CloudFormation {
   std::array<double, 2> size_m = {30000.0, 30000.0};  // lattice extent east, north; up spans the layer's thickness
   std::array<double, 2> origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner at time 0
   double steps_per_hour = 30.0;        // automaton steps per hour of clock time
-  int warmup_steps = 30;               // steps simulated before the sequence's first frame
+  int warmup_steps = 30;               // steps simulated before time 0 (the day's start)
+  // The temporal box filter (Dobashi 2000, section 4, smooths the density
+  // over neighbouring steps as over cells): the density at step s is the
+  // mean over the steps s - smoothing_steps .. s, 0..64 (0: step s alone).
+  int smoothing_steps = 0;
+  // The local clock hour of time 0 each day (see "The clock" above), 0..24.
+  double day_start_hour = 0.0;
   double extinction_probability = 0.05;  // Pext, 0..1, per step and cloud cell (times the mask's blue)
   double humidity_probability = 0.02;    // Phum, 0..1, per step and dry cell (times the mask's red)
   double phase_probability = 0.001;      // Pact, 0..1, per step and humid cell (times the mask's green)
@@ -117,15 +134,26 @@ CloudLattice InitialFormation(const CloudFormation& f, const CloudMask* mask, ui
 // the last lattice of each formation and continues from it when asked for
 // a later step (the result is the same either way).
 CloudLattice SimulateFormation(const CloudFormation& f, const CloudMask* mask, uint32_t seed, uint64_t steps);
+// The lattices of the steps first .. last (last - first + 1 of them); a
+// process keeps them, and continues from the last when asked for later ones.
+std::vector<CloudLattice> SimulateFormationSteps(const CloudFormation& f, const CloudMask* mask, uint32_t seed,
+                                                 uint64_t first, uint64_t last);
 
 // The binary cloud field smoothed into a continuous density in [0, 1]:
 // the mean of cld over a box of (2r + 1)^3 cells (x, y wrapping, z cut at
 // the ends), index as CloudLattice.
 std::vector<float> SmoothFormation(const CloudLattice& lattice, int radius_cells);
 
-// What a cloud layer takes from its formation at clock time `time_s` since
-// the sequence's first frame: the coverage map (column maximum of the
-// smoothed density, linear between the steps around the time), resampled
+// The formation's time of a frame, seconds: with the frame's local clock
+// time `local_clock_s` (seconds since its date's midnight), the seconds
+// since the last day_start_hour, in [0, 86400); without one, `since_first_s`
+// (the seconds since the sequence's first frame).
+double FormationTimeSeconds(const CloudFormation& f, std::optional<double> local_clock_s, double since_first_s);
+
+// What a cloud layer takes from its formation at the formation's time
+// `time_s` (FormationTimeSeconds): the coverage map (column maximum of the
+// smoothed density, in space and over smoothing_steps, linear between the
+// steps around the time), resampled
 // to resolution^2 texels (row 0 north), and where it lies.
 struct FormationCoverage {
   std::vector<float> map;
@@ -136,7 +164,7 @@ struct FormationCoverage {
 FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int resolution);
 
-// The smoothed density at clock time `time_s` (linear between the steps
+// The smoothed density at the formation's time `time_s` (linear between the steps
 // around it), resampled trilinearly to an n^3 volume over the lattice: x, y
 // wrapping as the coverage map (column c east, row r from the north edge),
 // z the layer's height fraction (level k at (k + 0.5) / n, clamped to the
@@ -145,8 +173,15 @@ FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* 
 std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int n);
 
+// Whether a formation layer's shape and detail noise are read through the
+// non-repeating warp of its weather_size_m (cloud_weather.glsl), as a weather
+// image's are: unless the layer tiles, or reads no noise (shape and detail
+// amounts 0; with formation.density the shape is not read). A noise tile
+// repeated under a sparse cover is a lattice of specks.
+bool FormationShapeWarped(const CloudLayer& layer);
+
 // A layer with formation.enabled: its weather map becomes the formation's
-// coverage at `time_s` (appended to `weather_images`, placed by `out`'s
+// coverage at the formation's time `time_s` (appended to `weather_images`, placed by `out`'s
 // weather and weather_origin as a weather image is); with formation.density
 // also its density volume (FormationDensityAt, volume_resolution^3, after
 // the map; out.weather.w = 2: it takes the shape volume's place).

@@ -43,6 +43,16 @@ enum class CloudType { kStratus, kStratocumulus, kCumulus, kCumulonimbus, kCirru
 std::array<double, 4> CloudTypeProfile(CloudType type);
 const char* CloudTypeName(CloudType type);
 
+// Cirrus (type = "cirrus", docs/clouds.md "Cirrus"): the noise squeezed
+// along the mean wind by the streak ratio, the fall streaks bent by the shear
+// (hook = shear along the streaks / (2 v_f), v_f the crystals' fall speed),
+// and the ice phase (shaders/cloud_ice_phase.glsl) in place of the water one.
+// kCirrusFallSpeedM_s: a typical terminal velocity of cirrus ice crystals,
+// 0.5-1.5 m/s for crystals of 100-500 um (Heymsfield and Iaquinta 2000,
+// "Cirrus crystal terminal velocities", J. Atmos. Sci. 57, 916-938).
+constexpr double kCirrusDefaultStreakRatio = 8.0;
+constexpr double kCirrusFallSpeedM_s = 1.0;
+
 struct CloudLayer {
   double altitude_m = 1500.0;   // bottom of the layer above the ground
   double thickness_m = 1500.0;  // top = altitude_m + thickness_m
@@ -69,7 +79,14 @@ struct CloudLayer {
   std::array<double, 2> weather_extent_m = {30000.0, 30000.0};  // [east, north] size of the image
   std::array<double, 2> weather_origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner
   CloudFormation formation;  // [cloud_layer.formation]: coverage from the automaton (cloud_formation.h)
+  // type = "cirrus" only: the streaks' length over their width (the noise
+  // squeezed along the layer's mean wind, shaders/cloud_cirrus.glsl).
+  double streak_ratio = kCirrusDefaultStreakRatio;
 };
+
+// The streaks' direction (unit [east, north]): the wind at the layer's middle
+// (wind + shear x half the thickness), or east when that is calm.
+std::array<double, 2> CirrusStreakDirection(const CloudLayer& layer);
 
 // Cloud sampling settings; quality.preset sets them, [quality] cloud_* keys
 // refine them.
@@ -100,6 +117,12 @@ CloudQuality CloudQualityPreset(const std::string& name);
 struct CloudSettings {
   std::vector<CloudLayer> layers;
   CloudQuality quality;
+  // The frame's local clock time, seconds since midnight of its date (a
+  // schedule's clock times, local = UTC + utc_offset_hours; set per frame by
+  // ResolveFrameStyles, not a style key): the clock of the layers' formations
+  // (FormationTimeSeconds, cloud_formation.h). None for a single bake and a
+  // schedule without clock times.
+  std::optional<double> local_clock_s;
 };
 
 // The layers a bake renders: those with coverage and density above 0 (the
@@ -193,6 +216,9 @@ bool CloudLightVolumeOn(const gpu::GpuClouds& clouds);
 // cloud_formation.h); off, the shaders compile that read out
 // (SPEC_CLOUD_FORMATION).
 bool CloudFormationDensityOn(const gpu::GpuClouds& clouds);
+// Whether some active layer is cirrus (GpuCloudLayer.streaks.z > 0); off, the
+// shaders compile the streaks and the ice phase out (SPEC_CLOUD_CIRRUS).
+bool CloudCirrusOn(const gpu::GpuClouds& clouds);
 bool CloudLightVolumeForSun(const gpu::GpuClouds& clouds, double sun_y);
 
 // What the renderer needs: the uniform block, the weather images (R channel,
@@ -204,7 +230,9 @@ struct CloudInputs {
   int layers() const { return uniform.counts.x; }
 };
 // `time_s`: clock time since the sequence's first frame; the wind moves the
-// clouds by wind x time_s (no re-randomising per frame).
+// clouds by wind x time_s (no re-randomising per frame). A layer with a
+// formation runs on the formation's clock instead (FormationTimeSeconds of
+// clouds.local_clock_s, cloud_formation.h): its wind, drift and lattice.
 CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
                           double time_s);
 

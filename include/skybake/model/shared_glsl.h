@@ -72,6 +72,8 @@ vec3 ComputeStyledSkyRadiance(IN(AtmosphereParameters) atm, IN(AoasParameters) a
 vec3 DirectionFromLatLongPixel(Real x, Real y, int width, int height);
 vec3 DirectionFromCubeStripPixel(int x, int y, int face_size);
 vec3 DirectionFromVulkanCubeTexel(int face, int x, int y, int face_size);
+// cloud_ice_phase.glsl: the phase of a cirrus layer's ice crystals, sr^-1.
+Real IceCrystalPhase(Real cos_theta, Real eccentricity);
 
 }  // namespace skybake::glsl
 

@@ -17,11 +17,15 @@
 //               = texel x inputs:intensity (1) x 2^inputs:exposure, and
 //               exposure = -log2(skybake:scale of the file), so the dome
 //               emits the sky's cd/m^2.
+//               inputs:texture:file carries colorSpace metadata naming
+//               the EXR's colour space (UsdColorSpaceToken).
 //   /Sky/Sun    DistantLight, normalize = true: inputs:intensity x
 //   /Sky/Moon   2^exposure x inputs:color is the illuminance (lux, per
 //               channel) on a surface facing the light; intensity is the
 //               manifest's illuminance_lux, colour = irradiance /
-//               illuminance (Rec.709 luminance 1), exposure 0;
+//               illuminance (Rec.709 luminance 1), exposure 0; the
+//               colour stays linear Rec.709 whatever output.color_space
+//               (colorSpace "lin_rec709_scene", USD's default space);
 //               inputs:angle is the disc's angular diameter in degrees;
 //               xformOp:rotateXYZ turns the light's +Z towards the source
 //               (a DistantLight shines along its -Z).
@@ -50,6 +54,7 @@ struct UsdFrame {
   int number = 0;                 // frame number, the time code of a sequence's samples
   std::string latlong_file;       // the latlong EXR, a plain file name beside the layer
   double texture_scale = 1.0;     // its skybake:scale (stored value = cd/m^2 x scale)
+  std::string color_space = "rec709";  // its skybake:color_space (output.color_space)
   std::string time;               // ISO 8601, or "" without clock times
   double sun_elevation_deg = 0.0;
   double sun_azimuth_deg = 0.0;
@@ -89,5 +94,15 @@ std::string WriteUsdLayer(const UsdLayerDescription& layer);
 // The skybake:scale recorded in an EXR written by skybake (1 when absent).
 // Throws OutputError when the file cannot be read.
 double ExrSkybakeScale(const std::string& path);
+// Its skybake:color_space ("rec709" when absent). Throws OutputError.
+std::string ExrSkybakeColorSpace(const std::string& path);
+
+// The colorSpace token USD's colour guide gives an output.color_space: the
+// canonical interoperable names (OpenUSD, MaterialX and OpenColorIO's
+// shared set) for the built-in spaces, rec709 -> "lin_rec709_scene",
+// acescg -> "lin_ap1_scene", aces2065-1 -> "lin_ap0_scene", rec2020 ->
+// "lin_rec2020_scene", xyz -> "lin_ciexyzd65_scene"; a space of an
+// OpenColorIO config keeps its config name.
+std::string UsdColorSpaceToken(const std::string& skybake_name);
 
 }  // namespace skybake

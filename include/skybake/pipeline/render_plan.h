@@ -47,7 +47,8 @@ struct FramePlan {
   FrameNames names;                // the first frame's carry the DFG table
   // Clock time since the sequence's first frame, in seconds: what the wind
   // moves the clouds by (0 for a single bake, and for a schedule without
-  // clock times).
+  // clock times). A cloud formation's layer takes its own clock from the
+  // frame's style instead (clouds.local_clock_s, cloud_formation.h).
   double CloudTimeSeconds() const { return hours_from_start * 3600.0; }
   // "frame N", or "render" for a single bake: the frame's stage name.
   std::string Label() const;

@@ -34,11 +34,18 @@ struct TestPatternOptions {
   std::string basename = "sky";
   int size = 256;                // cube face edge; the latlong is 2N x N
   bool force = false;
+  double max_memory_mib = 4096.0;  // budget (README "Limits"); over it, BudgetError (exit 7) before any file
 };
+
+// The pattern's memory in MiB: every image's directions (3 doubles a
+// texel) held at once, and the largest image's RGBA float pixels and its
+// file being encoded (about 16 bytes a texel more).
+double TestPatternMemoryMiB(const TestPatternOptions& options);
 
 // Writes the pattern as the files a bake would (the bake's own six Vulkan
 // faces, OpenEXR strip and latlong, and the preset's files) into out_dir.
-// Throws OutputError (exit 5) or OutputExistsError-like std::runtime_error
+// Throws BudgetError (exit 7) over options.max_memory_mib, before any file;
+// OutputError (exit 5) or OutputExistsError-like std::runtime_error
 // when a file exists without force. Returns the paths written.
 std::vector<std::string> WriteTestPattern(const TestPatternOptions& options);
 
