@@ -16,7 +16,7 @@ namespace {
 // CPU seconds of one automaton step of one cell: 10-13 ns on the 2-core CI
 // machine (one step of the 64 x 64 x 8 lattice of
 // configs/styles/afternoon_buildup.toml, 32,768 cells, in 0.32-0.42 ms;
-// docs/performance.md "Cloud formation and shadow map",
+// docs/performance_history.md "Cloud formation and shadow map",
 // build/tests/cloud_formation_benchmark --benchmark_filter=BM_FormationStep).
 constexpr double kSecondsPerCellStep = 13e-9;
 
