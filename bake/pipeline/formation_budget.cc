@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/model/cloud_formation.h"
 #include "skybake/model/clouds.h"
 
 namespace skybake {
@@ -46,7 +47,10 @@ FrameWork FrameFormationWork(const FramePlan& frame, std::map<std::string, doubl
   for (size_t i = 0; i < layers.size(); ++i) {
     const CloudFormation& f = layers[i].formation;
     if (!f.enabled) continue;
-    const double step = f.warmup_steps + f.steps_per_hour * std::max(frame.CloudTimeSeconds(), 0.0) / 3600.0;
+    // The formation's own clock (FormationTimeSeconds: from the day's start
+    // when the frame has a clock time), as ApplyCloudFormation steps it.
+    const double t_s = FormationTimeSeconds(f, frame.style->clouds.local_clock_s, frame.CloudTimeSeconds());
+    const double step = f.warmup_steps + f.steps_per_hour * std::max(t_s, 0.0) / 3600.0;
     const double n = std::floor(step);
     const std::string key = LatticeKey(i, f);
     // ApplyCloudFormation: the coverage at steps n (and n + 1 between two
