@@ -20,7 +20,7 @@
 // see halos in a minority of cirrus, Sassen et al. 1994).
 //
 // Units: per steradian, normalised over the sphere (the integral of p over
-// 4 pi sr is 1, tests/clouds_test.cc); cos_theta the cosine of the angle
+// 4 pi sr is 1, tests/model/clouds_test.cc); cos_theta the cosine of the angle
 // between the light's direction of travel and the scattered direction, as
 // the clouds' water phase (CloudPhase).
 #ifndef SKYBAKE_CLOUD_ICE_PHASE_GLSL

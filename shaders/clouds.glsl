@@ -159,7 +159,7 @@ float ShapeNoiseValue(vec3 x, uint seed) {
   float erosion = TiledWorleyFbm(x, 8, seed + 2000u);
   float shape = Remap(perlin_worley, erosion - 1.0, 1.0, 0.0, 1.0);
   // Spread over [0, 1] (the remaps leave it at mean 0.78, sd 0.07 for 48^3
-  // voxels, tests/clouds_test.cc): mean about 0.5, sd about 0.2.
+  // voxels, tests/model/clouds_test.cc): mean about 0.5, sd about 0.2.
   return clamp((shape - 0.6) / 0.35, 0.0, 1.0);
 }
 

@@ -175,7 +175,7 @@ void SkyRenderer::CompilePipelines(const QualitySettings& quality, const EffectS
   };
   // The variants built with the presets' settings fixed (CMakeLists.txt)
   // compile 10-20 times faster; they compute the same values to float
-  // rounding (tests/sky_renderer_test.cc). shaders.generic turns them off,
+  // rounding (tests/gpu/sky_renderer_test.cc). shaders.generic turns them off,
   // to tell a variant's fault from the shader's.
   const ShaderSources sources = ChooseShaderSources(quality, aoas.skydome, shaders);
   const bool analytic = sources.analytic_luts;

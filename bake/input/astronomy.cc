@@ -206,7 +206,7 @@ std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnit
   // the three J2000 axes (RA 0 and 90 deg on the equator, the pole) into
   // world directions once per frame, and each star's J2000 unit vector is
   // rotated by the matrix they make (the same place as HorizontalFromJ2000
-  // per star, to 1e-9; tests/astronomy_test.cc).
+  // per star, to 1e-9; tests/input/astronomy_test.cc).
   const double min_y = std::sin(min_elevation_deg * kDeg);
   std::vector<PlacedStar> placed;
   for (const CatalogueStar& s : catalogue.stars) {
@@ -277,7 +277,7 @@ MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double obs
   MoonState m;
   const LunarEphemeris e = ComputeLunarEphemeris(julian_day_ut);
   // Geocentric place. libnova 0.16 refers it to the J2000 equinox, as its
-  // solar coordinates (tests/astronomy_test.cc checks this against Meeus
+  // solar coordinates (tests/input/astronomy_test.cc checks this against Meeus
   // example 47.a), so it is precessed to the date.
   ln_equ_posn j2000{e.ra_deg, e.dec_deg};
   ln_equ_posn geocentric{};

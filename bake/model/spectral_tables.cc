@@ -8,7 +8,7 @@
 //   ozone       IUP Bremen cross section (233 K, 10 nm bins) x 300 DU x 2.687e20 m^-2
 //               / 15000 m: absorption at the tent peak, km^-1
 // CIE 1931 2-degree colour matching functions, 360..830 nm every 5 nm (CVRL).
-// Both are read in tests/spectrum_test.cc against ../shared/groundtruth/constants/.
+// Both are read in tests/model/spectrum_test.cc against ../shared/groundtruth/constants/.
 #include "spectral_tables.h"
 
 namespace skybake::spectral_tables {

@@ -4,7 +4,7 @@
 // chunks and the offset table. Against OpenEXR 3.1's own (zlib) encoder at
 // the same level: half the time on 2 threads and files a quarter smaller
 // (the codec table of docs/performance.md). Any OpenEXR reader decodes the
-// result (tests/exr_io_test.cc checks it against OpenEXR's encoder bit for
+// result (tests/output/exr_io_test.cc checks it against OpenEXR's encoder bit for
 // bit).
 #pragma once
 

@@ -2,7 +2,7 @@
 // `--engine babylon`) into Babylon.js as one float cube texture, the right
 // way up in Babylon's default (left-handed) scene with a skybake glTF scene
 // loaded by its glTF loader. Tested with Babylon.js 9.31
-// (tests/engine_babylon_test.cc); copy it into your project.
+// (tests/e2e/engine_babylon_test.cc); copy it into your project.
 //
 //   import { loadSkybakeBabylonCube } from './babylon_exr_cube.js';
 //   const sky = await loadSkybakeBabylonCube(BABYLON, scene, 'sky_babylon');

@@ -1,6 +1,6 @@
 // Loads a skybake KTX2 cube map (sky_specular.ktx2, sky_irradiance.ktx2)
 // into three.js as a cube texture with every mip level the file holds.
-// Tested with three.js 0.170 (tests/engine_threejs_test.cc); copy it into
+// Tested with three.js 0.170 (tests/e2e/engine_threejs_test.cc); copy it into
 // your project.
 //
 //   import { loadSkybakeKtx2Cube } from './threejs_ktx2_cube.js';

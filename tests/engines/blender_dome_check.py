@@ -1,4 +1,4 @@
-# The glTF dome seen through Blender's startup camera (tests/engine_blender_test.cc):
+# The glTF dome seen through Blender's startup camera (tests/e2e/engine_blender_test.cc):
 #   blender -b --factory-startup --python blender_dome_check.py -- SCENE.glb OUT_DIR
 # Imports the scene with Blender's glTF importer into the factory startup
 # scene (its cube, light and camera, as a user who opens Blender and imports

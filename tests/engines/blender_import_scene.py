@@ -1,4 +1,4 @@
-# Blender's glTF importer on a skybake scene (tests/sequence_test.cc):
+# Blender's glTF importer on a skybake scene (tests/e2e/sequence_test.cc):
 #   blender -b --factory-startup --python blender_import_scene.py -- SCENE
 # Prints one line:
 #   RESULT {"objects": [...], "lights": [[name, type]...], "fcurves": [data paths of every action]}

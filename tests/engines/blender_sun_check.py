@@ -1,4 +1,4 @@
-# Blender's own check of a latlong as a World texture (tests/engine_blender_test.cc):
+# Blender's own check of a latlong as a World texture (tests/e2e/engine_blender_test.cc):
 #   blender -b --factory-startup --python blender_sun_check.py -- SCENE.glb LATLONG.exr OUT_DIR [TURN_DEG]
 # Imports the scene with Blender's glTF importer, sets LATLONG as the World's
 # Environment Texture with the default mapping, hides the scene's dome (its

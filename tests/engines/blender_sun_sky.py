@@ -1,4 +1,4 @@
-# The bake's sky and Sun together in Blender, in units (tests/engine_blender_test.cc,
+# The bake's sky and Sun together in Blender, in units (tests/e2e/engine_blender_test.cc,
 # SkyAndSunShowOneExposure):
 #   blender -b --factory-startup --python blender_sun_sky.py -- \
 #       SCENE.glb LATLONG.exr OUT_DIR ALBEDO FOV_DEG SIZE LIGHTING_MODE BACKGROUND_STRENGTH SAMPLES SKY_VIEWS

@@ -3,7 +3,7 @@
 // it; an accepted one has at least one star, every star finite with |dec| <=
 // 90 deg and RA in [0, 360), and its faintest magnitude the largest of its
 // stars'. Used by the fuzz target (inputs_fuzz.cc) and replayed on
-// tests/fuzz/catalogues/ by tests/fuzz_regression_test.cc in every build.
+// tests/fuzz/catalogues/ by tests/e2e/fuzz_regression_test.cc in every build.
 #pragma once
 
 #include <algorithm>

@@ -7,7 +7,7 @@
 //   build-fuzz/tests/fuzz/inputs_fuzz -max_total_time=60 build-fuzz/corpus-inputs tests/fuzz/catalogues
 //
 // A crash writes crash-<sha1> in the working folder: copy it into
-// tests/fuzz/catalogues/ (tests/fuzz_regression_test.cc replays it in every
+// tests/fuzz/catalogues/ (tests/e2e/fuzz_regression_test.cc replays it in every
 // build) and fix the reader.
 #include <cstddef>
 #include <cstdint>

@@ -1,7 +1,7 @@
 // What the style and schedule parsers must do with any input: not crash,
 // and what they accept must hold together. Shared by the libFuzzer target
 // (tests/fuzz/parsers_fuzz.cc) and the regression test that replays
-// tests/fuzz/regressions/ in every build (tests/fuzz_regression_test.cc).
+// tests/fuzz/regressions/ in every build (tests/e2e/fuzz_regression_test.cc).
 //  - every error names a key and a message;
 //  - an accepted style's resolved TOML reads back to the same resolved TOML;
 //  - an accepted schedule has frames, and its first and last frames'

@@ -6,7 +6,7 @@
 //   build-fuzz/tests/fuzz/parsers_fuzz -max_total_time=60 build-fuzz/corpus configs configs/schedules tests/fuzz/regressions
 //
 // A crash writes crash-<sha1> in the working folder: copy it into
-// tests/fuzz/regressions/ (tests/fuzz_regression_test.cc replays it in every build)
+// tests/fuzz/regressions/ (tests/e2e/fuzz_regression_test.cc replays it in every build)
 // and fix the parser.
 #include <cstddef>
 #include <cstdint>

@@ -17,7 +17,7 @@ namespace skybake {
 // the equatorial place (eq. 13.3, 13.4, with libnova's obliquity), the
 // phase angle (eq. 48.2, 48.3), the lit fraction (eq. 48.1) and the bright
 // limb (eq. 48.5). Referred, as libnova refers them, to the J2000 mean
-// ecliptic (tests/astronomy_test.cc compares each with libnova's own
+// ecliptic (tests/input/astronomy_test.cc compares each with libnova's own
 // function over 1900-2100). ComputeMoon takes its Moon from here.
 struct LunarEphemeris {
   double ecliptic_longitude_deg = 0.0;  // [0, 360), as ln_get_lunar_ecl_coords

@@ -21,7 +21,7 @@
 // does not, the frame's stars are placed (PendingStars, once) and that view
 // and the ones after it go through BoundByTiles and SplatBound as in a
 // frame placed at once, so the maps are the same bytes
-// (tests/night_sky_test.cc). Used while the Sun is up (by night nearly
+// (tests/pipeline/night_sky_test.cc). Used while the Sun is up (by night nearly
 // every tile takes a star).
 #pragma once
 

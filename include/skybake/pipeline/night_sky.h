@@ -37,7 +37,7 @@
 //   to the maps, to the SH and to the IBL source; so a moonlit sky is a
 //   dim blue daylit sky. Rendered while the Sun is below the horizon and the
 //   Moon above -10 deg (lunar twilight); above the horizon the Sun's sky is
-//   over 2^11 times brighter (tests/night_sky_test.cc) and it adds nothing
+//   over 2^11 times brighter (tests/pipeline/night_sky_test.cc) and it adds nothing
 //   a half float can hold. Volumetric cloud layers are not lit by the Moon.
 //
 // Frame: skybake's, +Y up, North -Z, East +X. Irradiances are in the
@@ -127,7 +127,7 @@ size_t ApplyTexelAdds(const std::vector<TexelAdd>& adds, const float* rgba_in, f
 // ("open") texels need the splat, and only their additions to open texels
 // are kept: each texel kept gets the same sum, formed in the same order, as
 // in the whole splat, so the maps are byte for byte the same
-// (tests/night_sky_test.cc). No open texel: nothing to splat. The bound
+// (tests/pipeline/night_sky_test.cc). No open texel: nothing to splat. The bound
 // costs the texel lookups of the splat (shared with it), a sort of the
 // texels reached and one solid angle per texel.
 struct SplatBound {

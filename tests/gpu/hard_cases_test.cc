@@ -396,7 +396,7 @@ TEST(HardCaseExtraTest, SunDiscSurvivesHalfFloatOutput) {
 // The night sky's host-side parts (night_sky.h) at midnight, at dusk with
 // the Sun and the Moon both up, and with the Moon on the horizon: every
 // star, disc sample, airglow value and the Moon's irradiance finite and
-// non-negative, in both output units. (tests/night_sky_test.cc bakes the
+// non-negative, in both output units. (tests/pipeline/night_sky_test.cc bakes the
 // same cases on lavapipe and checks every texel of the maps.)
 TEST(HardCaseNightTest, NightSkyFiniteAndNonNegative) {
   std::string error;
