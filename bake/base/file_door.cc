@@ -58,8 +58,7 @@ std::string ReadAll(int fd, uint64_t max_bytes, std::string& bytes) {
   struct stat st {};
   if (::fstat(fd, &st) == 0 && uint64_t(st.st_size) > max_bytes) {
     ::close(fd);
-    return fmt::format("is {} bytes, more than the {} MiB such a file may have", uint64_t(st.st_size),
-                       max_bytes >> 20);
+    return fmt::format("is {} bytes, more than the {} MiB such a file may have", uint64_t(st.st_size), max_bytes >> 20);
   }
   if (st.st_size > 0) bytes.reserve(size_t(st.st_size));
   char buffer[1 << 16];
@@ -245,7 +244,6 @@ std::string ReadFolderFile(const std::string& dir, const std::string& name, uint
   if (std::string problem = CheckOpened(opened, fd); !problem.empty()) return problem;
   return ReadAll(fd, max_bytes, bytes);
 }
-
 
 std::string RegularFileSize(const std::string& path, uint64_t& size) {
   int fd = -1;

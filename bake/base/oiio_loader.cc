@@ -69,10 +69,12 @@ const OiioModule& LoadOiioModule() {
     module = entry();
     return *module;
   }
-  throw OutputError(fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (the gallery, cloud "
-                                "weather and formation images): it is built when OpenImageIO is installed "
-                                "(apt-get install libopenimageio-dev, then rebuild skybake), or set "
-                                "SKYBAKE_MODULE_DIR to the folder holding it; tried:{}", tried));
+  throw OutputError(
+      fmt::format("cannot load the OpenImageIO module libskybake_oiio.so (the gallery, cloud "
+                  "weather and formation images): it is built when OpenImageIO is installed "
+                  "(apt-get install libopenimageio-dev, then rebuild skybake), or set "
+                  "SKYBAKE_MODULE_DIR to the folder holding it; tried:{}",
+                  tried));
 }
 
 // The door's image read (file_door.h): the bytes kept by ReadKept, decoded by

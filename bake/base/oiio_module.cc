@@ -77,8 +77,8 @@ bool ReadImage(const std::string& name, const std::string& bytes, uint64_t max_s
     return false;
   }
   // From the header, before decoding: a small file may declare a huge image.
-  const uint64_t samples = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0)) *
-                           uint64_t(std::max(spec.nchannels, 0));
+  const uint64_t samples =
+      uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0)) * uint64_t(std::max(spec.nchannels, 0));
   if (samples > max_samples) {
     error = std::to_string(spec.width) + " x " + std::to_string(spec.height) + " texels of " +
             std::to_string(spec.nchannels) + " channels, more than the " + std::to_string(max_samples) +

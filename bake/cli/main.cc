@@ -68,8 +68,7 @@ void PrintError(const std::string& message) {
 
 void PrintErrors(const std::vector<ConfigError>& errors) {
   for (const ConfigError& e : errors) PrintError(e.Format());
-  std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(),
-               errors.size() == 1 ? "" : "s");
+  std::fprintf(stderr, "skybake: %zu error%s; nothing was baked\n", errors.size(), errors.size() == 1 ? "" : "s");
 }
 
 bool EnvFlag(const char* name) {
@@ -91,12 +90,13 @@ int RunDevices(const std::string& software_driver_selection, const std::string& 
     return kExitVulkan;
   }
   for (const DeviceInfo& d : devices) {
-    std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(),
-                d.api_version.c_str(), d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
+    std::printf("%d  %-40s %-15s Vulkan %s  %s\n", d.index, d.name.c_str(), d.type.c_str(), d.api_version.c_str(),
+                d.usable ? "usable" : ("rejected: " + d.rejected_because).c_str());
   }
   if (!software_driver_selection.empty())
-    std::printf("(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
-                "every installed driver)\n");
+    std::printf(
+        "(software driver only: this machine has no GPU device node; SKYBAKE_ALL_VULKAN_DRIVERS=1 loads "
+        "every installed driver)\n");
   const bool lavapipe = std::any_of(devices.begin(), devices.end(), IsLavapipe);
   if (lavapipe && !lavapipe_threads.empty())
     std::printf("(lavapipe: %s threads, twice the hardware threads; LP_NUM_THREADS sets another count)\n",
@@ -111,23 +111,23 @@ struct BakeArgs {
   int size = 0;
   int device = -1;
   std::vector<std::string> overrides;
-  bool quiet = false;             // errors only: no progress, no warnings
-  std::string progress_json;      // --progress-json PATH: JSON lines of progress events, or ""
+  bool quiet = false;         // errors only: no progress, no warnings
+  std::string progress_json;  // --progress-json PATH: JSON lines of progress events, or ""
   bool validation = false;
   bool force = false;
   bool resume = false;
   double max_memory_mib = 4096.0;
   double max_frame_seconds = 3600.0;
-  bool dry_run = false;  // print the plan instead of baking
-  std::string frames;    // --frames FIRST:LAST, empty: every frame
-  std::string shard;     // --shard I/N, empty: no split
-  ShaderSwitches shaders;  // from the environment (main)
+  bool dry_run = false;              // print the plan instead of baking
+  std::string frames;                // --frames FIRST:LAST, empty: every frame
+  std::string shard;                 // --shard I/N, empty: no split
+  ShaderSwitches shaders;            // from the environment (main)
   std::vector<std::string> engines;  // --engine NAME[,NAME...], repeatable: output.engine
-  bool usd = false;      // --usd: usd.enabled
+  bool usd = false;                  // --usd: usd.enabled
   // From the environment (main, ReadEnvironment): the loader's driver
   // choice, lavapipe's thread count, the default star catalogue.
   std::string software_driver_selection;
-  std::string lavapipe_threads;  // LP_NUM_THREADS main set, or ""
+  std::string lavapipe_threads;       // LP_NUM_THREADS main set, or ""
   std::string pipeline_cache_folder;  // PipelineCacheFolder, or "" when SKYBAKE_PIPELINE_CACHE=0
   std::string star_catalogue = DefaultStarCataloguePath();
   std::optional<int> stop_after_frame;  // $SKYBAKE_STOP_AFTER_FRAME: BakeOptions::stop_after_frame (farm tests)
@@ -205,8 +205,7 @@ bool CheckNight(const BakeArgs& args, const LoadedBake& bake) {
   std::vector<const SkyStyle*> styles;
   if (bake.schedule)
     for (const SkyStyle& style : bake.frame_styles) styles.push_back(&style);
-  else
-    styles.push_back(&bake.config.style);
+  else styles.push_back(&bake.config.style);
   const std::vector<ConfigError> night_errors =
       CheckNightSky(styles, bake.schedule ? &*bake.schedule : nullptr, args.star_catalogue);
   if (night_errors.empty()) return true;
@@ -255,10 +254,9 @@ int PrintCheck(const BakeArgs& args, const LoadedBake& bake, const ResourceEstim
     std::printf("cloud formation: %.3g cell updates in its busiest frame (%s), about %.1f s of CPU time\n",
                 formation.cell_updates, formation.frame.c_str(), formation.seconds);
   if (bake.schedule)
-    std::printf("%s with %s: ok, %zu frames\n", Printable(args.style_path).c_str(), Printable(bake.schedule_path).c_str(),
-                bake.schedule->frames.size());
-  else
-    std::printf("%s: ok\n", Printable(args.style_path).c_str());
+    std::printf("%s with %s: ok, %zu frames\n", Printable(args.style_path).c_str(),
+                Printable(bake.schedule_path).c_str(), bake.schedule->frames.size());
+  else std::printf("%s: ok\n", Printable(args.style_path).c_str());
   return kExitOk;
 }
 
@@ -339,27 +337,28 @@ int RunBake(const BakeArgs& args, Mode mode, ProgressReport* progress = nullptr)
   std::optional<FrameRange> part;
   if (frames || shard) {
     if (!bake.schedule)
-      throw UsageError("--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
-                       "[schedule])");
+      throw UsageError(
+          "--frames and --shard split a sequence bake: give --schedule (or a style with an inline "
+          "[schedule])");
     part = SelectFrames(*bake.schedule, frames, shard);
   }
   if (args.resume && !bake.schedule) {
-    PrintError("--resume continues a sequence bake: give --schedule (or a style with an inline [schedule]), or use "
-               "--force to bake a single style again");
+    PrintError(
+        "--resume continues a sequence bake: give --schedule (or a style with an inline [schedule]), or use "
+        "--force to bake a single style again");
     return kExitUsage;
   }
   // The cloud formation's host work, frame by frame in the order they bake.
-  const FormationEstimate formation =
-      CheckFormationBudget(bake.schedule ? PlanSequenceBake(bake.frame_styles, *bake.schedule, part)
-                                         : PlanSingleBake(bake.config.style),
-                           options);
+  const FormationEstimate formation = CheckFormationBudget(
+      bake.schedule ? PlanSequenceBake(bake.frame_styles, *bake.schedule, part) : PlanSingleBake(bake.config.style),
+      options);
   if (mode == Mode::kPlan || args.dry_run) return PrintPlan(args, bake, part);
   if (mode == Mode::kCheck) return PrintCheck(args, bake, largest, formation);
 
   // Bake: device, pipelines, LUTs, render, files, preview; then report.
   SetBakeOptions(args, part, *progress, options);
-  const BakeResult result = bake.schedule ? BakeSequence(bake.frame_styles, *bake.schedule, options)
-                                          : BakeStyle(bake.config.style, options);
+  const BakeResult result =
+      bake.schedule ? BakeSequence(bake.frame_styles, *bake.schedule, options) : BakeStyle(bake.config.style, options);
   return ReportBake(result, args.quiet);
 }
 
@@ -392,7 +391,8 @@ int RunGallery(const GalleryArgs& gallery, const BakeArgs& args) {
   for (const std::string& path : styles) {
     ConfigResult config = LoadSkyStyle(path, args.overrides);
     errors.insert(errors.end(), config.errors.begin(), config.errors.end());
-    if (config.ok()) GalleryFrameOf(path, args.overrides, args.star_catalogue, errors);  // its own [schedule], night sky
+    if (config.ok())
+      GalleryFrameOf(path, args.overrides, args.star_catalogue, errors);  // its own [schedule], night sky
   }
   if (!errors.empty()) {
     PrintErrors(errors);
@@ -450,10 +450,8 @@ CLI::Validator FinitePositive() { return FiniteNumber(false); }
 
 void AddStyleOptions(CLI::App* cmd, BakeArgs& args) {
   const CLI::Validator finite_positive = FinitePositive();
-  cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")
-      ->required();
-  cmd->add_option("--set", args.overrides,
-                  "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
+  cmd->add_option("style", args.style_path, "Sky style TOML file (see configs/default.toml)")->required();
+  cmd->add_option("--set", args.overrides, "Override a style key, e.g. --set sun.elevation_deg=10 (repeatable)");
   cmd->add_option("--schedule", args.schedule_path,
                   "Schedule TOML: bake a frame-numbered sequence (default: the style's inline "
                   "[schedule], if it has one)");
@@ -485,32 +483,41 @@ struct Cli {
 
 // bake, check and plan: a style (and its schedule) each.
 void AddBakeCommands(CLI::App& app, Cli& cli) {
-  cli.bake = app.add_subcommand("bake", "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
+  cli.bake = app.add_subcommand(
+      "bake",
+      "Bake a style (or a sequence, with --schedule) into EXR cube faces, cube strip, latlong, a PNG "
       "preview, a glTF scene and manifest.json");
   AddStyleOptions(cli.bake, cli.args);
   cli.bake->add_option("--out", cli.args.out_dir, "Output folder")->capture_default_str();
-  cli.bake->add_option("--size", cli.args.size,
+  cli.bake
+      ->add_option("--size", cli.args.size,
                    "Cube face size N; also sets the latlong to 2N x N (default: the style's, 512)")
       ->check(CLI::Range(1, 8192));
   cli.bake->add_option("--device", cli.args.device, "Vulkan device index from 'skybake devices' (default: best)");
-  CLI::Option* force = cli.bake->add_flag(
-      "--force", cli.args.force, "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
-  cli.bake->add_flag("--resume", cli.args.resume,
-                 "Sequence: keep the frames whose files match their checksums in the manifest in --out (manifest.json, or "
-                 "the shard's), bake the rest")
+  CLI::Option* force =
+      cli.bake->add_flag("--force", cli.args.force,
+                         "Overwrite the files of a previous bake in --out (without it, existing files stop the bake)");
+  cli.bake
+      ->add_flag(
+          "--resume", cli.args.resume,
+          "Sequence: keep the frames whose files match their checksums in the manifest in --out (manifest.json, or "
+          "the shard's), bake the rest")
       ->excludes(force);
-  cli.bake->add_option("--frames", cli.args.frames,
+  cli.bake
+      ->add_option("--frames", cli.args.frames,
                    "Sequence: bake only frames FIRST to LAST (inclusive), numbered as in file names (from "
                    "schedule.first_frame); writes manifest.shard-FIRST-LAST.json, no scene")
       ->type_name("FIRST:LAST");
-  cli.bake->add_option("--shard", cli.args.shard,
+  cli.bake
+      ->add_option("--shard", cli.args.shard,
                    "Sequence: bake shard I of N (I = 1..N), a contiguous block of nearly equal size of the frames "
                    "(of --frames, if given); join the parts with merge-manifest (README \"Scale-out\")")
       ->type_name("I/N");
   {
     std::string engines;
     for (const std::string& name : EngineNames()) engines += (engines.empty() ? "" : "|") + name;
-    cli.bake->add_option("--engine", cli.args.engines,
+    cli.bake
+        ->add_option("--engine", cli.args.engines,
                      "Also write the files these engines load the right way up, all from the same render: one "
                      "name, a list separated by commas, or the option repeated (output.engine; docs/engines.md)")
         ->type_name(engines)
@@ -521,9 +528,10 @@ void AddBakeCommands(CLI::App& app, Cli& cli) {
               const std::vector<std::string> names = EngineNames();
               for (const std::string& name : SplitEngineList(value))
                 if (std::find(names.begin(), names.end(), name) == names.end())
-                  return fmt::format("'{}' is not an engine preset: give one or more of {{{}}}, separated by "
-                                     "commas or as --engine repeated",
-                                     name, fmt::join(names, ","));
+                  return fmt::format(
+                      "'{}' is not an engine preset: give one or more of {{{}}}, separated by "
+                      "commas or as --engine repeated",
+                      name, fmt::join(names, ","));
               return std::string();
             },
             "ENGINE[,ENGINE...]"));
@@ -534,30 +542,31 @@ void AddBakeCommands(CLI::App& app, Cli& cli) {
   cli.bake->add_flag("--dry-run", cli.args.dry_run, "Print the pass plan (as 'skybake plan') and bake nothing");
   cli.bake->add_flag("--quiet,-q", cli.args.quiet,
                      "Errors only on stderr: no progress, no warnings (the files written still go to stdout)");
-  cli.bake->add_option("--progress-json", cli.args.progress_json,
-                       "Also write progress as JSON lines to PATH, one object per event (start, stage, frame_start, "
-                       "frame_end with the rate and time left, end with the exit code), each flushed as it happens; "
-                       "/dev/fd/N writes to an open file descriptor. Checked before anything else: a PATH that cannot "
-                       "be written stops the bake (exit 5) with nothing touched")
+  cli.bake
+      ->add_option("--progress-json", cli.args.progress_json,
+                   "Also write progress as JSON lines to PATH, one object per event (start, stage, frame_start, "
+                   "frame_end with the rate and time left, end with the exit code), each flushed as it happens; "
+                   "/dev/fd/N writes to an open file descriptor. Checked before anything else: a PATH that cannot "
+                   "be written stops the bake (exit 5) with nothing touched")
       ->type_name("PATH");
   cli.bake->add_flag("--vulkan-validation", cli.args.validation,
-                 "Load the Khronos validation layer; any message fails the bake (also "
-                 "SKYBAKE_VULKAN_VALIDATION=1)");
+                     "Load the Khronos validation layer; any message fails the bake (also "
+                     "SKYBAKE_VULKAN_VALIDATION=1)");
 
   cli.check = app.add_subcommand("check", "Validate a style without baking");
   AddStyleOptions(cli.check, cli.args);
 
   cli.plan = app.add_subcommand(
-      "plan", "Print the passes, LUT sizes, shader variant, estimated work and reuse of a bake, and why each "
-              "effect is on (also: bake --dry-run)");
+      "plan",
+      "Print the passes, LUT sizes, shader variant, estimated work and reuse of a bake, and why each "
+      "effect is on (also: bake --dry-run)");
   AddStyleOptions(cli.plan, cli.args);
 }
 
 void AddGalleryCommand(CLI::App& app, Cli& cli) {
-  cli.gallery = app.add_subcommand(
-      "gallery", "Bake every style of a folder and write one labelled contact sheet (gallery.png)");
-  cli.gallery->add_option("styles", cli.gallery_args.styles_dir, "Folder of style TOML files")
-      ->capture_default_str();
+  cli.gallery =
+      app.add_subcommand("gallery", "Bake every style of a folder and write one labelled contact sheet (gallery.png)");
+  cli.gallery->add_option("styles", cli.gallery_args.styles_dir, "Folder of style TOML files")->capture_default_str();
   cli.gallery->add_option("--out", cli.gallery_args.out_dir, "Output folder")->capture_default_str();
   cli.gallery->add_option("--size", cli.gallery_args.size, "Latlong height H of each style (2H x H)")
       ->capture_default_str()
@@ -567,25 +576,29 @@ void AddGalleryCommand(CLI::App& app, Cli& cli) {
       ->check(CLI::Range(1, 16));
   cli.gallery->add_option("--set", cli.args.overrides, "Override a key in every style (repeatable)");
   cli.gallery->add_option("--device", cli.args.device, "Vulkan device index from 'skybake devices'");
-  cli.gallery->add_option("--max-memory-mib", cli.args.max_memory_mib,
-                          "Memory budget per style in MiB; a gallery with a style over it is refused (exit 7) "
-                          "before any is baked")
+  cli.gallery
+      ->add_option("--max-memory-mib", cli.args.max_memory_mib,
+                   "Memory budget per style in MiB; a gallery with a style over it is refused (exit 7) "
+                   "before any is baked")
       ->capture_default_str()
       ->check(FinitePositive());
-  cli.gallery->add_option("--max-frame-seconds", cli.args.max_frame_seconds,
-                          "Time budget per style in estimated seconds; as --max-memory-mib")
+  cli.gallery
+      ->add_option("--max-frame-seconds", cli.args.max_frame_seconds,
+                   "Time budget per style in estimated seconds; as --max-memory-mib")
       ->capture_default_str()
       ->check(FinitePositive());
-  cli.gallery->add_flag("--force", cli.args.force, "Replace a previous gallery in --out (its sheet and every style's files)");
+  cli.gallery->add_flag("--force", cli.args.force,
+                        "Replace a previous gallery in --out (its sheet and every style's files)");
   cli.gallery->add_flag("--quiet,-q", cli.args.quiet, "No progress lines");
   cli.gallery->add_flag("--vulkan-validation", cli.args.validation, "Load the Khronos validation layer");
 }
 
 // testpattern, view, merge-manifest, devices, accuracy.
 void AddToolCommands(CLI::App& app, Cli& cli) {
-  cli.testpattern = app.add_subcommand(
-      "testpattern", "Write an orientation test pattern (faces named, axes, horizon, N E S W) as a bake's files, "
-                     "through an engine preset: check the preset in your engine (docs/engines.md)");
+  cli.testpattern =
+      app.add_subcommand("testpattern",
+                         "Write an orientation test pattern (faces named, axes, horizon, N E S W) as a bake's files, "
+                         "through an engine preset: check the preset in your engine (docs/engines.md)");
   cli.testpattern->add_option("--out", cli.pattern.out_dir, "Output folder")->capture_default_str();
   cli.testpattern->add_option("--engine", cli.pattern.engine, "Engine preset whose files to write too")
       ->check(CLI::IsMember(EngineNames()));
@@ -593,19 +606,22 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
       ->capture_default_str()
       ->check(CLI::Range(8, 4096));
   cli.testpattern->add_flag("--force", cli.pattern.force, "Overwrite the pattern's files in --out");
-  cli.testpattern->add_option("--max-memory-mib", cli.pattern.max_memory_mib,
-                              "Memory budget in MiB; a larger pattern is refused (exit 7) before any file")
+  cli.testpattern
+      ->add_option("--max-memory-mib", cli.pattern.max_memory_mib,
+                   "Memory budget in MiB; a larger pattern is refused (exit 7) before any file")
       ->capture_default_str()
       ->check(FinitePositive());
 
   cli.view = app.add_subcommand(
-      "view", "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
-              "to look around, exposure, frames");
+      "view",
+      "Write DIR/view.html: the bake's sky in one self-contained page (three.js inside, no network): drag "
+      "to look around, exposure, frames");
   cli.view->add_option("dir", cli.view_options.dir, "A bake's --out folder (or a testpattern folder)")->required();
   cli.view->add_flag("--force", cli.view_options.force, "Replace an existing view.html");
-  cli.view->add_option("--embed-mib", cli.view_options.embed_mib,
-                       "Frames inside the page while their files total at most this many MiB (the first always); "
-                       "later ones are loaded from their files when the page is served over HTTP")
+  cli.view
+      ->add_option("--embed-mib", cli.view_options.embed_mib,
+                   "Frames inside the page while their files total at most this many MiB (the first always); "
+                   "later ones are loaded from their files when the page is served over HTTP")
       ->capture_default_str()
       ->check(FiniteNumber(true));
 
@@ -614,9 +630,11 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
       "Join the shard manifests (manifest.shard-FIRST-LAST.json, from bake --shard or --frames) of a folder into "
       "manifest.json and write the glTF scene, equal to an unsharded bake's; checks that the parts are of one "
       "bake, cover every frame once, and that every listed file is there with its SHA-256");
-  cli.merge->add_option("dir", cli.merge_options.dir, "Folder holding every part's files and shard manifest")->required();
+  cli.merge->add_option("dir", cli.merge_options.dir, "Folder holding every part's files and shard manifest")
+      ->required();
   cli.merge->add_flag("--force", cli.merge_options.force, "Replace an existing manifest.json and glTF scene");
-  cli.merge->add_flag("--sizes-only", cli.sizes_only, "Check listed files by size only, without reading them for SHA-256");
+  cli.merge->add_flag("--sizes-only", cli.sizes_only,
+                      "Check listed files by size only, without reading them for SHA-256");
 
   cli.devices = app.add_subcommand("devices", "List Vulkan devices and whether skybake can use them");
 
@@ -624,14 +642,17 @@ void AddToolCommands(CLI::App& app, Cli& cli) {
       "accuracy", "Run the accuracy-versus-time study of every integrator and write its tables and plot");
   cli.accuracy->add_option("--out", cli.study.out_dir, "Folder for accuracy_results.md, accuracy.csv, accuracy.png")
       ->capture_default_str();
-  cli.accuracy->add_option("--shared", cli.study.shared_dir, "Folder holding groundtruth/kider2014")->capture_default_str();
+  cli.accuracy->add_option("--shared", cli.study.shared_dir, "Folder holding groundtruth/kider2014")
+      ->capture_default_str();
   cli.accuracy->add_flag("--quick", cli.study.quick, "Fewer cases and directions (a smoke run)");
   cli.accuracy->add_option("--only", cli.study.only,
-                           "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\" or \"kider-spectral\": that study alone");
-  cli.accuracy->add_option("--study", cli.study.study,
-                           "Which studies: sky (integrators, Kider 2014), clouds (cloud settings: cloud_study.csv), "
-                           "spectral (wavelength counts: spectral.csv), twilight (presets and sky-view variants at sun "
-                           "3..-10 deg: twilight.csv), all")
+                           "Only the cases whose name contains this text, e.g. \"sky-view\"; \"spectral\" or "
+                           "\"kider-spectral\": that study alone");
+  cli.accuracy
+      ->add_option("--study", cli.study.study,
+                   "Which studies: sky (integrators, Kider 2014), clouds (cloud settings: cloud_study.csv), "
+                   "spectral (wavelength counts: spectral.csv), twilight (presets and sky-view variants at sun "
+                   "3..-10 deg: twilight.csv), all")
       ->capture_default_str()
       ->check(CLI::IsMember({"all", "sky", "clouds", "spectral", "twilight"}));
   cli.accuracy->add_option("--observer-altitude-m", cli.study.observer_altitude_m, "Observer altitude of the study (m)")
@@ -723,7 +744,7 @@ int RunCommand(Cli& cli) {
                                     cli.args.progress_json, std::strerror(error)));
     }
   }
-  const ProgressStyle style = cli.args.quiet              ? ProgressStyle::kQuiet
+  const ProgressStyle style = cli.args.quiet               ? ProgressStyle::kQuiet
                               : isatty(STDERR_FILENO) == 1 ? ProgressStyle::kLiveLine
                                                            : ProgressStyle::kLines;
   cli.progress = std::make_unique<ProgressReport>(style, stderr, cli.progress_file, SKYBAKE_VERSION, kBuildCommit);
@@ -740,8 +761,9 @@ int RunReportingErrors(Cli& cli) {
     else PrintError(e.message());
     return e.exit_code();
   } catch (const std::bad_alloc&) {
-    PrintError("out of memory: lower render.cube_size or render.latlong_height, or --max-memory-mib so that the "
-               "budget check refuses such bakes (README \"Limits\")");
+    PrintError(
+        "out of memory: lower render.cube_size or render.latlong_height, or --max-memory-mib so that the "
+        "budget check refuses such bakes (README \"Limits\")");
     return kExitBudget;
   } catch (const std::filesystem::filesystem_error& e) {
     PrintError(e.what());
@@ -761,8 +783,9 @@ int RunVersion(int argc, char** argv) {
     std::string rest;
     for (int i = 1; i < argc; ++i)
       if (std::string_view(argv[i]) != "--version") rest += std::string(rest.empty() ? "" : " ") + argv[i];
-    std::fprintf(stderr, "skybake: error: --version takes no subcommand or other option (given: %s): run "
-                         "'skybake --version' alone\n",
+    std::fprintf(stderr,
+                 "skybake: error: --version takes no subcommand or other option (given: %s): run "
+                 "'skybake --version' alone\n",
                  Printable(rest.empty() ? "--version twice" : rest).c_str());
     return kExitUsage;
   }
@@ -776,16 +799,17 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (std::string_view(argv[i]) == "--version") return RunVersion(argc, argv);
   KeepFrameMemoryInHeap();
-  CLI::App app{"skybake " SKYBAKE_VERSION
-               ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
-               "into OpenEXR environment maps with Vulkan compute.\n"
-               "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
-               "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
-               "manifests that do not merge."};
+  CLI::App app{
+      "skybake " SKYBAKE_VERSION
+      ": bakes physical, art-directable skies (AOAS on a Hillaire 2020 atmosphere) "
+      "into OpenEXR environment maps with Vulkan compute.\n"
+      "Exit codes: 0 ok, 1 internal error, 2 usage, 3 invalid style or schedule, 4 Vulkan, 5 output "
+      "(disk full, permissions), 6 outputs exist (--force, --resume), 7 over the memory or time budget, 8 shard "
+      "manifests that do not merge."};
   app.require_subcommand(1);
   // Handled before parsing (RunVersion); here for the help.
-  app.add_flag("--version")->description(
-      "Print the version and the git commit skybake was built from, and exit (alone only)");
+  app.add_flag("--version")
+      ->description("Print the version and the git commit skybake was built from, and exit (alone only)");
   app.get_formatter()->column_width(34);
   Cli cli;
   AddBakeCommands(app, cli);

@@ -11,10 +11,13 @@ namespace skybake {
 int CloudPanoramaHeightFor(const ViewRequest& view) {
   constexpr double kHalfPi = 1.57079632679489662;
   switch (view.mapping) {
-    case MAPPING_LATLONG: return view.height;
+    case MAPPING_LATLONG:
+      return view.height;
     case MAPPING_CUBE_STRIP:
-    case MAPPING_VULKAN_FACE: return int(std::ceil(kHalfPi * double(view.width)));
-    default: return 0;
+    case MAPPING_VULKAN_FACE:
+      return int(std::ceil(kHalfPi * double(view.width)));
+    default:
+      return 0;
   }
 }
 

@@ -82,7 +82,9 @@ CubeLevel DownsampleCube(const CubeLevel& level) {
     for (int y = 0; y < down.size; ++y)
       for (int x = 0; x < down.size; ++x)
         for (int c = 0; c < 4; ++c) {
-          auto at = [&](int sx, int sy) { return src[(size_t(std::min(sy, n - 1)) * n + std::min(sx, n - 1)) * 4 + c]; };
+          auto at = [&](int sx, int sy) {
+            return src[(size_t(std::min(sy, n - 1)) * n + std::min(sx, n - 1)) * 4 + c];
+          };
           dst[(size_t(y) * down.size + x) * 4 + c] =
               0.25f * (at(2 * x, 2 * y) + at(2 * x + 1, 2 * y) + at(2 * x, 2 * y + 1) + at(2 * x + 1, 2 * y + 1));
         }
@@ -110,10 +112,11 @@ CubeTexel VulkanCubeTexelFromDirection(const glm::dvec3& d, int face_size) {
     tc = -d.y;
     ma = az;
   }
-  auto texel = [&](double v) { return std::clamp(int(std::floor((v / ma + 1.0) * 0.5 * face_size)), 0, face_size - 1); };
+  auto texel = [&](double v) {
+    return std::clamp(int(std::floor((v / ma + 1.0) * 0.5 * face_size)), 0, face_size - 1);
+  };
   return {face, texel(sc), texel(tc)};
 }
-
 
 // --------------------------------------------------------------- the device pass
 
@@ -283,7 +286,9 @@ gpu::IblPush PushFor(const IblRequest& request, const Pass& p, double roughness,
 }
 
 const char* TimingName(int mode) {
-  return mode == IBL_MODE_SPECULAR || mode == IBL_MODE_SPECULAR_GRID ? "IBL specular" : mode == IBL_MODE_IRRADIANCE ? "IBL irradiance" : "IBL DFG";
+  return mode == IBL_MODE_SPECULAR || mode == IBL_MODE_SPECULAR_GRID ? "IBL specular"
+         : mode == IBL_MODE_IRRADIANCE                               ? "IBL irradiance"
+                                                                     : "IBL DFG";
 }
 
 }  // namespace
@@ -303,7 +308,8 @@ IblBaker::IblBaker(VulkanContext& context) : context_(context) {
                         VK_ERROR_FORMAT_NOT_SUPPORTED);
 
     VkDescriptorSetLayoutBinding bindings[2] = {};
-    bindings[0] = {IBL_BINDING_SOURCE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
+    bindings[0] = {IBL_BINDING_SOURCE, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT,
+                   nullptr};
     bindings[1] = {IBL_BINDING_OUTPUT, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, nullptr};
     const ComputeLayouts layouts = CreateComputeLayouts(device, bindings, 2, sizeof(gpu::IblPush));
     set_layout_ = layouts.set;
@@ -525,8 +531,8 @@ std::vector<int> IblBaker::RecordPasses(const Resources& r, const std::vector<gp
     push.target.x = IBL_MODE_GGX_SAMPLES;
     push.target.y = width;
     push.target.z = push.source.z;
-    PushAndDispatch(cmd, pipeline_layout_, push, Groups(width, SKYBAKE_LOCAL_SIZE_X), Groups(rows, SKYBAKE_LOCAL_SIZE_Y),
-                    1);
+    PushAndDispatch(cmd, pipeline_layout_, push, Groups(width, SKYBAKE_LOCAL_SIZE_X),
+                    Groups(rows, SKYBAKE_LOCAL_SIZE_Y), 1);
     tables = true;
   }
   if (tables) {
@@ -635,7 +641,8 @@ IblMaps IblBaker::Bake(const IblRequest& request, const CubeLevel& source) {
   CreateSourceImage(r, SourceMipChain(source));
   CreateOutputAndSet(r, list.texels);
   std::vector<gpu::IblPush> pushes;
-  for (const Pass& p : list.passes) pushes.push_back(PushFor(request, p, roughness[p.level], source.size, r.image_levels));
+  for (const Pass& p : list.passes)
+    pushes.push_back(PushFor(request, p, roughness[p.level], source.size, r.image_levels));
   const std::vector<int> modes = RecordPasses(r, pushes);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;

@@ -51,13 +51,9 @@ VkDescriptorType BindingType(uint32_t binding) {
 
 // Texels of the cloud tables: the aerial-perspective LUT's in-scattering and
 // transmittance halves, then two per ambient altitude (clouds.glsl).
-size_t CloudLutTexels(const gpu::GpuClouds& c) {
-  return 2 * size_t(c.lut.x) * c.lut.y * c.lut.z + 2 * size_t(c.lut.w);
-}
+size_t CloudLutTexels(const gpu::GpuClouds& c) { return 2 * size_t(c.lut.x) * c.lut.y * c.lut.z + 2 * size_t(c.lut.w); }
 
-uint32_t GroupCount(int texels, int local_size) {
-  return uint32_t((texels + local_size - 1) / local_size);
-}
+uint32_t GroupCount(int texels, int local_size) { return uint32_t((texels + local_size - 1) / local_size); }
 
 // The push constants of a dispatch over one view: the Sun and the view's
 // mapping, size and face (the offsets are the caller's).
@@ -70,9 +66,8 @@ gpu::SkyPush ViewPush(const glm::dvec3& sun, const ViewRequest& v) {
 
 }  // namespace
 
-SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
-                         const QualitySettings& quality, const EffectSettings& effects,
-                         const Rgb& output_scale, bool output_directions,
+SkyRenderer::SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                         const EffectSettings& effects, const Rgb& output_scale, bool output_directions,
                          const AoasInputs& aoas, const CloudInputs& clouds, const ShaderSwitches& shaders)
     : SkyRenderer(Role::kSky, context, atmosphere, quality, effects, output_scale, output_directions, aoas, clouds,
                   shaders) {}
@@ -119,10 +114,10 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   std::memcpy(atmosphere_buffer_.mapped, &gpu_atmosphere_, sizeof(gpu_atmosphere_));
   aoas_buffer_ = CreateBuffer(sizeof(gpu::GpuAoas), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
   std::memcpy(aoas_buffer_.mapped, &aoas.uniform, sizeof(gpu::GpuAoas));
-  transmittance_buffer_ = CreateBuffer(
-      VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
-  multiscattering_buffer_ = CreateBuffer(
-      VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
+  transmittance_buffer_ =
+      CreateBuffer(VkDeviceSize(quality.transmittance_width) * quality.transmittance_height * 16, storage);
+  multiscattering_buffer_ =
+      CreateBuffer(VkDeviceSize(quality.multiscattering_size) * quality.multiscattering_size * 16, storage);
   output_buffer_ = CreateBuffer(16 * 64, storage);
   skyview_buffer_ = CreateBuffer(
       quality.sky_view_lut ? VkDeviceSize(quality.sky_view_width) * quality.sky_view_height * 8 : 16, storage);
@@ -132,11 +127,12 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   cloud_light_volume_ = cloud_layers_ > 0 && CloudLightVolumeOn(gpu_clouds_);
   cloud_formation_ = cloud_layers_ > 0 && CloudFormationRead(gpu_clouds_);
   cloud_cirrus_ = cloud_layers_ > 0 && CloudCirrusOn(gpu_clouds_);
-  cloud_noise_buffer_ = CreateBuffer(
-      cloud_layers_ > 0
-          ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_) + (cloud_light_volume_ ? CloudLightVolumeFloats(gpu_clouds_) : 0)) * 4
-          : 16,
-      storage);
+  cloud_noise_buffer_ =
+      CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudNoiseFloats(gpu_clouds_) +
+                                                    (cloud_light_volume_ ? CloudLightVolumeFloats(gpu_clouds_) : 0)) *
+                                           4
+                                     : 16,
+                   storage);
   cloud_lut_buffer_ = CreateBuffer(cloud_layers_ > 0 ? VkDeviceSize(CloudLutTexels(gpu_clouds_)) * 16 : 16, storage);
   dispatch_buffer_ = CreateBuffer(64 * sizeof(gpu::SkyPush), storage);  // grown by Submit when a submission needs more
   // The shaders read through texel views, not the storage buffers (the same
@@ -149,7 +145,8 @@ SkyRenderer::SkyRenderer(Role role, VulkanContext& context, const AtmospherePara
   // and the shaders read the storage buffers.
   texel_views_whole_ = texel_views_allowed_;
   for (int i = 0; i < TEXEL_VIEW_COUNT; ++i)
-    texel_views_whole_ = texel_views_whole_ && TexelViewRange(i).texels <= context_.properties().limits.maxTexelBufferElements;
+    texel_views_whole_ =
+        texel_views_whole_ && TexelViewRange(i).texels <= context_.properties().limits.maxTexelBufferElements;
   for (int i = 0; i < TEXEL_VIEW_COUNT; ++i) CreateTexelView(i);
 
   CreateDescriptorSet();
@@ -190,9 +187,9 @@ void SkyRenderer::CompilePipelines(const QualitySettings& quality, const EffectS
   else if (NeedsTransmittanceLut(quality, effects) || cloud_layers_ > 0)
     jobs.push_back(job(&transmittance_pipeline_, analytic, kTransmittanceLutAnalyticSpv, kTransmittanceLutSpv));
   if (effects.multiple_scattering && !style_pass_)
-    jobs.push_back(
-        job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
-  if (sky_view && !style_pass_) jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
+    jobs.push_back(job(&multiscattering_pipeline_, analytic, kMultiscatteringLutAnalyticSpv, kMultiscatteringLutSpv));
+  if (sky_view && !style_pass_)
+    jobs.push_back(job(&skyview_pipeline_, analytic, kSkyviewLutAnalyticSpv, kSkyviewLutSpv));
   if (!style_pass_) jobs.push_back(job(&sky_pipeline_, sources.sky_view_render, kSkyRenderSkyViewSpv, kSkyRenderSpv));
   sky_view_variant_ = sources.sky_view_render && !style_pass_;
   for (PipelineJob& j : jobs) j.sun_disc = effects.sun_disc;
@@ -310,8 +307,7 @@ std::vector<TexelRect> TexelsNearDirection(const ViewRequest& view, const glm::d
       // Joined with the row of tiles above when they span the same columns.
       if (!rects.empty() && rects.back().y1 == ty && rects.back().x0 == first && rects.back().x1 == last)
         rects.back().y1 = y1;
-      else
-        rects.push_back({first, ty, last, y1});
+      else rects.push_back({first, ty, last, y1});
     }
   }
   return rects;
@@ -335,11 +331,10 @@ void SkyRenderer::DestroyAll() {
   if (query_pool_) vkDestroyQueryPool(device, query_pool_, nullptr);
   if (fence_) vkDestroyFence(device, fence_, nullptr);
   if (command_pool_) vkDestroyCommandPool(device, command_pool_, nullptr);
-  for (VkPipeline* p : {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_,
-                        &transmittance_pipeline_, &cloud_lut_pipeline_, &cloud_pipeline_,
-                        &cloud_resample_pipeline_, &cloud_shadow_pipeline_, &twilight_sky_pipeline_, &shadowed_cloud_pipeline_,
-                        &marched_light_cloud_pipeline_,
-                        &style_pipeline_}) {
+  for (VkPipeline* p :
+       {&sky_pipeline_, &disc_pipeline_, &skyview_pipeline_, &multiscattering_pipeline_, &transmittance_pipeline_,
+        &cloud_lut_pipeline_, &cloud_pipeline_, &cloud_resample_pipeline_, &cloud_shadow_pipeline_,
+        &twilight_sky_pipeline_, &shadowed_cloud_pipeline_, &marched_light_cloud_pipeline_, &style_pipeline_}) {
     if (*p) vkDestroyPipeline(device, *p, nullptr);
     *p = VK_NULL_HANDLE;
   }
@@ -448,9 +443,8 @@ SkyRenderer::Buffer SkyRenderer::CreateBuffer(VkDeviceSize size, VkBufferUsageFl
   VkResult result = vkAllocateMemory(device, &alloc, nullptr, &b.memory);
   if (result != VK_SUCCESS) {
     vkDestroyBuffer(device, b.buffer, nullptr);
-    throw VulkanError("cannot allocate " + std::to_string(size >> 20) +
-                          " MiB of Vulkan memory (" + VkResultName(result) +
-                          "): lower render.cube_size or render.latlong_height",
+    throw VulkanError("cannot allocate " + std::to_string(size >> 20) + " MiB of Vulkan memory (" +
+                          VkResultName(result) + "): lower render.cube_size or render.latlong_height",
                       result);
   }
   VK_CHECK(vkBindBufferMemory(device, b.buffer, b.memory, 0));
@@ -518,7 +512,11 @@ void SkyRenderer::UpdateDescriptors() {
       {cloud_noise_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {cloud_lut_buffer_.buffer, 0, VK_WHOLE_SIZE},
       {dispatch_buffer_.buffer, 0, VK_WHOLE_SIZE},
-      {}, {}, {}, {}, {},  // the texel views
+      {},
+      {},
+      {},
+      {},
+      {},  // the texel views
   };
   VkWriteDescriptorSet writes[kBindingCount] = {};
   for (uint32_t i = 0; i < kBindingCount; ++i) {
@@ -571,10 +569,8 @@ const std::vector<RowRange>& SkyRenderer::TwilightRows(const ViewRequest& view) 
   for (RowRange r : RowsReachingElevations(view, elevations.x - kFloatMargin, elevations.y + kFloatMargin)) {
     r.begin -= r.begin % SKYBAKE_LOCAL_SIZE_Y;
     r.end = std::min(view.height, r.end + (SKYBAKE_LOCAL_SIZE_Y - r.end % SKYBAKE_LOCAL_SIZE_Y) % SKYBAKE_LOCAL_SIZE_Y);
-    if (!runs.empty() && runs.back().end >= r.begin)
-      runs.back().end = std::max(runs.back().end, r.end);
-    else
-      runs.push_back(r);
+    if (!runs.empty() && runs.back().end >= r.begin) runs.back().end = std::max(runs.back().end, r.end);
+    else runs.push_back(r);
   }
   twilight_row_runs_.push_back({view, std::move(runs)});
   return twilight_row_runs_.back().second;
@@ -639,8 +635,7 @@ bool SkyRenderer::CloudsInEarthShadow(const glm::dvec3& sun) const {
 VkPipeline SkyRenderer::ShadowedCloudPipeline() {
   if (!shadowed_cloud_pipeline_) {
     // cloud_pipeline_ with the Sun's light (and its light march) compiled out.
-    shadowed_cloud_pipeline_ =
-        CreatePipeline(kCloudRenderSpv, sizeof(kCloudRenderSpv), false, false, false, false);
+    shadowed_cloud_pipeline_ = CreatePipeline(kCloudRenderSpv, sizeof(kCloudRenderSpv), false, false, false, false);
     ++counters_.pipelines;
   }
   return shadowed_cloud_pipeline_;
@@ -688,30 +683,56 @@ VkPipeline SkyRenderer::CreatePipeline(const uint32_t* code, size_t bytes, bool 
     int32_t cloud_layers;
     VkBool32 twilight_march, cloud_sun_light, cloud_light_volume, ground_cloud_shadow, texel_views, cloud_formation;
     VkBool32 cloud_cirrus;
-  } values = {effects_.multiple_scattering, sun_disc, effects_.ground,
-              output_directions_,           aoas_switches_.skydome, aoas_switches_.ambiguity,
-              aoas_switches_.cloud_noise,   aoas_switches_.cloud_shapes,
-              quality_.integrator,          quality_.sky_view_lut, effects_.mie, effects_.ozone,
-              effects_.night_dimming,       sun_disc_pass, std::max(cloud_layers_, 1),
-              twilight_march,               cloud_sun_light, cloud_light_volume,
-              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f, texel_views_whole_,
-              cloud_formation_,             cloud_cirrus_};
-  const VkSpecializationMapEntry entries[22] = {
-      {SPEC_MULTIPLE_SCATTERING, 0, 4}, {SPEC_SUN_DISC, 4, 4},      {SPEC_GROUND, 8, 4},
-      {SPEC_OUTPUT_DIRECTION, 12, 4},   {SPEC_SKYDOME, 16, 4},      {SPEC_AMBIGUITY, 20, 4},
-      {SPEC_CLOUD_NOISE, 24, 4},        {SPEC_CLOUD_SHAPES, 28, 4}, {SPEC_INTEGRATOR, 32, 4},
-      {SPEC_USE_SKY_VIEW, 36, 4},       {SPEC_MIE, 40, 4},          {SPEC_OZONE, 44, 4},
-      {SPEC_NIGHT, 48, 4},              {SPEC_SUN_DISC_PASS, 52, 4}, {SPEC_CLOUD_LAYERS, 56, 4},
-      {SPEC_TWILIGHT_MARCH, 60, 4},     {SPEC_CLOUD_SUN_LIGHT, 64, 4}, {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
-      {SPEC_GROUND_CLOUD_SHADOW, 72, 4}, {SPEC_TEXEL_VIEWS, 76, 4},
-      {SPEC_CLOUD_FORMATION, 80, 4},    {SPEC_CLOUD_CIRRUS, 84, 4}};
+  } values = {effects_.multiple_scattering,
+              sun_disc,
+              effects_.ground,
+              output_directions_,
+              aoas_switches_.skydome,
+              aoas_switches_.ambiguity,
+              aoas_switches_.cloud_noise,
+              aoas_switches_.cloud_shapes,
+              quality_.integrator,
+              quality_.sky_view_lut,
+              effects_.mie,
+              effects_.ozone,
+              effects_.night_dimming,
+              sun_disc_pass,
+              std::max(cloud_layers_, 1),
+              twilight_march,
+              cloud_sun_light,
+              cloud_light_volume,
+              cloud_layers_ > 0 && gpu_clouds_.ground_shadow.x > 0.0f,
+              texel_views_whole_,
+              cloud_formation_,
+              cloud_cirrus_};
+  const VkSpecializationMapEntry entries[22] = {{SPEC_MULTIPLE_SCATTERING, 0, 4},
+                                                {SPEC_SUN_DISC, 4, 4},
+                                                {SPEC_GROUND, 8, 4},
+                                                {SPEC_OUTPUT_DIRECTION, 12, 4},
+                                                {SPEC_SKYDOME, 16, 4},
+                                                {SPEC_AMBIGUITY, 20, 4},
+                                                {SPEC_CLOUD_NOISE, 24, 4},
+                                                {SPEC_CLOUD_SHAPES, 28, 4},
+                                                {SPEC_INTEGRATOR, 32, 4},
+                                                {SPEC_USE_SKY_VIEW, 36, 4},
+                                                {SPEC_MIE, 40, 4},
+                                                {SPEC_OZONE, 44, 4},
+                                                {SPEC_NIGHT, 48, 4},
+                                                {SPEC_SUN_DISC_PASS, 52, 4},
+                                                {SPEC_CLOUD_LAYERS, 56, 4},
+                                                {SPEC_TWILIGHT_MARCH, 60, 4},
+                                                {SPEC_CLOUD_SUN_LIGHT, 64, 4},
+                                                {SPEC_CLOUD_LIGHT_VOLUME, 68, 4},
+                                                {SPEC_GROUND_CLOUD_SHADOW, 72, 4},
+                                                {SPEC_TEXEL_VIEWS, 76, 4},
+                                                {SPEC_CLOUD_FORMATION, 80, 4},
+                                                {SPEC_CLOUD_CIRRUS, 84, 4}};
   VkSpecializationInfo specialization{22, entries, sizeof(values), &values};
   return CreateComputePipeline(context_.device(), code, bytes, pipeline_layout_, &specialization,
                                context_.pipeline_cache());
 }
 
-void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
-                         const std::vector<bool>& barrier_after) {
+void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches, const std::vector<bool>& barrier_after) {
   VkDevice device = context_.device();
   uint32_t queries = uint32_t(2 * dispatches.size());
   if (timestamps_supported_ && queries > query_capacity_) {
@@ -735,8 +756,8 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   VK_CHECK(vkBeginCommandBuffer(command_buffer_, &begin));
   if (timestamps_supported_) vkCmdResetQueryPool(command_buffer_, query_pool_, 0, queries);
-  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1,
-                          &descriptor_set_, 0, nullptr);
+  vkCmdBindDescriptorSets(command_buffer_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &descriptor_set_, 0,
+                          nullptr);
   for (size_t i = 0; i < dispatches.size(); ++i) {
     const Dispatch& d = dispatches[i];
     if (timestamps_supported_)
@@ -747,23 +768,22 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
                        &dispatch_index);
     vkCmdDispatch(command_buffer_, d.groups_x, d.groups_y, 1);
     if (timestamps_supported_)
-      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, query_pool_,
-                          uint32_t(2 * i + 1));
+      vkCmdWriteTimestamp(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, query_pool_, uint32_t(2 * i + 1));
     if (barrier_after[i]) {
       // Orders this dispatch's LUT writes before the next dispatch's LUT reads.
       VkMemoryBarrier barrier{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       barrier.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
       barrier.dstAccessMask = VK_ACCESS_SHADER_READ_BIT;
-      vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1, &barrier, 0, nullptr, 0, nullptr);
+      vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                           0, 1, &barrier, 0, nullptr, 0, nullptr);
     }
   }
   // Makes every shader write of the submission visible to host reads after the fence.
   VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
   to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+  vkCmdPipelineBarrier(command_buffer_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1,
+                       &to_host, 0, nullptr, 0, nullptr);
   VK_CHECK(vkEndCommandBuffer(command_buffer_));
 
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
@@ -776,18 +796,15 @@ void SkyRenderer::Submit(const std::vector<Dispatch>& dispatches,
   timings_.clear();
   std::vector<uint64_t> stamps(queries, 0);
   if (timestamps_supported_ && queries > 0)
-    VK_CHECK(vkGetQueryPoolResults(device, query_pool_, 0, queries, stamps.size() * sizeof(uint64_t),
-                                   stamps.data(), sizeof(uint64_t),
-                                   VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+    VK_CHECK(vkGetQueryPoolResults(device, query_pool_, 0, queries, stamps.size() * sizeof(uint64_t), stamps.data(),
+                                   sizeof(uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
   double period_ns = context_.properties().limits.timestampPeriod;
   for (size_t i = 0; i < dispatches.size(); ++i) {
     PassTiming t;
     t.name = dispatches[i].name;
     if (timestamps_supported_) t.gpu_ms = double(stamps[2 * i + 1] - stamps[2 * i]) * period_ns * 1e-6;
-    if (dispatches[i].continues && !timings_.empty())
-      timings_.back().gpu_ms += t.gpu_ms;
-    else
-      timings_.push_back(t);
+    if (dispatches[i].continues && !timings_.empty()) timings_.back().gpu_ms += t.gpu_ms;
+    else timings_.push_back(t);
   }
 }
 
@@ -848,8 +865,8 @@ void SkyRenderer::GenerateCloudNoise() {
                           GroupCount(nd * nd, SKYBAKE_LOCAL_SIZE_Y)});
     if (layer.weather.w < 0.5f) {
       push.view.x = CLOUD_PASS_WEATHER;
-      dispatches.push_back({"cloud weather map", cloud_lut_pipeline_, push,
-                            GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_X), GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_Y)});
+      dispatches.push_back({"cloud weather map", cloud_lut_pipeline_, push, GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_X),
+                            GroupCount(n_weather, SKYBAKE_LOCAL_SIZE_Y)});
     }
   }
   CopyCloudWeatherImages();
@@ -865,7 +882,8 @@ void SkyRenderer::GenerateCloudNoise() {
 void SkyRenderer::FillCloudSkipMaps() {
   // The noise's writes were made visible to the host by the submission's
   // last barrier and its fence; the host's writes reach the next submission.
-  if (gpu_clouds_.range.w > 0.5f) skybake::FillCloudSkipMaps(gpu_clouds_, static_cast<float*>(cloud_noise_buffer_.mapped));
+  if (gpu_clouds_.range.w > 0.5f)
+    skybake::FillCloudSkipMaps(gpu_clouds_, static_cast<float*>(cloud_noise_buffer_.mapped));
 }
 
 void SkyRenderer::CopyCloudWeatherImages() {
@@ -901,8 +919,8 @@ void SkyRenderer::AddCloudTables(const glm::dvec3& sun, std::vector<Dispatch>& d
   ++counters_.cloud_table_builds;
 }
 
-std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
-                                                    const std::vector<ViewRequest>& views, bool sun_disc) {
+std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
+                                                    bool sun_disc) {
   if (spectral_) {
     std::vector<std::vector<float>> images = spectral_->Render(sun, views, sun_disc);
     SyncSpectral();
@@ -925,8 +943,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
     std::vector<std::vector<float>> images =
         Render(sun, std::vector<ViewRequest>(views.begin(), views.begin() + half), sun_disc);
     std::vector<PassTiming> timings = last_timings();
-    for (std::vector<float>& image :
-         Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), sun_disc))
+    for (std::vector<float>& image : Render(sun, std::vector<ViewRequest>(views.begin() + half, views.end()), sun_disc))
       images.push_back(std::move(image));
     timings.insert(timings.end(), last_timings().begin(), last_timings().end());
     timings_ = timings;
@@ -944,8 +961,7 @@ std::vector<std::vector<float>> SkyRenderer::Render(const glm::dvec3& sun,
   return images;
 }
 
-RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views,
-                                         bool sun_disc) {
+RenderedViews SkyRenderer::RenderInPlace(const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc) {
   if (spectral_) {  // combined on the host, held in memory of its own
     auto images = std::make_shared<std::vector<std::vector<float>>>(Render(sun, views, sun_disc));
     RenderedViews result;
@@ -1007,8 +1023,8 @@ std::vector<SkyRenderer::Dispatch> SkyRenderer::ViewDispatches(const glm::dvec3&
     gpu::SkyPush push = ViewPush(sun, v);
     // MAPPING_DIRECTIONS (RenderDirections): the directions follow the texels.
     push.offsets = {int32_t(offsets[i]), sun_disc ? 0 : 1, int32_t(offsets[i] + size_t(v.width) * v.height), 0};
-    std::string name = v.mapping == MAPPING_LATLONG      ? "latlong"
-                       : v.mapping == MAPPING_CUBE_STRIP ? "cube strip"
+    std::string name = v.mapping == MAPPING_LATLONG       ? "latlong"
+                       : v.mapping == MAPPING_CUBE_STRIP  ? "cube strip"
                        : v.mapping == MAPPING_VULKAN_FACE ? std::string("face ") + kFaceNames[v.face % 6]
                                                           : "directions";
     dispatches.push_back({name, sky_pipeline_, push, GroupCount(v.width, SKYBAKE_LOCAL_SIZE_X),
@@ -1072,7 +1088,8 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   CloudPanoramaRows panorama_rows{0, panorama.height};
   if (panorama.width > 0) {
     std::vector<std::array<double, 2>> bands;
-    for (int b = 0; b < gpu_clouds_.resolution.w; ++b) bands.push_back({gpu_clouds_.bands[b].x, gpu_clouds_.bands[b].y});
+    for (int b = 0; b < gpu_clouds_.resolution.w; ++b)
+      bands.push_back({gpu_clouds_.bands[b].x, gpu_clouds_.bands[b].y});
     panorama_rows = CloudPanoramaRowsSeeingBands(panorama, gpu_atmosphere_.radii.x, gpu_atmosphere_.radii.z, bands);
   }
   const int32_t panorama_row_range = panorama_rows.begin + panorama_rows.end * 65536;
@@ -1083,7 +1100,7 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   const bool shadowed_clouds = CloudsInEarthShadow(sun);
   // A Sun too low for the light volume (CloudLightVolumeForSun): every light sample marched.
   const bool light_volume = cloud_light_volume_ && !shadowed_clouds && CloudLightVolumeForSun(gpu_clouds_, sun.y);
-  const VkPipeline cloud_pipeline = shadowed_clouds ? ShadowedCloudPipeline()
+  const VkPipeline cloud_pipeline = shadowed_clouds                        ? ShadowedCloudPipeline()
                                     : cloud_light_volume_ && !light_volume ? MarchedLightCloudPipeline()
                                                                            : cloud_pipeline_;
   if (shadowed_clouds && part != FramePart::kClouds) ++counters_.shadowed_cloud_frames;
@@ -1123,8 +1140,8 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
       push.rect = {int32_t(CloudLutTexels(gpu_clouds_)), panorama.width, panorama.height, CLOUD_MODE_PANORAMA};
       push.offsets.w = panorama_row_range;
       // Read by the cloud passes after the barrier the sun disc or the composites set.
-      dispatches.push_back({"clouds panorama", cloud_pipeline, push,
-                            GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X), row_blocks});
+      dispatches.push_back(
+          {"clouds panorama", cloud_pipeline, push, GroupCount(panorama.width, SKYBAKE_LOCAL_SIZE_X), row_blocks});
       barriers.push_back(false);
       ++counters_.cloud_dispatches;
     }
@@ -1136,8 +1153,8 @@ void SkyRenderer::SubmitViews(const Buffer& target, const glm::dvec3& sun, const
   if (part != FramePart::kClouds) ++counters_.frames;
 }
 
-std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun,
-                                                 const std::vector<glm::dvec3>& directions, bool sun_disc) {
+std::vector<float> SkyRenderer::RenderDirections(const glm::dvec3& sun, const std::vector<glm::dvec3>& directions,
+                                                 bool sun_disc) {
   if (spectral_) {
     std::vector<float> radiance = spectral_->RenderDirections(sun, directions, sun_disc);
     SyncSpectral();
@@ -1306,7 +1323,7 @@ bool SkyRenderer::UpdateClouds(const CloudInputs& clouds) {
       !same(c.lut, gpu_clouds_.lut) || !same(c.light_volume, gpu_clouds_.light_volume) ||
       (cloud_layers_ > 0 && CloudLightVolumeOn(c) != cloud_light_volume_) ||
       (cloud_layers_ > 0 && CloudFormationRead(c) != cloud_formation_) ||  // SPEC_CLOUD_FORMATION
-      (cloud_layers_ > 0 && CloudCirrusOn(c) != cloud_cirrus_) ||  // SPEC_CLOUD_CIRRUS
+      (cloud_layers_ > 0 && CloudCirrusOn(c) != cloud_cirrus_) ||          // SPEC_CLOUD_CIRRUS
       (c.ground_shadow.x > 0.0f) != (gpu_clouds_.ground_shadow.x > 0.0f))  // kGroundCloudShadow's pipelines
     return false;
   // The noise depends on the seeds, the buffer layout and the weather images.

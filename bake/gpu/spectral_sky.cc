@@ -104,7 +104,7 @@ std::vector<std::vector<float>> SpectralSky::Render(const glm::dvec3& sun, const
     timings_.insert(timings_.end(), renderers_[g]->last_timings().begin(), renderers_[g]->last_timings().end());
     for (size_t i = 0; i < views.size(); ++i)
       AddTransformed(rendered.views[i], size_t(views[i].width) * views[i].height, groups_[g].to_rgb, g == 0,
-                 sum[i].data());
+                     sum[i].data());
   }
   if (style_) {
     style_->ApplyStyle(sun, views, sum);
@@ -207,8 +207,8 @@ bool SpectralSky::UpdateAtmosphere(const AtmosphereParams& atmosphere, const Qua
     if (!renderers_[g]->UpdateAtmosphere(groups[g].atmosphere, GroupQuality(quality), GroupEffects(effects),
                                          Rgb{1.0, 1.0, 1.0}))
       return false;
-  if (style_ && !style_->UpdateAtmosphere(groups.front().atmosphere, GroupQuality(quality), effects,
-                                          StyleScale(style_aoas_)))
+  if (style_ &&
+      !style_->UpdateAtmosphere(groups.front().atmosphere, GroupQuality(quality), effects, StyleScale(style_aoas_)))
     return false;
   style_effects_ = effects;
   groups_ = groups;

@@ -18,28 +18,37 @@ constexpr const char* kInstallDriver =
 
 std::string DeviceTypeName(VkPhysicalDeviceType type) {
   switch (type) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
-    default: return "other";
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return "CPU";
+    default:
+      return "other";
   }
 }
 
 // Lower is better.
 int DeviceRank(VkPhysicalDeviceType type) {
   switch (type) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-    default: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+      return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+      return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+      return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:
+      return 3;
+    default:
+      return 4;
   }
 }
 
 std::string VersionString(uint32_t v) {
-  return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(v), VK_API_VERSION_MINOR(v),
-                     VK_API_VERSION_PATCH(v));
+  return fmt::format("{}.{}.{}", VK_API_VERSION_MAJOR(v), VK_API_VERSION_MINOR(v), VK_API_VERSION_PATCH(v));
 }
 
 bool HasLayer(const char* name) {
@@ -154,10 +163,18 @@ std::vector<std::filesystem::path> ManifestFolders(const EnvironmentVariables& e
 }  // namespace
 
 const std::vector<std::string>& DriverEnvironmentVariableNames() {
-  static const std::vector<std::string> names = {
-      "VK_ICD_FILENAMES", "VK_DRIVER_FILES", "VK_ADD_DRIVER_FILES", "VK_LOADER_DRIVERS_SELECT",
-      "VK_LOADER_DRIVERS_DISABLE", "SKYBAKE_ALL_VULKAN_DRIVERS", "HOME", "XDG_CONFIG_HOME", "XDG_CONFIG_DIRS",
-      "XDG_DATA_HOME", "XDG_DATA_DIRS", "LP_NUM_THREADS"};
+  static const std::vector<std::string> names = {"VK_ICD_FILENAMES",
+                                                 "VK_DRIVER_FILES",
+                                                 "VK_ADD_DRIVER_FILES",
+                                                 "VK_LOADER_DRIVERS_SELECT",
+                                                 "VK_LOADER_DRIVERS_DISABLE",
+                                                 "SKYBAKE_ALL_VULKAN_DRIVERS",
+                                                 "HOME",
+                                                 "XDG_CONFIG_HOME",
+                                                 "XDG_CONFIG_DIRS",
+                                                 "XDG_DATA_HOME",
+                                                 "XDG_DATA_DIRS",
+                                                 "LP_NUM_THREADS"};
   return names;
 }
 
@@ -206,20 +223,34 @@ std::string LavapipeThreadCount(const EnvironmentVariables& environment, unsigne
 
 const char* VkResultName(VkResult result) {
   switch (result) {
-    case VK_SUCCESS: return "VK_SUCCESS";
-    case VK_NOT_READY: return "VK_NOT_READY";
-    case VK_TIMEOUT: return "VK_TIMEOUT";
-    case VK_ERROR_OUT_OF_HOST_MEMORY: return "VK_ERROR_OUT_OF_HOST_MEMORY";
-    case VK_ERROR_OUT_OF_DEVICE_MEMORY: return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
-    case VK_ERROR_INITIALIZATION_FAILED: return "VK_ERROR_INITIALIZATION_FAILED";
-    case VK_ERROR_DEVICE_LOST: return "VK_ERROR_DEVICE_LOST";
-    case VK_ERROR_MEMORY_MAP_FAILED: return "VK_ERROR_MEMORY_MAP_FAILED";
-    case VK_ERROR_LAYER_NOT_PRESENT: return "VK_ERROR_LAYER_NOT_PRESENT";
-    case VK_ERROR_EXTENSION_NOT_PRESENT: return "VK_ERROR_EXTENSION_NOT_PRESENT";
-    case VK_ERROR_FEATURE_NOT_PRESENT: return "VK_ERROR_FEATURE_NOT_PRESENT";
-    case VK_ERROR_INCOMPATIBLE_DRIVER: return "VK_ERROR_INCOMPATIBLE_DRIVER";
-    case VK_ERROR_TOO_MANY_OBJECTS: return "VK_ERROR_TOO_MANY_OBJECTS";
-    default: return "VkResult(other)";
+    case VK_SUCCESS:
+      return "VK_SUCCESS";
+    case VK_NOT_READY:
+      return "VK_NOT_READY";
+    case VK_TIMEOUT:
+      return "VK_TIMEOUT";
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+      return "VK_ERROR_OUT_OF_HOST_MEMORY";
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+      return "VK_ERROR_OUT_OF_DEVICE_MEMORY";
+    case VK_ERROR_INITIALIZATION_FAILED:
+      return "VK_ERROR_INITIALIZATION_FAILED";
+    case VK_ERROR_DEVICE_LOST:
+      return "VK_ERROR_DEVICE_LOST";
+    case VK_ERROR_MEMORY_MAP_FAILED:
+      return "VK_ERROR_MEMORY_MAP_FAILED";
+    case VK_ERROR_LAYER_NOT_PRESENT:
+      return "VK_ERROR_LAYER_NOT_PRESENT";
+    case VK_ERROR_EXTENSION_NOT_PRESENT:
+      return "VK_ERROR_EXTENSION_NOT_PRESENT";
+    case VK_ERROR_FEATURE_NOT_PRESENT:
+      return "VK_ERROR_FEATURE_NOT_PRESENT";
+    case VK_ERROR_INCOMPATIBLE_DRIVER:
+      return "VK_ERROR_INCOMPATIBLE_DRIVER";
+    case VK_ERROR_TOO_MANY_OBJECTS:
+      return "VK_ERROR_TOO_MANY_OBJECTS";
+    default:
+      return "VkResult(other)";
   }
 }
 
@@ -237,15 +268,12 @@ std::vector<DeviceInfo> VulkanContext::ListDevices() {
   return infos;
 }
 
-VkBool32 VulkanContext::DebugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-                                      VkDebugUtilsMessageTypeFlagsEXT,
-                                      const VkDebugUtilsMessengerCallbackDataEXT* data,
-                                      void* user) {
+VkBool32 VulkanContext::DebugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
   auto* self = static_cast<VulkanContext*>(user);
-  const char* level =
-      (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
-  std::string text = fmt::format("vulkan validation {}: {}", level,
-                                 data && data->pMessage ? data->pMessage : "(no message)");
+  const char* level = (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning";
+  std::string text =
+      fmt::format("vulkan validation {}: {}", level, data && data->pMessage ? data->pMessage : "(no message)");
   ++self->validation_messages_;
   self->messages_.push_back(text);
   if (self->print_messages_) std::fprintf(stderr, "%s\n", text.c_str());
@@ -261,10 +289,9 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
   try {
     if (options.validation) {
       VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
-      info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                             VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-      info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                         VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+      info.messageSeverity =
+          VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+      info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
                          VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
       info.pfnUserCallback = &VulkanContext::DebugCallback;
       info.pUserData = this;
@@ -275,18 +302,16 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
     }
 
     std::vector<VkPhysicalDevice> devices = EnumerateDevices(instance_);
-    if (devices.empty())
-      throw VulkanUnavailable(fmt::format("no Vulkan device found; {}", kInstallDriver));
+    if (devices.empty()) throw VulkanUnavailable(fmt::format("no Vulkan device found; {}", kInstallDriver));
     int chosen = -1;
     if (options.device_index >= 0) {
       if (options.device_index >= int(devices.size()))
-        throw VulkanUnavailable(fmt::format(
-            "device {} does not exist: there are {} devices (run 'skybake devices')",
-            options.device_index, devices.size()));
+        throw VulkanUnavailable(fmt::format("device {} does not exist: there are {} devices (run 'skybake devices')",
+                                            options.device_index, devices.size()));
       DeviceInfo info = Describe(devices[options.device_index], options.device_index);
       if (!info.usable)
-        throw VulkanUnavailable(fmt::format("device {} ({}) cannot be used: it {}", info.index,
-                                            info.name, info.rejected_because));
+        throw VulkanUnavailable(
+            fmt::format("device {} ({}) cannot be used: it {}", info.index, info.name, info.rejected_because));
       chosen = options.device_index;
     } else {
       int best_rank = 1 << 20;
@@ -300,8 +325,7 @@ VulkanContext::VulkanContext(const VulkanOptions& options) : print_messages_(opt
           chosen = int(i);
         }
       }
-      if (chosen < 0)
-        throw VulkanUnavailable(fmt::format("no usable Vulkan device; {}", kInstallDriver));
+      if (chosen < 0) throw VulkanUnavailable(fmt::format("no usable Vulkan device; {}", kInstallDriver));
     }
     physical_device_ = devices[chosen];
     device_info_ = Describe(physical_device_, chosen);
@@ -359,8 +383,7 @@ uint32_t VulkanContext::FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags
     if (fallback < 0) fallback = int(i);
   }
   if (fallback < 0)
-    throw VulkanError("no Vulkan memory type with the required properties",
-                      VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    throw VulkanError("no Vulkan memory type with the required properties", VK_ERROR_OUT_OF_DEVICE_MEMORY);
   return uint32_t(fallback);
 }
 

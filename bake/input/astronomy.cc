@@ -63,9 +63,10 @@ std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::str
   // process, so every frame of a bake draws the same stars.
   std::shared_ptr<const std::string> bytes;
   if (const std::string problem = ReadKept(path, kMaxCatalogueBytes, bytes); !problem.empty()) {
-    error = fmt::format("cannot read the star catalogue {}: it {}: give night.star_catalogue the path of a d3-celestial "
-                        "stars.*.json (bash .ci/setup installs configs/stars/node_modules/d3-celestial/data/stars.8.json)",
-                        EscapedText(path), problem == "no such file" ? "does not exist" : problem);
+    error = fmt::format(
+        "cannot read the star catalogue {}: it {}: give night.star_catalogue the path of a d3-celestial "
+        "stars.*.json (bash .ci/setup installs configs/stars/node_modules/d3-celestial/data/stars.8.json)",
+        EscapedText(path), problem == "no such file" ? "does not exist" : problem);
     return std::nullopt;
   }
   return ParseStarCatalogue(*bytes, path, error);
@@ -74,9 +75,10 @@ std::optional<StarCatalogue> LoadStarCatalogue(const std::string& path, std::str
 std::optional<StarCatalogue> ParseStarCatalogue(const std::string& text, const std::string& path, std::string& error) {
   nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_object() || !doc.contains("features") || !doc["features"].is_array()) {
-    error = fmt::format("{} is not a d3-celestial star file (a GeoJSON FeatureCollection with \"features\"): give "
-                        "night.star_catalogue a stars.6.json, stars.8.json or stars.14.json of d3-celestial",
-                        EscapedText(path));
+    error = fmt::format(
+        "{} is not a d3-celestial star file (a GeoJSON FeatureCollection with \"features\"): give "
+        "night.star_catalogue a stars.6.json, stars.8.json or stars.14.json of d3-celestial",
+        EscapedText(path));
     return std::nullopt;
   }
   StarCatalogue catalogue;
@@ -87,15 +89,15 @@ std::optional<StarCatalogue> ParseStarCatalogue(const std::string& text, const s
     ++index;
     const nlohmann::json* coords = nullptr;
     const nlohmann::json* props = nullptr;
-    if (f.is_object() && f.contains("geometry") && f["geometry"].is_object() &&
-        f["geometry"].contains("coordinates"))
+    if (f.is_object() && f.contains("geometry") && f["geometry"].is_object() && f["geometry"].contains("coordinates"))
       coords = &f["geometry"]["coordinates"];
     if (f.is_object() && f.contains("properties") && f["properties"].is_object()) props = &f["properties"];
     if (!coords || !props || !coords->is_array() || coords->size() < 2 || !(*coords)[0].is_number() ||
         !(*coords)[1].is_number() || !props->contains("mag") || !(*props)["mag"].is_number()) {
-      error = fmt::format("{}: star {} has no [lon, lat] coordinates or no numeric \"mag\": give "
-                          "night.star_catalogue an unmodified d3-celestial stars.*.json",
-                          EscapedText(path), index);
+      error = fmt::format(
+          "{}: star {} has no [lon, lat] coordinates or no numeric \"mag\": give "
+          "night.star_catalogue an unmodified d3-celestial stars.*.json",
+          EscapedText(path), index);
       return std::nullopt;
     }
     CatalogueStar s;
@@ -104,8 +106,10 @@ std::optional<StarCatalogue> ParseStarCatalogue(const std::string& text, const s
     s.dec_j2000_deg = lat;
     s.v_magnitude = (*props)["mag"].get<double>();
     if (!std::isfinite(lon) || !std::isfinite(lat) || std::abs(lat) > 90.0 || !std::isfinite(s.v_magnitude)) {
-      error = fmt::format("{}: star {} has coordinates or a magnitude out of range: give night.star_catalogue an "
-                          "unmodified d3-celestial stars.*.json", EscapedText(path), index);
+      error = fmt::format(
+          "{}: star {} has coordinates or a magnitude out of range: give night.star_catalogue an "
+          "unmodified d3-celestial stars.*.json",
+          EscapedText(path), index);
       return std::nullopt;
     }
     if (props->contains("bv")) {
@@ -193,7 +197,9 @@ glm::dvec3 J2000Axes::ToJ2000(const glm::dvec3& world) const {
   return {glm::dot(world, x), glm::dot(world, y), glm::dot(world, z)};
 }
 
-glm::dvec3 WorldFromJ2000(const J2000Axes& axes, const glm::dvec3& v) { return v.x * axes.x + v.y * axes.y + v.z * axes.z; }
+glm::dvec3 WorldFromJ2000(const J2000Axes& axes, const glm::dvec3& v) {
+  return v.x * axes.x + v.y * axes.y + v.z * axes.z;
+}
 
 std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnitude_limit, double julian_day_ut,
                                    const GeoLocation& place, double min_elevation_deg) {

@@ -45,16 +45,16 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
       if (!value.is_boolean()) error(&value, p, "expected true or false");
       else f.enabled = value.as_boolean()->get();
     } else if (k == "density") {
-      if (!value.is_boolean()) error(&value, p, "expected true (the automaton's whole density) or false (its coverage)");
+      if (!value.is_boolean())
+        error(&value, p, "expected true (the automaton's whole density) or false (its coverage)");
       else f.density = value.as_boolean()->get();
     } else if (k == "cells") {
       numbers(value, p, 3, "[east, north, up] cell counts", [&](const toml::node& v, const std::string& q, size_t j) {
         integer(v, q, j < 2 ? 4 : 1, j < 2 ? 512 : 64, f.cells[j]);
       });
     } else if (k == "size_m") {
-      numbers(value, p, 2, "[east, north] extent in m", [&](const toml::node& v, const std::string& q, size_t j) {
-        number(v, q, 10.0, 1e7, f.size_m[j]);
-      });
+      numbers(value, p, 2, "[east, north] extent in m",
+              [&](const toml::node& v, const std::string& q, size_t j) { number(v, q, 10.0, 1e7, f.size_m[j]); });
     } else if (k == "origin_m") {
       numbers(value, p, 2, "[east, north] of the south-west corner in m",
               [&](const toml::node& v, const std::string& q, size_t j) { number(v, q, -1e7, 1e7, f.origin_m[j]); });
@@ -90,12 +90,13 @@ void ReadCloudFormation(const toml::node& node, const std::string& path, CloudFo
     } else if (k == "mask_layer") {
       number(value, p, 0.0, 255.0, f.mask_layer);
     } else {
-      error(&value, p,
-            fmt::format("unknown key '{}' (a formation has enabled, cells, size_m, origin_m, steps_per_hour, "
-                        "day_start_hour, warmup_steps, extinction_probability, humidity_probability, phase_probability, "
-                        "initial_humidity, smoothing_cells, smoothing_steps, mask_image, mask_layers, mask_layer, "
-                        "velocity_cells_per_hour, density)",
-                        k));
+      error(
+          &value, p,
+          fmt::format("unknown key '{}' (a formation has enabled, cells, size_m, origin_m, steps_per_hour, "
+                      "day_start_hour, warmup_steps, extinction_probability, humidity_probability, phase_probability, "
+                      "initial_humidity, smoothing_cells, smoothing_steps, mask_image, mask_layers, mask_layer, "
+                      "velocity_cells_per_hour, density)",
+                      k));
     }
   }
   if (f.mask_layer > f.mask_layers - 1) {

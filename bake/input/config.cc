@@ -73,9 +73,9 @@ constexpr Range kSunRadiusRad{1e-6, 0.5, false, false};
 constexpr Range kSunAzimuth{-1e5, 1e5, false, false};
 constexpr Range kIrradiance{0.0, 1e4, false, false};
 constexpr Range kMultiplier{0.0, 1e3, false, false};
-constexpr Range kEv100{-50.0, 50.0, false, false};    // moonless night about -10, snow in sunlight about 16
+constexpr Range kEv100{-50.0, 50.0, false, false};         // moonless night about -10, snow in sunlight about 16
 constexpr Range kViewerPosition{-1e6, 1e6, false, false};  // within the largest dome
-constexpr Range kGltfRadiusM{1e-3, 1e8, false, false};  // finite in float32 with its vertices' products
+constexpr Range kGltfRadiusM{1e-3, 1e8, false, false};     // finite in float32 with its vertices' products
 
 // Documented limits (README "Limits"): beyond these a bake would need more
 // than the memory budget or hours of lavapipe time.
@@ -156,8 +156,10 @@ void VisitQuality(SkyStyle& s, Visitor& v) {
   QualitySettings& q = s.quality;
   v.Preset("quality.preset", s.quality_preset, q, s.clouds.quality);  // first: the keys below refine it
   v.Choice("quality.integrator", q.integrator,
-           {{"analytic", INTEGRATOR_ANALYTIC}, {"midpoint", INTEGRATOR_MIDPOINT},
-            {"trapezoid", INTEGRATOR_TRAPEZOID}, {"simpson", INTEGRATOR_SIMPSON}});
+           {{"analytic", INTEGRATOR_ANALYTIC},
+            {"midpoint", INTEGRATOR_MIDPOINT},
+            {"trapezoid", INTEGRATOR_TRAPEZOID},
+            {"simpson", INTEGRATOR_SIMPSON}});
   v.Int("quality.light_steps", q.light_steps, 0, kMaxSteps);
   v.Choice("quality.step_distribution", q.step_distribution,
            {{"uniform", STEPS_UNIFORM}, {"quadratic", STEPS_QUADRATIC}});
@@ -219,13 +221,14 @@ void VisitOutputs(SkyStyle& s, Visitor& v) {
   v.FileName("output.basename", o.basename);
   v.Choice("output.pixel_type", o.pixel_type, {{"half", PixelType::kHalf}, {"float", PixelType::kFloat}});
   v.Choice("output.compression", o.compression,
-           {{"none", std::string("none")}, {"rle", std::string("rle")}, {"zips", std::string("zips")},
-            {"zip", std::string("zip")}, {"piz", std::string("piz")}});
+           {{"none", std::string("none")},
+            {"rle", std::string("rle")},
+            {"zips", std::string("zips")},
+            {"zip", std::string("zip")},
+            {"piz", std::string("piz")}});
   v.Int("output.zip_level", o.zip_level, 1, 9);
-  v.Choice("output.overflow", o.overflow,
-           {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
-  v.Choice("output.units", o.units,
-           {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
+  v.Choice("output.overflow", o.overflow, {{"scale", OverflowPolicy::kScale}, {"refuse", OverflowPolicy::kRefuse}});
+  v.Choice("output.units", o.units, {{"luminance", OutputUnits::kLuminance}, {"spectral", OutputUnits::kSpectral}});
   v.Choice("output.sun", o.sun, {{"light", SunOutput::kLight}, {"map", SunOutput::kMap}});
   v.Text("output.color_space", o.color_space.name);  // resolved by CheckColorSpace
   if (v.kReads || !o.ocio_config.empty()) v.Text("output.ocio_config", o.ocio_config);
@@ -327,8 +330,9 @@ void VisitIbl(SkyStyle& s, Visitor& v) {
   v.Bool("ibl.include_sun", i.include_sun);
   v.Bool("ibl.exr", i.exr);
   v.Bool("ibl.ktx2", i.ktx2);
-  v.Choice("ibl.ktx2_format", i.ktx2_format,
-           {{"rgba16f", KtxFormat::kRgba16f}, {"b10g11r11", KtxFormat::kB10g11r11}, {"e5b9g9r9", KtxFormat::kE5b9g9r9}});
+  v.Choice(
+      "ibl.ktx2_format", i.ktx2_format,
+      {{"rgba16f", KtxFormat::kRgba16f}, {"b10g11r11", KtxFormat::kB10g11r11}, {"e5b9g9r9", KtxFormat::kE5b9g9r9}});
   v.Int("ibl.ktx2_zstd_level", i.ktx2_zstd_level, 0, 19);
 }
 
@@ -466,7 +470,8 @@ class StyleReader : public TomlReader {
                 ? fmt::format("a name of {} characters is longer than the 128 a plain file name may have", text.size())
                 : fmt::format("{} is not a plain file name: use letters, digits, '_', '-', '.', '+', no '/' or "
                               "'..', not starting with '.' or '-', not a name Windows reserves (CON, NUL, COM1, "
-                              "...)", EscapedText(text)));
+                              "...)",
+                              EscapedText(text)));
       return;
     }
     out = text;
@@ -493,8 +498,7 @@ class StyleReader : public TomlReader {
       }
       if (!FindEnginePreset(name)) {
         Error(node, path,
-              name == "none" ? fmt::format("'none' cannot be given with other presets: '{}'",
-                                           node->as_string()->get())
+              name == "none" ? fmt::format("'none' cannot be given with other presets: '{}'", node->as_string()->get())
                              : fmt::format("'{}' is not one of {}", name, choices));
         return;
       }
@@ -539,8 +543,7 @@ class StyleReader : public TomlReader {
   void Uint(const char* path, uint32_t& out) {
     const toml::node* node = Find(path);
     if (!node) return;
-    if (!node->is_integer() || node->as_integer()->get() < 0 ||
-        node->as_integer()->get() > int64_t(UINT32_MAX)) {
+    if (!node->is_integer() || node->as_integer()->get() < 0 || node->as_integer()->get() > int64_t(UINT32_MAX)) {
       Error(node, path, fmt::format("expected an integer in [0, {}]", UINT32_MAX));
       return;
     }
@@ -632,7 +635,8 @@ class StyleReader : public TomlReader {
           ok = false;
           Error(&value, key_path,
                 fmt::format("unknown key '{}' (a shape has kind, points, closed, radius_deg, "
-                            "strength)", k));
+                            "strength)",
+                            k));
         }
       }
       if (ok && shape.points.empty()) {
@@ -714,7 +718,8 @@ class StyleReader : public TomlReader {
         else if (k == "weather_extent_m")
           numbers(value, key_path, kWeatherSize, layer.weather_extent_m.data(), 2, "[east, north] size in m");
         else if (k == "weather_origin_m")
-          numbers(value, key_path, kOrigin, layer.weather_origin_m.data(), 2, "[east, north] of the south-west corner in m");
+          numbers(value, key_path, kOrigin, layer.weather_origin_m.data(), 2,
+                  "[east, north] of the south-west corner in m");
         else if (k == "profile") {
           numbers(value, key_path, kUnit, layer.profile.data(), 4, "[bottom_in, bottom_full, top_full, top_out]");
           has_profile = true;
@@ -751,12 +756,13 @@ class StyleReader : public TomlReader {
           }
         } else {
           ok = false;
-          Error(&value, key_path,
-                fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
-                            "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
-                            "wind_m_s, shear_m_s_per_km, seed, weather_size_m, tiling, weather_image, weather_extent_m, "
-                            "weather_origin_m, formation, streak_ratio)",
-                            k));
+          Error(
+              &value, key_path,
+              fmt::format("unknown key '{}' (a cloud layer has altitude_m, thickness_m, type, profile, coverage, "
+                          "density_per_m, albedo, shape_amount, shape_size_m, detail_amount, detail_size_m, "
+                          "wind_m_s, shear_m_s_per_km, seed, weather_size_m, tiling, weather_image, weather_extent_m, "
+                          "weather_origin_m, formation, streak_ratio)",
+                          k));
         }
       }
       if (ok && has_streak_ratio && layer.type != CloudType::kCirrus) {
@@ -769,7 +775,8 @@ class StyleReader : public TomlReader {
       }
       if (ok && !has_profile && layer.type == CloudType::kCustom) {
         ok = false;
-        Error(array->get(i), where + ".type", "type = \"custom\" needs profile = [bottom_in, bottom_full, top_full, top_out]");
+        Error(array->get(i), where + ".type",
+              "type = \"custom\" needs profile = [bottom_in, bottom_full, top_full, top_out]");
       }
       if (ok && !has_profile) layer.profile = CloudTypeProfile(layer.type);
       if (ok) layers.push_back(std::move(layer));
@@ -977,8 +984,8 @@ std::optional<toml::source_position> DeepKey(std::string_view text) {
       in_chain = true;
       continue;
     }
-    const bool bare = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' ||
-                      c == '-' || c == '+';
+    const bool bare =
+        (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' || c == '+';
     if (bare) {
       in_chain = true;
     } else if (c == '.' && in_chain) {
@@ -1051,15 +1058,17 @@ void ApplyOverride(toml::table& root, const std::string& text, std::vector<Confi
     return;
   }
   if (key == "schedule" || key.rfind("schedule.", 0) == 0) {
-    fail("a schedule is not changed with --set (it would be ignored): edit the schedule file, or use its "
-         "[schedule.ramp] or a frame's set");
+    fail(
+        "a schedule is not changed with --set (it would be ignored): edit the schedule file, or use its "
+        "[schedule.ramp] or a frame's set");
     return;
   }
   if (KeyHasTooManyParts(key)) {
     // Refused before the key is split (the key named by its first part).
-    fail(fmt::format("the key has more than {} dotted parts (skybake's keys have at most 5, e.g. "
-                     "atmosphere.rayleigh.scale_height_km): give a style key",
-                     kMaxKeyParts));
+    fail(
+        fmt::format("the key has more than {} dotted parts (skybake's keys have at most 5, e.g. "
+                    "atmosphere.rayleigh.scale_height_km): give a style key",
+                    kMaxKeyParts));
     errors.back().key = key.substr(0, key.find('.')) + ".(...)";
     return;
   }
@@ -1136,8 +1145,8 @@ bool IsPlainFileName(const std::string& name) {
   if (stem.size() == 4 && (stem.rfind("COM", 0) == 0 || stem.rfind("LPT", 0) == 0) && stem[3] >= '1' && stem[3] <= '9')
     return false;
   for (char c : name) {
-    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-              c == '_' || c == '-' || c == '.' || c == '+';
+    bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_' || c == '-' ||
+              c == '.' || c == '+';
     if (!ok) return false;
   }
   return name.find("..") == std::string::npos;
@@ -1182,8 +1191,8 @@ void CheckAtmosphere(const SkyStyle& style, StyleChecks& c) {
   const AtmosphereParams& a = style.atmosphere;
   if (!(a.top_radius_km > a.bottom_radius_km)) {
     ConfigError e = c.Locate("atmosphere.top_radius_km");
-    e.message = fmt::format("top radius {} km must be above the bottom radius {} km",
-                            a.top_radius_km, a.bottom_radius_km);
+    e.message =
+        fmt::format("top radius {} km must be above the bottom radius {} km", a.top_radius_km, a.bottom_radius_km);
     c.errors.push_back(e);
   }
   for (int channel = 0; channel < 3; ++channel) {
@@ -1204,9 +1213,10 @@ void CheckAoas(const SkyStyle& style, StyleChecks& c) {
     const glm::dvec3& p = x.skydome.viewer_position;
     if (!(glm::length(p) < 0.99 * x.skydome.radius)) {
       ConfigError e = c.Locate("skydome.viewer_position");
-      e.message = fmt::format("the viewer must be inside the dome: |position| = {} must be below "
-                              "0.99 x radius = {}",
-                              glm::length(p), 0.99 * x.skydome.radius);
+      e.message = fmt::format(
+          "the viewer must be inside the dome: |position| = {} must be below "
+          "0.99 x radius = {}",
+          glm::length(p), 0.99 * x.skydome.radius);
       c.errors.push_back(e);
     }
     if (p.y < 0.0) {
@@ -1223,8 +1233,8 @@ void CheckAoas(const SkyStyle& style, StyleChecks& c) {
       c.errors.push_back(e);
     } else if (arcs > AOAS_MAX_SHAPE_SEGMENTS) {
       ConfigError e = c.Locate("shapes.shape");
-      e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit",
-                              arcs, kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
+      e.message = fmt::format("the shapes need {} arcs (a spline takes {} per span); at most {} fit", arcs,
+                              kAoasSplineSubdivisions, AOAS_MAX_SHAPE_SEGMENTS);
       c.errors.push_back(e);
     }
   }
@@ -1237,25 +1247,26 @@ void CheckCloudLayers(const SkyStyle& style, StyleChecks& c) {
   for (const CloudProblem& p : ValidateClouds(style.clouds, a, style_dir)) {
     std::string key = p.layer < 0 ? "cloud_layer" : fmt::format("cloud_layer[{}]", p.layer);
     if (p.layer == -3) {  // the light volume's size
-      ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_volume_columns").node()
-                                   ? "quality.cloud_light_volume_columns"
-                                   : "quality.cloud_light_volume_slices");
+      ConfigError e =
+          c.Locate(c.root.at_path("quality.cloud_light_volume_columns").node() ? "quality.cloud_light_volume_columns"
+                                                                               : "quality.cloud_light_volume_slices");
       e.message = p.message;
       c.errors.push_back(e);
       continue;
     }
     if (p.layer == -2) {  // the sampling settings
       ConfigError e = c.Locate(c.root.at_path("quality.cloud_light_steps").node() ? "quality.cloud_light_steps"
-                                                                              : "quality.cloud_view_steps");
+                                                                                  : "quality.cloud_view_steps");
       e.message = p.message;
       c.errors.push_back(e);
       continue;
     }
     ConfigError e = c.Locate("cloud_layer");
-    if (const toml::array* layers = c.root["cloud_layer"].as_array(); layers && p.layer >= 0 &&
-                                                                    size_t(p.layer) < layers->size()) {
+    if (const toml::array* layers = c.root["cloud_layer"].as_array();
+        layers && p.layer >= 0 && size_t(p.layer) < layers->size()) {
       const toml::node* at = layers->get(size_t(p.layer));
-      if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->at_path(p.key).node()) at = t->at_path(p.key).node();
+      if (const toml::table* t = at->as_table(); t && !p.key.empty() && t->at_path(p.key).node())
+        at = t->at_path(p.key).node();
       if (at->source().begin) {
         e.line = int(at->source().begin.line);
         e.column = int(at->source().begin.column);
@@ -1288,8 +1299,10 @@ void CheckFaceNames(const SkyStyle& style, StyleChecks& c) {
       e.message = reserved ? fmt::format("'{}' is the name of another output file: choose another face name", faces[i])
                   : faces[twin] == faces[i]
                       ? fmt::format("'{}' is given twice: each face is its own file", faces[i])
-                      : fmt::format("'{}' and '{}' differ only in case, one file on a case-insensitive file "
-                                    "system: each face is its own file", faces[twin], faces[i]);
+                      : fmt::format(
+                            "'{}' and '{}' differ only in case, one file on a case-insensitive file "
+                            "system: each face is its own file",
+                            faces[twin], faces[i]);
       c.errors.push_back(e);
       break;
     }
@@ -1300,21 +1313,24 @@ void CheckFaceNames(const SkyStyle& style, StyleChecks& c) {
 void CheckSceneAndEngine(const SkyStyle& style, StyleChecks& c) {
   if (style.gltf.image_based_light && (!style.ibl.specular || !style.gltf.enabled)) {
     ConfigError e = c.Locate("gltf.image_based_light");
-    e.message = "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
-                "(and gltf.enabled = true), or gltf.image_based_light = false";
+    e.message =
+        "the scene's image-based light is made of the prefiltered specular maps: set ibl.specular = true "
+        "(and gltf.enabled = true), or gltf.image_based_light = false";
     c.errors.push_back(e);
   }
   // The USD layer's dome is the latlong EXR, in cd/m^2 (UsdLux: nits).
   if (style.usd.enabled && !style.output.latlong) {
     ConfigError e = c.Locate("usd.enabled");
-    e.message = "the USD layer's DomeLight is textured with the latlong EXR: set output.latlong = true, or "
-                "usd.enabled = false";
+    e.message =
+        "the USD layer's DomeLight is textured with the latlong EXR: set output.latlong = true, or "
+        "usd.enabled = false";
     c.errors.push_back(e);
   }
   if (style.usd.enabled && style.output.units != OutputUnits::kLuminance) {
     ConfigError e = c.Locate("usd.enabled");
-    e.message = "UsdLux lights emit in nits (cd/m^2): the USD layer needs output.units = \"luminance\", or "
-                "usd.enabled = false";
+    e.message =
+        "UsdLux lights emit in nits (cd/m^2): the USD layer needs output.units = \"luminance\", or "
+        "usd.enabled = false";
     c.errors.push_back(e);
   }
   if (std::optional<std::string> engine = EngineStyleError(style)) {
@@ -1363,9 +1379,10 @@ void CheckSunInMaps(const SkyStyle& style, StyleChecks& c) {
       o.units != OutputUnits::kLuminance || !style.effects.sun_disc || style.effects.sun_disc_strength <= 0.0)
     return;
   ConfigError e = c.Locate("output.sun");
-  e.message = "the solar disc in half-float maps exceeds half range (65504 cd/m^2) and output.overflow = \"refuse\" "
-              "forbids a scale: set output.sun = \"light\" (the Sun as a light, the default), "
-              "output.pixel_type = \"float\", or output.overflow = \"scale\"";
+  e.message =
+      "the solar disc in half-float maps exceeds half range (65504 cd/m^2) and output.overflow = \"refuse\" "
+      "forbids a scale: set output.sun = \"light\" (the Sun as a light, the default), "
+      "output.pixel_type = \"float\", or output.overflow = \"scale\"";
   c.errors.push_back(e);
 }
 
@@ -1395,17 +1412,19 @@ void CheckSpectral(SkyStyle& style, StyleChecks& c) {
   const bool radiance = style.output.units == OutputUnits::kSpectral;
   if (radiance && !style.output.color_space.IsRec709()) {
     ConfigError e = c.Locate("output.color_space");
-    e.message = "radiance at 680/550/440 nm (output.units = \"spectral\") has no primaries: set "
-                "output.units = \"luminance\" or output.color_space = \"rec709\"";
+    e.message =
+        "radiance at 680/550/440 nm (output.units = \"spectral\") has no primaries: set "
+        "output.units = \"luminance\" or output.color_space = \"rec709\"";
     c.errors.push_back(e);
   }
   if (style.quality.wavelengths <= kRgbWavelengths) return;
   if (radiance) {
     ConfigError w = c.Locate("quality.wavelengths");
-    w.message = fmt::format("output.units = \"spectral\" writes radiance at 680/550/440 nm, so the {} bins are "
-                            "not rendered (the three-wavelength path is): set output.units = \"luminance\" for "
-                            "the spectral mode's colour",
-                            style.quality.wavelengths);
+    w.message = fmt::format(
+        "output.units = \"spectral\" writes radiance at 680/550/440 nm, so the {} bins are "
+        "not rendered (the three-wavelength path is): set output.units = \"luminance\" for "
+        "the spectral mode's colour",
+        style.quality.wavelengths);
     c.warnings.push_back(w);
     style.quality.wavelengths = kRgbWavelengths;
   }
@@ -1420,9 +1439,10 @@ void WarnPresetChangesNothing(const SkyStyle& style, const StyleReader& reader, 
       ConfigError w = c.Locate("quality.preset");
       std::string list;
       for (const std::string& k : keys) list += (list.empty() ? "" : ", ") + k;
-      w.message = fmt::format("preset '{}' changes nothing: every key it sets is given explicitly ({}), and "
-                              "explicit keys refine the preset; remove or comment out those keys to use it",
-                              style.quality_preset, list);
+      w.message = fmt::format(
+          "preset '{}' changes nothing: every key it sets is given explicitly ({}), and "
+          "explicit keys refine the preset; remove or comment out those keys to use it",
+          style.quality_preset, list);
       c.warnings.push_back(w);
     }
   }
@@ -1462,7 +1482,8 @@ ConfigResult ParseSkyStyle(std::string_view toml_text, const std::string& name,
   StyleReader reader(root, name, result.errors);
   VisitStyle(result.style, reader);
   reader.ReportUnknownKeys({"schedule"});  // read by LoadSchedule (schedule.h)
-  if (const toml::node* c = root.at_path("night.star_catalogue").node(); c && c->source().path && *c->source().path != name)
+  if (const toml::node* c = root.at_path("night.star_catalogue").node();
+      c && c->source().path && *c->source().path != name)
     result.style.night.star_catalogue_set = *c->source().path;
 
   // Cross-field checks, located at the second key.
@@ -1506,9 +1527,10 @@ std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string
   e.line = int(at->line);
   e.column = int(at->column);
   e.key = "(syntax)";
-  e.message = fmt::format("a dotted key or table name of more than {} parts: skybake's keys have at most 5, e.g. "
-                          "atmosphere.rayleigh.scale_height_km",
-                          kMaxKeyParts);
+  e.message = fmt::format(
+      "a dotted key or table name of more than {} parts: skybake's keys have at most 5, e.g. "
+      "atmosphere.rayleigh.scale_height_km",
+      kMaxKeyParts);
   return e;
 }
 
@@ -1520,18 +1542,19 @@ std::optional<ConfigError> ReadInputFile(const std::string& path, const char* wh
   // whatever the size says (a file in /proc says 0).
   const std::string problem = ReadRegularFile(path, kMaxInputBytes, FileLinks::kFollow, text);
   if (problem.empty()) return std::nullopt;
-  if (problem == "no such file" || problem.rfind("cannot be opened", 0) == 0 || problem.rfind("cannot be read (no", 0) == 0)
+  if (problem == "no such file" || problem.rfind("cannot be opened", 0) == 0 ||
+      problem.rfind("cannot be read (no", 0) == 0)
     e.message = fmt::format("cannot open the {} file: check the path", what);
   else if (problem == "is a directory, not a file")
     e.message = fmt::format("is a directory: give a {} TOML file", what);
   else if (problem.find("not a regular file") != std::string::npos)
     e.message = fmt::format("is not a regular file (a device, a pipe or a socket): give a {} TOML file", what);
   else if (problem.find("MiB") != std::string::npos)
-    e.message = fmt::format("is larger than {} MiB, the limit of a style or schedule file (a schedule of "
-                            "100,000 frames listed one by one is under 8 MiB): give a {} TOML file",
-                            kMaxInputBytes >> 20, what);
-  else
-    e.message = fmt::format("the {} file {}", what, problem);
+    e.message = fmt::format(
+        "is larger than {} MiB, the limit of a style or schedule file (a schedule of "
+        "100,000 frames listed one by one is under 8 MiB): give a {} TOML file",
+        kMaxInputBytes >> 20, what);
+  else e.message = fmt::format("the {} file {}", what, problem);
   return e;
 }
 

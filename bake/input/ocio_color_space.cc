@@ -42,8 +42,11 @@ Matrix3 SampledMatrix(const OCIO::ConstCPUProcessorRcPtr& cpu) {
 // Whether the processor is the matrix on colours from dark to bright and
 // out of gamut (to float precision).
 bool IsLinear(const OCIO::ConstCPUProcessorRcPtr& cpu, const Matrix3& m) {
-  for (const std::array<double, 3>& v : std::vector<std::array<double, 3>>{
-           {0.18, 0.18, 0.18}, {0.001, 0.002, 0.0005}, {40.0, 25.0, 10.0}, {1000.0, 3000.0, 2000.0}, {-0.05, 0.3, 0.9}}) {
+  for (const std::array<double, 3>& v : std::vector<std::array<double, 3>>{{0.18, 0.18, 0.18},
+                                                                           {0.001, 0.002, 0.0005},
+                                                                           {40.0, 25.0, 10.0},
+                                                                           {1000.0, 3000.0, 2000.0},
+                                                                           {-0.05, 0.3, 0.9}}) {
     const std::array<double, 3> got = ApplyProcessor(cpu, v), want = Apply(m, v);
     const double scale = std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
     for (int i = 0; i < 3; ++i)
@@ -83,8 +86,8 @@ void CollectLutFiles(const OCIO::ConstTransformRcPtr& t, std::vector<std::string
 std::string LutFilesProblem(const OCIO::ConstConfigRcPtr& config) {
   std::vector<std::string> files;
   for (int i = 0; i < config->getNumColorSpaces(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL); ++i) {
-    auto space = config->getColorSpace(config->getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL,
-                                                                        OCIO::COLORSPACE_ALL, i));
+    auto space = config->getColorSpace(
+        config->getColorSpaceNameByIndex(OCIO::SEARCH_REFERENCE_SPACE_ALL, OCIO::COLORSPACE_ALL, i));
     if (!space) continue;
     CollectLutFiles(space->getTransform(OCIO::COLORSPACE_DIR_TO_REFERENCE), files);
     CollectLutFiles(space->getTransform(OCIO::COLORSPACE_DIR_FROM_REFERENCE), files);
@@ -116,8 +119,8 @@ std::string LutFilesProblem(const OCIO::ConstConfigRcPtr& config) {
     if (problem.empty()) {
       struct stat st {};
       if (::fstat(fd, &st) == 0 && uint64_t(st.st_size) > kMaxLutBytes)
-        problem = fmt::format("is {} bytes, more than the {} MiB a LUT may have", uint64_t(st.st_size),
-                              kMaxLutBytes >> 20);
+        problem =
+            fmt::format("is {} bytes, more than the {} MiB a LUT may have", uint64_t(st.st_size), kMaxLutBytes >> 20);
       ::close(fd);
     }
     if (!problem.empty()) return fmt::format("its LUT file '{}' ({}) {}", src, resolved, problem);
@@ -132,9 +135,10 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
   // Through the door (file_door.h): a regular file, capped, read once.
   std::shared_ptr<const std::string> bytes;
   if (const std::string problem = ReadKept(path, kMaxConfigBytes, bytes); !problem.empty()) {
-    r.error = fmt::format("'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
-                          "cannot be read: it {}",
-                          name, BuiltinColorSpaceNames(), path, problem);
+    r.error = fmt::format(
+        "'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
+        "cannot be read: it {}",
+        name, BuiltinColorSpaceNames(), path, problem);
     return r;
   }
   OCIO::ConstConfigRcPtr config;
@@ -146,9 +150,10 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
     read->setWorkingDir(std::filesystem::absolute(path).parent_path().string().c_str());
     config = read;
   } catch (const OCIO::Exception& e) {
-    r.error = fmt::format("'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
-                          "cannot be read: {}",
-                          name, BuiltinColorSpaceNames(), path, e.what());
+    r.error = fmt::format(
+        "'{}' is not a built-in space ({}), and the OpenColorIO config {} that would name it "
+        "cannot be read: {}",
+        name, BuiltinColorSpaceNames(), path, e.what());
     return r;
   }
   std::string lut_problem;
@@ -158,21 +163,24 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
     lut_problem = fmt::format("its transforms cannot be listed ({})", e.what());
   }
   if (const std::string& problem = lut_problem; !problem.empty()) {
-    r.error = fmt::format("the OpenColorIO config {} cannot be used: {}; give the LUT as a regular file of at "
-                          "most {} MiB, or a config that does not name it",
-                          path, problem, kMaxLutBytes >> 20);
+    r.error = fmt::format(
+        "the OpenColorIO config {} cannot be used: {}; give the LUT as a regular file of at "
+        "most {} MiB, or a config that does not name it",
+        path, problem, kMaxLutBytes >> 20);
     return r;
   }
   if (!config->getColorSpace(name.c_str())) {
-    r.error = fmt::format("'{}' is neither a built-in space ({}) nor a colour space of the OpenColorIO config {} "
-                          "(its spaces: {})",
-                          name, BuiltinColorSpaceNames(), path, ConfigSpaceNames(config));
+    r.error = fmt::format(
+        "'{}' is neither a built-in space ({}) nor a colour space of the OpenColorIO config {} "
+        "(its spaces: {})",
+        name, BuiltinColorSpaceNames(), path, ConfigSpaceNames(config));
     return r;
   }
   if (!config->hasRole("aces_interchange")) {
-    r.error = fmt::format("the OpenColorIO config {} has no 'aces_interchange' role, the ACES2065-1 space through "
-                          "which skybake enters a config: add the role (OpenColorIO 2 configs have it)",
-                          path);
+    r.error = fmt::format(
+        "the OpenColorIO config {} has no 'aces_interchange' role, the ACES2065-1 space through "
+        "which skybake enters a config: add the role (OpenColorIO 2 configs have it)",
+        path);
     return r;
   }
   try {
@@ -180,15 +188,17 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
         config->getProcessor("aces_interchange", name.c_str())->getDefaultCPUProcessor();
     const Matrix3 from_aces = SampledMatrix(to_space);
     if (!IsLinear(to_space, from_aces)) {
-      r.error = fmt::format("'{}' of the OpenColorIO config {} is not a linear space: skybake writes scene-linear "
-                            "light (cd/m^2); name a linear space of the config",
-                            name, path);
+      r.error = fmt::format(
+          "'{}' of the OpenColorIO config {} is not a linear space: skybake writes scene-linear "
+          "light (cd/m^2); name a linear space of the config",
+          name, path);
       return r;
     }
     // The space's primaries and white as light, through OpenColorIO's ACES AP0 to D65 XYZ.
     OCIO::BuiltinTransformRcPtr to_xyz = OCIO::BuiltinTransform::Create();
     to_xyz->setStyle("UTILITY - ACES-AP0_to_CIE-XYZ-D65_BFD");
-    const Matrix3 aces_to_xyz = SampledMatrix(OCIO::Config::CreateRaw()->getProcessor(to_xyz)->getDefaultCPUProcessor());
+    const Matrix3 aces_to_xyz =
+        SampledMatrix(OCIO::Config::CreateRaw()->getProcessor(to_xyz)->getDefaultCPUProcessor());
     const Matrix3 space_to_xyz = Multiply(aces_to_xyz, Inverse(from_aces));
     OutputColorSpace space;
     space.name = name;
@@ -201,8 +211,8 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
     }
     for (const auto& xy : space.chromaticities)
       if (!std::isfinite(xy[0]) || !std::isfinite(xy[1])) {
-        r.error = fmt::format("'{}' of the OpenColorIO config {} has no chromaticities (a primary of no light)",
-                              name, path);
+        r.error =
+            fmt::format("'{}' of the OpenColorIO config {} has no chromaticities (a primary of no light)", name, path);
         return r;
       }
     r.space = space;
@@ -216,7 +226,8 @@ ColorSpaceLookup FromConfig(const std::string& name, const std::string& path) {
 
 std::string BuiltinColorSpaceNames() {
   std::string names;
-  for (const NamedColorSpace& n : BuiltinColorSpaces()) names += fmt::format("{}'{}'", names.empty() ? "" : ", ", n.name);
+  for (const NamedColorSpace& n : BuiltinColorSpaces())
+    names += fmt::format("{}'{}'", names.empty() ? "" : ", ", n.name);
   return names;
 }
 

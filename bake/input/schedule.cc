@@ -72,12 +72,12 @@ class ScheduleReader : public TomlReader {
   }
 
   // start, start + step, ... up to end inclusive (to a millionth of a step).
-  std::optional<std::vector<double>> Steps(const toml::node* node, const std::string& key, double start,
-                                           double end, double step) {
+  std::optional<std::vector<double>> Steps(const toml::node* node, const std::string& key, double start, double end,
+                                           double step) {
     if (step == 0.0 || (end - start) * step < 0.0) {
       Error(node, key,
-            fmt::format("step {} cannot go from {} to {}: use a non-zero step with the sign of end - start",
-                        step, start, end));
+            fmt::format("step {} cannot go from {} to {}: use a non-zero step with the sign of end - start", step,
+                        start, end));
       return std::nullopt;
     }
     double count = std::floor((end - start) / step + 1e-6) + 1.0;
@@ -131,7 +131,8 @@ class ScheduleReader : public TomlReader {
       // Refused here, once, before any frame's style splits it at the dots.
       Error(&node, where.substr(0, where.size() - key.size()) + key.substr(0, key.find('.')) + ".(...)",
             fmt::format("a style key of more than {} dotted parts: skybake's keys have at most 5, e.g. "
-                        "\"atmosphere.mie.g\"", kMaxKeyParts));
+                        "\"atmosphere.mie.g\"",
+                        kMaxKeyParts));
       ok = false;
     }
     return ok;
@@ -176,7 +177,6 @@ class ScheduleReader : public TomlReader {
     node.visit([&](const auto& v) { out << v; });
     return out.str();
   }
-
 };
 
 CivilTime MakeCivilTime(const toml::date& date, const toml::time& time, double offset) {
@@ -206,8 +206,7 @@ class ScheduleParser {
     if (const toml::node* n = s_.get("first_frame")) {
       if (!n->is_integer() || n->as_integer()->get() < 1 || n->as_integer()->get() > 9999999)
         r_.Error(n, "schedule.first_frame", "expected an integer in [1, 9999999]");
-      else
-        first_frame = int(n->as_integer()->get());
+      else first_frame = int(n->as_integer()->get());
     }
     return first_frame;
   }
@@ -221,7 +220,8 @@ class ScheduleParser {
     if (latitude_ && std::abs(*latitude_) > 90.0)
       r_.Error(s_.get("latitude_deg"), "schedule.latitude_deg", "latitude must be within [-90, 90]");
     if (longitude_ && std::abs(*longitude_) > 180.0)
-      r_.Error(s_.get("longitude_deg"), "schedule.longitude_deg", "longitude must be within [-180, 180], east positive");
+      r_.Error(s_.get("longitude_deg"), "schedule.longitude_deg",
+               "longitude must be within [-180, 180], east positive");
     if (offset_ && std::abs(*offset_) > 14.0)
       r_.Error(s_.get("utc_offset_hours"), "schedule.utc_offset_hours", "UTC offset must be within [-14, 14] hours");
     if (date_ && (date_->month < 1 || date_->month > 12 || date_->day < 1 ||
@@ -265,13 +265,17 @@ class ScheduleParser {
     if (!elevation || !azimuth) return;
     size_t n = std::max(elevation->size(), azimuth->size());
     if (elevation->size() != n && elevation->size() != 1) {
-      r_.Error(&sun, key, fmt::format("elevation_deg has {} values and azimuth_deg {}: give equal counts, or one "
-                                      "value for all", elevation->size(), azimuth->size()));
+      r_.Error(&sun, key,
+               fmt::format("elevation_deg has {} values and azimuth_deg {}: give equal counts, or one "
+                           "value for all",
+                           elevation->size(), azimuth->size()));
       return;
     }
     if (azimuth->size() != n && azimuth->size() != 1) {
-      r_.Error(&sun, key, fmt::format("azimuth_deg has {} values and elevation_deg {}: give equal counts, or one "
-                                      "value for all", azimuth->size(), elevation->size()));
+      r_.Error(&sun, key,
+               fmt::format("azimuth_deg has {} values and elevation_deg {}: give equal counts, or one "
+                           "value for all",
+                           azimuth->size(), elevation->size()));
       return;
     }
     for (size_t i = 0; i < n; ++i) {
@@ -308,10 +312,8 @@ class ScheduleParser {
       std::optional<ScheduleFrame> f = t->get("time") ? ListedTimeFrame(*t, fkey) : ListedSunFrame(*t, fkey);
       if (!f) continue;
       if (const toml::node* set = t->get("set")) {
-        if (const toml::table* st = set->as_table())
-          r_.Flatten(*st, "", f->overrides, fkey + ".set");
-        else
-          r_.Error(set, fkey + ".set", "expected a table of style keys, e.g. set = { \"atmosphere.mie.g\" = 0.7 }");
+        if (const toml::table* st = set->as_table()) r_.Flatten(*st, "", f->overrides, fkey + ".set");
+        else r_.Error(set, fkey + ".set", "expected a table of style keys, e.g. set = { \"atmosphere.mie.g\" = 0.7 }");
       }
       frames_.push_back(std::move(*f));
     }
@@ -338,16 +340,15 @@ class ScheduleParser {
         if (frames[i].hours_from_start > frames[i - 1].hours_from_start) continue;
         r_.Error(s_.get(list), std::string("schedule.") + list,
                  fmt::format("frame {} ({}) is not after frame {} ({}): give clock times in increasing order, each "
-                             "once", i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
+                             "once",
+                             i + 1, frames[i].time->Iso8601(), i, frames[i - 1].time->Iso8601()));
         break;
       }
     }
     const double span_hours = frames.empty() ? 0.0 : frames.back().hours_from_start;
     for (size_t i = 0; i < frames.size(); ++i) {
-      if (schedule_.clock_times && span_hours != 0.0)
-        frames[i].fraction = frames[i].hours_from_start / span_hours;
-      else
-        frames[i].fraction = frames.size() > 1 ? double(i) / double(frames.size() - 1) : 0.0;
+      if (schedule_.clock_times && span_hours != 0.0) frames[i].fraction = frames[i].hours_from_start / span_hours;
+      else frames[i].fraction = frames.size() > 1 ? double(i) / double(frames.size() - 1) : 0.0;
     }
     schedule_.frames = std::move(frames);
   }
@@ -361,22 +362,25 @@ class ScheduleParser {
       r_.Error(ramp, "schedule.ramp", "expected a table: \"style.key\" = [from, to]");
       return;
     }
-    r_.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
-      const std::string where = "schedule.ramp." + key;
-      const toml::array* pair = node.as_array();
-      if (!pair || pair->size() != 2) {
-        r_.Error(&node, where, "expected [from, to]: two numbers, or two RGB triples");
-        return;
-      }
-      std::optional<std::vector<double>> from = r_.NumberOrTriple(*pair->get(0), where + "[0]");
-      std::optional<std::vector<double>> to = r_.NumberOrTriple(*pair->get(1), where + "[1]");
-      if (!from || !to) return;
-      if (from->size() != to->size()) {
-        r_.Error(&node, where, "from and to must both be numbers or both RGB triples");
-        return;
-      }
-      schedule_.ramps.push_back({key, *from, *to, r_.Origin(&node, key)});
-    }, "schedule.ramp");
+    r_.FlattenNumbers(
+        *t, "",
+        [&](const std::string& key, const toml::node& node) {
+          const std::string where = "schedule.ramp." + key;
+          const toml::array* pair = node.as_array();
+          if (!pair || pair->size() != 2) {
+            r_.Error(&node, where, "expected [from, to]: two numbers, or two RGB triples");
+            return;
+          }
+          std::optional<std::vector<double>> from = r_.NumberOrTriple(*pair->get(0), where + "[0]");
+          std::optional<std::vector<double>> to = r_.NumberOrTriple(*pair->get(1), where + "[1]");
+          if (!from || !to) return;
+          if (from->size() != to->size()) {
+            r_.Error(&node, where, "from and to must both be numbers or both RGB triples");
+            return;
+          }
+          schedule_.ramps.push_back({key, *from, *to, r_.Origin(&node, key)});
+        },
+        "schedule.ramp");
   }
 
   // `per_hour`: "style.key" = rate, for clock-time frames.
@@ -390,10 +394,13 @@ class ScheduleParser {
     }
     if (!schedule_.clock_times && !t->empty())
       r_.Error(per_hour, "schedule.per_hour", "rates per hour need clock-time frames (`times`)");
-    r_.FlattenNumbers(*t, "", [&](const std::string& key, const toml::node& node) {
-      std::optional<std::vector<double>> rate = r_.NumberOrTriple(node, "schedule.per_hour." + key);
-      if (rate) schedule_.rates.push_back({key, *rate, r_.Origin(&node, key)});
-    }, "schedule.per_hour");
+    r_.FlattenNumbers(
+        *t, "",
+        [&](const std::string& key, const toml::node& node) {
+          std::optional<std::vector<double>> rate = r_.NumberOrTriple(node, "schedule.per_hour." + key);
+          if (rate) schedule_.rates.push_back({key, *rate, r_.Origin(&node, key)});
+        },
+        "schedule.per_hour");
   }
 
  private:
@@ -405,8 +412,10 @@ class ScheduleParser {
                                 {"longitude_deg", longitude_.has_value()},
                                 {"utc_offset_hours", offset_.has_value()}}) {
       if (!value && !s_.get(field)) {
-        r_.Error(where, key, fmt::format("clock times need schedule.{} (and date, latitude_deg, longitude_deg, "
-                                         "utc_offset_hours)", field));
+        r_.Error(where, key,
+                 fmt::format("clock times need schedule.{} (and date, latitude_deg, longitude_deg, "
+                             "utc_offset_hours)",
+                             field));
         ok = false;
       }
     }
@@ -430,10 +439,13 @@ class ScheduleParser {
     std::optional<toml::time> end = r_.Time(range.get("end"), key + ".end");
     std::optional<double> step = r_.Number(range.get("step_minutes"), key + ".step_minutes");
     if (!range.get("start") || !range.get("end") || !range.get("step_minutes"))
-      r_.Error(&times, key, "a time range needs start, end and step_minutes, e.g. "
-                            "{ start = 06:00:00, end = 20:00:00, step_minutes = 15 }");
+      r_.Error(&times, key,
+               "a time range needs start, end and step_minutes, e.g. "
+               "{ start = 06:00:00, end = 20:00:00, step_minutes = 15 }");
     if (!start || !end || !step) return;
-    auto seconds = [](const toml::time& t) { return t.hour * 3600.0 + t.minute * 60.0 + t.second + t.nanosecond * 1e-9; };
+    auto seconds = [](const toml::time& t) {
+      return t.hour * 3600.0 + t.minute * 60.0 + t.second + t.nanosecond * 1e-9;
+    };
     double s0 = seconds(*start), s1 = seconds(*end);
     if (!(*step > 0.0)) {
       r_.Error(range.get("step_minutes"), key + ".step_minutes", "must be above 0");
@@ -523,8 +535,8 @@ ScheduleResult ParseSchedule(std::string_view toml_text, const std::string& name
     return result;
   }
   r.CheckKeys(*s, "schedule",
-              {"first_frame", "date", "latitude_deg", "longitude_deg", "utc_offset_hours", "times", "sun",
-               "frames", "ramp", "per_hour"});
+              {"first_frame", "date", "latitude_deg", "longitude_deg", "utc_offset_hours", "times", "sun", "frames",
+               "ramp", "per_hour"});
   ScheduleParser parser(r, *s, schedule);
   const int first_frame = parser.FirstFrame();
   parser.ReadPlace();

@@ -12,9 +12,7 @@ namespace {
 // Rec.709 luminance weights of linear RGB.
 constexpr double kLuminanceWeights[3] = {0.2126, 0.7152, 0.0722};
 
-double SrgbDecode(double v) {
-  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
+double SrgbDecode(double v) { return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4); }
 
 // SplitMix64 (Steele, Lea, Flood 2014): a well-mixed 64-bit hash of a counter.
 uint64_t SplitMix64(uint64_t x) {
@@ -25,8 +23,8 @@ uint64_t SplitMix64(uint64_t x) {
 }
 
 // Uniform Catmull-Rom interpolation between p1 and p2 at t in [0, 1].
-glm::dvec3 CatmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2,
-                      const glm::dvec3& p3, double t) {
+glm::dvec3 CatmullRom(const glm::dvec3& p0, const glm::dvec3& p1, const glm::dvec3& p2, const glm::dvec3& p3,
+                      double t) {
   double t2 = t * t, t3 = t2 * t;
   return 0.5 * ((2.0 * p1) + (-p0 + p2) * t + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2 +
                 (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3);
@@ -54,12 +52,11 @@ bool ParseHexColor(const std::string& text, Rgb& linear_rgb) {
   return true;
 }
 
-Rgb RayleighForTargetColor(const Rgb& target, const AtmosphereParams& physical,
-                           const Rgb& display_scale) {
+Rgb RayleighForTargetColor(const Rgb& target, const AtmosphereParams& physical, const Rgb& display_scale) {
   double physical_weight = 0.0, target_weight = 0.0;
   for (int c = 0; c < 3; ++c) {
-    physical_weight += kLuminanceWeights[c] * physical.rayleigh_scattering_per_km[c] *
-                       physical.solar_irradiance[c] * display_scale[c];
+    physical_weight +=
+        kLuminanceWeights[c] * physical.rayleigh_scattering_per_km[c] * physical.solar_irradiance[c] * display_scale[c];
     target_weight += kLuminanceWeights[c] * target[c];
   }
   Rgb beta = {0.0, 0.0, 0.0};
@@ -94,9 +91,7 @@ std::vector<ShapeArc> ShapeArcs(const CloudShapeSettings& settings) {
     for (const auto& point : shape.points) p.push_back(DomeDirection(point[0], point[1]));
     if (p.empty()) continue;
     const double radius = shape.radius_deg * kDegToRad;
-    auto add = [&](const glm::dvec3& a, const glm::dvec3& b) {
-      arcs.push_back({a, b, radius, shape.strength});
-    };
+    auto add = [&](const glm::dvec3& a, const glm::dvec3& b) { arcs.push_back({a, b, radius, shape.strength}); };
     const size_t n = p.size();
     if (shape.kind == ShapeKind::kPoint || n == 1) {
       for (const glm::dvec3& q : p) add(q, q);
@@ -116,9 +111,7 @@ std::vector<ShapeArc> ShapeArcs(const CloudShapeSettings& settings) {
       glm::dvec3 previous = a;
       for (int s = 1; s <= kAoasSplineSubdivisions; ++s) {
         double t = double(s) / kAoasSplineSubdivisions;
-        glm::dvec3 next = s == kAoasSplineSubdivisions
-                              ? b
-                              : glm::normalize(CatmullRom(before, a, b, after, t));
+        glm::dvec3 next = s == kAoasSplineSubdivisions ? b : glm::normalize(CatmullRom(before, a, b, after, t));
         add(previous, next);
         previous = next;
       }
@@ -140,20 +133,17 @@ AoasInputs ToAoasInputs(const AoasSettings& aoas, const Rgb& color_scale) {
   AoasInputs in;
   std::vector<ShapeArc> arcs = aoas.shapes.enabled ? ShapeArcs(aoas.shapes) : std::vector<ShapeArc>{};
   if (arcs.size() > AOAS_MAX_SHAPE_SEGMENTS)
-    throw std::invalid_argument(fmt::format("the cloud shapes need {} arcs; at most {} fit",
-                                            arcs.size(), AOAS_MAX_SHAPE_SEGMENTS));
+    throw std::invalid_argument(
+        fmt::format("the cloud shapes need {} arcs; at most {} fit", arcs.size(), AOAS_MAX_SHAPE_SEGMENTS));
   in.switches.skydome = aoas.skydome.enabled;
   in.switches.ambiguity = aoas.ambiguity.enabled;
   in.switches.cloud_noise = aoas.clouds.enabled;
   in.switches.cloud_shapes = aoas.shapes.enabled && !arcs.empty();
 
-  auto v4 = [](const glm::dvec3& v, double w) {
-    return gpu::vec4{float(v.x), float(v.y), float(v.z), float(w)};
-  };
+  auto v4 = [](const glm::dvec3& v, double w) { return gpu::vec4{float(v.x), float(v.y), float(v.z), float(w)}; };
   gpu::GpuAoas& g = in.uniform;
   const SkydomeSettings& dome = aoas.skydome;
-  g.dome = {float(dome.enabled ? dome.radius : 1.0), float(aoas.ambiguity.l_pt),
-            float(aoas.ambiguity.grain), 0.0f};
+  g.dome = {float(dome.enabled ? dome.radius : 1.0), float(aoas.ambiguity.l_pt), float(aoas.ambiguity.grain), 0.0f};
   g.viewer = v4(dome.enabled ? dome.viewer_position : glm::dvec3(0.0), 0.0);
   g.perturbation_offset = v4(SeedOffset(aoas.seed, 0), 0.0);
   g.noise = {float(aoas.clouds.s_noise), float(aoas.clouds.threshold), float(aoas.clouds.strength),

@@ -10,8 +10,7 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
   double elevation = elevation_deg * kDegToRad;
   double azimuth = azimuth_deg * kDegToRad;
   // North = -Z, East = +X: azimuth 0 -> -Z, azimuth 90 -> +X.
-  return {std::sin(azimuth) * std::cos(elevation), std::sin(elevation),
-          -std::cos(azimuth) * std::cos(elevation)};
+  return {std::sin(azimuth) * std::cos(elevation), std::sin(elevation), -std::cos(azimuth) * std::cos(elevation)};
 }
 
 // Each preset is the cheapest case of the accuracy study's Pareto front that
@@ -78,11 +77,9 @@ bool NeedsTransmittanceLut(const QualitySettings& q, const EffectSettings& e) {
   return q.light_steps <= 0 || e.multiple_scattering || e.ground || e.sun_disc;
 }
 
-gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySettings& q,
-                                   const EffectSettings& effects, const Rgb& output_scale) {
-  auto v4 = [](const Rgb& rgb, double w) {
-    return gpu::vec4{float(rgb[0]), float(rgb[1]), float(rgb[2]), float(w)};
-  };
+gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySettings& q, const EffectSettings& effects,
+                                   const Rgb& output_scale) {
+  auto v4 = [](const Rgb& rgb, double w) { return gpu::vec4{float(rgb[0]), float(rgb[1]), float(rgb[2]), float(w)}; };
   gpu::GpuAtmosphere g{};
   g.rayleigh_scattering = v4(a.rayleigh_scattering_per_km, a.rayleigh_scale_height_km);
   g.mie_scattering = v4(a.mie_scattering_per_km, a.mie_scale_height_km);
@@ -90,8 +87,8 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
   g.absorption_extinction = v4(a.ozone_absorption_per_km, a.ozone_peak_altitude_km);
   g.ground_albedo = v4(a.ground_albedo, a.ozone_half_width_km);
   g.solar_irradiance = v4(a.solar_irradiance, a.sun_angular_radius_rad);
-  g.radii = {float(a.bottom_radius_km), float(a.top_radius_km),
-             float(a.observer_altitude_m * 1e-3), float(a.limb_darkening_u)};
+  g.radii = {float(a.bottom_radius_km), float(a.top_radius_km), float(a.observer_altitude_m * 1e-3),
+             float(a.limb_darkening_u)};
   g.output_scale = v4(output_scale, 0.0);
   for (int i = 0; i < 3; ++i) {  // one conversion for every path until SetOutputConversion (colour_conversion.h)
     Rgb row{};
@@ -101,11 +98,9 @@ gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& a, const QualitySetti
     identity[i] = 1.0;
     g.ambient_to_direct[i] = v4(identity, 0.0);
   }
-  g.lut_sizes = {q.transmittance_width, q.transmittance_height, q.multiscattering_size,
-                 q.multiscattering_size};
+  g.lut_sizes = {q.transmittance_width, q.transmittance_height, q.multiscattering_size, q.multiscattering_size};
   g.samples = {q.view_steps, q.transmittance_steps, q.multiscattering_steps, q.integrator};
-  g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground,
-               q.multiscattering_sqrt_dirs};
+  g.effects = {effects.multiple_scattering, effects.sun_disc, effects.ground, q.multiscattering_sqrt_dirs};
   g.render = {q.light_steps, q.sky_view_width, q.sky_view_height, q.step_distribution};
   g.strengths = {float(effects.multiple_scattering_strength), float(effects.sun_disc_strength), 0.0f, 0.0f};
   g.night = v4(NightSkyRadiance(effects), effects.night_dimming_strength);

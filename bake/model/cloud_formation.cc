@@ -31,9 +31,10 @@ std::string LoadMask(const std::string& path, const CloudFormation& f, CloudMask
     return fmt::format("{} channel{}; a mask needs 3 or 4 (R humidity, G phase readiness, B extinction)", channels,
                        channels == 1 ? "" : "s");
   if (width != f.cells[0] || height != f.cells[1] * f.mask_layers)
-    return fmt::format("{} x {} texels; {} layer(s) of the {} x {} lattice need {} x {} (formation.cells, "
-                       "formation.mask_layers)",
-                       width, height, f.mask_layers, f.cells[0], f.cells[1], f.cells[0], f.cells[1] * f.mask_layers);
+    return fmt::format(
+        "{} x {} texels; {} layer(s) of the {} x {} lattice need {} x {} (formation.cells, "
+        "formation.mask_layers)",
+        width, height, f.mask_layers, f.cells[0], f.cells[1], f.cells[0], f.cells[1] * f.mask_layers);
   if (mask) {
     mask->width = f.cells[0];
     mask->height = f.cells[1];
@@ -87,8 +88,10 @@ void ApplyFormationRules(CloudLattice& l) {
     for (int i = 0; i < n; ++i) w[size_t(i)] = ((i + d) % n + n) % n;
     return w;
   };
-  const std::vector<int> xm1 = wrapped(l.nx, -1), xp1 = wrapped(l.nx, 1), xm2 = wrapped(l.nx, -2), xp2 = wrapped(l.nx, 2);
-  const std::vector<int> ym1 = wrapped(l.ny, -1), yp1 = wrapped(l.ny, 1), ym2 = wrapped(l.ny, -2), yp2 = wrapped(l.ny, 2);
+  const std::vector<int> xm1 = wrapped(l.nx, -1), xp1 = wrapped(l.nx, 1), xm2 = wrapped(l.nx, -2),
+                         xp2 = wrapped(l.nx, 2);
+  const std::vector<int> ym1 = wrapped(l.ny, -1), yp1 = wrapped(l.ny, 1), ym2 = wrapped(l.ny, -2),
+                         yp2 = wrapped(l.ny, 2);
   const size_t layer = size_t(l.nx) * l.ny;
   for (int z = 0; z < l.nz; ++z) {
     const uint8_t* here = act.data() + z * layer;
@@ -134,8 +137,7 @@ FormationThresholds FormationThresholdsAt(const CloudFormation& f, const CloudMa
   if (mask && mask->layers > 0) {
     // The layer moves with velocity z (mask layers per hour of clock time),
     // held at the first and the last layer.
-    const double hours =
-        f.steps_per_hour > 0.0 ? std::max(0.0, double(step) - f.warmup_steps) / f.steps_per_hour : 0.0;
+    const double hours = f.steps_per_hour > 0.0 ? std::max(0.0, double(step) - f.warmup_steps) / f.steps_per_hour : 0.0;
     const double layer = std::clamp(f.mask_layer + f.velocity_cells_per_hour[2] * hours, 0.0, double(mask->layers - 1));
     const int l0 = int(std::floor(layer)), l1 = std::min(l0 + 1, mask->layers - 1);
     const float w = float(layer - l0);
@@ -182,10 +184,9 @@ std::string FormationKey(const CloudFormation& f, const CloudMask* mask, uint32_
   uint64_t mask_hash = 0;
   if (mask)
     for (float v : mask->rgb) mask_hash = Mix64(mask_hash ^ uint64_t(std::llround(double(v) * 1e9)));
-  return fmt::format("{} {} {} {} {:a} {:a} {:a} {:a} {:a} {} {:a} {:a} {}", seed, f.cells[0], f.cells[1],
-                     f.cells[2], f.steps_per_hour, f.extinction_probability, f.humidity_probability,
-                     f.phase_probability, f.initial_humidity, f.mask_layers, f.mask_layer,
-                     f.velocity_cells_per_hour[2], mask_hash) +
+  return fmt::format("{} {} {} {} {:a} {:a} {:a} {:a} {:a} {} {:a} {:a} {}", seed, f.cells[0], f.cells[1], f.cells[2],
+                     f.steps_per_hour, f.extinction_probability, f.humidity_probability, f.phase_probability,
+                     f.initial_humidity, f.mask_layers, f.mask_layer, f.velocity_cells_per_hour[2], mask_hash) +
          fmt::format(" {}", f.warmup_steps);
 }
 
@@ -396,8 +397,7 @@ std::vector<float> FormationDensityAt(const CloudFormation& f, const CloudMask* 
 
 bool FormationShapeWarped(const CloudLayer& layer) {
   // The whole density (formation.density) reads the detail noise alone.
-  const bool reads_noise =
-      layer.detail_amount > 0.0 || (!layer.formation.density && layer.shape_amount > 0.0);
+  const bool reads_noise = layer.detail_amount > 0.0 || (!layer.formation.density && layer.shape_amount > 0.0);
   return !layer.tiling && reads_noise;
 }
 

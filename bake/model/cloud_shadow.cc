@@ -46,24 +46,21 @@ CloudShadowInfo CloudShadowInfoOf(const CloudSettings& clouds, const CloudShadow
   info.extent_m = s.extent_m;
   // North-west corner: west of the centre by half the extent, north by half
   // (world z = -north).
-  info.origin_m = {s.center_east_m - 0.5 * s.extent_m, s.receiver_altitude_m,
-                   -(s.center_north_m + 0.5 * s.extent_m)};
+  info.origin_m = {s.center_east_m - 0.5 * s.extent_m, s.receiver_altitude_m, -(s.center_north_m + 0.5 * s.extent_m)};
   info.receiver_altitude_m = s.receiver_altitude_m;
   info.sun_direction = sun;
   info.sun_above_horizon = sun.y > 0.0;
   info.strength = s.strength;
   info.tiles = CloudShadowTiles(clouds, s.extent_m);
-  for (const CloudLayer& l : ActiveCloudLayers(clouds))
-  {
+  for (const CloudLayer& l : ActiveCloudLayers(clouds)) {
     // A formation's layer moves on the formation's clock (ToCloudInputs).
-    const double t_s =
-        l.formation.enabled ? FormationTimeSeconds(l.formation, clouds.local_clock_s, time_s) : time_s;
+    const double t_s = l.formation.enabled ? FormationTimeSeconds(l.formation, clouds.local_clock_s, time_s) : time_s;
     std::array<double, 2> offset = {l.wind_m_s[0] * t_s, l.wind_m_s[1] * t_s};
     // A formation's drift (cloud_formation.h) moves its coverage as well.
     if (l.formation.enabled)
       for (int a = 0; a < 2; ++a)
-        offset[a] += l.formation.velocity_cells_per_hour[a] * t_s / 3600.0 * l.formation.size_m[a] /
-                     l.formation.cells[a];
+        offset[a] +=
+            l.formation.velocity_cells_per_hour[a] * t_s / 3600.0 * l.formation.size_m[a] / l.formation.cells[a];
     info.wind_offset_m.push_back(offset);
   }
   return info;

@@ -9,7 +9,6 @@
 
 #include <fmt/format.h>
 
-
 namespace skybake {
 
 std::array<double, 4> CloudTypeProfile(CloudType type) {
@@ -19,24 +18,36 @@ std::array<double, 4> CloudTypeProfile(CloudType type) {
   // the whole column for cumulonimbus, a thin sheet for cirrus), each for a
   // layer that holds one type.
   switch (type) {
-    case CloudType::kStratus: return {0.0, 0.1, 0.7, 1.0};
-    case CloudType::kStratocumulus: return {0.0, 0.15, 0.55, 1.0};
-    case CloudType::kCumulus: return {0.0, 0.08, 0.45, 1.0};
-    case CloudType::kCumulonimbus: return {0.0, 0.05, 0.8, 1.0};
-    case CloudType::kCirrus: return {0.0, 0.35, 0.65, 1.0};
-    case CloudType::kCustom: break;
+    case CloudType::kStratus:
+      return {0.0, 0.1, 0.7, 1.0};
+    case CloudType::kStratocumulus:
+      return {0.0, 0.15, 0.55, 1.0};
+    case CloudType::kCumulus:
+      return {0.0, 0.08, 0.45, 1.0};
+    case CloudType::kCumulonimbus:
+      return {0.0, 0.05, 0.8, 1.0};
+    case CloudType::kCirrus:
+      return {0.0, 0.35, 0.65, 1.0};
+    case CloudType::kCustom:
+      break;
   }
   return {0.0, 0.1, 0.5, 1.0};
 }
 
 const char* CloudTypeName(CloudType type) {
   switch (type) {
-    case CloudType::kStratus: return "stratus";
-    case CloudType::kStratocumulus: return "stratocumulus";
-    case CloudType::kCumulus: return "cumulus";
-    case CloudType::kCumulonimbus: return "cumulonimbus";
-    case CloudType::kCirrus: return "cirrus";
-    case CloudType::kCustom: return "custom";
+    case CloudType::kStratus:
+      return "stratus";
+    case CloudType::kStratocumulus:
+      return "stratocumulus";
+    case CloudType::kCumulus:
+      return "cumulus";
+    case CloudType::kCumulonimbus:
+      return "cumulonimbus";
+    case CloudType::kCirrus:
+      return "cirrus";
+    case CloudType::kCustom:
+      return "custom";
   }
   return "custom";
 }
@@ -104,19 +115,19 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
                                     clouds.layers.size(), kMaxCloudLayers)});
   const double loops = CloudLoopIterationsPerTexel(clouds);
   if (loops > kMaxCloudLoopIterations)
-    problems.push_back({-2, "",
-                        fmt::format("{} cloud layer(s) x {} view steps x {} light steps may run {:.0f} loop "
-                                    "iterations per texel; lavapipe ends a shader's loops after 65535 in all "
-                                    "(LP_MAX_TGSI_LOOP_ITERATIONS): lower quality.cloud_view_steps or "
-                                    "quality.cloud_light_steps (at most {:.0f} iterations)",
-                                    std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers),
-                                    clouds.quality.view_steps, clouds.quality.light_steps, loops,
-                                    kMaxCloudLoopIterations)});
+    problems.push_back(
+        {-2, "",
+         fmt::format("{} cloud layer(s) x {} view steps x {} light steps may run {:.0f} loop "
+                     "iterations per texel; lavapipe ends a shader's loops after 65535 in all "
+                     "(LP_MAX_TGSI_LOOP_ITERATIONS): lower quality.cloud_view_steps or "
+                     "quality.cloud_light_steps (at most {:.0f} iterations)",
+                     std::min<size_t>(ActiveCloudLayers(clouds).size(), kMaxCloudLayers), clouds.quality.view_steps,
+                     clouds.quality.light_steps, loops, kMaxCloudLoopIterations)});
   // The light volume shares the noise buffer (one storage buffer: lavapipe
   // binds at most 128 MiB): at most 64 MiB of it.
   const CloudQuality& q = clouds.quality;
-  const double volume_mib = double(q.light_volume_columns) * q.light_volume_columns * q.light_volume_slices * 4.0 /
-                            (1024.0 * 1024.0);
+  const double volume_mib =
+      double(q.light_volume_columns) * q.light_volume_columns * q.light_volume_slices * 4.0 / (1024.0 * 1024.0);
   if (!ActiveCloudLayers(clouds).empty() && q.light_volume_columns > 0 && volume_mib > 64.0)
     problems.push_back({-3, "",
                         fmt::format("{0} x {0} columns x {1} slices make a light volume of {2:.0f} MiB, above 64 MiB: "
@@ -141,16 +152,15 @@ std::vector<CloudProblem> ValidateClouds(const CloudSettings& clouds, const Atmo
     if (l.formation.enabled && !l.formation.mask_image.empty()) {
       const std::string path = ResolvePath(l.formation.mask_image, style_dir);
       std::string problem = CheckCloudMask(path, l.formation);
-      if (!problem.empty())
-        problems.push_back({index, "formation.mask_image", fmt::format("{}: {}", path, problem)});
+      if (!problem.empty()) problems.push_back({index, "formation.mask_image", fmt::format("{}: {}", path, problem)});
     }
     if (!l.weather_image.empty()) {
       const std::string path = ResolvePath(l.weather_image, style_dir);
       std::string problem = CheckWeatherImage(path);
       if (!problem.empty())
-        problems.push_back({index, "weather_image",
-                            fmt::format("{}: {}: give an EXR or PNG whose first channel is the coverage, 0..1",
-                                        path, problem)});
+        problems.push_back(
+            {index, "weather_image",
+             fmt::format("{}: {}: give an EXR or PNG whose first channel is the coverage, 0..1", path, problem)});
     }
   }
   return problems;
@@ -281,8 +291,7 @@ gpu::GpuClouds CloudGeometryUniform(const CloudSettings& clouds) {
       // streaks, (m/s per km) / (m/s) = km^-1.
       const std::array<double, 2> a = CirrusStreakDirection(l);
       const double shear_along = l.shear_m_s_per_km[0] * a[0] + l.shear_m_s_per_km[1] * a[1];
-      o.streaks = {float(a[0]), float(-a[1]), float(l.streak_ratio),
-                   float(shear_along / (2.0 * kCirrusFallSpeedM_s))};
+      o.streaks = {float(a[0]), float(-a[1]), float(l.streak_ratio), float(shear_along / (2.0 * kCirrusFallSpeedM_s))};
     }
   }
   // range.w: the view march skips empty space (FillCloudSkipMaps).

@@ -96,8 +96,8 @@ namespace {
 // bins, then the three), per unit of each wavelength's solar irradiance
 // times that irradiance: W m^-2 sr^-1 nm^-1.
 constexpr int kViewSteps = 48;
-std::vector<double> SingleScattering(const glsl::AtmosphereParameters& atm, const Probe& probe,
-                                     const glm::dvec3& view, const glm::dvec3& sun, double mie_g) {
+std::vector<double> SingleScattering(const glsl::AtmosphereParameters& atm, const Probe& probe, const glm::dvec3& view,
+                                     const glm::dvec3& sun, double mie_g) {
   const size_t n = probe.bins.size() + 3;
   auto wavelength = [&](size_t k) -> const Wavelength& {
     return k < probe.bins.size() ? probe.bins[k] : probe.rgb[k - probe.bins.size()];
@@ -217,8 +217,7 @@ OutputConversion UniformOutputConversion(const Rgb& scale) {
 Rgb BrunetonSkyFactors() { return {114974.916437, 71305.954816, 65310.548555}; }
 Rgb BrunetonSunFactors() { return {98242.79, 69954.40, 66475.01}; }
 
-SunLight SunLightAtObserver(const AtmosphereParams& atmosphere, const EffectSettings& effects,
-                            const glm::dvec3& sun) {
+SunLight SunLightAtObserver(const AtmosphereParams& atmosphere, const EffectSettings& effects, const glm::dvec3& sun) {
   SunLight light;
   const Probe probe = MakeProbe(atmosphere, effects);
   const glsl::AtmosphereParameters atm = ColumnAtmosphere(atmosphere, effects);

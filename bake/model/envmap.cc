@@ -42,12 +42,24 @@ glm::dvec3 VulkanCubeTexelDirection(int face, int x, int y, int n) {
   double tc = 2.0 * t - 1.0;
   glm::dvec3 d;
   switch (face) {
-    case 0: d = {1.0, -tc, -sc}; break;   // +X: sc = -rz, tc = -ry
-    case 1: d = {-1.0, -tc, sc}; break;   // -X: sc = +rz, tc = -ry
-    case 2: d = {sc, 1.0, tc}; break;     // +Y: sc = +rx, tc = +rz
-    case 3: d = {sc, -1.0, -tc}; break;   // -Y: sc = +rx, tc = -rz
-    case 4: d = {sc, -tc, 1.0}; break;    // +Z: sc = +rx, tc = -ry
-    default: d = {-sc, -tc, -1.0}; break; // -Z: sc = -rx, tc = -ry
+    case 0:
+      d = {1.0, -tc, -sc};
+      break;  // +X: sc = -rz, tc = -ry
+    case 1:
+      d = {-1.0, -tc, sc};
+      break;  // -X: sc = +rz, tc = -ry
+    case 2:
+      d = {sc, 1.0, tc};
+      break;  // +Y: sc = +rx, tc = +rz
+    case 3:
+      d = {sc, -1.0, -tc};
+      break;  // -Y: sc = +rx, tc = -rz
+    case 4:
+      d = {sc, -tc, 1.0};
+      break;  // +Z: sc = +rx, tc = -ry
+    default:
+      d = {-sc, -tc, -1.0};
+      break;  // -Z: sc = -rx, tc = -ry
   }
   return glm::normalize(d);
 }

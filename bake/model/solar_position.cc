@@ -17,10 +17,10 @@ std::string CivilTime::Iso8601() const {
   double offset_minutes_total = std::round(std::abs(utc_offset_hours) * 60.0);
   int offset_h = int(offset_minutes_total) / 60;
   int offset_m = int(offset_minutes_total) % 60;
-  std::string seconds = second == std::floor(second) ? fmt::format("{:02d}", int(second))
-                                                     : fmt::format("{:06.3f}", second);
-  return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{}{}{:02d}:{:02d}", year, month, day, hour,
-                     minute, seconds, utc_offset_hours < 0.0 ? '-' : '+', offset_h, offset_m);
+  std::string seconds =
+      second == std::floor(second) ? fmt::format("{:02d}", int(second)) : fmt::format("{:06.3f}", second);
+  return fmt::format("{:04d}-{:02d}-{:02d}T{:02d}:{:02d}:{}{}{:02d}:{:02d}", year, month, day, hour, minute, seconds,
+                     utc_offset_hours < 0.0 ? '-' : '+', offset_h, offset_m);
 }
 
 int DaysInMonth(int year, int month) {

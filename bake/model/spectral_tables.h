@@ -9,7 +9,7 @@ struct AtmosphereRow {
   double rayleigh_per_km;        // scattering at sea level
   double mie_scattering_per_km;  // at sea level
   double mie_extinction_per_km;
-  double ozone_per_km;           // absorption at the tent peak
+  double ozone_per_km;  // absorption at the tent peak
 };
 constexpr int kAtmosphereRows = 48;  // 360..830 nm every 10 nm
 extern const AtmosphereRow kAtmosphere[kAtmosphereRows];

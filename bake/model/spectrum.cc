@@ -27,7 +27,8 @@ double Interpolate(const Row* rows, int count, double lambda_nm, Field field, bo
 }
 
 double Table(double lambda_nm, double spectral_tables::AtmosphereRow::*field) {
-  return Interpolate(kAtmosphere, kAtmosphereRows, lambda_nm, [field](const auto& r) { return r.*field; }, true);
+  return Interpolate(
+      kAtmosphere, kAtmosphereRows, lambda_nm, [field](const auto& r) { return r.*field; }, true);
 }
 
 // The mean over [a, b] of a column read as the 10 nm bins it tabulates (the
@@ -51,14 +52,14 @@ double TripletAt(const Rgb& rgb, double lambda_nm) {
     double lambda_nm, value;
   };
   const Knot knots[3] = {{440.0, rgb[2]}, {550.0, rgb[1]}, {680.0, rgb[0]}};
-  return Interpolate(knots, 3, lambda_nm, [](const Knot& k) { return k.value; }, true);
+  return Interpolate(
+      knots, 3, lambda_nm, [](const Knot& k) { return k.value; }, true);
 }
 
 // A style coefficient at a wavelength (width 0: linear in the table) or over
 // a bin of `width_nm` about it (the mean of the table's 10 nm bins), times the
 // ratio of the style's to the table's at 680/550/440 nm, interpolated.
-double ScaledAt(const Rgb& style, double spectral_tables::AtmosphereRow::*field, double lambda_nm,
-                double width_nm) {
+double ScaledAt(const Rgb& style, double spectral_tables::AtmosphereRow::*field, double lambda_nm, double width_nm) {
   Rgb ratio{};
   const double named[3] = {680.0, 550.0, 440.0};
   for (int c = 0; c < 3; ++c) {
@@ -122,7 +123,6 @@ std::array<double, 3> Apply(const Matrix3& m, const std::array<double, 3>& v) {
           m[2][0] * v[0] + m[2][1] * v[1] + m[2][2] * v[2]};
 }
 
-
 SpectralBins WavelengthBins(int count) {
   SpectralBins bins;
   const double width = (kSpectralUpperNm - kSpectralLowerNm) / count;
@@ -145,9 +145,12 @@ SpectralBins BinsAt(const std::vector<double>& centre_nm, double width_nm) {
 }
 
 std::array<double, 3> CieXyzBar(double lambda_nm) {
-  return {Interpolate(kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.xbar; }, false),
-          Interpolate(kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.ybar; }, false),
-          Interpolate(kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.zbar; }, false)};
+  return {Interpolate(
+              kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.xbar; }, false),
+          Interpolate(
+              kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.ybar; }, false),
+          Interpolate(
+              kCie1931, kCieRows, lambda_nm, [](const auto& r) { return r.zbar; }, false)};
 }
 
 std::vector<std::array<double, 3>> CieWeights(const SpectralBins& bins) {
@@ -338,7 +341,8 @@ double DeltaE2000(const std::array<double, 3>& lab1, const std::array<double, 3>
   const double d_theta = 30.0 * std::exp(-std::pow((h_mean - 275.0) / 25.0, 2.0));
   const double cp_mean7 = std::pow(cp_mean, 7.0);
   const double rc = 2.0 * std::sqrt(cp_mean7 / (cp_mean7 + std::pow(25.0, 7.0)));
-  const double sl = 1.0 + 0.015 * (l_mean - 50.0) * (l_mean - 50.0) / std::sqrt(20.0 + (l_mean - 50.0) * (l_mean - 50.0));
+  const double sl =
+      1.0 + 0.015 * (l_mean - 50.0) * (l_mean - 50.0) / std::sqrt(20.0 + (l_mean - 50.0) * (l_mean - 50.0));
   const double sc = 1.0 + 0.045 * cp_mean, sh = 1.0 + 0.015 * cp_mean * t;
   const double rt = -std::sin(rad(2.0 * d_theta)) * rc;
   const double x = dl / sl, y = dc / sc, z = dH / sh;
@@ -351,7 +355,8 @@ std::array<double, 3> Srgb8ToLab(const std::array<unsigned char, 3>& srgb) {
     const double v = srgb[c] / 255.0;
     linear[c] = v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
   }
-  return XyzToLab(Apply(RgbToXyz(ColorSpace::kRec709), linear), XyzOfChromaticity(Chromaticities(ColorSpace::kRec709)[3]));
+  return XyzToLab(Apply(RgbToXyz(ColorSpace::kRec709), linear),
+                  XyzOfChromaticity(Chromaticities(ColorSpace::kRec709)[3]));
 }
 
 }  // namespace skybake

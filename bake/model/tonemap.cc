@@ -64,8 +64,7 @@ double AutoEv100(const std::vector<float>& rgba, int width, int height) {
   return std::max(sky, lower);
 }
 
-std::vector<uint8_t> TonemapToSrgb8(const std::vector<float>& rgba, int width, int height,
-                                    double exposure) {
+std::vector<uint8_t> TonemapToSrgb8(const std::vector<float>& rgba, int width, int height, double exposure) {
   std::vector<uint8_t> out(size_t(width) * height * 3);
   for (size_t i = 0, n = size_t(width) * height; i < n; ++i) {
     for (int c = 0; c < 3; ++c) {

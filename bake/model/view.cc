@@ -41,10 +41,8 @@ std::vector<RowRange> RowsReachingElevations(const ViewRequest& v, double low, d
       hi = std::max(hi, e);
     }
     if (!(hi + widen >= low && lo - widen <= high)) continue;
-    if (!runs.empty() && runs.back().end == y)
-      runs.back().end = y + 1;
-    else
-      runs.push_back({y, y + 1});
+    if (!runs.empty() && runs.back().end == y) runs.back().end = y + 1;
+    else runs.push_back({y, y + 1});
   }
   return runs;
 }

@@ -24,12 +24,14 @@ nlohmann::json CloudShadowJson(const CloudShadowInfo& i) {
 
 CloudShadowInfo CloudShadowFromJson(const nlohmann::json& j) {
   auto member = [&](const char* key) -> const nlohmann::json& {
-    if (!j.is_object() || !j.contains(key)) throw std::runtime_error(std::string("cloud_shadow.") + key + " is missing");
+    if (!j.is_object() || !j.contains(key))
+      throw std::runtime_error(std::string("cloud_shadow.") + key + " is missing");
     return j.at(key);
   };
   auto triple = [&](const char* key) {
     const nlohmann::json& a = member(key);
-    if (!a.is_array() || a.size() != 3) throw std::runtime_error(std::string("cloud_shadow.") + key + ": expected 3 numbers");
+    if (!a.is_array() || a.size() != 3)
+      throw std::runtime_error(std::string("cloud_shadow.") + key + ": expected 3 numbers");
     return std::array<double, 3>{a[0].get<double>(), a[1].get<double>(), a[2].get<double>()};
   };
   CloudShadowInfo i;
@@ -45,7 +47,8 @@ CloudShadowInfo CloudShadowFromJson(const nlohmann::json& j) {
     i.sun_above_horizon = member("sun_above_horizon").get<bool>();
     i.strength = member("strength").get<double>();
     i.tiles = member("tiles").get<bool>();
-    for (const nlohmann::json& w : member("wind_offset_m")) i.wind_offset_m.push_back({w.at(0).get<double>(), w.at(1).get<double>()});
+    for (const nlohmann::json& w : member("wind_offset_m"))
+      i.wind_offset_m.push_back({w.at(0).get<double>(), w.at(1).get<double>()});
   } catch (const nlohmann::json::exception& e) {
     throw std::runtime_error(std::string("cloud_shadow: ") + e.what());
   }

@@ -232,8 +232,7 @@ int64_t WriteToSink(exr_const_context_t, void* user_data, const void* buffer, ui
 thread_local Sink* assembling_sink = nullptr;
 
 void RecordError(exr_const_context_t, exr_result_t code, const char* message) {
-  if (assembling_sink)
-    assembling_sink->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
+  if (assembling_sink) assembling_sink->error = fmt::format("{} ({})", message, exr_get_error_code_as_string(code));
 }
 
 // The file around its encoded chunks: OpenEXRCore writes the header, the
@@ -269,14 +268,12 @@ std::string AssembleExr(const ExrFile& file, const std::vector<Chunk>& chunks) {
         "the required attributes");
   const exr_pixel_type_t type = options.pixel_type == PixelType::kHalf ? EXR_PIXEL_HALF : EXR_PIXEL_FLOAT;
   for (const char* channel : {"B", "G", "R"})
-    check(exr_result_t(exr_add_channel(context, part, channel, type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1)),
-          "a channel");
+    check(exr_result_t(exr_add_channel(context, part, channel, type, EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1)), "a channel");
   // The primaries and white of the options (Rec.709 and D65 unless told).
   const std::array<float, 8>& xy = options.chromaticities;
   const exr_attr_chromaticities_t primaries{xy[0], xy[1], xy[2], xy[3], xy[4], xy[5], xy[6], xy[7]};
   check(exr_attr_set_chromaticities(context, part, "chromaticities", &primaries), "chromaticities");
-  if (options.envmap >= 0)
-    check(exr_attr_set_envmap(context, part, "envmap", exr_envmap_t(options.envmap)), "envmap");
+  if (options.envmap >= 0) check(exr_attr_set_envmap(context, part, "envmap", exr_envmap_t(options.envmap)), "envmap");
   if (options.white_luminance > 0.0)
     check(exr_attr_set_float(context, part, "whiteLuminance", float(options.white_luminance)), "whiteLuminance");
   for (const auto& [key, value] : options.attributes)

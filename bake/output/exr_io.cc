@@ -112,8 +112,8 @@ void WriteFileAtomically(const std::string& path, const std::function<void(const
   auto fail = [&](const char* what, int error, int fd) {
     if (fd >= 0) ::close(fd);
     if (created) remove_temporary();
-    throw OutputError(fmt::format("cannot write {} ({} {}: {}){}", path, what, temporary, std::strerror(error),
-                                  WriteFix(error)));
+    throw OutputError(
+        fmt::format("cannot write {} ({} {}: {}){}", path, what, temporary, std::strerror(error), WriteFix(error)));
   };
   // In a held folder (file_door.h) relative to its descriptor: the
   // folder the bake locked, whatever its name points to now.
@@ -244,10 +244,10 @@ double CheckedMaxValue(const std::vector<const RgbaImage*>& images) {
 double HalfRangeScale(double max_value, OverflowPolicy policy) {
   if (max_value <= kHalfMax) return 1.0;
   if (policy == OverflowPolicy::kRefuse)
-    throw OutputError(fmt::format(
-        "the brightest value {:.6g} exceeds the half-float maximum {}: set output.pixel_type = "
-        "\"float\", or output.overflow = \"scale\" to scale the image by a power of two",
-        max_value, kHalfMax));
+    throw OutputError(
+        fmt::format("the brightest value {:.6g} exceeds the half-float maximum {}: set output.pixel_type = "
+                    "\"float\", or output.overflow = \"scale\" to scale the image by a power of two",
+                    max_value, kHalfMax));
   return std::exp2(-std::ceil(std::log2(max_value / kHalfMax)));
 }
 
@@ -283,8 +283,7 @@ std::string EncodeWithOpenExr(const std::string& path, const RgbaImage& image, c
   Imf::addChromaticities(header, Imf::Chromaticities({xy[0], xy[1]}, {xy[2], xy[3]}, {xy[4], xy[5]}, {xy[6], xy[7]}));
   if (options.envmap >= 0) Imf::addEnvmap(header, Imf::Envmap(options.envmap));
   if (options.white_luminance > 0.0) Imf::addWhiteLuminance(header, float(options.white_luminance));
-  for (const auto& [key, value] : options.attributes)
-    header.insert(key, Imf::StringAttribute(value));
+  for (const auto& [key, value] : options.attributes) header.insert(key, Imf::StringAttribute(value));
 
   // Scaled RGB copy in the file's pixel type (OpenEXR's OutputFile does not
   // convert float frame buffers to half channels).

@@ -27,7 +27,6 @@
 #define TINYGLTF_NO_INCLUDE_JSON
 #include <tiny_gltf.h>
 
-
 #include "skybake/model/spectrum.h"
 #include "skybake/model/tonemap.h"
 #include "skybake/output/exr_io.h"
@@ -54,8 +53,8 @@ int AddBufferView(tinygltf::Model& model, const void* bytes, size_t size, int ta
   return int(model.bufferViews.size() - 1);
 }
 
-int AddAccessor(tinygltf::Model& model, int view, int component, size_t count, int type,
-                std::vector<double> min = {}, std::vector<double> max = {}) {
+int AddAccessor(tinygltf::Model& model, int view, int component, size_t count, int type, std::vector<double> min = {},
+                std::vector<double> max = {}) {
   tinygltf::Accessor a;
   a.bufferView = view;
   a.componentType = component;
@@ -93,8 +92,7 @@ tinygltf::Value ToValue(const json& j) {
 int AddPositions(tinygltf::Model& model, const std::vector<glm::vec3>& positions) {
   glm::vec3 lo(1e30f), hi(-1e30f);
   for (const glm::vec3& p : positions) lo = glm::min(lo, p), hi = glm::max(hi, p);
-  return AddAccessor(model,
-                     AddBufferView(model, positions.data(), positions.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
+  return AddAccessor(model, AddBufferView(model, positions.data(), positions.size() * 12, TINYGLTF_TARGET_ARRAY_BUFFER),
                      TINYGLTF_COMPONENT_TYPE_FLOAT, positions.size(), TINYGLTF_TYPE_VEC3, {lo.x, lo.y, lo.z},
                      {hi.x, hi.y, hi.z});
 }
@@ -173,7 +171,6 @@ std::string ReadFile(const std::string& path) {
   return bytes;
 }
 
-
 // The ground plane under the dome (gltf_scene.h "ground"): a square at the
 // receiver altitude over the cloud shadow map's extent, UV (0, 0) at the
 // map's north-west corner (row 0, column 0), u along its axis_u (east),
@@ -222,12 +219,9 @@ void AddImageBasedLight(const SceneDescription& scene, tinygltf::Model& model, t
   }
   json coefficients = json::array();
   for (const Rgb& c : scene.ibl_sh) coefficients.push_back({c[0] * k, c[1] * k, c[2] * k});
-  json light = {{"name", scene.name + " sky"},
-                {"intensity", 1.0 / k},
-                {"rotation", {0.0, 0.0, 0.0, 1.0}},
-                {"irradianceCoefficients", coefficients},
-                {"specularImageSize", size},
-                {"specularImages", levels}};
+  json light = {{"name", scene.name + " sky"},      {"intensity", 1.0 / k},
+                {"rotation", {0.0, 0.0, 0.0, 1.0}}, {"irradianceCoefficients", coefficients},
+                {"specularImageSize", size},        {"specularImages", levels}};
   model.extensions["EXT_lights_image_based"] = ToValue(json{{"lights", json::array({light})}});
   model.extensionsUsed.push_back("EXT_lights_image_based");
   gltf_scene.extensions["EXT_lights_image_based"] = ToValue(json{{"light", 0}});
@@ -268,8 +262,8 @@ DomeMesh BuildDome(const GltfSettings& settings, int w, int h) {
       double y = (0.5 - lat / M_PI) * (h - 1);
       mesh.uvs.push_back(glm::vec2(float((x + 0.5) / w), float((y + 0.5) / h)));
       mesh.directions.push_back(d);
-      mesh.positions.push_back(glm::vec3(float(settings.radius_m * d.x), float(vertical * d.y),
-                                         float(settings.radius_m * d.z)));
+      mesh.positions.push_back(
+          glm::vec3(float(settings.radius_m * d.x), float(vertical * d.y), float(settings.radius_m * d.z)));
     }
   }
   const int columns = segments + 1;
@@ -284,8 +278,8 @@ DomeMesh BuildDome(const GltfSettings& settings, int w, int h) {
     for (int j = 0; j < segments; ++j) {
       uint32_t a = uint32_t(i * columns + j), b = a + 1;
       uint32_t c = uint32_t((i + 1) * columns + j), d = c + 1;
-      if (i != 0) add(a, c, b);                // no degenerate triangle at the top pole
-      if (i + 1 != rings_full) add(b, c, d);   // nor at the bottom pole
+      if (i != 0) add(a, c, b);               // no degenerate triangle at the top pole
+      if (i + 1 != rings_full) add(b, c, d);  // nor at the bottom pole
     }
   }
   return mesh;
@@ -353,9 +347,9 @@ RotationKeys AddRotationKeys(tinygltf::Model& model, const std::vector<SceneSun>
       for (int c = 0; c < 4; ++c) rotations[k + c] = -rotations[k + c];
   }
   RotationKeys track;
-  track.input = AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0),
-                            TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_SCALAR, {times.front()},
-                            {times.back()});
+  track.input =
+      AddAccessor(model, AddBufferView(model, times.data(), times.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                  times.size(), TINYGLTF_TYPE_SCALAR, {times.front()}, {times.back()});
   track.output = AddAccessor(model, AddBufferView(model, rotations.data(), rotations.size() * 4, 0),
                              TINYGLTF_COMPONENT_TYPE_FLOAT, times.size(), TINYGLTF_TYPE_VEC4);
   // Animation data is not vertex data: no target.
@@ -404,9 +398,9 @@ int LightOfNode(const tinygltf::Model& model, int node) {
 void AnimateLightProperty(tinygltf::Model& model, int light, const std::string& property, int times,
                           const std::vector<float>& values, int components) {
   const size_t count = values.size() / size_t(components);
-  const int output = AddAccessor(model, AddBufferView(model, values.data(), values.size() * 4, 0),
-                                 TINYGLTF_COMPONENT_TYPE_FLOAT, count,
-                                 components == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3);
+  const int output =
+      AddAccessor(model, AddBufferView(model, values.data(), values.size() * 4, 0), TINYGLTF_COMPONENT_TYPE_FLOAT,
+                  count, components == 1 ? TINYGLTF_TYPE_SCALAR : TINYGLTF_TYPE_VEC3);
   model.bufferViews[model.accessors[output].bufferView].target = 0;
   tinygltf::AnimationChannel& channel = AddLinearChannel(model, times, output);
   channel.target_path = "pointer";
@@ -493,9 +487,10 @@ tinygltf::Model BuildSceneModel(const SceneDescription& scene) {
   model.defaultScene = 0;
   json asset_extras = {
       {"skybake",
-       {{"units", {{"length", "metre"},
-                   {"sun_intensity", "lux (KHR_lights_punctual directional): intensity x Y(colour) is the illuminance"},
-                   {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
+       {{"units",
+         {{"length", "metre"},
+          {"sun_intensity", "lux (KHR_lights_punctual directional): intensity x Y(colour) is the illuminance"},
+          {"texture", "tone-mapped sRGB preview of the latlong (exposure, ACES filmic, sRGB OETF)"}}},
         {"frame", "+Y up, right-handed, North -Z, East +X; sun light shines along its node's -Z"},
         {"texture_layout", "OpenEXR latlong (Imf::LatLongMap): u = 0 at longitude +pi, v = 0 at latitude +pi/2"}}}};
   model.asset.extras = ToValue(asset_extras);
@@ -624,9 +619,10 @@ void WriteCloudShadowGroundPng(const std::string& exr_path, const std::string& p
   int width = 0, height = 0;
   std::vector<float> rgba;
   if (const std::string problem = ReadExrRgba(exr_path, width, height, rgba); !problem.empty())
-    throw OutputError(fmt::format("{}: cannot read the cloud shadow map for the glTF ground: it {}; bake its frame "
-                                  "again",
-                                  exr_path, problem));
+    throw OutputError(
+        fmt::format("{}: cannot read the cloud shadow map for the glTF ground: it {}; bake its frame "
+                    "again",
+                    exr_path, problem));
   std::vector<uint8_t> rgb(size_t(width) * size_t(height) * 3);
   for (size_t i = 0; i < size_t(width) * size_t(height); ++i) {
     const double t = std::clamp(double(rgba[4 * i]), 0.0, 1.0);

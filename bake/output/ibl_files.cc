@@ -101,8 +101,8 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& rec709_maps, const SkySty
             "GGX-prefiltered radiance (split sum, Karis 2013), N = V = R; level {} of {}; perceptual roughness {:.9g} "
             "= level / (levels - 1), alpha = roughness^2 = {:.9g}; {} samples, filtered importance sampling, mip bias "
             "{:.9g}",
-            level, levels, roughness, roughness * roughness,
-            level == 0 ? s.samples : IblLevelSamples(s, roughness), s.lod_bias);
+            level, levels, roughness, roughness * roughness, level == 0 ? s.samples : IblLevelSamples(s, roughness),
+            s.lod_bias);
         o.attributes["skybake:ibl_sun"] = sun;
         o.attributes["skybake:layout"] = layout;
         exrs.push_back({fmt::format("specular level {}", level), nullptr, o});
@@ -173,8 +173,9 @@ std::vector<std::string> EncodeIblFiles(const IblMaps& rec709_maps, const SkySty
       o.format = KtxFormat::kRgba16f;
       o.zstd_level = s.ktx2_zstd_level;
       o.metadata = {{"skybake:version", SKYBAKE_VERSION},
-                    {"skybake:ibl", "split-sum DFG table: x = N.V, y = perceptual roughness (0 at the top), R = scale, "
-                                    "G = bias of F0"}};
+                    {"skybake:ibl",
+                     "split-sum DFG table: x = N.V, y = perceptual roughness (0 at the top), R = scale, "
+                     "G = bias of F0"}};
       encoded.push_back(EncodeKtx2Image(maps.dfg_size, maps.dfg_size, maps.dfg, o));
     }
   }

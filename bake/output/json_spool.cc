@@ -57,8 +57,8 @@ void JsonArraySpool::Add(const std::string& element_text) {
     ssize_t n = ::pwrite(fd_, text.data() + done, text.size() - done, off_t(bytes_ + done));
     if (n < 0 && errno == EINTR) continue;
     if (n <= 0)
-      throw OutputError(fmt::format("cannot write the bake's record of its frames to a temporary file in {}: {}",
-                                    dir_, std::strerror(n < 0 ? errno : EIO)));
+      throw OutputError(fmt::format("cannot write the bake's record of its frames to a temporary file in {}: {}", dir_,
+                                    std::strerror(n < 0 ? errno : EIO)));
     done += size_t(n);
   }
   bytes_ += text.size();

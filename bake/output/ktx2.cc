@@ -53,17 +53,19 @@ uint32_t PackUnsignedFloat(float v, int mantissa_bits, const char* channel) {
   // A mantissa rounded up to 2^mb carries into the exponent through the bit layout.
   const uint32_t bits = (uint32_t(exponent) << mantissa_bits) + mantissa;
   if ((bits >> mantissa_bits) >= 31)
-    throw OutputError(fmt::format("KTX2: {} value {} is beyond the B10G11R11 range (max {}): use "
-                                  "ibl.ktx2_format = \"rgba16f\" or output.overflow = \"scale\"",
-                                  channel, v, mantissa_bits == 6 ? 65024 : 64512));
+    throw OutputError(
+        fmt::format("KTX2: {} value {} is beyond the B10G11R11 range (max {}): use "
+                    "ibl.ktx2_format = \"rgba16f\" or output.overflow = \"scale\"",
+                    channel, v, mantissa_bits == 6 ? 65024 : 64512));
   return bits;
 }
 
 uint16_t HalfBits(float v) {
   if (!std::isfinite(v) || std::abs(v) > 65504.0f)
-    throw OutputError(fmt::format("KTX2: value {} is beyond half-float range (max 65504): set output.overflow = "
-                                  "\"scale\" (every file scaled by the same power of two)",
-                                  v));
+    throw OutputError(
+        fmt::format("KTX2: value {} is beyond half-float range (max 65504): set output.overflow = "
+                    "\"scale\" (every file scaled by the same power of two)",
+                    v));
   return Imath::half(v).bits();
 }
 
@@ -81,8 +83,12 @@ void EncodeTexels(const float* rgba, size_t texels, const Ktx2Options& o, std::s
         }
         break;
       }
-      case KtxFormat::kB10g11r11: Put32(out, PackB10G11R11(r, g, b)); break;
-      case KtxFormat::kE5b9g9r9: Put32(out, PackE5B9G9R9(r, g, b)); break;
+      case KtxFormat::kB10g11r11:
+        Put32(out, PackB10G11R11(r, g, b));
+        break;
+      case KtxFormat::kE5b9g9r9:
+        Put32(out, PackE5B9G9R9(r, g, b));
+        break;
     }
   }
 }
@@ -128,13 +134,13 @@ std::string DataFormatDescriptor(KtxFormat format, uint32_t primaries) {
   }
   const uint32_t block_size = 24 + 16 * uint32_t(samples.size());
   std::string d;
-  Put32(d, 4 + block_size);                   // dfdTotalSize
-  Put32(d, 0);                                // vendorId 0 (Khronos), descriptorType 0 (basic)
-  Put32(d, 2u | (block_size << 16));          // versionNumber 2 (KDF 1.3), descriptorBlockSize
+  Put32(d, 4 + block_size);                      // dfdTotalSize
+  Put32(d, 0);                                   // vendorId 0 (Khronos), descriptorType 0 (basic)
+  Put32(d, 2u | (block_size << 16));             // versionNumber 2 (KDF 1.3), descriptorBlockSize
   Put32(d, 1u | (primaries << 8) | (1u << 16));  // colorModel RGBSDA, colorPrimaries, transfer LINEAR, flags 0
-  Put32(d, 0);                                // texelBlockDimension 1 x 1 x 1 x 1
-  Put32(d, Ktx2TexelBytes(format));           // bytesPlane0
-  Put32(d, 0);                                // bytesPlane4..7
+  Put32(d, 0);                                   // texelBlockDimension 1 x 1 x 1 x 1
+  Put32(d, Ktx2TexelBytes(format));              // bytesPlane0
+  Put32(d, 0);                                   // bytesPlane4..7
   for (const Sample& s : samples) {
     Put32(d, s.bit_offset | ((s.bit_length - 1) << 16) | ((s.channel | s.qualifiers) << 24));
     Put32(d, 0);  // sample position 0
@@ -214,9 +220,12 @@ std::string Assemble(uint32_t width, uint32_t height, uint32_t faces, const std:
 
 uint32_t Ktx2VkFormat(KtxFormat format) {
   switch (format) {
-    case KtxFormat::kRgba16f: return 97;     // VK_FORMAT_R16G16B16A16_SFLOAT
-    case KtxFormat::kB10g11r11: return 122;  // VK_FORMAT_B10G11R11_UFLOAT_PACK32
-    case KtxFormat::kE5b9g9r9: return 123;   // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
+    case KtxFormat::kRgba16f:
+      return 97;  // VK_FORMAT_R16G16B16A16_SFLOAT
+    case KtxFormat::kB10g11r11:
+      return 122;  // VK_FORMAT_B10G11R11_UFLOAT_PACK32
+    case KtxFormat::kE5b9g9r9:
+      return 123;  // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
   }
   return 0;
 }
@@ -225,9 +234,12 @@ uint32_t Ktx2TexelBytes(KtxFormat format) { return format == KtxFormat::kRgba16f
 
 const char* Ktx2FormatName(KtxFormat format) {
   switch (format) {
-    case KtxFormat::kRgba16f: return "rgba16f";
-    case KtxFormat::kB10g11r11: return "b10g11r11";
-    case KtxFormat::kE5b9g9r9: return "e5b9g9r9";
+    case KtxFormat::kRgba16f:
+      return "rgba16f";
+    case KtxFormat::kB10g11r11:
+      return "b10g11r11";
+    case KtxFormat::kE5b9g9r9:
+      return "e5b9g9r9";
   }
   return "";
 }
@@ -246,9 +258,10 @@ uint32_t PackE5B9G9R9(float r, float g, float b) {
     if (!(v >= 0.0f) || std::isinf(v))
       throw OutputError(fmt::format("KTX2: value {} cannot be stored (negative, infinite or NaN)", v));
     if (v > max_value)
-      throw OutputError(fmt::format("KTX2: value {} is beyond the E5B9G9R9 range (max {}): use "
-                                    "output.overflow = \"scale\"",
-                                    v, max_value));
+      throw OutputError(
+          fmt::format("KTX2: value {} is beyond the E5B9G9R9 range (max {}): use "
+                      "output.overflow = \"scale\"",
+                      v, max_value));
   }
   const double max_rgb = std::max({double(r), double(g), double(b)});
   int exp_shared = std::max(-kB - 1, int(std::floor(std::log2(std::max(max_rgb, 1e-300))))) + 1 + kB;

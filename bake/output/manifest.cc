@@ -55,14 +55,21 @@ json FileJson(const ManifestFile& f) {
   return file;
 }
 
-json RangeJson(const FrameRange& r) { return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}}; }
+json RangeJson(const FrameRange& r) {
+  return {{"first_frame", r.first}, {"last_frame", r.last}, {"frames", r.count()}};
+}
 
 json MoonJson(const MoonRecord& m) {
-  return {{"direction", VectorJson(m.direction)},   {"elevation_deg", m.elevation_deg},
-          {"azimuth_deg", m.azimuth_deg},           {"phase_angle_deg", m.phase_angle_deg},
-          {"illuminated_fraction", m.illuminated_fraction}, {"bright_limb_deg", m.bright_limb_deg},
-          {"angular_radius_rad", m.angular_radius_rad},     {"top_illuminance_lux", m.top_illuminance_lux},
-          {"illuminance_lux", m.illuminance_lux},   {"irradiance", RgbJson(m.irradiance)},
+  return {{"direction", VectorJson(m.direction)},
+          {"elevation_deg", m.elevation_deg},
+          {"azimuth_deg", m.azimuth_deg},
+          {"phase_angle_deg", m.phase_angle_deg},
+          {"illuminated_fraction", m.illuminated_fraction},
+          {"bright_limb_deg", m.bright_limb_deg},
+          {"angular_radius_rad", m.angular_radius_rad},
+          {"top_illuminance_lux", m.top_illuminance_lux},
+          {"illuminance_lux", m.illuminance_lux},
+          {"irradiance", RgbJson(m.irradiance)},
           {"light", m.light}};
 }
 
@@ -77,18 +84,19 @@ json FrameJsonWithoutMoon(const ManifestFrame& f) {
   json files = json::array();
   for (const ManifestFile& file : f.files) files.push_back(FileJson(file));
   json frame = {{"frame", f.number},
-          {"style_sha256", f.style_sha256},
-          {"time", f.time ? json(*f.time) : json(nullptr)},
-          {"hours_from_start", f.hours_from_start},
-          {"animation_time_s", f.animation_time_s},
-          {"sun", {{"elevation_deg", f.sun_elevation_deg},
-                   {"azimuth_deg", f.sun_azimuth_deg},
-                   {"direction", VectorJson(f.sun_direction)},
-                   {"illuminance_lux", f.sun_illuminance_lux},
-                   {"irradiance", RgbJson(f.sun_irradiance)}}},
-          {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
-          {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
-          {"files", files}};
+                {"style_sha256", f.style_sha256},
+                {"time", f.time ? json(*f.time) : json(nullptr)},
+                {"hours_from_start", f.hours_from_start},
+                {"animation_time_s", f.animation_time_s},
+                {"sun",
+                 {{"elevation_deg", f.sun_elevation_deg},
+                  {"azimuth_deg", f.sun_azimuth_deg},
+                  {"direction", VectorJson(f.sun_direction)},
+                  {"illuminance_lux", f.sun_illuminance_lux},
+                  {"irradiance", RgbJson(f.sun_irradiance)}}},
+                {"sh_irradiance_with_sun", ShJson(f.sh_irradiance_with_sun)},
+                {"sh_irradiance_without_sun", ShJson(f.sh_irradiance_without_sun)},
+                {"files", files}};
   if (f.cloud_shadow) frame["cloud_shadow"] = CloudShadowJson(*f.cloud_shadow);
   if (f.sun_angular_radius_rad) frame["sun"]["angular_radius_rad"] = *f.sun_angular_radius_rad;
   return frame;
@@ -108,18 +116,17 @@ json ManifestJson(const Manifest& m) {
       {"half_scale", m.half_scale},
       {"sh_basis", kShBasis},
       {"frame_convention", kFrameConvention},
-      {"gltf", {{"enabled", m.gltf.enabled},
-                {"name", m.gltf.name},
-                {"dome", m.gltf.dome.dome == DomeShape::kHemisphere ? "hemisphere" : "sphere"},
-                {"radius_m", m.gltf.dome.radius_m},
-                {"flattening", m.gltf.dome.flattening},
-                {"segments", m.gltf.dome.segments},
-                {"texture", {{"file", m.gltf.texture_file},
-                             {"width", m.gltf.texture_width},
-                             {"height", m.gltf.texture_height}}}}},
+      {"gltf",
+       {{"enabled", m.gltf.enabled},
+        {"name", m.gltf.name},
+        {"dome", m.gltf.dome.dome == DomeShape::kHemisphere ? "hemisphere" : "sphere"},
+        {"radius_m", m.gltf.dome.radius_m},
+        {"flattening", m.gltf.dome.flattening},
+        {"segments", m.gltf.dome.segments},
+        {"texture",
+         {{"file", m.gltf.texture_file}, {"width", m.gltf.texture_width}, {"height", m.gltf.texture_height}}}}},
   };
-  if (m.usd.enabled)
-    j["usd"] = {{"enabled", true}, {"name", m.usd.name}};
+  if (m.usd.enabled) j["usd"] = {{"enabled", true}, {"name", m.usd.name}};
   if (m.place) j["place"] = {{"latitude_deg", m.place->latitude_deg}, {"longitude_deg", m.place->longitude_deg}};
   if (m.sequence) j["sequence"] = RangeJson(*m.sequence);
   if (m.part) {
@@ -184,7 +191,8 @@ class Reader {
   // 100,000 frames, a sequence of at most 100,000 (schedule.h).
   FrameRange Range(const json& object, const char* key) const {
     const json& r = Get<json>(object, key);
-    FrameRange range{int(Integer(r, "first_frame", 1, kMaxFrameNumber)), int(Integer(r, "last_frame", 1, kMaxFrameNumber))};
+    FrameRange range{int(Integer(r, "first_frame", 1, kMaxFrameNumber)),
+                     int(Integer(r, "last_frame", 1, kMaxFrameNumber))};
     if (range.last < range.first) Fail(fmt::format("'{}' ends before it starts", key));
     if (int64_t(range.last) - range.first >= kMaxSequenceFrames)
       Fail(fmt::format("'{}' spans more than the {} frames of a sequence", key, kMaxSequenceFrames));
@@ -271,9 +279,10 @@ json SharedPart(json manifest) {
 // manifest was edited (or is hostile). Nothing is opened under it.
 [[noreturn]] void FailName(const std::string& path, const std::string& where, const std::string& name,
                            const std::string& expected) {
-  throw ManifestError(fmt::format("{}: {}: {} is not {}: the manifest was edited or is not skybake's; nothing was "
-                                  "read under that name. Bake the part again (with --force) to rewrite it",
-                                  path, where, EscapedText(name), expected));
+  throw ManifestError(
+      fmt::format("{}: {}: {} is not {}: the manifest was edited or is not skybake's; nothing was "
+                  "read under that name. Bake the part again (with --force) to rewrite it",
+                  path, where, EscapedText(name), expected));
 }
 
 }  // namespace
@@ -309,8 +318,9 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
     const bool level_ok = m != std::string::npos && m > 0 && m + 11 < stem.size() &&
                           stem.find_first_not_of("0123456789", m + 11) == std::string::npos;
     if (stage > 3 || !IsListedNameOk(file.file) || !face_ok || !level_ok)
-      FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE_specular_mLEVEL_FACE{})",
-                                                   file.kind, number_in_name, tail));
+      FailName(path, where, file.file,
+               fmt::format("the {} file skybake names for frame {} (BASE_specular_mLEVEL_FACE{})", file.kind,
+                           number_in_name, tail));
     const std::string b = stem.substr(0, m);
     if (!base.empty() && b != base)
       FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
@@ -319,24 +329,31 @@ void CheckIblName(const std::string& path, const std::string& where, int number_
     return;
   }
   const std::string number = file.kind == "ibl_dfg" ? std::string() : FrameNumberSuffix(number_in_name, number_width);
-  const char* suffix = file.kind == "ibl_specular" ? "_specular" : file.kind == "ibl_irradiance" ? "_irradiance" : "_dfg";
+  const char* suffix = file.kind == "ibl_specular"     ? "_specular"
+                       : file.kind == "ibl_irradiance" ? "_irradiance"
+                                                       : "_dfg";
   const std::string shape = fmt::format("BASE{}{}.exr or .ktx2{}", suffix, number,
                                         file.kind == "ibl_specular" ? " (BASE_specular_mLEVEL... for EXR levels)" : "");
   std::string stem;
   for (const char* ext : {".exr", ".ktx2"})
-    if (stem.empty() && EndsWith(file.file, number + ext)) stem = file.file.substr(0, file.file.size() - number.size() - std::strlen(ext));
+    if (stem.empty() && EndsWith(file.file, number + ext))
+      stem = file.file.substr(0, file.file.size() - number.size() - std::strlen(ext));
   if (stage > 3 || !IsListedNameOk(file.file) || stem.empty())
-    FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+    FailName(path, where, file.file,
+             fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
   // An EXR specular level: strip its _mLEVEL.
   if (file.kind == "ibl_specular" && EndsWith(file.file, ".exr")) {
     const size_t m = stem.rfind("_m");
     const bool digits = m != std::string::npos && m + 2 < stem.size() &&
                         stem.find_first_not_of("0123456789", m + 2) == std::string::npos;
-    if (!digits) FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+    if (!digits)
+      FailName(path, where, file.file,
+               fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
     stem.resize(m);
   }
   if (!EndsWith(stem, suffix) || stem.size() == std::strlen(suffix))
-    FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
+    FailName(path, where, file.file,
+             fmt::format("the {} file skybake names for frame {} ({})", file.kind, number_in_name, shape));
   const std::string b = stem.substr(0, stem.size() - std::strlen(suffix));
   if (!base.empty() && b != base)
     FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
@@ -364,15 +381,15 @@ void CheckNames(const std::string& path, const Manifest& m) {
     auto stem_of = [&](const ManifestFile& file, const char* ext, const char* what) {
       const std::string tail = number + ext;
       if (!IsListedNameOk(file.file) || !EndsWith(file.file, tail) || file.file.size() == tail.size())
-        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (...{})", what,
-                                                     f.number, tail));
+        FailName(path, where, file.file,
+                 fmt::format("the {} file skybake names for frame {} (...{})", what, f.number, tail));
       return file.file.substr(0, file.file.size() - tail.size());
     };
     auto with_suffix = [&](const ManifestFile& file, const std::string& stem, const char* suffix, const char* what,
                            int at) {
       if (stage > at || !EndsWith(stem, suffix) || stem.size() == std::strlen(suffix))
-        FailName(path, where, file.file, fmt::format("the {} file skybake names for frame {} (BASE{}{})", what,
-                                                     f.number, suffix, number));
+        FailName(path, where, file.file,
+                 fmt::format("the {} file skybake names for frame {} (BASE{}{})", what, f.number, suffix, number));
       const std::string b = stem.substr(0, stem.size() - std::strlen(suffix));
       if (!base.empty() && b != base)
         FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
@@ -399,8 +416,10 @@ void CheckNames(const std::string& path, const Manifest& m) {
         // BASE_ENGINE_SUFFIX.NNNN.exr (engine_preset.h), after the IBL files.
         const std::optional<std::string> b = EngineFileBase(file.file, f.number, number_width);
         if (stage > 4 || !IsListedNameOk(file.file) || !b || b->empty())
-          FailName(path, where, file.file, fmt::format("an engine preset's file skybake names for frame {} "
-                                                       "(BASE_ENGINE_SUFFIX{}.exr)", f.number, number));
+          FailName(path, where, file.file,
+                   fmt::format("an engine preset's file skybake names for frame {} "
+                               "(BASE_ENGINE_SUFFIX{}.exr)",
+                               f.number, number));
         if (!base.empty() && *b != base)
           FailName(path, where, file.file, fmt::format("a file of the frame's other files' basename '{}'", base));
         base = *b;
@@ -416,7 +435,8 @@ void CheckNames(const std::string& path, const Manifest& m) {
       }
     }
     if (!faces.empty() && faces.size() != 6)
-      FailName(path, where, faces.back(), "one of six face files (the frame lists " + std::to_string(faces.size()) + ")");
+      FailName(path, where, faces.back(),
+               "one of six face files (the frame lists " + std::to_string(faces.size()) + ")");
     // The faces share the frame's basename (the other files', else the
     // scene's name, else their common prefix) and differ from each other.
     if (!faces.empty()) {
@@ -461,7 +481,8 @@ void CheckNames(const std::string& path, const Manifest& m) {
     if (file.kind == "usd" && m.usd.enabled && file.file == m.usd.name + ".usda") continue;
     auto it = kSceneExtension.find(file.kind);
     if (it == kSceneExtension.end() || file.file != m.gltf.name + it->second)
-      FailName(path, "scene", file.file, fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png, .usda)", m.gltf.name));
+      FailName(path, "scene", file.file,
+               fmt::format("a scene file skybake names ({}.gltf, .bin, .glb, _ground.png, .usda)", m.gltf.name));
   }
 }
 
@@ -543,8 +564,7 @@ ManifestFrame FrameOf(const Reader& r, const json& f) {
   frame.sun_illuminance_lux = r.Real(sun, "illuminance_lux", 0.0, kMaxLux);
   const glm::dvec3 irradiance = r.Bounded(sun, "irradiance", 0.0, kMaxLux);  // output units x sr
   frame.sun_irradiance = {irradiance.x, irradiance.y, irradiance.z};
-  if (sun.contains("angular_radius_rad"))
-    frame.sun_angular_radius_rad = r.Real(sun, "angular_radius_rad", 1e-6, 0.5);
+  if (sun.contains("angular_radius_rad")) frame.sun_angular_radius_rad = r.Real(sun, "angular_radius_rad", 1e-6, 0.5);
   frame.sh_irradiance_with_sun = r.Sh(f, "sh_irradiance_with_sun");
   frame.sh_irradiance_without_sun = r.Sh(f, "sh_irradiance_without_sun");
   if (f.contains("moon")) frame.moon = MoonOf(r, r.Get<json>(f, "moon"));
@@ -714,10 +734,14 @@ std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir
       frames_compact += (i == 0 ? "" : ",") + extras.dump();
       frames_pretty += (i == 0 ? "\n    " : ",\n    ") + IndentedJson(extras.dump(2), "    ");
     }
-    const json provenance = {{"version", manifest.version},       {"style", manifest.style},
-                             {"schedule", manifest.schedule},     {"units", manifest.units},
-                             {"exposure_ev100", manifest.exposure_ev100}, {"texture_frame", manifest.texture_frame},
-                             {"sh_basis", kShBasis},              {"frames", json::array()}};
+    const json provenance = {{"version", manifest.version},
+                             {"style", manifest.style},
+                             {"schedule", manifest.schedule},
+                             {"units", manifest.units},
+                             {"exposure_ev100", manifest.exposure_ev100},
+                             {"texture_frame", manifest.texture_frame},
+                             {"sh_basis", kShBasis},
+                             {"frames", json::array()}};
     // The frames in place of the empty list: the bytes dump() and dump(2)
     // give the whole object (json_spool.h).
     scene.extras_json = SplicedJson(provenance.dump(), "\"frames\":[]", "\"frames\":[" + frames_compact + "]");
@@ -730,15 +754,15 @@ std::vector<BakedFile> WriteScene(Manifest& manifest, const std::string& out_dir
     if (scene.ground) files.push_back({(fs::path(out_dir) / scene.ground_texture_file).string(), "gltf_ground"});
     for (auto [path, kind] : files) {
       scene_files.push_back({path, kind, WrittenFileSize(path), Sha256OfFile(path)});
-      manifest.scene.push_back({fs::path(path).filename().string(), kind, scene_files.back().bytes,
-                                scene_files.back().sha256});
+      manifest.scene.push_back(
+          {fs::path(path).filename().string(), kind, scene_files.back().bytes, scene_files.back().sha256});
     }
   }
   if (manifest.usd.enabled && !manifest.frames.empty()) {
     const std::string path = WriteUsdLayer(UsdLayerOf(manifest, out_dir));
     scene_files.push_back({path, "usd", WrittenFileSize(path), Sha256OfFile(path)});
-    manifest.scene.push_back({fs::path(path).filename().string(), "usd", scene_files.back().bytes,
-                              scene_files.back().sha256});
+    manifest.scene.push_back(
+        {fs::path(path).filename().string(), "usd", scene_files.back().bytes, scene_files.back().sha256});
   }
   return scene_files;
 }
@@ -767,8 +791,8 @@ std::string TimingsStageText(const StageReport& stage) { return TimingsStageJson
 
 std::string TimingsFrameText(const FrameResult& frame) { return TimingsFrameJson(frame).dump(2); }
 
-void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds,
-                  const std::string& path, const TimingsSpools* spools) {
+void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds, const std::string& path,
+                  const TimingsSpools* spools) {
   json stages = json::array();
   for (const StageReport& s : result.stages) stages.push_back(TimingsStageJson(s));
   json frames = json::array();
@@ -809,9 +833,10 @@ MergeParts ReadMergeParts(const MergeOptions& options) {
     if (e.is_regular_file() && std::regex_match(name, kPartName)) p.paths.push_back(e.path().string());
   }
   if (p.paths.empty())
-    throw ManifestError(fmt::format("no shard manifests (manifest.shard-FIRST-LAST.json) in {}: bake with --shard "
-                                    "I/N or --frames A:B into it first",
-                                    options.dir));
+    throw ManifestError(
+        fmt::format("no shard manifests (manifest.shard-FIRST-LAST.json) in {}: bake with --shard "
+                    "I/N or --frames A:B into it first",
+                    options.dir));
   for (const std::string& path : p.paths) {
     Manifest m = ReadManifest(path);
     p.parts.emplace_back(std::move(m), SharedPart(json::parse(ManifestBytes(path))));
@@ -850,18 +875,20 @@ void CheckEveryFrameOnce(const MergeParts& p, const FrameRange& sequence, const 
   for (size_t i : p.order) {
     const Manifest& m = p[i];
     if (!m.complete || int(m.frames.size()) != m.part->count())
-      throw ManifestError(fmt::format("{} is incomplete ({} of frames {} baked): finish it by running its bake "
-                                      "again with --resume",
-                                      p.paths[i], m.frames.size(), FrameRangeText(*m.part)));
+      throw ManifestError(
+          fmt::format("{} is incomplete ({} of frames {} baked): finish it by running its bake "
+                      "again with --resume",
+                      p.paths[i], m.frames.size(), FrameRangeText(*m.part)));
     for (const ManifestFrame& f : m.frames) {
       if (!m.part->Contains(f.number) || !sequence.Contains(f.number))
-        throw ManifestError(fmt::format("{} lists frame {}, outside its part {}", p.paths[i], f.number,
-                                        FrameRangeText(*m.part)));
+        throw ManifestError(
+            fmt::format("{} lists frame {}, outside its part {}", p.paths[i], f.number, FrameRangeText(*m.part)));
       auto [it, inserted] = owner.emplace(f.number, i);
       if (!inserted)
-        throw ManifestError(fmt::format("frame {} is in both {} and {}: the shards overlap; remove one of the two "
-                                        "manifests (with its files if they differ) and merge again",
-                                        f.number, p.paths[it->second], p.paths[i]));
+        throw ManifestError(
+            fmt::format("frame {} is in both {} and {}: the shards overlap; remove one of the two "
+                        "manifests (with its files if they differ) and merge again",
+                        f.number, p.paths[it->second], p.paths[i]));
     }
   }
   std::vector<int> missing;
@@ -872,9 +899,8 @@ void CheckEveryFrameOnce(const MergeParts& p, const FrameRange& sequence, const 
   throw ManifestError(fmt::format(
       "frame{} {} of {} {} missing: no shard manifest in {} lists {}: bake {} into {} (the missing --shard, or {}), "
       "then merge again",
-      missing.size() == 1 ? "" : "s", RangesText(missing), FrameRangeText(sequence),
-      missing.size() == 1 ? "is" : "are", dir, missing.size() == 1 ? "it" : "them",
-      missing.size() == 1 ? "it" : "them", dir,
+      missing.size() == 1 ? "" : "s", RangesText(missing), FrameRangeText(sequence), missing.size() == 1 ? "is" : "are",
+      dir, missing.size() == 1 ? "it" : "them", missing.size() == 1 ? "it" : "them", dir,
       one_range ? fmt::format("--frames {}:{}", missing.front(), missing.back())
                 : "--frames FIRST:LAST for each missing range"));
 }
@@ -888,21 +914,22 @@ void CheckListedFile(const fs::path& dir, const ManifestFile& file, const Manife
   uint64_t bytes = 0;
   const std::string problem = RegularFileSize(path.string(), bytes);
   if (problem == "no such file")
-    throw ManifestError(fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
-                                    "{}, or bake them again with --frames {}:{} --resume",
-                                    path.string(), part_path, FrameRangeText(*part.part), part.part->first,
-                                    part.part->last));
+    throw ManifestError(
+        fmt::format("{}, listed in {}, is missing: copy it from the machine that baked frames "
+                    "{}, or bake them again with --frames {}:{} --resume",
+                    path.string(), part_path, FrameRangeText(*part.part), part.part->first, part.part->last));
   if (!problem.empty())
-    throw ManifestError(fmt::format("{}, listed in {}, {}: put the file itself in the "
-                                    "folder",
-                                    path.string(), part_path, problem));
+    throw ManifestError(
+        fmt::format("{}, listed in {}, {}: put the file itself in the "
+                    "folder",
+                    path.string(), part_path, problem));
   if (bytes != file.bytes || (verify_checksums && Sha256OfFile(path.string()) != file.sha256))
-    throw ManifestError(fmt::format("{} does not match {} ({}): it is truncated, changed or from another bake; "
-                                    "bake frame {} again with --frames {}:{} --resume",
-                                    path.string(), part_path,
-                                    bytes != file.bytes ? fmt::format("{} bytes, listed with {}", bytes, file.bytes)
-                                                        : "SHA-256 differs",
-                                    f.number, f.number, f.number));
+    throw ManifestError(fmt::format(
+        "{} does not match {} ({}): it is truncated, changed or from another bake; "
+        "bake frame {} again with --frames {}:{} --resume",
+        path.string(), part_path,
+        bytes != file.bytes ? fmt::format("{} bytes, listed with {}", bytes, file.bytes) : "SHA-256 differs", f.number,
+        f.number, f.number));
 }
 
 // The frames are the ones the parts say they baked: their numbers, times,
@@ -918,15 +945,17 @@ void CheckMergedIdentity(const Manifest& merged, const std::string& dir) {
         if (file.kind == "preview" || file.kind == "gltf_texture") texture = file.file;
   }
   if (Sha256OfText(identity) != merged.sequence_sha256)
-    throw ManifestError(fmt::format("the frames of the shard manifests in {} (their numbers, times, suns and "
-                                    "style_sha256) do not give their sequence_sha256: a manifest was edited, or "
-                                    "the parts come from different bakes; bake the parts again with --force",
-                                    dir));
+    throw ManifestError(
+        fmt::format("the frames of the shard manifests in {} (their numbers, times, suns and "
+                    "style_sha256) do not give their sequence_sha256: a manifest was edited, or "
+                    "the parts come from different bakes; bake the parts again with --force",
+                    dir));
   if (merged.gltf.enabled && texture != merged.gltf.texture_file)
-    throw ManifestError(fmt::format("gltf.texture.file {} of the shard manifests in {} is not the PNG of texture "
-                                    "frame {} ({}): a manifest was edited; bake the parts again with --force",
-                                    EscapedText(merged.gltf.texture_file), dir, merged.texture_frame,
-                                    texture.empty() ? "none" : EscapedText(texture)));
+    throw ManifestError(
+        fmt::format("gltf.texture.file {} of the shard manifests in {} is not the PNG of texture "
+                    "frame {} ({}): a manifest was edited; bake the parts again with --force",
+                    EscapedText(merged.gltf.texture_file), dir, merged.texture_frame,
+                    texture.empty() ? "none" : EscapedText(texture)));
 }
 
 }  // namespace

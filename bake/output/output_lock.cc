@@ -61,8 +61,7 @@ std::string ProcessCommandLine() {
   for (size_t i = 2; i < args.size(); ++i) {
     if ((args[i] == "--shard" || args[i] == "--frames") && i + 1 < args.size())
       command += " " + args[i] + " " + args[i + 1];
-    else if (args[i].rfind("--shard=", 0) == 0 || args[i].rfind("--frames=", 0) == 0)
-      command += " " + args[i];
+    else if (args[i].rfind("--shard=", 0) == 0 || args[i].rfind("--frames=", 0) == 0) command += " " + args[i];
   }
   return EscapedName(command);
 }
@@ -119,9 +118,10 @@ std::string ReadAll(int fd) {
 }
 
 [[noreturn]] void FailLock(const std::string& dir, const char* what, int error) {
-  throw OutputError(fmt::format("cannot lock the output folder {} ({} {}/{}: {}): choose a writable --out folder "
-                                "that holds no link named {}",
-                                dir, what, dir, kMutexName, std::strerror(error), kMutexName));
+  throw OutputError(
+      fmt::format("cannot lock the output folder {} ({} {}/{}: {}): choose a writable --out folder "
+                  "that holds no link named {}",
+                  dir, what, dir, kMutexName, std::strerror(error), kMutexName));
 }
 
 bool LockingUnsupported(int error) { return error == ENOLCK || error == EOPNOTSUPP || error == ENOSYS; }
@@ -134,7 +134,8 @@ std::string MutexHolder(int fd) {
   char buffer[512] = {};
   const ssize_t n = ::pread(fd, buffer, sizeof buffer - 1, 0);
   Claim holder;
-  const std::string text = std::string(kClaimHeader) + std::string(buffer, n > 0 ? size_t(n) : 0) + "command \nnames 0\n";
+  const std::string text =
+      std::string(kClaimHeader) + std::string(buffer, n > 0 ? size_t(n) : 0) + "command \nnames 0\n";
   if (!ParseClaim(text, holder) || holder.pid.empty()) return "an unknown process";
   return fmt::format("pid {} on {}", EscapedName(holder.pid), EscapedName(holder.host));
 }
@@ -152,7 +153,8 @@ int LockFolder(const std::string& dir, double wait_seconds) {
   for (;;) {
     int fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK, 0644);
     if (fd < 0) FailLock(dir, "opening", errno);
-    struct stat held {}, named {};
+    struct stat held {
+    }, named{};
     if (::fstat(fd, &held) != 0 || !S_ISREG(held.st_mode)) {
       ::close(fd);
       FailLock(dir, "checking", EINVAL);
@@ -178,8 +180,10 @@ int LockFolder(const std::string& dir, double wait_seconds) {
       const int error = errno;
       ::close(fd);
       if (LockingUnsupported(error)) {
-        std::fprintf(stderr, "skybake: warning: %s cannot be locked (%s): concurrent bakes into it are not "
-                             "detected\n", dir.c_str(), std::strerror(error));
+        std::fprintf(stderr,
+                     "skybake: warning: %s cannot be locked (%s): concurrent bakes into it are not "
+                     "detected\n",
+                     dir.c_str(), std::strerror(error));
         return -1;
       }
       FailLock(dir, "locking", error);
@@ -214,9 +218,10 @@ double MutexWaitSeconds() {
   char* end = nullptr;
   const double seconds = std::strtod(text, &end);
   if (*end != '\0' || !std::isfinite(seconds) || seconds < 0.0 || seconds > 86400.0)
-    throw UsageError(fmt::format("SKYBAKE_LOCK_WAIT_SECONDS='{}' is not a number of seconds in [0, 86400]: "
-                                 "give e.g. 30, or unset it (default {} s)",
-                                 EscapedName(text), kDefaultMutexWaitSeconds));
+    throw UsageError(
+        fmt::format("SKYBAKE_LOCK_WAIT_SECONDS='{}' is not a number of seconds in [0, 86400]: "
+                    "give e.g. 30, or unset it (default {} s)",
+                    EscapedName(text), kDefaultMutexWaitSeconds));
   return seconds;
 }
 

@@ -23,11 +23,21 @@ std::string UsdStringLiteral(std::string_view text) {
   for (const char ch : text) {
     const unsigned char c = static_cast<unsigned char>(ch);
     switch (ch) {
-      case '\\': out += "\\\\"; break;
-      case '"': out += "\\\""; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (c < 0x20 || c == 0x7f) out += fmt::format("\\x{:02x}", c);
         else out += ch;
@@ -93,7 +103,8 @@ double DomeExposure(double texture_scale) {
 void Attribute(std::string& out, const std::string& indent, const std::string& decl, const UsdLayerDescription& layer,
                const std::vector<std::string>& values, const std::string& color_space = "") {
   const std::string metadata =
-      color_space.empty() ? "" : " (\n" + indent + "    colorSpace = " + UsdStringLiteral(color_space) + "\n" + indent + ")";
+      color_space.empty() ? ""
+                          : " (\n" + indent + "    colorSpace = " + UsdStringLiteral(color_space) + "\n" + indent + ")";
   if (!layer.sequence) {
     if (!values.front().empty()) out += indent + decl + " = " + values.front() + metadata + "\n";
     return;
@@ -103,9 +114,9 @@ void Attribute(std::string& out, const std::string& indent, const std::string& d
     if (!values[i].empty()) samples.emplace_back(layer.frames[i].number, values[i]);
   if (samples.empty()) return;
   // A value the same in every frame needs no samples.
-  const bool constant = samples.size() == layer.frames.size() &&
-                        std::all_of(samples.begin(), samples.end(),
-                                    [&](const auto& s) { return s.second == samples.front().second; });
+  const bool constant =
+      samples.size() == layer.frames.size() &&
+      std::all_of(samples.begin(), samples.end(), [&](const auto& s) { return s.second == samples.front().second; });
   if (constant) {
     out += indent + decl + " = " + samples.front().second + metadata + "\n";
     return;
@@ -148,22 +159,22 @@ void DistantLight(std::string& out, const UsdLayerDescription& layer, const char
   const std::string in = "        ";
   auto key = [&](const UsdFrame& f) -> const UsdDistantKey* { return moon ? (f.moon ? &*f.moon : nullptr) : &f.sun; };
   out += fmt::format("    def DistantLight \"{}\" (\n", name);
-  out += fmt::format("        doc = \"{}: intensity x 2^exposure x color = illuminance per channel (lux, linear "
-                     "Rec.709) on a surface facing it (normalize); shines along -Z, +Z towards the {}\"\n",
-                     moon ? "The Moon" : "The Sun", moon ? "Moon" : "Sun");
+  out += fmt::format(
+      "        doc = \"{}: intensity x 2^exposure x color = illuminance per channel (lux, linear "
+      "Rec.709) on a surface facing it (normalize); shines along -Z, +Z towards the {}\"\n",
+      moon ? "The Moon" : "The Sun", moon ? "Moon" : "Sun");
   out += "    )\n    {\n";
   Attribute(out, in, "float inputs:angle", layer, PerFrame(layer, [&](const UsdFrame& f) {
               const UsdDistantKey* k = key(f);
               return k ? Float(k->angular_diameter_deg) : std::string();
             }));
-  Attribute(
-      out, in, "color3f inputs:color", layer,
-      PerFrame(layer,
-               [&](const UsdFrame& f) {
-                 const UsdDistantKey* k = key(f);
-                 return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
-               }),
-      UsdColorSpaceToken("rec709"));
+  Attribute(out, in, "color3f inputs:color", layer,
+            PerFrame(layer,
+                     [&](const UsdFrame& f) {
+                       const UsdDistantKey* k = key(f);
+                       return Float3(k ? KeyColor(*k) : glm::dvec3(1.0));
+                     }),
+            UsdColorSpaceToken("rec709"));
   out += in + "float inputs:exposure = 0\n";
   Attribute(out, in, "float inputs:intensity", layer, PerFrame(layer, [&](const UsdFrame& f) {
               const UsdDistantKey* k = key(f);
@@ -199,8 +210,8 @@ void SkyCustomData(std::string& out, const UsdLayerDescription& layer) {
   out += in + "string schedule = " + UsdStringLiteral(layer.schedule) + "\n";
   out += in + "string sequence_sha256 = " + UsdStringLiteral(layer.sequence_sha256) + "\n";
   out += in + "string style = " + UsdStringLiteral(layer.style) + "\n";
-  out += in + "string dome_color_space = " + UsdStringLiteral(UsdColorSpaceToken(layer.frames.front().color_space)) +
-         "\n";
+  out +=
+      in + "string dome_color_space = " + UsdStringLiteral(UsdColorSpaceToken(layer.frames.front().color_space)) + "\n";
   out += in + "string light_color_space = " + UsdStringLiteral(UsdColorSpaceToken("rec709")) + "\n";
   out += in + "string units = \"dome: cd/m^2 (nits) = texel x intensity x 2^exposure; distant lights: lux\"\n";
   out += in + "string version = " + UsdStringLiteral(layer.version) + "\n";
@@ -214,14 +225,17 @@ std::string UsdLayerText(const UsdLayerDescription& layer) {
   // One colour space for the dome's texture (one colorSpace on its attribute).
   for (const UsdFrame& f : layer.frames)
     if (f.color_space != layer.frames.front().color_space)
-      throw OutputError(fmt::format("{}.usda: frame {}'s latlong EXR is in {}, frame {}'s in {}: the dome's texture "
-                                    "has one colour space; bake the frames with one output.color_space",
-                                    layer.name, layer.frames.front().number, layer.frames.front().color_space,
-                                    f.number, f.color_space));
+      throw OutputError(fmt::format(
+          "{}.usda: frame {}'s latlong EXR is in {}, frame {}'s in {}: the dome's texture "
+          "has one colour space; bake the frames with one output.color_space",
+          layer.name, layer.frames.front().number, layer.frames.front().color_space, f.number, f.color_space));
   std::string out = "#usda 1.0\n(\n";
   out += "    defaultPrim = \"Sky\"\n";
-  out += "    doc = " + UsdStringLiteral("skybake " + layer.version + " sky: DomeLight (latlong EXR, cd/m^2) and "
-                                        "DistantLights (lux); +Y up, North -Z, East +X, metres") + "\n";
+  out += "    doc = " +
+         UsdStringLiteral("skybake " + layer.version +
+                          " sky: DomeLight (latlong EXR, cd/m^2) and "
+                          "DistantLights (lux); +Y up, North -Z, East +X, metres") +
+         "\n";
   if (layer.sequence) {
     out += fmt::format("    endTimeCode = {}\n", layer.frames.back().number);
     out += "    framesPerSecond = 24\n";
@@ -243,8 +257,9 @@ std::string UsdLayerText(const UsdLayerDescription& layer) {
   // latlong DomeLight with the pole along the stage's +Y.
   const std::string in = "        ";
   out += "    def DomeLight \"Dome\" (\n";
-  out += "        doc = \"The sky: emitted radiance (cd/m^2) = texel x intensity x 2^exposure; exposure = "
-         "-log2(skybake:scale of the EXR). OpenEXR latlong layout, +Y pole, +Z at longitude 0: no transform\"\n";
+  out +=
+      "        doc = \"The sky: emitted radiance (cd/m^2) = texel x intensity x 2^exposure; exposure = "
+      "-log2(skybake:scale of the EXR). OpenEXR latlong layout, +Y pole, +Z at longitude 0: no transform\"\n";
   out += "    )\n    {\n";
   out += in + "color3f inputs:color = (1, 1, 1)\n";
   Attribute(out, in, "float inputs:exposure", layer,
@@ -273,10 +288,10 @@ std::string WriteUsdLayer(const UsdLayerDescription& layer) {
 
 std::string UsdColorSpaceToken(const std::string& skybake_name) {
   static const std::map<std::string, std::string> kCanonical = {{"rec709", "lin_rec709_scene"},
-                                                                 {"acescg", "lin_ap1_scene"},
-                                                                 {"aces2065-1", "lin_ap0_scene"},
-                                                                 {"rec2020", "lin_rec2020_scene"},
-                                                                 {"xyz", "lin_ciexyzd65_scene"}};
+                                                                {"acescg", "lin_ap1_scene"},
+                                                                {"aces2065-1", "lin_ap0_scene"},
+                                                                {"rec2020", "lin_rec2020_scene"},
+                                                                {"xyz", "lin_ciexyzd65_scene"}};
   const auto it = kCanonical.find(skybake_name);
   return it == kCanonical.end() ? skybake_name : it->second;
 }

@@ -20,8 +20,8 @@ OutputLock ClaimOutputs(const RenderPlan& plan, const BakeOptions& options) {
   std::error_code ec;
   const std::filesystem::file_status out = std::filesystem::status(options.out_dir, ec);
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
-    throw OutputError(fmt::format("--out {} is not a folder: give a folder (it is created when missing)",
-                                  options.out_dir));
+    throw OutputError(
+        fmt::format("--out {} is not a folder: give a folder (it is created when missing)", options.out_dir));
   std::filesystem::create_directories(options.out_dir, ec);
   if (ec)
     throw OutputError(fmt::format("cannot create the output folder {}: {}: choose a writable --out folder",
@@ -52,29 +52,28 @@ void CheckNoPreviousBake(const RenderPlan& plan, const BakeOptions& options) {
     std::error_code ec;
     // A link (dangling or not) at the name is a file in the way too.
     if (std::filesystem::exists(std::filesystem::symlink_status(OutputPath(options, name), ec)))
-      throw OutputExistsError(fmt::format(
-          "{} already exists: pass --force to overwrite the bake's files{}, or choose another --out",
-          OutputPath(options, name), plan.sequence ? ", --resume to finish an interrupted sequence" : ""));
+      throw OutputExistsError(
+          fmt::format("{} already exists: pass --force to overwrite the bake's files{}, or choose another --out",
+                      OutputPath(options, name), plan.sequence ? ", --resume to finish an interrupted sequence" : ""));
   }
 }
 
 }  // namespace
 
-PreviousBake PrepareOutputs(const RenderPlan& plan, const BakeOptions& options, StageTimer& timer,
-                            BakeResult& result) {
+PreviousBake PrepareOutputs(const RenderPlan& plan, const BakeOptions& options, StageTimer& timer, BakeResult& result) {
   CheckNothingInTheWay(plan, options);
   CheckNoPreviousBake(plan, options);
   PreviousBake previous;
   if (options.resume) previous = ReadPreviousManifest(OutputPath(options, plan.manifest_name));
   result.removed_temporaries = RemoveStaleTemporaries(options.out_dir, plan.files);
-  timer.Finish("outputs", fmt::format("{} files planned{}{}", plan.files.size(),
-                                      result.removed_temporaries.empty()
-                                          ? ""
-                                          : fmt::format(", {} stale temporary file(s) removed",
-                                                        result.removed_temporaries.size()),
-                                      previous.loaded ? fmt::format(", resuming from {} frame(s) in {}",
-                                                                    previous.frames.size(), plan.manifest_name)
-                                                      : ""));
+  timer.Finish("outputs",
+               fmt::format("{} files planned{}{}", plan.files.size(),
+                           result.removed_temporaries.empty()
+                               ? ""
+                               : fmt::format(", {} stale temporary file(s) removed", result.removed_temporaries.size()),
+                           previous.loaded ? fmt::format(", resuming from {} frame(s) in {}", previous.frames.size(),
+                                                         plan.manifest_name)
+                                           : ""));
   return previous;
 }
 

@@ -27,7 +27,6 @@ OutputLock ClaimOutputs(const RenderPlan& plan, const BakeOptions& options);
 // What is in the way of the planned files (OutputError, OutputExistsError),
 // the previous manifest with --resume, the stale temporaries removed (into
 // result.removed_temporaries); reports the "outputs" stage.
-PreviousBake PrepareOutputs(const RenderPlan& plan, const BakeOptions& options, StageTimer& timer,
-                            BakeResult& result);
+PreviousBake PrepareOutputs(const RenderPlan& plan, const BakeOptions& options, StageTimer& timer, BakeResult& result);
 
 }  // namespace skybake

@@ -118,8 +118,8 @@ void CheckBudget(const SkyStyle& style, const BakeOptions& options) {
         "the bake needs an estimated {} MiB of memory per frame (cube {}, latlong {}x{}{}), above the budget "
         "of {} MiB: lower render.cube_size or render.latlong_height{}, turn off outputs, or raise "
         "--max-memory-mib (README \"Limits\")",
-        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height,
-        SpectralNote(style), budget, SpectralAdvice(style)));
+        need, style.render.cube_size, 2 * style.render.latlong_height, style.render.latlong_height, SpectralNote(style),
+        budget, SpectralAdvice(style)));
   }
   if (e.seconds > options.max_frame_seconds)
     throw BudgetError(fmt::format(

@@ -55,16 +55,16 @@ void AddCloudMarchPlan(const SkyStyle& first, int layers, const std::vector<View
   std::vector<std::array<double, 2>> bands;
   for (const CloudLayer& l : ActiveCloudLayers(first.clouds))
     bands.push_back({l.altitude_m * 1e-3, (l.altitude_m + l.thickness_m) * 1e-3});
-  const CloudPanoramaRows rows = CloudPanoramaRowsSeeingBands(
-      panorama, first.atmosphere.bottom_radius_km, first.atmosphere.observer_altitude_m * 1e-3, bands);
+  const CloudPanoramaRows rows = CloudPanoramaRowsSeeingBands(panorama, first.atmosphere.bottom_radius_km,
+                                                              first.atmosphere.observer_altitude_m * 1e-3, bands);
   march("clouds panorama",
         fmt::format("{} x {}, rows {} to {} marched, {} texels", panorama.width, panorama.height, rows.begin,
                     rows.end - 1, CloudPanoramaMarchedTexels(panorama, rows)),
         fmt::format("once per frame (quality.cloud_panorama_scale = {})", cq.panorama_scale),
         double(CloudPanoramaMarchedTexels(panorama, rows)));
   for (const ViewRequest& v : views)
-    plan.passes.push_back({view_name(v) + " (resampled)", fmt::format("{} x {}", v.width, v.height),
-                           "once per frame", frames, 0.0});
+    plan.passes.push_back(
+        {view_name(v) + " (resampled)", fmt::format("{} x {}", v.width, v.height), "once per frame", frames, 0.0});
 }
 
 void AddCloudShadowPlan(const SkyStyle& first, int frames, PassPlan& plan) {

@@ -15,7 +15,9 @@ std::vector<EngineImageSize> PlanEngineImages(const SkyStyle& style) {
     // The layout of a 1 x 1 bake (no directions worth computing): its kinds.
     for (const EngineImage& e : EngineImages(*preset, 1, 1))
       sizes.push_back({preset->name + "_" + e.suffix, e.kind == "latlong" ? 2 * h : n,
-                       e.kind == "latlong" ? h : e.kind == "cube strip" ? 6 * n : n});
+                       e.kind == "latlong"      ? h
+                       : e.kind == "cube strip" ? 6 * n
+                                                : n});
   return sizes;
 }
 
@@ -23,8 +25,8 @@ std::vector<RgbaImage> RenderEngineImages(SkyRenderer& renderer, const glm::dvec
   std::vector<RgbaImage> images;
   for (const EnginePreset* preset : EnginePresetsOf(style.output.engine))
     for (const EngineImage& e : EngineImages(*preset, style.render.cube_size, style.render.latlong_height))
-      images.push_back(
-          {e.width, e.height, renderer.RenderDirections(sun, e.directions, style.output.sun == SunOutput::kMap), nullptr});
+      images.push_back({e.width, e.height,
+                        renderer.RenderDirections(sun, e.directions, style.output.sun == SunOutput::kMap), nullptr});
   return images;
 }
 

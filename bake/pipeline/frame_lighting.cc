@@ -83,12 +83,12 @@ IblMaps RenderFrameIbl(SkyRenderer& renderer, std::unique_ptr<IblBaker>& baker, 
   IblMaps maps = baker->Bake(request, source);
   maps.gltf_scale = GltfIblScale(frame.sh_irradiance_without_sun);
   for (const PassTiming& t : baker->last_timings()) frame.gpu_passes.push_back(t);
-  timer.Finish("IBL", fmt::format("{}: {} x {} source without the sun disc, {} specular levels x {} samples, "
-                                  "irradiance {} x {} samples{}{}",
-                                  plan.Label(), n, n, style.ibl.specular ? IblLevelCount(style.ibl) : 0,
-                                  style.ibl.samples, style.ibl.irradiance ? style.ibl.irradiance_size : 0,
-                                  style.ibl.irradiance_samples, request.dfg ? ", DFG table" : "",
-                                  style.ibl.include_sun ? ", sun included" : ""));
+  timer.Finish("IBL",
+               fmt::format("{}: {} x {} source without the sun disc, {} specular levels x {} samples, "
+                           "irradiance {} x {} samples{}{}",
+                           plan.Label(), n, n, style.ibl.specular ? IblLevelCount(style.ibl) : 0, style.ibl.samples,
+                           style.ibl.irradiance ? style.ibl.irradiance_size : 0, style.ibl.irradiance_samples,
+                           request.dfg ? ", DFG table" : "", style.ibl.include_sun ? ", sun included" : ""));
   return maps;
 }
 

@@ -34,9 +34,10 @@ double FrameHalfScale(const FrameJob& job, bool sequence) {
   if (style.output.pixel_type != PixelType::kHalf) return job.half_scale;
   if (!sequence || style.output.sun == SunOutput::kLight) return HalfRangeScale(max_value, style.output.overflow);
   if (max_value * job.half_scale > kHalfMax)
-    throw OutputError(fmt::format(
-        "frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
-        "output.pixel_type = \"float\"", job.plan->number, max_value, job.half_scale));
+    throw OutputError(
+        fmt::format("frame {}: the brightest value {:.6g} exceeds the sequence's half-float scale {:.9g}: set "
+                    "output.pixel_type = \"float\"",
+                    job.plan->number, max_value, job.half_scale));
   return job.half_scale;
 }
 
@@ -101,7 +102,8 @@ std::vector<RgbaImage> InOutputColorSpace(const FrameJob& job, ExrWriteOptions& 
 // The faces, strip and latlong EXRs encoded together in memory (their
 // chunks shared among the threads), then each written atomically and
 // checksummed from the same bytes.
-std::vector<BakedFile> WriteViewExrs(const FrameJob& job, const ExrWriteOptions& frame_exr, const BakeOptions& options) {
+std::vector<BakedFile> WriteViewExrs(const FrameJob& job, const ExrWriteOptions& frame_exr,
+                                     const BakeOptions& options) {
   const OutputSettings& o = job.plan->style->output;
   const FrameNames& names = job.plan->names;
   ExrWriteOptions exr = frame_exr;

@@ -36,15 +36,17 @@ constexpr const char* kDetailFont = "DejaVuSans";
 std::string StyleFolder(const std::string& out_dir, const std::string& name) {
   const std::string dir = (std::filesystem::path(out_dir) / name).string();
   if (!FolderNameProblem(name).empty())
-    throw OutputError(fmt::format("{} cannot be a style's folder in the gallery: rename the style file", EscapedText(dir)));
+    throw OutputError(
+        fmt::format("{} cannot be a style's folder in the gallery: rename the style file", EscapedText(dir)));
   if (::mkdir(dir.c_str(), 0777) != 0 && errno != EEXIST)
-    throw OutputError(fmt::format("cannot make the folder {} ({}): choose a writable --out", EscapedText(dir),
-                                  std::strerror(errno)));
+    throw OutputError(
+        fmt::format("cannot make the folder {} ({}): choose a writable --out", EscapedText(dir), std::strerror(errno)));
   struct stat st {};
   if (::lstat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
-    throw OutputExistsError(fmt::format("{} is {}, not a folder: the gallery writes each style into a folder of "
-                                        "--out; remove it, or choose another --out",
-                                        EscapedText(dir), S_ISLNK(st.st_mode) ? "a symbolic link" : "a file"));
+    throw OutputExistsError(
+        fmt::format("{} is {}, not a folder: the gallery writes each style into a folder of "
+                    "--out; remove it, or choose another --out",
+                    EscapedText(dir), S_ISLNK(st.st_mode) ? "a symbolic link" : "a file"));
   return dir;
 }
 
@@ -53,8 +55,7 @@ std::string StyleFolder(const std::string& out_dir, const std::string& name) {
 std::vector<std::string> StyleFilesIn(const std::string& dir) {
   std::vector<std::string> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir))
-    if (entry.is_regular_file() && entry.path().extension() == ".toml")
-      files.push_back(entry.path().string());
+    if (entry.is_regular_file() && entry.path().extension() == ".toml") files.push_back(entry.path().string());
   std::sort(files.begin(), files.end());
   return files;
 }
@@ -114,8 +115,8 @@ std::vector<std::string> GalleryOverrides(const std::string& path, const Gallery
   std::vector<std::string> overrides = options.overrides;
   const std::string name = std::filesystem::path(path).stem().string();
   for (const std::string& o :
-       {std::string("output.faces=false"), std::string("output.cube_strip=false"),
-        std::string("output.latlong=false"), std::string("output.preview=true"), std::string("gltf.enabled=false"),
+       {std::string("output.faces=false"), std::string("output.cube_strip=false"), std::string("output.latlong=false"),
+        std::string("output.preview=true"), std::string("gltf.enabled=false"),
         fmt::format("output.basename=\"{}\"", name), fmt::format("render.latlong_height={}", options.latlong_height)})
     overrides.push_back(o);
   return overrides;
@@ -160,8 +161,8 @@ GalleryResult BakeGallery(const std::vector<std::string>& style_paths, const Gal
   const OutputLock lock = OutputLock::Claim(options.out_dir, {"gallery.png"});
   std::error_code ec;
   if (!options.bake.force && std::filesystem::exists(std::filesystem::symlink_status(sheet_path, ec)))
-    throw OutputExistsError(fmt::format("{} already exists: pass --force to replace the gallery, or choose another --out",
-                                        sheet_path));
+    throw OutputExistsError(
+        fmt::format("{} already exists: pass --force to replace the gallery, or choose another --out", sheet_path));
 
   // Bake each style's latlong preview only.
   for (const std::string& path : style_paths) {

@@ -12,7 +12,11 @@ namespace skybake {
 
 ManifestBuilder::ManifestBuilder(const RenderPlan& plan, const BakeOptions& options, const BakeExposure& exposure,
                                  BakeResult& result)
-    : plan_(plan), options_(options), exposure_(exposure), result_(result), spool_(options.out_dir),
+    : plan_(plan),
+      options_(options),
+      exposure_(exposure),
+      result_(result),
+      spool_(options.out_dir),
       written_(Clock::now()) {
   std::string sequence_identity;
   for (size_t i = 0; i < plan.frames.size(); ++i) {
@@ -50,8 +54,8 @@ Manifest ManifestBuilder::Head() const {
   m.part = plan_.part;
   // The scene's texture: the reference frame's PNG, a 2h x h latlong.
   const SkyStyle& ref = *reference.style;
-  m.gltf = {first.gltf.enabled, first.output.basename, first.gltf, reference.names.png,
-            2 * ref.render.latlong_height, ref.render.latlong_height};
+  m.gltf = {first.gltf.enabled,  first.output.basename,         first.gltf,
+            reference.names.png, 2 * ref.render.latlong_height, ref.render.latlong_height};
   if (first.usd.enabled) m.usd = {true, first.output.basename};
   return m;
 }
@@ -61,9 +65,9 @@ void ManifestBuilder::Add(const FrameResult& f) {
   ManifestFrame frame = ManifestFrameOf(f);
   frame.style_sha256 = style_sha256_[i];
   frame.hours_from_start = plan_.frames[i].hours_from_start;
-  frame.animation_time_s =
-      plan_.schedule && plan_.schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
-  if (plan_.first().usd.enabled) frame.sun_angular_radius_rad = plan_.frames[i].style->atmosphere.sun_angular_radius_rad;
+  frame.animation_time_s = plan_.schedule && plan_.schedule->clock_times ? plan_.frames[i].hours_from_start : double(i);
+  if (plan_.first().usd.enabled)
+    frame.sun_angular_radius_rad = plan_.frames[i].style->atmosphere.sun_angular_radius_rad;
   spool_.Add(ManifestFrameText(frame));
   if (!keeps_scene_frames_) return;
   // The scene keeps of the frames what it reads (WriteScene): the texture

@@ -25,8 +25,7 @@ class ManifestBuilder {
   // Reads the exposure as it stands when a manifest is written (a single
   // bake's is chosen by its frame); sets result.manifest_path and counts
   // its writes there.
-  ManifestBuilder(const RenderPlan& plan, const BakeOptions& options, const BakeExposure& exposure,
-                  BakeResult& result);
+  ManifestBuilder(const RenderPlan& plan, const BakeOptions& options, const BakeExposure& exposure, BakeResult& result);
 
   // A frame done: its manifest entry goes to the record on disk (the
   // manifest is written around it, never built whole in memory), and what

@@ -63,7 +63,8 @@ StarGrid::StarGrid(const StarCatalogue& catalogue, double magnitude_limit, Outpu
   prefix_.assign(size_t(kRows) * (kColumns + 1), 0.0);
   for (int r = 0; r < kRows; ++r)
     for (int c = 0; c < kColumns; ++c)
-      prefix_[size_t(r) * (kColumns + 1) + c + 1] = prefix_[size_t(r) * (kColumns + 1) + c] + cells[size_t(r) * kColumns + c];
+      prefix_[size_t(r) * (kColumns + 1) + c + 1] =
+          prefix_[size_t(r) * (kColumns + 1) + c] + cells[size_t(r) * kColumns + c];
   std::stable_sort(binned.begin(), binned.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   first_.assign(size_t(kRows) * kColumns + 1, 0);
   for (const auto& [cell, star] : binned) ++first_[cell + 1];
@@ -148,7 +149,8 @@ RectCone ConeOfRect(const ViewRequest& view, int x0, int x1, int y0, int y1) {
     // (its sublevel sets are the plane's sections of convex cones), so its
     // largest over a rectangle is at a corner.
     for (int y : corners_y)
-      for (int x : corners_x) c.texel_radius_rad = std::max(c.texel_radius_rad, AngleBetween(c.centre, ViewTexelDirection(view, x, y)));
+      for (int x : corners_x)
+        c.texel_radius_rad = std::max(c.texel_radius_rad, AngleBetween(c.centre, ViewTexelDirection(view, x, y)));
     // The source and its targets are in one cell of the grid of texel
     // centres on the plane at distance 1 (or more) from the eye: the angle
     // is at most the cell's diagonal.
@@ -161,7 +163,8 @@ RectCone ConeOfRect(const ViewRequest& view, int x0, int x1, int y0, int y1) {
   c.min_solid_angle = std::numeric_limits<double>::infinity();
   for (int y : corners_y)
     for (int x : corners_x)
-      c.min_solid_angle = std::min(c.min_solid_angle, ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG ? 0 : x, y));
+      c.min_solid_angle =
+          std::min(c.min_solid_angle, ViewTexelSolidAngle(view, view.mapping == MAPPING_LATLONG ? 0 : x, y));
   const double elevation = std::asin(std::clamp(c.centre.y, -1.0, 1.0));
   const double r = c.texel_radius_rad + kAngleMarginRad;
   c.min_mu = float(std::sin(std::max(-M_PI / 2, elevation - r)) - 1e-6);
@@ -188,7 +191,8 @@ struct PreBound {
 
   // The Moon's part of Load: all its samples where its disc may reach.
   double MoonBound(const RectCone& c) const {
-    if (light.moon_total > 0.0 && AngleBetween(c.centre, light.moon_centre) <= c.reach_rad + light.moon_radius_rad + kAngleMarginRad)
+    if (light.moon_total > 0.0 &&
+        AngleBetween(c.centre, light.moon_centre) <= c.reach_rad + light.moon_radius_rad + kAngleMarginRad)
       return light.moon_total;
     return 0.0;
   }
@@ -228,7 +232,8 @@ struct PreBound {
 
   bool Clears(int x0, int x1, int y0, int y1, const RectCone& c) {
     const double load = Load(c);
-    const double glow = light.airglow && !light.airglow->empty() ? AirglowMaxOver(*light.airglow, c.min_mu, c.max_mu) : 0.0;
+    const double glow =
+        light.airglow && !light.airglow->empty() ? AirglowMaxOver(*light.airglow, c.min_mu, c.max_mu) : 0.0;
     if (load <= 0.0 && glow <= 0.0) return true;
     ++rects_read;
     const double floor = RectFloor(rgba, view.width, x0, x1, y0, y1);

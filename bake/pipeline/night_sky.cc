@@ -273,8 +273,8 @@ ViewTargets TargetsOf(const ViewRequest& view, const std::vector<PointSource>& s
 }
 
 // The splat of the sources `which` (increasing indices; all when null).
-std::vector<TexelAdd> SplatFromTargets(const ViewRequest& view, const std::vector<PointSource>& sources,
-                                       ViewTargets& v, const std::vector<size_t>* which) {
+std::vector<TexelAdd> SplatFromTargets(const ViewRequest& view, const std::vector<PointSource>& sources, ViewTargets& v,
+                                       const std::vector<size_t>* which) {
   std::map<size_t, std::array<double, 3>> sums;
   const int w = view.width;
   const size_t count = which ? which->size() : sources.size();
@@ -333,8 +333,9 @@ std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<Po
       reach.push_back({t.index, k});
       if (view.mapping == MAPPING_LATLONG && t.x == 0) reach.push_back({size_t(t.y) * w + (w - 1), k});
     }
-  std::sort(reach.begin(), reach.end(),
-            [](const Reach& a, const Reach& b) { return a.texel != b.texel ? a.texel < b.texel : a.source < b.source; });
+  std::sort(reach.begin(), reach.end(), [](const Reach& a, const Reach& b) {
+    return a.texel != b.texel ? a.texel < b.texel : a.source < b.source;
+  });
   // Each texel's load against its capacity (less a margin far wider than
   // float's rounding of the sums); the latlong's repeated meridian has
   // column 0's solid angle (it receives column 0's additions).
@@ -363,9 +364,8 @@ std::vector<TexelAdd> BoundedSplat(const ViewRequest& view, const std::vector<Po
   std::vector<TexelAdd> adds;
   if (!bound.sources.empty()) {
     adds = SplatFromTargets(view, sources, v, &bound.sources);
-    std::erase_if(adds, [&](const TexelAdd& a) {
-      return !std::binary_search(bound.open.begin(), bound.open.end(), a.texel);
-    });
+    std::erase_if(
+        adds, [&](const TexelAdd& a) { return !std::binary_search(bound.open.begin(), bound.open.end(), a.texel); });
   }
   if (bound_out) *bound_out = std::move(bound);
   return adds;
@@ -573,7 +573,8 @@ std::vector<Rgb> AirglowTable(const AtmosphereParams& atmosphere, const Transmit
     const Rgb tr = t.At(mu);
     // Neutral in Rec.709 luminance, then the output units (as NightSkyRadiance).
     for (int c = 0; c < 3; ++c)
-      table[i][c] = zenith_t[c] > 0.0 ? zenith_cd_m2 / to_luminance[c] * output[c] * van_rhijn * tr[c] / zenith_t[c] : 0.0;
+      table[i][c] =
+          zenith_t[c] > 0.0 ? zenith_cd_m2 / to_luminance[c] * output[c] * van_rhijn * tr[c] / zenith_t[c] : 0.0;
   }
   return table;
 }
@@ -610,7 +611,7 @@ std::vector<PointSource> MoonDiscSources(const glm::dvec3& moon_direction, doubl
       const double mu = std::sqrt(1.0 - rr);
       const glm::dvec3 normal = a * e1 + b * e2 - mu * m;
       const double mu0 = glm::dot(normal, s);
-      if (mu0 <= 0.0) continue;  // the night side (no earthshine)
+      if (mu0 <= 0.0) continue;           // the night side (no earthshine)
       const double f = mu0 / (mu0 + mu);  // Lommel-Seeliger
       PointSource p;
       p.direction = glm::normalize(m + std::tan(rho) * (a * e1 + b * e2));
@@ -658,15 +659,15 @@ NightFrame ComputeNightFrame(const SkyStyle& style, const StarCatalogue* catalog
     if (defer && night.daylight)
       night.pending = std::make_shared<PendingStars>(*catalogue, *defer, t, n.star_magnitude_limit, style.output.units,
                                                      julian_day_ut, place);
-    else
-      night.sources = StarSources(*catalogue, n.star_magnitude_limit, style.output.units, t, julian_day_ut, place);
+    else night.sources = StarSources(*catalogue, n.star_magnitude_limit, style.output.units, t, julian_day_ut, place);
     night.stars = night.sources.size();
   }
   if (n.moon || n.moonlight) {
     const MoonState moon = ComputeMoon(julian_day_ut, place, style.atmosphere.observer_altitude_m);
     night.moon = moon;
     const Rgb& solar = style.atmosphere.solar_irradiance;
-    const double sun_lux = Luminance({solar[0] * to_luminance[0], solar[1] * to_luminance[1], solar[2] * to_luminance[2]});
+    const double sun_lux =
+        Luminance({solar[0] * to_luminance[0], solar[1] * to_luminance[1], solar[2] * to_luminance[2]});
     const double k = sun_lux > 0.0 ? moon.illuminance_lux / sun_lux : 0.0;
     Rgb disc{};
     for (int c = 0; c < 3; ++c) disc[c] = k * solar[c] * output[c];
@@ -752,8 +753,8 @@ TileBound NightSkyRenderer::Bound(const ViewRequest& view, const NightFrame& nig
     for (size_t k = 0; k < sources.size(); ++k) all.sources.push_back(k);
     return all;
   }
-  TileBound b = BoundByTiles(view, TilesOf(view, !night.airglow.empty()), sources, night.airglow, rgba,
-                             kNightSplatMinRelative);
+  TileBound b =
+      BoundByTiles(view, TilesOf(view, !night.airglow.empty()), sources, night.airglow, rgba, kNightSplatMinRelative);
   if (!b.splat) {
     ++splats_skipped_;
     ++tiles_skipped_;
@@ -901,24 +902,26 @@ void NightSkyRenderer::AddToFaces(const SkyStyle& style, const NightFrame& night
 void AddNightSkyPlan(const std::vector<SkyStyle>& frames, PassPlan& plan) {
   if (frames.empty() || !frames.front().night.Any()) return;
   const NightSettings& night = frames.front().night;
-  const int day = int(std::count_if(frames.begin(), frames.end(),
-                                    [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
+  const int day =
+      int(std::count_if(frames.begin(), frames.end(), [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
   const std::string pruned =
       day == 0 ? std::string("no frame has the Sun up: every view splatted")
-               : fmt::format("in the {} of {} frames with the Sun up each view is first bounded before any star is "
-                             "placed (the catalogue binned by J2000 position against each tile's darkest texel, and "
-                             "star by star at a texel that the bins do not clear): a frame whose views no star, Moon "
-                             "or glow can change places no star and splats nothing; "
-                             "a view that may change then goes through the tile bound, skipped where no addition can "
-                             "reach 2^-13 of a texel (the daylit sky outshines it)",
-                             day, int(frames.size()));
+               : fmt::format(
+                     "in the {} of {} frames with the Sun up each view is first bounded before any star is "
+                     "placed (the catalogue binned by J2000 position against each tile's darkest texel, and "
+                     "star by star at a texel that the bins do not clear): a frame whose views no star, Moon "
+                     "or glow can change places no star and splats nothing; "
+                     "a view that may change then goes through the tile bound, skipped where no addition can "
+                     "reach 2^-13 of a texel (the daylit sky outshines it)",
+                     day, int(frames.size()));
   if (night.stars || night.moon)
     plan.passes.push_back({"star and Moon splat (host)",
                            fmt::format("{}{}4 texels a source", night.stars ? "stars to V " : "",
                                        night.stars ? fmt::format("{}, ", night.star_magnitude_limit) : ""),
                            "per frame; " + pruned, plan.frames, 0.0});
   if (night.airglow)
-    plan.passes.push_back({"airglow (host)", "every texel above the horizon", "per frame; " + pruned, plan.frames, 0.0});
+    plan.passes.push_back(
+        {"airglow (host)", "every texel above the horizon", "per frame; " + pruned, plan.frames, 0.0});
 }
 
 const StarCatalogue& StarCatalogues::Get(const std::string& path) {
@@ -1043,10 +1046,11 @@ double NightSkyBake::TakeSeconds() {
 }
 
 std::string NightSkyBake::Describe(const NightFrame& night) {
-  std::string d = !night.pending         ? fmt::format("{} stars", night.stars)
-                  : night.pending->placed() ? fmt::format("{} stars (placed for the views the daylight may not hide them in)",
-                                                          night.pending->stars())
-                                            : std::string("no star placed (the daylit sky outshines them in every view)");
+  std::string d =
+      !night.pending ? fmt::format("{} stars", night.stars)
+      : night.pending->placed()
+          ? fmt::format("{} stars (placed for the views the daylight may not hide them in)", night.pending->stars())
+          : std::string("no star placed (the daylit sky outshines them in every view)");
   if (night.moon)
     d += fmt::format(", Moon at {:.1f} deg, phase angle {:.1f} deg, {:.3g} lux{}", night.moon->sky.elevation_deg,
                      night.moon->phase_angle_deg, night.moon_illuminance_lux,

@@ -51,13 +51,9 @@ SkyStyle PrunedStyle(const SkyStyle& style) {
   return s;
 }
 
-bool NeedsSkyViewLut(const SkyStyle& style) {
-  return style.quality.sky_view_lut && !style.aoas.skydome.enabled;
-}
+bool NeedsSkyViewLut(const SkyStyle& style) { return style.quality.sky_view_lut && !style.aoas.skydome.enabled; }
 
-bool RendersLatlong(const SkyStyle& style) {
-  return style.output.latlong || WritesLatlongPng(style);
-}
+bool RendersLatlong(const SkyStyle& style) { return style.output.latlong || WritesLatlongPng(style); }
 
 bool WritesLatlongPng(const SkyStyle& style) { return style.output.preview || style.gltf.enabled; }
 
@@ -113,9 +109,9 @@ void PlanEffects(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) 
     const std::vector<CloudLayer> active = ActiveCloudLayers(first.clouds);
     std::string why_on;
     for (const CloudLayer& l : active)
-      why_on += fmt::format("{}{} at {}-{} m, coverage {}, density {} /m", why_on.empty() ? "" : "; ",
-                            CloudTypeName(l.type), l.altitude_m, l.altitude_m + l.thickness_m, l.coverage,
-                            l.density_per_m);
+      why_on +=
+          fmt::format("{}{} at {}-{} m, coverage {}, density {} /m", why_on.empty() ? "" : "; ", CloudTypeName(l.type),
+                      l.altitude_m, l.altitude_m + l.thickness_m, l.coverage, l.density_per_m);
     decide("volumetric clouds", !first.clouds.layers.empty(), !active.empty(),
            "every [[cloud_layer]] has coverage 0 or density_per_m 0 (pruned)",
            fmt::format("{} [[cloud_layer]]: {}", active.size(), why_on));
@@ -130,7 +126,6 @@ void PlanEffects(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan) 
   decide("night sky (stars, Moon, moonlight, airglow)", night.Any(), night.Any(), "",
          fmt::format("night.stars = {} (to V {}), night.moon = {}, night.moonlight = {}, night.airglow = {}",
                      night.stars, night.star_magnitude_limit, night.moon, night.moonlight, night.airglow));
-
 }
 
 // Distinct atmospheres over the frames: each one rebuilds the LUTs.
@@ -138,15 +133,13 @@ int DistinctAtmospheres(const std::vector<SkyStyle>& frames) {
   std::vector<gpu::GpuAtmosphere> keys;
   for (const SkyStyle& f : frames) {
     SkyStyle fp = PrunedStyle(f);
-    gpu::GpuAtmosphere key = ToGpuAtmosphere(StyledAtmosphere(fp.atmosphere, fp.aoas), fp.quality, fp.effects,
-                                             OutputScale(fp.output.units));
-    bool seen = std::any_of(keys.begin(), keys.end(), [&](const gpu::GpuAtmosphere& k) {
-      return std::memcmp(&k, &key, sizeof key) == 0;
-    });
+    gpu::GpuAtmosphere key =
+        ToGpuAtmosphere(StyledAtmosphere(fp.atmosphere, fp.aoas), fp.quality, fp.effects, OutputScale(fp.output.units));
+    bool seen = std::any_of(keys.begin(), keys.end(),
+                            [&](const gpu::GpuAtmosphere& k) { return std::memcmp(&k, &key, sizeof key) == 0; });
     if (!seen) keys.push_back(key);
   }
   return int(keys.size());
-
 }
 
 // Samples per rendered texel: one LUT read with the sky-view LUT, else the
@@ -172,8 +165,8 @@ void PlanSkyPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
                                q.multiscattering_sqrt_dirs * q.multiscattering_steps});
   const bool sky_view = NeedsSkyViewLut(pruned);
   if (sky_view)
-    plan.passes.push_back({"sky-view LUT", Size(q.sky_view_width, q.sky_view_height), "once per frame",
-                           plan.frames, double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
+    plan.passes.push_back({"sky-view LUT", Size(q.sky_view_width, q.sky_view_height), "once per frame", plan.frames,
+                           double(q.sky_view_width) * q.sky_view_height * q.view_steps * light});
   const double per_texel = sky_view ? 1.0 : double(q.view_steps) * light;
   for (const ViewRequest& v : PlanViews(first)) {
     std::string name = v.mapping == MAPPING_LATLONG      ? "render latlong"
@@ -218,8 +211,10 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
   const AtmosphereParams& a = first.atmosphere;
   const double ratio = a.bottom_radius_km / (a.bottom_radius_km + std::max(a.observer_altitude_m, 0.0) * 1e-3);
   const double dip_deg = std::acos(std::min(ratio, 1.0)) * 180.0 / M_PI;
-  const std::string extent = dip_deg > 0.0 ? fmt::format("the horizon ({:.2f} deg below the horizontal) to {:g} deg above the horizontal", dip_deg, band)
-                                           : fmt::format("0..{:g} deg above the horizon", band);
+  const std::string extent =
+      dip_deg > 0.0
+          ? fmt::format("the horizon ({:.2f} deg below the horizontal) to {:g} deg above the horizontal", dip_deg, band)
+          : fmt::format("0..{:g} deg above the horizon", band);
   const double fraction = 0.5 * (std::sin(band * M_PI / 180.0) + std::sin(dip_deg * M_PI / 180.0));
   const double night_deg = SunlitAirDepressionDeg(a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
                                                   a.sun_angular_radius_rad);
@@ -229,14 +224,12 @@ void PlanTwilightBand(const std::vector<SkyStyle>& frames, const SkyStyle& first
                       !first.night.Any() && ActiveCloudLayers(pruned.clouds).empty();
   const std::string skip =
       probed ? ", less those it changes by under a quarter of a half-float step (probed at the exposure stage)" : "";
-  plan.passes.push_back({"twilight band march", extent,
-                         night_deg >= 180.0
-                             ? fmt::format("frames with the Sun below {:g} deg (sunlit air in view from space){}",
-                                           below, skip)
-                             : fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg{}", below,
-                                           night_deg, skip),
-                         runs,
-                         texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
+  plan.passes.push_back(
+      {"twilight band march", extent,
+       night_deg >= 180.0
+           ? fmt::format("frames with the Sun below {:g} deg (sunlit air in view from space){}", below, skip)
+           : fmt::format("frames with the Sun below {:g} deg and above -{:.1f} deg{}", below, night_deg, skip),
+       runs, texels * (fraction + kTwilightAboveBandShare) * steps * std::max(q.light_steps, 1)});
 }
 
 // Whether the sun disc is a pass of its own (UsesSunDiscPass).
@@ -258,8 +251,8 @@ std::string FrameRanges(const std::vector<int>& frames) {
   for (size_t i = 0; i < frames.size();) {
     size_t j = i;
     while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
-    out += (out.empty() ? "" : ", ") +
-           (j == i ? std::to_string(frames[i]) : fmt::format("{}-{}", frames[i], frames[j]));
+    out +=
+        (out.empty() ? "" : ", ") + (j == i ? std::to_string(frames[i]) : fmt::format("{}-{}", frames[i], frames[j]));
     i = j + 1;
   }
   return out;
@@ -275,9 +268,9 @@ double CloudShadowBelowDeg(const SkyStyle& style, double* top_km) {
   const gpu::GpuClouds clouds = CloudGeometryUniform(pruned.clouds);
   *top_km = 0.0;
   for (int b = 0; b < clouds.resolution.w; ++b) *top_km = std::max(*top_km, double(clouds.bands[b].y));
-  return CloudEarthShadowElevationDeg(clouds, ToGpuAtmosphere(StyledAtmosphere(pruned.atmosphere, pruned.aoas),
-                                                              pruned.quality, pruned.effects,
-                                                              OutputScale(pruned.output.units)));
+  return CloudEarthShadowElevationDeg(
+      clouds, ToGpuAtmosphere(StyledAtmosphere(pruned.atmosphere, pruned.aoas), pruned.quality, pruned.effects,
+                              OutputScale(pruned.output.units)));
 }
 
 // Volumetric cloud layers: the noise volumes, the tables, every view; the
@@ -293,14 +286,14 @@ void PlanCloudPasses(const std::vector<SkyStyle>& frames, const SkyStyle& first,
     std::vector<int> shadowed;
     for (size_t i = 0; i < frames.size(); ++i)
       if (frames[i].sun.elevation_deg < below) shadowed.push_back(int(i));
-    const std::string geometry = fmt::format("the Sun below {:.2f} deg: every band (top {:g} km, within {:g} km) in "
-                                             "the Earth's shadow",
-                                             below, top_km, cq.max_distance_km);
+    const std::string geometry = fmt::format(
+        "the Sun below {:.2f} deg: every band (top {:g} km, within {:g} km) in "
+        "the Earth's shadow",
+        below, top_km, cq.max_distance_km);
     const bool on = shaders.shadowed_clouds && !shadowed.empty();
     plan.effects.push_back(
         {"clouds in the Earth's shadow", true, on,
-         !shaders.shadowed_clouds
-             ? "SKYBAKE_SHADOWED_CLOUDS=0: every frame's clouds march the Sun's light"
+         !shaders.shadowed_clouds ? "SKYBAKE_SHADOWED_CLOUDS=0: every frame's clouds march the Sun's light"
          : on ? fmt::format("{} of {} frames (plan order {}) with {}: their cloud march runs without the Sun's "
                             "light march (constant 21 off), the same bytes",
                             shadowed.size(), frames.size(), FrameRanges(shadowed), geometry)
@@ -310,8 +303,8 @@ void PlanCloudPasses(const std::vector<SkyStyle>& frames, const SkyStyle& first,
     const double shape = double(cq.shape_resolution) * cq.shape_resolution * cq.shape_resolution;
     const double detail = double(cq.detail_resolution) * cq.detail_resolution * cq.detail_resolution;
     plan.passes.push_back({"cloud noise volumes",
-                           fmt::format("{} x ({}^3 + {}^3 + {}^2)", layers, cq.shape_resolution,
-                                       cq.detail_resolution, cq.weather_resolution),
+                           fmt::format("{} x ({}^3 + {}^3 + {}^2)", layers, cq.shape_resolution, cq.detail_resolution,
+                                       cq.weather_resolution),
                            "once per bake (from the seeds)", 1,
                            layers * (shape + detail + double(cq.weather_resolution) * cq.weather_resolution)});
     // CloudInputs: aerial perspective 32 x 64 x 32 (4 steps per slice),
@@ -350,8 +343,8 @@ void PlanIblPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
   const IblSettings& ibl = first.ibl;
   if (ibl.Requested()) {
     const double source_texels = 6.0 * ibl.size * ibl.size;
-    plan.passes.push_back({"IBL source (no sun disc)", Size(ibl.size, ibl.size) + " x6", "once per frame",
-                           plan.frames, source_texels * per_texel});
+    plan.passes.push_back({"IBL source (no sun disc)", Size(ibl.size, ibl.size) + " x6", "once per frame", plan.frames,
+                           source_texels * per_texel});
     if (ibl.specular) {
       double texels = 0.0, reads = 0.0;
       std::string counts;  // per level, with ibl.lobe_samples
@@ -365,7 +358,7 @@ void PlanIblPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
       }
       plan.passes.push_back({fmt::format("IBL specular {} levels", IblLevelCount(ibl)),
                              ibl.full_samples_roughness > 0.0 ? fmt::format("{} samples (levels 1..)", counts)
-                                                    : fmt::format("{} samples", ibl.samples),
+                                                              : fmt::format("{} samples", ibl.samples),
                              "once per frame (cube reads)", plan.frames, reads});
     }
     if (ibl.irradiance)
@@ -376,7 +369,6 @@ void PlanIblPasses(const SkyStyle& first, const SkyStyle& pruned, PassPlan& plan
       plan.passes.push_back({"IBL DFG table", Size(ibl.dfg_size, ibl.dfg_size), "once per bake", 1,
                              double(ibl.dfg_size) * ibl.dfg_size * ibl.dfg_samples});
   }
-
 }
 
 // The specialization constants of the render shader, the SPIR-V it comes
@@ -396,13 +388,13 @@ std::string DescribeVariant(const SkyStyle& first, const SkyStyle& pruned, bool 
       "sky_render: multiple_scattering={} sun_disc={} ground={} mie={} ozone={} night={} skydome={} ambiguity={} "
       "cloud_noise={} cloud_shapes={} integrator={} sky_view={}",
       p.multiple_scattering, p.sun_disc, p.ground, p.mie, p.ozone, p.night_dimming, xp.skydome.enabled,
-      xp.ambiguity.enabled,
-      xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)], sky_view);
+      xp.ambiguity.enabled, xp.clouds.enabled, xp.shapes.enabled, kIntegrators[std::clamp(q.integrator, 0, 3)],
+      sky_view);
   const ShaderSources sources = ChooseShaderSources(q, xp.skydome.enabled, shaders);
   variant += fmt::format(
-      "\n  SPIR-V: sky_render {}; LUT shaders {}", sources.sky_view_render
-          ? "from the built-in sky-view variant (ray march compiled out)"
-          : "generic, specialized at pipeline creation",
+      "\n  SPIR-V: sky_render {}; LUT shaders {}",
+      sources.sky_view_render ? "from the built-in sky-view variant (ray march compiled out)"
+                              : "generic, specialized at pipeline creation",
       sources.analytic_luts ? "from the built-in analytic variants" : "generic, specialized at pipeline creation");
   if (disc_pass)
     variant += "\n  sun disc: compiled out of sky_render and added by a pass of its own over the texels near the Sun";
@@ -417,8 +409,7 @@ std::string DescribeVariant(const SkyStyle& first, const SkyStyle& pruned, bool 
                           "constant 21 off: no Sun's light, no light march",
                           CloudShadowBelowDeg(first, &top_km))
             : "every frame with the Sun's light march (SKYBAKE_SHADOWED_CLOUDS=0)");
-  else
-    variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
+  else variant += "\n  clouds: none (no cloud pipeline, no noise volume, no cloud pass)";
   return variant;
 }
 
@@ -429,9 +420,10 @@ void PlanReuse(PassPlan& plan) {
       plan.reused.push_back("transmittance and multiple-scattering LUTs: built once, reused by all " +
                             std::to_string(plan.frames) + " frames (the atmosphere does not change)");
     else
-      plan.reused.push_back(fmt::format("transmittance and multiple-scattering LUTs: built {} times, once per "
-                                        "distinct atmosphere of the schedule",
-                                        plan.atmospheres));
+      plan.reused.push_back(
+          fmt::format("transmittance and multiple-scattering LUTs: built {} times, once per "
+                      "distinct atmosphere of the schedule",
+                      plan.atmospheres));
     plan.reused.push_back("pipelines: compiled once per atmosphere, never per frame");
   }
 }
@@ -466,7 +458,7 @@ PassPlan PlanPasses(const std::vector<SkyStyle>& frames, const ShaderSwitches& s
   }
   PlanCloudPasses(frames, first, shaders, plan);
   PlanMoonlitPasses(first, pruned, plan);
-  AddNightSkyPlan(frames, plan);  // night_sky.h: the host's splat and glow, and what prunes them
+  AddNightSkyPlan(frames, plan);                 // night_sky.h: the host's splat and glow, and what prunes them
   AddCloudShadowPlan(first, plan.frames, plan);  // cloud_plan.h
   for (const PlannedPass& pass : plan.passes) plan.total_samples += pass.samples * pass.runs;
   AddCloudFormationPlan(frames, hours_from_start, plan);  // CPU cell updates, not medium samples
@@ -483,8 +475,8 @@ std::string FormatPlan(const PassPlan& plan, const std::string& source) {
     out += fmt::format("  {:<28} {:<4} {}\n", e.name, e.on ? "on" : "off", e.reason);
   out += "\npasses:\n";
   for (const PlannedPass& p : plan.passes)
-    out += fmt::format("  {:<26} {:>12}  {:<28} x{:<5} {:>10.3g} samples/run\n", p.name, p.size, p.frequency,
-                       p.runs, p.samples);
+    out += fmt::format("  {:<26} {:>12}  {:<28} x{:<5} {:>10.3g} samples/run\n", p.name, p.size, p.frequency, p.runs,
+                       p.samples);
   out += fmt::format("\nshader variant:\n  {}\n", plan.variant);
   out += fmt::format("\nestimated work: {:.3g} medium samples, about {:.3g} GFLOP at ~{} FLOP per sample\n",
                      plan.total_samples, plan.total_samples * kFlopPerSample * 1e-9, int(kFlopPerSample));

@@ -57,7 +57,7 @@ void CheckDeviceLimits(const RenderPlan& plan, VulkanContext& context) {
 // The persistent pipeline cache's part in the pipelines stage (gpu/pipeline_cache.h).
 std::string PipelineCacheReport(const PipelineCacheStatus& s) {
   if (!s.enabled) return "pipeline cache off";
-  std::string report = s.loaded ? fmt::format("pipeline cache hit ({} bytes)", s.loaded_bytes)
+  std::string report = s.loaded                    ? fmt::format("pipeline cache hit ({} bytes)", s.loaded_bytes)
                        : s.ignored_because.empty() ? "pipeline cache empty"
                                                    : "pipeline cache ignored: " + s.ignored_because;
   if (s.saved) report += fmt::format(", saved ({} bytes)", s.saved_bytes);
@@ -77,9 +77,9 @@ void PreparePipelines(const SkyStyle& first, RendererCache& renderers, VulkanCon
   }
   renderers.Main(first).PrecomputeLuts();
   for (const PassTiming& t : renderers.Main(first).last_timings()) result.gpu_passes.push_back(t);
-  timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}",
-                                   first.quality.transmittance_width, first.quality.transmittance_height,
-                                   first.quality.multiscattering_size, first.quality.multiscattering_size));
+  timer.Finish("LUTs", fmt::format("transmittance {}x{}, multiple scattering {}x{}", first.quality.transmittance_width,
+                                   first.quality.transmittance_height, first.quality.multiscattering_size,
+                                   first.quality.multiscattering_size));
 }
 
 // What every frame's stages share: the plan, the device and its renderers,
@@ -127,7 +127,8 @@ bool BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
   // A resumed sequence skips frames whose files are verified against the manifest.
   std::optional<std::vector<BakedFile>> verified;
   if (s.plan.sequence && s.options.resume)
-    verified = VerifiedFrame(s.previous, plan, s.options.out_dir, s.exposure.half_scale, s.exposure.ev100.value_or(0.0));
+    verified =
+        VerifiedFrame(s.previous, plan, s.options.out_dir, s.exposure.half_scale, s.exposure.ev100.value_or(0.0));
 
   // Render: every view of the frame in one submission, then the SH views.
   // In place: the writer thread reads the texels where the device wrote
@@ -177,7 +178,12 @@ bool BakeFrame(const FramePlan& plan, FrameStages& s, FrameWriter& writer) {
 
   // Files: encoded, written and checksummed on the writer thread while the
   // device renders the next frame.
-  FrameJob job{&plan, {}, std::move(rendered.hold), std::move(ibl), std::move(engine), std::move(cloud_shadow),
+  FrameJob job{&plan,
+               {},
+               std::move(rendered.hold),
+               std::move(ibl),
+               std::move(engine),
+               std::move(cloud_shadow),
                frame.cloud_shadow};
   for (size_t i = 0; i < plan.views.size(); ++i)
     job.images.push_back({plan.views[i].width, plan.views[i].height, {}, rendered.views[i]});
@@ -245,13 +251,13 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   VulkanContext context(options.vulkan);
   std::optional<NightSkyRenderer> night_renderer;  // the moonlit sky's renderer, destroyed before the device
   if (night) night_renderer.emplace(context);
-  timer.Finish("device", fmt::format("{} ({}){}{}", context.device_info().name, context.device_info().type,
-                                     options.vulkan.software_driver_selection.empty()
-                                         ? ""
-                                         : ", software driver only (no GPU device node)",
-                                     options.vulkan.lavapipe_threads.empty() || !IsLavapipe(context.device_info())
-                                         ? ""
-                                         : fmt::format(", lavapipe threads {}", options.vulkan.lavapipe_threads)));
+  timer.Finish(
+      "device",
+      fmt::format("{} ({}){}{}", context.device_info().name, context.device_info().type,
+                  options.vulkan.software_driver_selection.empty() ? "" : ", software driver only (no GPU device node)",
+                  options.vulkan.lavapipe_threads.empty() || !IsLavapipe(context.device_info())
+                      ? ""
+                      : fmt::format(", lavapipe threads {}", options.vulkan.lavapipe_threads)));
   CheckDeviceLimits(plan, context);
 
   RendererCache renderers(context, result, options.shaders);
@@ -272,10 +278,11 @@ BakeResult BakeFrames(const RenderPlan& plan, const BakeOptions& options) {
   // one's render, the manifest rewritten as they are done.
   ManifestBuilder manifest(plan, options, exposure, result);
   FrameWriter writer(plan, options, timer, exposure, manifest, result);
-  FrameStages stages{plan,     options, context,  renderers,  ibl_baker, night.get(),
-                     night_renderer ? &*night_renderer : nullptr, previous, exposure, twilight_skip, timer};
-  const int frame_count = int(std::count_if(plan.frames.begin(), plan.frames.end(),
-                                             [&](const FramePlan& f) { return plan.Bakes(f); }));
+  FrameStages stages{
+      plan,     options,  context,       renderers, ibl_baker, night.get(), night_renderer ? &*night_renderer : nullptr,
+      previous, exposure, twilight_skip, timer};
+  const int frame_count =
+      int(std::count_if(plan.frames.begin(), plan.frames.end(), [&](const FramePlan& f) { return plan.Bakes(f); }));
   int frame_index = 0;
   for (const FramePlan& frame : plan.frames) {
     if (!plan.Bakes(frame)) continue;  // another part's frame

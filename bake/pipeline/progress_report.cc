@@ -26,7 +26,6 @@ size_t TerminalWidth(std::FILE* file) {
   return 80;
 }
 
-
 }  // namespace
 
 std::string Printable(const std::string& text) {

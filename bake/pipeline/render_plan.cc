@@ -114,8 +114,8 @@ RenderPlan PlanSingleBake(const SkyStyle& style) {
 RenderPlan PlanSequenceBake(const std::vector<SkyStyle>& styles, const Schedule& schedule,
                             const std::optional<FrameRange>& part) {
   if (styles.size() != schedule.frames.size() || styles.empty())
-    throw std::invalid_argument(fmt::format("BakeSequence: {} styles for {} frames", styles.size(),
-                                            schedule.frames.size()));
+    throw std::invalid_argument(
+        fmt::format("BakeSequence: {} styles for {} frames", styles.size(), schedule.frames.size()));
   if (part) {
     const FrameRange all = ScheduleFrameRange(schedule);
     if (!all.Contains(part->first) || !all.Contains(part->last) || part->count() < 1)

@@ -21,10 +21,8 @@ SkyRenderer& RendererCache::Main(const SkyStyle& style, double cloud_time_s, con
     // A hue-styled sky (AOAS [hue]: a free RGB vector for the Rayleigh
     // constants) is a colour, not a spectrum: it keeps the conversion its
     // target colour is solved with (RayleighForTargetColor, the sky factors).
-    if (hue_)
-      conversion_.sky = UniformOutputConversion(BrunetonSkyFactors()).sky;
-    else if (twilight_fit_)
-      FitTwilightSky(sun, conversion_.sky);
+    if (hue_) conversion_.sky = UniformOutputConversion(BrunetonSkyFactors()).sky;
+    else if (twilight_fit_) FitTwilightSky(sun, conversion_.sky);
     conversion_sun_ = sun;
   }
   main_->SetOutputConversion(conversion_);
@@ -43,8 +41,7 @@ bool RendererCache::FitTwilightSky(const glm::dvec3& sun, Matrix3& sky) {
       !SunlitAirInView(elevation_deg, a.bottom_radius_km, a.top_radius_km, a.observer_altitude_m * 1e-3,
                        a.sun_angular_radius_rad))
     return false;
-  if (!probe_)
-    probe_ = std::make_unique<SkyRenderer>(context_, a, probe_quality_, probe_effects_, Rgb{1.0, 1.0, 1.0});
+  if (!probe_) probe_ = std::make_unique<SkyRenderer>(context_, a, probe_quality_, probe_effects_, Rgb{1.0, 1.0, 1.0});
   const std::vector<glm::dvec3> directions = SkyProbeDirections(sun);
   const std::vector<float> reference = probe_->RenderDirections(sun, directions, false);
   // The main renderer's own radiance at the same directions, unconverted.

@@ -43,6 +43,7 @@ class RendererCache {
   SkyRenderer& Main(const SkyStyle& style, double cloud_time_s, const glm::dvec3& sun);
   // The renderer of the last frame.
   SkyRenderer& Current() { return *main_; }
+
  private:
   void Update(const SkyStyle& unpruned, double cloud_time_s);
 
@@ -61,7 +62,7 @@ class RendererCache {
   // same probe directions (FitTwilightSky).
   bool FitTwilightSky(const glm::dvec3& sun, Matrix3& sky);
   bool luminance_ = false;
-  bool hue_ = false;  // the style's sky is a hue vector's colour
+  bool hue_ = false;           // the style's sky is a hue vector's colour
   bool twilight_fit_ = false;  // FitTwilightSky applies to the style
   QualitySettings probe_quality_;
   EffectSettings probe_effects_;

@@ -20,19 +20,23 @@ PreviousBake ReadPreviousManifest(const std::string& path) {
   // What --resume cannot read is the folder's problem, not a write failure:
   // exit 6, as for any file in the way, with the fix.
   if (std::filesystem::is_directory(status))
-    throw OutputExistsError(fmt::format("{} is a directory, not a manifest, so --resume cannot tell which frames are "
-                                        "done: move it away, or pass --force instead to bake every frame again",
-                                        path));
+    throw OutputExistsError(
+        fmt::format("{} is a directory, not a manifest, so --resume cannot tell which frames are "
+                    "done: move it away, or pass --force instead to bake every frame again",
+                    path));
   if (!std::filesystem::is_regular_file(status))
-    throw OutputExistsError(fmt::format("{} is not a regular file (a link, a pipe or a device), so --resume does not "
-                                        "read it: move it away, or pass --force instead to bake every frame again",
-                                        path));
+    throw OutputExistsError(
+        fmt::format("{} is not a regular file (a link, a pipe or a device), so --resume does not "
+                    "read it: move it away, or pass --force instead to bake every frame again",
+                    path));
   Manifest manifest;
   try {
     manifest = ReadManifest(path, ManifestNames::kUnchecked);
   } catch (const ManifestSyntaxError&) {
-    throw OutputExistsError(fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
-                                        "--force instead to bake every frame again", path));
+    throw OutputExistsError(
+        fmt::format("{} is not valid JSON, so --resume cannot tell which frames are done: pass "
+                    "--force instead to bake every frame again",
+                    path));
   } catch (const ManifestError&) {
     previous.loaded = true;  // proves no frame: every frame is baked again
     return previous;
@@ -49,8 +53,7 @@ PreviousBake ReadPreviousManifest(const std::string& path) {
 
 std::optional<std::vector<BakedFile>> VerifiedFrame(const PreviousBake& previous, const FramePlan& frame,
                                                     const std::string& out_dir, double half_scale, double ev100) {
-  if (!previous.loaded || previous.half_scale != half_scale || previous.exposure_ev100 != ev100)
-    return std::nullopt;
+  if (!previous.loaded || previous.half_scale != half_scale || previous.exposure_ev100 != ev100) return std::nullopt;
   auto it = previous.frames.find(frame.number);
   if (it == previous.frames.end()) return std::nullopt;
   const ManifestFrame& f = it->second;

@@ -34,16 +34,14 @@ class StageTimer {
   // (on the writer thread), as a stage of its own; the next Finish times the
   // rest.
   void Split(const std::string& name, double seconds, const std::string& detail = "") {
-    Clock::time_point end = std::min(Clock::now(), start_ + std::chrono::duration_cast<Clock::duration>(
-                                                                 std::chrono::duration<double>(seconds)));
+    Clock::time_point end = std::min(
+        Clock::now(), start_ + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds)));
     Add({name, std::chrono::duration<double>(end - start_).count(), detail});
     start_ = end;
   }
   // A stage timed elsewhere (on the writer thread): reported, not counted
   // against the time since the last Finish.
-  void Report(const std::string& name, double seconds, const std::string& detail = "") {
-    Add({name, seconds, detail});
-  }
+  void Report(const std::string& name, double seconds, const std::string& detail = "") { Add({name, seconds, detail}); }
   // From now on, stages go to timings.json's record on disk, not into
   // result.stages, and so do the frames' timings (FrameWriter): a bake that
   // keeps no frame records (BakeOptions::keep_frame_records).

@@ -31,16 +31,26 @@ const std::array<uint8_t, 7>* Glyph(char c) {
   static const std::array<uint8_t, 7> kS = {0x0f, 0x10, 0x10, 0x0e, 0x01, 0x01, 0x1e};
   static const std::array<uint8_t, 7> kW = {0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0a};
   switch (c) {
-    case '+': return &kPlus;
-    case '-': return &kMinus;
-    case 'X': return &kX;
-    case 'Y': return &kY;
-    case 'Z': return &kZ;
-    case 'N': return &kN;
-    case 'E': return &kE;
-    case 'S': return &kS;
-    case 'W': return &kW;
-    default: return nullptr;
+    case '+':
+      return &kPlus;
+    case '-':
+      return &kMinus;
+    case 'X':
+      return &kX;
+    case 'Y':
+      return &kY;
+    case 'Z':
+      return &kZ;
+    case 'N':
+      return &kN;
+    case 'E':
+      return &kE;
+    case 'S':
+      return &kS;
+    case 'W':
+      return &kW;
+    default:
+      return nullptr;
   }
 }
 
@@ -94,7 +104,7 @@ glm::dvec3 TestPatternColor(const glm::dvec3& direction) {
   // The horizon.
   if (std::abs(elevation_deg) < 1.0) return {1, 1, 1};  // 2 degrees: a row of any latlong 90 high or more
   // Compass letters, 3 to 9 degrees up, in the view's own frame.
-  if (elevation_deg > 3.0 && elevation_deg < 9.0) {  // 6 degrees tall
+  if (elevation_deg > 3.0 && elevation_deg < 9.0) {            // 6 degrees tall
     double azimuth_deg = std::atan2(d.x, -d.z) * 180.0 / kPi;  // clockwise from North
     const char* letters = "NESW";
     for (int k = 0; k < 4; ++k) {
@@ -114,8 +124,7 @@ glm::dvec3 TestPatternColor(const glm::dvec3& direction) {
   const double m = glm::dot(d, kAxes[face]);
   const double a = glm::dot(d, right) / m, b = glm::dot(d, top) / m;  // [-1, 1] across the face
   const bool text = OnText(CubeFaceLabel(face), a, b, 0.0, 0.35, 0.3) ||
-                    OnText(AxisName(right), a, b, 0.75, 0.0, 0.16) ||
-                    OnText(AxisName(top), a, b, 0.0, 0.8, 0.16);
+                    OnText(AxisName(right), a, b, 0.75, 0.0, 0.16) || OnText(AxisName(top), a, b, 0.0, 0.8, 0.16);
   return text ? glm::dvec3(0.0) : TestPatternFaceColor(face);
 }
 
@@ -136,11 +145,11 @@ double TestPatternMemoryMiB(const TestPatternOptions& options) {
 std::vector<std::string> WriteTestPattern(const TestPatternOptions& options) {
   const int n = options.size;
   if (const double mib = TestPatternMemoryMiB(options); !(mib <= options.max_memory_mib))
-    throw BudgetError(fmt::format("testpattern --size {}{} needs an estimated {:.0f} MiB of memory (every image's "
-                                  "directions, the largest image's pixels and file), above the budget of {:.0f} MiB: "
-                                  "lower --size, or raise --max-memory-mib (README \"Limits\"); nothing was written",
-                                  n, options.engine == "none" ? "" : " --engine " + options.engine, mib,
-                                  options.max_memory_mib));
+    throw BudgetError(
+        fmt::format("testpattern --size {}{} needs an estimated {:.0f} MiB of memory (every image's "
+                    "directions, the largest image's pixels and file), above the budget of {:.0f} MiB: "
+                    "lower --size, or raise --max-memory-mib (README \"Limits\"); nothing was written",
+                    n, options.engine == "none" ? "" : " --engine " + options.engine, mib, options.max_memory_mib));
   struct Image {
     std::string name;
     std::vector<glm::dvec3> directions;
@@ -170,7 +179,8 @@ std::vector<std::string> WriteTestPattern(const TestPatternOptions& options) {
   if (!options.force)
     for (const std::string& path : paths)
       if (std::filesystem::exists(std::filesystem::symlink_status(path)))
-        throw OutputExistsError(fmt::format("{} already exists: pass --force to overwrite, or choose another --out", path));
+        throw OutputExistsError(
+            fmt::format("{} already exists: pass --force to overwrite, or choose another --out", path));
   for (size_t i = 0; i < images.size(); ++i) {
     RgbaImage rgba{images[i].width, images[i].height, {}, nullptr};
     rgba.rgba.reserve(4 * images[i].directions.size());
@@ -181,8 +191,9 @@ std::vector<std::string> WriteTestPattern(const TestPatternOptions& options) {
     ExrWriteOptions exr;
     exr.envmap = images[i].envmap;
     exr.attributes = {{"skybake:version", SKYBAKE_VERSION},
-                      {"skybake:test_pattern", "faces tinted and named, axes at their right and top edges, horizon, "
-                                               "N E S W (docs/engines.md)"},
+                      {"skybake:test_pattern",
+                       "faces tinted and named, axes at their right and top edges, horizon, "
+                       "N E S W (docs/engines.md)"},
                       {"skybake:frame", "+Y up, North -Z, East +X; right-handed"},
                       {"skybake:engine_mapping", images[i].mapping}};
     WriteExr(paths[i], rgba, exr);

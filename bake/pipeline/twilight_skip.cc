@@ -40,8 +40,7 @@ double HalfStepsApart(const std::vector<float>& a, const std::vector<float>& b, 
   return worst;
 }
 
-TwilightSkip ChooseTwilightSkips(const RenderPlan& plan, RendererCache& renderers, double half_scale,
-                                 bool night_sky) {
+TwilightSkip ChooseTwilightSkips(const RenderPlan& plan, RendererCache& renderers, double half_scale, bool night_sky) {
   TwilightSkip skip;
   const SkyStyle& first = plan.first();
   if (!plan.sequence || night_sky || first.output.pixel_type != PixelType::kHalf) return skip;
@@ -74,9 +73,10 @@ TwilightSkip ChooseTwilightSkips(const RenderPlan& plan, RendererCache& renderer
   if (skip.probed == 0) return skip;
   skip.report = skip.frames.empty()
                     ? fmt::format("twilight march in every frame ({} probed)", skip.probed)
-                    : fmt::format("no twilight march in frames {} (Sun at or below {:.1f} deg: their probes with and "
-                                  "without it at most {:.3f} of a half-float step apart; {} probed)",
-                                  Runs(skip.frames), highest_skipped, closest, skip.probed);
+                    : fmt::format(
+                          "no twilight march in frames {} (Sun at or below {:.1f} deg: their probes with and "
+                          "without it at most {:.3f} of a half-float step apart; {} probed)",
+                          Runs(skip.frames), highest_skipped, closest, skip.probed);
   return skip;
 }
 

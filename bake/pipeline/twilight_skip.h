@@ -53,7 +53,6 @@ inline constexpr double kTwilightProbeSteps = 0.25;
 // not finite.
 double HalfStepsApart(const std::vector<float>& a, const std::vector<float>& b, double scale);
 
-TwilightSkip ChooseTwilightSkips(const RenderPlan& plan, RendererCache& renderers, double half_scale,
-                                 bool night_sky);
+TwilightSkip ChooseTwilightSkips(const RenderPlan& plan, RendererCache& renderers, double half_scale, bool night_sky);
 
 }  // namespace skybake

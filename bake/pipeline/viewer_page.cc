@@ -40,14 +40,15 @@ std::string Slurp(const fs::path& path) {
 // manifest lists, checked by the one check of listed names (manifest.h),
 // opened in `dir` without following a link, a regular file (a FIFO or a
 // device is refused unread) of at most kMaxShownBytes.
-constexpr uint64_t kMaxShownBytes = uint64_t(1) << 30;  // a 16384 x 8192 RGBA float EXR is 2 GiB; the half scale 512 MiB
+constexpr uint64_t kMaxShownBytes = uint64_t(1)
+                                    << 30;  // a 16384 x 8192 RGBA float EXR is 2 GiB; the half scale 512 MiB
 
 std::string FolderFile(const fs::path& dir, const std::string& name, const std::string& manifest = "") {
   if (!manifest.empty()) CheckListedName(manifest, "frames[].files[].file", name);
   std::string bytes;
   if (const std::string problem = ReadFolderFile(dir.string(), name, kMaxShownBytes, bytes); !problem.empty())
-    throw OutputError(fmt::format("cannot read {}: it {}: bake the folder again", EscapedText((dir / name).string()),
-                                  problem));
+    throw OutputError(
+        fmt::format("cannot read {}: it {}: bake the folder again", EscapedText((dir / name).string()), problem));
   return bytes;
 }
 
@@ -369,10 +370,8 @@ json FrameEntries(const std::vector<Frame>& frames, const fs::path& dir, double 
       }
     }
     json entry = {{"type", f.type}, {"label", f.label}, {"scale", f.scale}, {"width", width}, {"height", height}};
-    if (embed)
-      entry["data"] = Base64(data);
-    else
-      entry["url"] = f.file;  // the manifest's names are plain file names of DIR
+    if (embed) entry["data"] = Base64(data);
+    else entry["url"] = f.file;  // the manifest's names are plain file names of DIR
     list.push_back(entry);
   }
   return list;
@@ -384,13 +383,16 @@ json ThreeImportMap(const ViewPageOptions& options) {
   const fs::path three = ThreeDir(options);
   const fs::path core = three / "build" / "three.module.min.js";
   if (!fs::is_regular_file(core))
-    throw OutputError(fmt::format("three.js is not at {}: run .ci/setup (npm ci in tests/viewer), or set "
-                                  "SKYBAKE_THREE_DIR to an npm 'three' package folder", three.string()));
+    throw OutputError(
+        fmt::format("three.js is not at {}: run .ci/setup (npm ci in tests/viewer), or set "
+                    "SKYBAKE_THREE_DIR to an npm 'three' package folder",
+                    three.string()));
   std::string loader = Slurp(three / "examples" / "jsm" / "loaders" / "EXRLoader.js");
   // Its one relative import, to the import map's name.
   const std::string relative = "'../libs/fflate.module.js'";
   const size_t at = loader.find(relative);
-  if (at == std::string::npos) throw OutputError("EXRLoader.js of " + three.string() + " does not import fflate as expected");
+  if (at == std::string::npos)
+    throw OutputError("EXRLoader.js of " + three.string() + " does not import fflate as expected");
   loader.replace(at, relative.size(), "'three/fflate'");
   return {{"imports",
            {{"three", DataModule(Slurp(core))},
@@ -403,15 +405,18 @@ json ThreeImportMap(const ViewPageOptions& options) {
 std::string WriteViewPage(const ViewPageOptions& options) {
   const fs::path dir(options.dir);
   const fs::path page = dir / "view.html";
-  if (!fs::is_directory(dir)) throw OutputError(fmt::format("{} is not a folder: give a bake's --out folder", options.dir));
+  if (!fs::is_directory(dir))
+    throw OutputError(fmt::format("{} is not a folder: give a bake's --out folder", options.dir));
   if (!options.force && fs::exists(fs::symlink_status(page)))
     throw OutputExistsError(fmt::format("{} already exists: pass --force to replace it", page.string()));
 
   const fs::path manifest_path = dir / "manifest.json";
   const ShownFrames shown = fs::is_regular_file(manifest_path) ? ManifestFrames(manifest_path) : FolderLatlongs(dir);
   if (shown.frames.empty())
-    throw OutputError(fmt::format("{} holds no latlong to show (no manifest.json frame with a latlong EXR or "
-                                  "preview, no BASE_latlong.exr): bake into it first", options.dir));
+    throw OutputError(
+        fmt::format("{} holds no latlong to show (no manifest.json frame with a latlong EXR or "
+                    "preview, no BASE_latlong.exr): bake into it first",
+                    options.dir));
   const json list = FrameEntries(shown.frames, dir, options.embed_mib);
   // Exposure of the bake's EV100 (ISO 2720 calibration K = 12.5: H = 1 / (1.2 2^EV100)), 1 unmetered.
   const double exposure = shown.metered ? 1.0 / (1.2 * std::exp2(shown.exposure_ev100)) : 1.0;

@@ -28,7 +28,8 @@ float UnsignedFloat(uint32_t bits, int mantissa_bits) {
   const uint32_t exponent = bits >> mantissa_bits, mantissa = bits & ((1u << mantissa_bits) - 1);
   const double fraction = double(mantissa) / double(1u << mantissa_bits);
   if (exponent == 0) return float(std::ldexp(fraction, -14));
-  if (exponent == 31) return mantissa ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
+  if (exponent == 31)
+    return mantissa ? std::numeric_limits<float>::quiet_NaN() : std::numeric_limits<float>::infinity();
   return float(std::ldexp(1.0 + fraction, int(exponent) - 15));
 }
 

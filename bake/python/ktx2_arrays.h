@@ -12,8 +12,8 @@
 namespace skybake {
 
 struct Ktx2Level {
-  int size = 0;      // width = height, texels
-  int faces = 0;     // 6 for a cube, 1 for an image
+  int size = 0;            // width = height, texels
+  int faces = 0;           // 6 for a cube, 1 for an image
   std::vector<float> rgb;  // faces x size x size x 3
 };
 

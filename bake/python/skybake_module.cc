@@ -130,14 +130,22 @@ PythonClasses& Classes() {
 py::object ClassOfExitCode(int code) {
   const PythonClasses& c = Classes();
   switch (code) {
-    case kExitUsage: return c.usage;
-    case kExitConfig: return c.style;
-    case kExitVulkan: return c.vulkan;
-    case kExitOutput: return c.output;
-    case kExitExists: return c.folder;
-    case kExitBudget: return c.budget;
-    case kExitMerge: return c.manifest;
-    default: return c.error;
+    case kExitUsage:
+      return c.usage;
+    case kExitConfig:
+      return c.style;
+    case kExitVulkan:
+      return c.vulkan;
+    case kExitOutput:
+      return c.output;
+    case kExitExists:
+      return c.folder;
+    case kExitBudget:
+      return c.budget;
+    case kExitMerge:
+      return c.manifest;
+    default:
+      return c.error;
   }
 }
 
@@ -176,8 +184,9 @@ FailureKind FailureOf(std::exception_ptr failure) {
   } catch (const Error& e) {
     return {e.exit_code(), e.message()};
   } catch (const std::bad_alloc&) {
-    return {kExitBudget, "out of memory: lower render.cube_size or render.latlong_height, or max_memory_mib so "
-                         "that the budget check refuses such bakes (README \"Limits\")"};
+    return {kExitBudget,
+            "out of memory: lower render.cube_size or render.latlong_height, or max_memory_mib so "
+            "that the budget check refuses such bakes (README \"Limits\")"};
   } catch (const std::filesystem::filesystem_error& e) {
     return {kExitOutput, e.what()};
   } catch (const std::exception& e) {
@@ -280,13 +289,16 @@ struct TomlWriter {
 
   std::string Key(py::handle key, const std::string& path) {
     if (!py::isinstance<py::str>(key)) {
-      Fail(path, fmt::format("a key must be a string, not {}", std::string(py::str(py::type::of(key).attr("__name__")))));
+      Fail(path,
+           fmt::format("a key must be a string, not {}", std::string(py::str(py::type::of(key).attr("__name__")))));
       return "\"\"";
     }
     return TomlString(key.cast<std::string>());
   }
 
-  static std::string Join(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+  static std::string Join(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+  }
 
   // A datetime.date, .time or .datetime as a TOML local date, local time,
   // local or offset date-time (a schedule's `date`, `times`): its isoformat.
@@ -296,8 +308,9 @@ struct TomlWriter {
     const bool is_time = py::isinstance(v, datetime.attr("time"));
     if (!is_datetime && !is_time && !py::isinstance(v, datetime.attr("date"))) return std::nullopt;
     if (is_time && !v.attr("tzinfo").is_none()) {
-      Fail(key, "a time with a time zone has no TOML form: give a naive datetime.time (the schedule's "
-                "utc_offset_hours places it)");
+      Fail(key,
+           "a time with a time zone has no TOML form: give a naive datetime.time (the schedule's "
+           "utc_offset_hours places it)");
       return "0";
     }
     return v.attr("isoformat")().cast<std::string>();
@@ -349,7 +362,8 @@ struct TomlWriter {
     for (auto [k, item] : table)
       if (!py::isinstance<py::dict>(item)) {
         const std::string quoted = Key(k, path);
-        out += quoted + " = " + Value(item, Join(path, py::isinstance<py::str>(k) ? k.cast<std::string>() : "?")) + "\n";
+        out +=
+            quoted + " = " + Value(item, Join(path, py::isinstance<py::str>(k) ? k.cast<std::string>() : "?")) + "\n";
       }
     for (auto [k, item] : table)
       if (py::isinstance<py::dict>(item)) {
@@ -458,8 +472,7 @@ LoadedBake Load(const PyStyle& style, const PySchedule* schedule, const std::vec
   std::vector<const SkyStyle*> pointers;
   if (bake.schedule)
     for (const SkyStyle& s : bake.frame_styles) pointers.push_back(&s);
-  else
-    pointers.push_back(&bake.config.style);
+  else pointers.push_back(&bake.config.style);
   const std::vector<ConfigError> night =
       CheckNightSky(pointers, bake.schedule ? &*bake.schedule : nullptr, env.star_catalogue);
   if (!night.empty()) ThrowConfigErrors(night);
@@ -607,9 +620,9 @@ struct PyFrame {
   py::object cube = py::none();
   py::dict faces;
   py::dict engine;
-  py::dict ibl;                                   // every IBL file's texels, by file name
-  py::list ibl_specular;                          // the prefiltered levels, (6, N, N, 3) each
-  py::object ibl_irradiance = py::none();         // (6, N, N, 3)
+  py::dict ibl;                            // every IBL file's texels, by file name
+  py::list ibl_specular;                   // the prefiltered levels, (6, N, N, 3) each
+  py::object ibl_irradiance = py::none();  // (6, N, N, 3)
   double render_seconds = 0.0;
 };
 
@@ -700,8 +713,8 @@ py::list LevelsOf(const std::vector<Ktx2Level>& levels) {
   py::list list;
   for (const Ktx2Level& l : levels) {
     const size_t n = size_t(l.size);
-    py::array_t<float> a = l.faces == 6 ? py::array_t<float>({size_t(6), n, n, size_t(3)})
-                                        : py::array_t<float>({n, n, size_t(3)});
+    py::array_t<float> a =
+        l.faces == 6 ? py::array_t<float>({size_t(6), n, n, size_t(3)}) : py::array_t<float>({n, n, size_t(3)});
     std::memcpy(a.mutable_data(), l.rgb.data(), l.rgb.size() * sizeof(float));
     list.append(a);
   }
@@ -752,7 +765,8 @@ PyFrame FrameOf(const FrameResult& f, const FrameImages* images) {
       if (file.kind == "latlong" && frame.latlong.is_none()) frame.latlong = array;
       else if (file.kind == "cube") frame.cube = array;
       else if (file.kind == "face") frame.faces[py::str(std::filesystem::path(file.path).filename().string())] = array;
-      else if (file.kind == "engine") frame.engine[py::str(std::filesystem::path(file.path).filename().string())] = array;
+      else if (file.kind == "engine")
+        frame.engine[py::str(std::filesystem::path(file.path).filename().string())] = array;
     }
     IblArraysOf(f, *images, frame);
   }
@@ -760,7 +774,8 @@ PyFrame FrameOf(const FrameResult& f, const FrameImages* images) {
 }
 
 // === The module's functions.
-PyStyle LoadStyle(py::object source, const std::vector<std::string>& overrides, const std::optional<std::string>& name) {
+PyStyle LoadStyle(py::object source, const std::vector<std::string>& overrides,
+                  const std::optional<std::string>& name) {
   if (py::isinstance<py::dict>(source)) {
     const std::string style_name = name.value_or("<dict>");
     return MakeStyle(style_name, StyleDictToToml(py::reinterpret_borrow<py::dict>(source), style_name), overrides);
@@ -768,8 +783,9 @@ PyStyle LoadStyle(py::object source, const std::vector<std::string>& overrides, 
   if (py::isinstance<py::str>(source) || py::hasattr(source, "__fspath__"))
     return MakeStyle(py::str(py::module_::import("os").attr("fspath")(source)).cast<std::string>(), std::nullopt,
                      overrides);
-  throw py::type_error("load_style: give a path (str or os.PathLike) or a dict of style keys; TOML text goes to "
-                       "parse_style");
+  throw py::type_error(
+      "load_style: give a path (str or os.PathLike) or a dict of style keys; TOML text goes to "
+      "parse_style");
 }
 
 py::list Check(const PyStyle& style, const PySchedule* schedule, double max_memory_mib, double max_frame_seconds) {
@@ -839,8 +855,9 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
     CheckFrameBudgets(bake, options);
     options.frames = SelectPart(bake, frames, shard);
     if (resume && !bake.schedule)
-      throw UsageError("resume continues a sequence bake: give a schedule (or a style with an inline [schedule]), "
-                       "or force=True to bake a single style again");
+      throw UsageError(
+          "resume continues a sequence bake: give a schedule (or a style with an inline [schedule]), "
+          "or force=True to bake a single style again");
   } catch (const py::error_already_set&) {
     throw;
   } catch (...) {
@@ -912,7 +929,8 @@ PyBake Bake(const PyStyle& style, const std::string& out, const PySchedule* sche
 }
 
 std::string Repr(const PyStyle& s) {
-  return fmt::format("<skybake.Style {}{}>", s.source, s.overrides.empty() ? "" : fmt::format(" +{} overrides", s.overrides.size()));
+  return fmt::format("<skybake.Style {}{}>", s.source,
+                     s.overrides.empty() ? "" : fmt::format(" +{} overrides", s.overrides.size()));
 }
 
 }  // namespace
@@ -1040,7 +1058,8 @@ void RegisterTypes(py::module_& m) {
       .def_readonly("files", &PyBake::files, "Every file: the frames', then the scene's, manifest.json, timings.json.")
       .def_readonly("manifest", &PyBake::manifest, "manifest.json, read back as a dict.")
       .def_readonly("manifest_path", &PyBake::manifest_path, "manifest.json's path.")
-      .def_readonly("half_scale", &PyBake::half_scale, "The power-of-two factor the EXRs were scaled by to fit half range.")
+      .def_readonly("half_scale", &PyBake::half_scale,
+                    "The power-of-two factor the EXRs were scaled by to fit half range.")
       .def_readonly("preview_ev100", &PyBake::preview_ev100, "The preview's exposure, EV100.")
       .def_readonly("warnings", &PyBake::warnings, "The style's and schedule's warnings (Location tuples).")
       .def_readonly("stages", &PyBake::stages, "Every stage as (name, seconds, detail).")
@@ -1051,8 +1070,8 @@ void RegisterTypes(py::module_& m) {
 
 // load_style, parse_style, load_schedule, check, estimate, plan and bake.
 void RegisterFunctions(py::module_& m) {
-  m.def("load_style", &LoadStyle, py::arg("source"), py::arg("overrides") = std::vector<std::string>{},
-        py::kw_only(), py::arg("name") = py::none(),
+  m.def("load_style", &LoadStyle, py::arg("source"), py::arg("overrides") = std::vector<std::string>{}, py::kw_only(),
+        py::arg("name") = py::none(),
         "Loads and validates a style: `source` is a TOML file's path, or a dict of style keys (nested dicts are "
         "tables: {'sun': {'elevation_deg': 10}}), written as TOML and read exactly as a file, named `name` "
         "(default '<dict>') in errors and provenance; a [schedule] table in it (dates and times as datetime.date and "
@@ -1066,7 +1085,8 @@ void RegisterFunctions(py::module_& m) {
       py::arg("text"), py::arg("overrides") = std::vector<std::string>{}, py::arg("name") = "<text>",
       "Loads and validates a style from TOML text, named `name` in errors and provenance. Raises StyleError.");
   m.def(
-      "load_schedule", [](py::object path) {
+      "load_schedule",
+      [](py::object path) {
         return LoadScheduleOrThrow(py::str(py::module_::import("os").attr("fspath")(path)).cast<std::string>());
       },
       py::arg("path"),

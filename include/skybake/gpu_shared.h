@@ -5,6 +5,10 @@
 //
 // Frames and units: lengths in km, scattering coefficients in km^-1, angles in
 // radians, +Y up; sun_direction points towards the Sun.
+//
+// Not laid out by clang-format: glslang reads it too, and its tables of
+// constants keep their comments on their own lines.
+// clang-format off
 #ifndef SKYBAKE_GPU_SHARED_H
 #define SKYBAKE_GPU_SHARED_H
 
@@ -270,3 +274,4 @@ static_assert(sizeof(GpuAoas) == (7 + 2 * AOAS_MAX_SHAPE_SEGMENTS + 64) * 16,
 #endif
 
 #endif  // SKYBAKE_GPU_SHARED_H
+// clang-format on

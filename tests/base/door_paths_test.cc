@@ -73,7 +73,7 @@ TEST(DoorPaths, ExrReadBackRefusesWhatIsNotARegularExr) {
     ADD_FAILURE() << "a FIFO was read as the cloud shadow map";
   } catch (const OutputError& e) {
     EXPECT_NE(std::string(e.what()).find(dir + "/fifo.exr: cannot read the cloud shadow map for the glTF ground: it "
-                                         "is a FIFO"),
+                                               "is a FIFO"),
               std::string::npos)
         << e.what();
   }
@@ -92,7 +92,8 @@ TEST(DoorPaths, ProgressJsonRefusesAFifoNoOneReads) {
   const std::string bake = "bake '" + Style() + "' --size 16 --dry-run --out '" + dir + "/out' --progress-json ";
   CommandRun fifo = RunSkybake(bake + "'" + dir + "/fifo'", kTimeout);
   EXPECT_EQ(fifo.exit_code, 5) << fifo.output;
-  EXPECT_NE(fifo.output.find("--progress-json " + dir + "/fifo cannot be written: it is a FIFO (named pipe) or socket "
+  EXPECT_NE(fifo.output.find("--progress-json " + dir +
+                             "/fifo cannot be written: it is a FIFO (named pipe) or socket "
                              "that no process reads; nothing was baked"),
             std::string::npos)
       << fifo.output;
@@ -117,8 +118,8 @@ class DoorPathsBaked : public ::testing::Test {
     root_ = testing::FreshTempDir("door_paths");
     schedule_ = testing::WriteFile(root_, "two.toml", kTwoFrames);
     for (const char* frames : {"1:1", "2:2"}) {
-      CommandRun run = RunSkybake("bake '" + Style() + "' --schedule '" + schedule_ + "' --size 16 -q --out '" +
-                                      root_ + "/parts' --frames " + frames,
+      CommandRun run = RunSkybake("bake '" + Style() + "' --schedule '" + schedule_ + "' --size 16 -q --out '" + root_ +
+                                      "/parts' --frames " + frames,
                                   kTimeout);
       ASSERT_EQ(run.exit_code, 0) << run.output;
     }
@@ -167,8 +168,8 @@ TEST_F(DoorPathsBaked, ResumeRefusesAFifoAndBakesOverALink) {
   const std::string dir = Copy("resume");
   const std::string planted = dir + "/sky_latlong.0002.exr";
   const std::string original = testing::ReadFileBytes(planted);
-  const std::string resume = "bake '" + Style() + "' --schedule '" + schedule_ + "' --size 16 --out '" + dir +
-                             "' --frames 2:2 --resume";
+  const std::string resume =
+      "bake '" + Style() + "' --schedule '" + schedule_ + "' --size 16 --out '" + dir + "' --frames 2:2 --resume";
   ASSERT_TRUE(fs::remove(planted));
   ASSERT_EQ(::mkfifo(planted.c_str(), 0600), 0);
   CommandRun fifo = RunSkybake(resume, kTimeout);
@@ -211,10 +212,12 @@ TEST(DoorPaths, OcioConfigWithAHostileLutIsRefused) {
        "is a FIFO (named pipe), not a regular file"},
       {"device", [](const std::string& p) { fs::create_symlink("/dev/zero", p); }, "is a device, not a regular file"},
       {"folder", [](const std::string& p) { fs::create_directory(p); }, "is a directory, not a file"},
-      {"huge", [](const std::string& p) { ASSERT_EQ(::truncate(testing::WriteFile(fs::path(p).parent_path().string(),
-                                                                                   "lut.spi1d", "").c_str(),
-                                                               off_t(65) << 20),
-                                                    0); },
+      {"huge",
+       [](const std::string& p) {
+         ASSERT_EQ(::truncate(testing::WriteFile(fs::path(p).parent_path().string(), "lut.spi1d", "").c_str(),
+                              off_t(65) << 20),
+                   0);
+       },
        "is 68157440 bytes, more than the 64 MiB a LUT may have"},
   };
   for (const Case& c : cases) {

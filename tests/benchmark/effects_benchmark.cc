@@ -56,11 +56,15 @@ void BM_Frame(benchmark::State& state, std::string toml) {
 }
 
 // Each effect with and without it; "without" compiles it out.
-#define EFFECT(name, with, without)                                              \
-  BENCHMARK_CAPTURE(BM_Frame, name##_with, std::string(with))                    \
-      ->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3);           \
-  BENCHMARK_CAPTURE(BM_Frame, name##_without, std::string(without))              \
-      ->UseManualTime()->Unit(benchmark::kMillisecond)->Iterations(3)
+#define EFFECT(name, with, without)                                 \
+  BENCHMARK_CAPTURE(BM_Frame, name##_with, std::string(with))       \
+      ->UseManualTime()                                             \
+      ->Unit(benchmark::kMillisecond)                               \
+      ->Iterations(3);                                              \
+  BENCHMARK_CAPTURE(BM_Frame, name##_without, std::string(without)) \
+      ->UseManualTime()                                             \
+      ->Unit(benchmark::kMillisecond)                               \
+      ->Iterations(3)
 
 EFFECT(multiple_scattering, "", "[effects]\nmultiple_scattering = false\n");
 EFFECT(mie, "", "[effects]\nmie = false\n");

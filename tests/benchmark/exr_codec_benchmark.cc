@@ -105,7 +105,8 @@ void BM_WriteFsync(benchmark::State& state, PixelType type) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "skybake_codec_bench";
   std::filesystem::create_directories(dir);
   for (auto _ : state)
-    for (size_t i = 0; i < encoded.size(); ++i) WriteFileAtomically((dir / fmt::format("f{}.exr", i)).string(), encoded[i]);
+    for (size_t i = 0; i < encoded.size(); ++i)
+      WriteFileAtomically((dir / fmt::format("f{}.exr", i)).string(), encoded[i]);
   std::filesystem::remove_all(dir);
   state.counters["MB_written"] = double(bytes) * 1e-6;
   state.counters["files"] = double(encoded.size());
@@ -119,17 +120,15 @@ void Register() {
   };
   const Codec codecs[] = {{false, "none", 0}, {false, "zips", 1}, {false, "zips", 2}, {false, "zip", 1},
                           {false, "zip", 2},  {false, "zip", 3},  {false, "zip", 4},  {false, "zip", 6},
-                          {false, "zip", 9},  {true, "none", 0},
-                          {true, "rle", 0},   {true, "zips", 1},  {true, "zip", 1},  {true, "zip", 4},
-                          {true, "piz", 0}};
+                          {false, "zip", 9},  {true, "none", 0},  {true, "rle", 0},   {true, "zips", 1},
+                          {true, "zip", 1},   {true, "zip", 4},   {true, "piz", 0}};
   for (PixelType type : {PixelType::kHalf, PixelType::kFloat}) {
     const char* type_name = type == PixelType::kHalf ? "half" : "float";
     for (const Codec& c : codecs) {
       const char* encoder = c.openexr ? "openexr" : "encode";
       std::string name = c.level > 0 ? fmt::format("{}/{}/{}/level{}", encoder, type_name, c.name, c.level)
-                                      : fmt::format("{}/{}/{}", encoder, type_name, c.name);
-      benchmark::RegisterBenchmark(name.c_str(), BM_Encode, type, std::string(c.name), std::max(c.level, 1),
-                                   c.openexr)
+                                     : fmt::format("{}/{}/{}", encoder, type_name, c.name);
+      benchmark::RegisterBenchmark(name.c_str(), BM_Encode, type, std::string(c.name), std::max(c.level, 1), c.openexr)
           ->Arg(1)
           ->Arg(2)
           ->ArgName("threads")
@@ -152,7 +151,8 @@ int main(int argc, char** argv) {
   const std::string flag = "--sun-elevation-deg=";
   int kept = 1;
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]).rfind(flag, 0) == 0) g_sun_elevation_deg = std::stod(std::string(argv[i]).substr(flag.size()));
+    if (std::string(argv[i]).rfind(flag, 0) == 0)
+      g_sun_elevation_deg = std::stod(std::string(argv[i]).substr(flag.size()));
     else argv[kept++] = argv[i];
   }
   argc = kept;

@@ -43,7 +43,7 @@ static void* Run(void* out) {
     for (int l = 0; l < 8; ++l) sum += lanes[l];
   }
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
-  ((Result*)out)->sum = sum;  /* kept, so the loop is not optimized away */
+  ((Result*)out)->sum = sum; /* kept, so the loop is not optimized away */
   ((Result*)out)->cpu_seconds = (t1.tv_sec - t0.tv_sec) + 1e-9 * (t1.tv_nsec - t0.tv_nsec);
   return NULL;
 }
@@ -60,9 +60,10 @@ int main(int argc, char** argv) {
   const double flop = (double)threads * kIterations * kChains * 8 * 2;
   double cpu = 0.0;
   for (int t = 0; t < threads; ++t) cpu += results[t].cpu_seconds;
-  printf("%d threads: %.1f GFLOP/s by the wall clock (%.3f s); %.1f GFLOP/s per core of CPU time, %.1f GFLOP/s for "
-         "%d hardware threads (checksum %g)\n",
-         threads, flop / seconds * 1e-9, seconds, flop / cpu * 1e-9, flop / cpu * 1e-9 * sysconf(_SC_NPROCESSORS_ONLN),
-         (int)sysconf(_SC_NPROCESSORS_ONLN), (double)results[0].sum);
+  printf(
+      "%d threads: %.1f GFLOP/s by the wall clock (%.3f s); %.1f GFLOP/s per core of CPU time, %.1f GFLOP/s for "
+      "%d hardware threads (checksum %g)\n",
+      threads, flop / seconds * 1e-9, seconds, flop / cpu * 1e-9, flop / cpu * 1e-9 * sysconf(_SC_NPROCESSORS_ONLN),
+      (int)sysconf(_SC_NPROCESSORS_ONLN), (double)results[0].sum);
   return 0;
 }

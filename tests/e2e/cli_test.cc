@@ -106,9 +106,9 @@ TEST(CliTest, FloatOutputNeedsNoScale) {
 TEST(CliTest, RefusedOverflowWritesNothing) {
   std::string out = FreshDir("refuse");
   // A sky beyond half range (a style made a thousand times brighter) is refused when written.
-  CommandRun run = Skybake("bake " + Style() +
-                           " --size 8 -q --set sun.irradiance=[1474.0,1850.4,1911.98] --set output.overflow=refuse --out " +
-                           out);
+  CommandRun run =
+      Skybake("bake " + Style() +
+              " --size 8 -q --set sun.irradiance=[1474.0,1850.4,1911.98] --set output.overflow=refuse --out " + out);
   EXPECT_EQ(run.exit_code, 5) << run.output;
   EXPECT_NE(run.output.find("exceeds the half-float maximum"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("output.pixel_type"), std::string::npos) << "names the fix";
@@ -159,7 +159,7 @@ TEST(CliTest, PresetOverriddenByEveryKeyWarns) {
 
 TEST(CliTest, MissingVulkanDriverNamesThePackage) {
   CommandRun run = Skybake("bake " + Style() + " --size 4 --out " + FreshDir("nodriver"),
-                    "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");
+                           "VK_ICD_FILENAMES=/nonexistent/icd.json VK_DRIVER_FILES=/nonexistent/icd.json");
   EXPECT_EQ(run.exit_code, 4) << run.output;
   EXPECT_NE(run.output.find("mesa-vulkan-drivers"), std::string::npos) << run.output;
 }

@@ -93,8 +93,8 @@ void BakePair(const std::string& style, const std::string& schedule, const std::
   const std::string common = " --schedule " + schedule + " --size " + std::to_string(size) +
                              " -q --vulkan-validation --set output.pixel_type=float --set output.faces=false "
                              "--set output.cube_strip=false --set output.preview=false --set gltf.enabled=false";
-  for (const auto& [name, extra] : std::vector<std::pair<std::string, std::string>>{
-           {"rgb", ""}, {"spectral48", " --set quality.wavelengths=48"}}) {
+  for (const auto& [name, extra] :
+       std::vector<std::pair<std::string, std::string>>{{"rgb", ""}, {"spectral48", " --set quality.wavelengths=48"}}) {
     const testing::CommandRun r = testing::RunSkybake("bake " + style + common + extra + " --out " + dir + "/" + name);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
@@ -167,8 +167,8 @@ TEST_F(ColourAgainstSpectral, TheClearSkyMatchesTheSpectralMode) {
 
 // White clouds lit by the Sun and the overcast deck, over the upper
 // hemisphere (the clouds and the sky between them): mean within 0.003 with
-// the Sun at 45 and at 10 deg (cumulus_noon and overcast_stratus). Latlongs of 16 x 8: a 48-bin cloud bake compiles and fills
-// the cloud passes of 16 renderer groups.
+// the Sun at 45 and at 10 deg (cumulus_noon and overcast_stratus). Latlongs of 16 x 8: a 48-bin cloud bake compiles and
+// fills the cloud passes of 16 renderer groups.
 TEST(ColourClouds, CloudsMatchTheSpectralMode) {
   const std::string dir = testing::FreshTempDir("colour_clouds");
   const std::string schedule = ElevationSchedule(dir, {45.0, 10.0});
@@ -192,9 +192,10 @@ TEST(ColourClouds, CloudsMatchTheSpectralMode) {
 TEST(SunSkySplit, DefaultHalfBakeHoldsTheSkyInCandelasWithTheSunAsALight) {
   const std::string dir = testing::FreshTempDir("colour_split");
   for (const std::string type : {"half", "float"}) {
-    const testing::CommandRun r =
-        testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --size 64 --vulkan-validation --set "
-                            "output.pixel_type=" + type + " --out " + dir + "/" + type);
+    const testing::CommandRun r = testing::RunSkybake("bake " + testing::SourceDir() +
+                                                      "/configs/default.toml --size 64 --vulkan-validation --set "
+                                                      "output.pixel_type=" +
+                                                      type + " --out " + dir + "/" + type);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(r.output.find("scaled"), std::string::npos) << r.output;
   }
@@ -232,8 +233,9 @@ TEST(SunSkySplit, DefaultHalfBakeHoldsTheSkyInCandelasWithTheSunAsALight) {
 // fit it and the scale recorded.
 TEST(SunSkySplit, SunInTheMapsOnRequestScalesHalfFiles) {
   const std::string dir = testing::FreshTempDir("colour_sun_map");
-  const testing::CommandRun r = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml --size 64 --vulkan-validation --set output.sun=map --out " + dir);
+  const testing::CommandRun r =
+      testing::RunSkybake("bake " + testing::SourceDir() +
+                          "/configs/default.toml --size 64 --vulkan-validation --set output.sun=map --out " + dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const Latlong l = ReadLatlong(dir + "/sky_latlong.exr");
   EXPECT_NE(l.attributes.at("skybake:scale"), "1");
@@ -247,9 +249,10 @@ TEST(SunSkySplit, SunInTheMapsOnRequestScalesHalfFiles) {
 TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
   const std::string dir = testing::FreshTempDir("colour_no_disc");
   for (const std::string disc : {"true", "false"}) {
-    const testing::CommandRun r = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --set effects.sun_disc=" +
-        disc + " --out " + dir + "/" + disc);
+    const testing::CommandRun r =
+        testing::RunSkybake("bake " + testing::SourceDir() +
+                            "/configs/default.toml --size 16 -q --vulkan-validation --set effects.sun_disc=" + disc +
+                            " --out " + dir + "/" + disc);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   const json with = json::parse(testing::ReadFileBytes(dir + "/true/manifest.json"))["frames"][0]["sun"];
@@ -261,8 +264,8 @@ TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
   // The glTF light: intensity x Y(colour) is the illuminance (clients light with colour x intensity).
   const json gltf = json::parse(testing::ReadFileBytes(dir + "/false/sky.gltf"));
   const json& light = gltf["extensions"]["KHR_lights_punctual"]["lights"][0];
-  const double y = Luminance({light["color"][0].get<double>(), light["color"][1].get<double>(),
-                              light["color"][2].get<double>()});
+  const double y =
+      Luminance({light["color"][0].get<double>(), light["color"][1].get<double>(), light["color"][2].get<double>()});
   EXPECT_NEAR(light["intensity"].get<double>() * y, without["illuminance_lux"].get<double>(),
               1e-5 * without["illuminance_lux"].get<double>());
 }
@@ -273,9 +276,11 @@ TEST(SunSkySplit, TheSunsLightStaysWithoutTheDisc) {
 TEST(SunSkySplit, HueStyledSkyKeepsTheConversionOfItsTargetColour) {
   const std::string dir = testing::FreshTempDir("colour_hue");
   for (const std::string units : {"luminance", "spectral"}) {
-    const testing::CommandRun r = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/styles/yellow_turbulent.toml --size 16 -q --vulkan-validation "
-        "--set output.pixel_type=float --set output.units=" + units + " --out " + dir + "/" + units);
+    const testing::CommandRun r =
+        testing::RunSkybake("bake " + testing::SourceDir() +
+                            "/configs/styles/yellow_turbulent.toml --size 16 -q --vulkan-validation "
+                            "--set output.pixel_type=float --set output.units=" +
+                            units + " --out " + dir + "/" + units);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   const Latlong lum = ReadLatlong(dir + "/luminance/sky_latlong.exr");
@@ -285,7 +290,8 @@ TEST(SunSkySplit, HueStyledSkyKeepsTheConversionOfItsTargetColour) {
   for (int y = 0; y < lum.height / 2; ++y)
     for (int x = 0; x < lum.width; ++x) {
       const std::array<double, 3> a = lum.at(x, y), b = raw.at(x, y);
-      for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c] * k[c], 1e-5 * a[c] + 1e-6) << x << "," << y << " channel " << c;
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(a[c], b[c] * k[c], 1e-5 * a[c] + 1e-6) << x << "," << y << " channel " << c;
       ++checked;
     }
   EXPECT_EQ(checked, lum.width * lum.height / 2);
@@ -311,10 +317,11 @@ utc_offset_hours = -4.0
 times = { start = 00:00:00, end = 23:45:00, step_minutes = 15 }
 )");
   for (const std::string type : {"half", "float"}) {
-    const testing::CommandRun r = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/night/moonlit.toml --schedule " + schedule +
-        " --size 16 -q --vulkan-validation --set output.faces=false --set output.cube_strip=false "
-        "--set output.pixel_type=" + type + " --out " + dir + "/" + type);
+    const testing::CommandRun r =
+        testing::RunSkybake("bake " + testing::SourceDir() + "/configs/night/moonlit.toml --schedule " + schedule +
+                            " --size 16 -q --vulkan-validation --set output.faces=false --set output.cube_strip=false "
+                            "--set output.pixel_type=" +
+                            type + " --out " + dir + "/" + type);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   const json m = json::parse(testing::ReadFileBytes(dir + "/float/manifest.json"));

@@ -39,7 +39,8 @@ void WritePng(const std::string& stem) {
   std::vector<float> rgb(size_t(spec.width) * spec.height * 3);
   ASSERT_TRUE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, rgb.data()));
   std::vector<unsigned char> bytes(rgb.size());
-  for (size_t i = 0; i < rgb.size(); ++i) bytes[i] = (unsigned char)std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f);
+  for (size_t i = 0; i < rgb.size(); ++i)
+    bytes[i] = (unsigned char)std::lround(std::clamp(rgb[i], 0.0f, 1.0f) * 255.0f);
   auto out = OIIO::ImageOutput::create(stem + ".png");
   ASSERT_TRUE(out);
   ASSERT_TRUE(out->open(stem + ".png", OIIO::ImageSpec(spec.width, spec.height, 3, OIIO::TypeDesc::UINT8)));
@@ -58,15 +59,14 @@ TEST(EngineBabylonTest, TestPatternFacesAreWhereTheySayInBabylon) {
   // The directions of engine_threejs_test, in skybake's world: face axes 10
   // degrees below the horizon (the horizon line and the letters are above
   // or on it), the +X face's horizon and beside it, North's letter.
-  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0}, {0, -1, 0}, {0, -0.18, 1},
-                                        {0, -0.18, -1},
-                                        {1, 0, 0.5},
-                                        {1, 0.2, 0.5},
-                                        {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
+  const std::vector<glm::dvec3> dirs = {
+      {1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0},
+      {0, -1, 0},    {0, -0.18, 1},  {0, -0.18, -1},
+      {1, 0, 0.5},   {1, 0.2, 0.5},  {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
   std::string query = "bases=sky_babylon,sky&dirs=";
   for (size_t i = 0; i < dirs.size(); ++i)
-    query += (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
-             std::to_string(dirs[i].z);
+    query +=
+        (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," + std::to_string(dirs[i].z);
   const nlohmann::json line = testing::RunViewerPage("engine_babylon_cube.html", dir, dir + "/babylon.png", query);
   ASSERT_FALSE(line.is_null());
   const nlohmann::json report = line["report"];
@@ -117,15 +117,14 @@ TEST(EngineBabylonTest, PresetsExrFacesLoadWithTheDocumentedSnippet) {
   testing::CommandRun r = testing::RunSkybake("testpattern --engine babylon --size 64 --out " + dir + "/pattern");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::filesystem::copy_file(snippet, dir + "/pattern/babylon_exr_cube.js");
-  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0}, {0, -1, 0}, {0, -0.18, 1},
-                                        {0, -0.18, -1},
-                                        {1, 0, 0.5},
-                                        {1, 0.2, 0.5},
-                                        {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
+  const std::vector<glm::dvec3> dirs = {
+      {1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0},
+      {0, -1, 0},    {0, -0.18, 1},  {0, -0.18, -1},
+      {1, 0, 0.5},   {1, 0.2, 0.5},  {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};
   std::string query = "dirs=";
   for (size_t i = 0; i < dirs.size(); ++i)
-    query += (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
-             std::to_string(dirs[i].z);
+    query +=
+        (i ? ";" : "") + std::to_string(-dirs[i].x) + "," + std::to_string(dirs[i].y) + "," + std::to_string(dirs[i].z);
   nlohmann::json line =
       testing::RunViewerPage("engine_babylon_exr_cube.html", dir + "/pattern", dir + "/pattern.png", query);
   ASSERT_FALSE(line.is_null());
@@ -166,8 +165,7 @@ TEST(EngineBabylonTest, PresetsExrFacesLoadWithTheDocumentedSnippet) {
     ASSERT_EQ(v.size(), 4u);
     if (base == "sky_babylon")
       EXPECT_GT(v[0], 2.0 * std::max({v[1], v[2], v[3]})) << "the sky's Sun is not along Babylon's sun light";
-    else
-      EXPECT_LT(v[0], 0.5 * std::max({v[1], v[2], v[3]})) << "skybake's Vulkan faces load right without the preset";
+    else EXPECT_LT(v[0], 0.5 * std::max({v[1], v[2], v[3]})) << "skybake's Vulkan faces load right without the preset";
   }
 }
 
@@ -216,8 +214,8 @@ TEST(EngineBabylonTest, SkyAndSunShowOneExposure) {
 // the dome covers every pixel.
 TEST(EngineBabylonTest, DomeIsInsideTheDefaultCamerasRange) {
   const std::string dir = testing::FreshTempDir("engine_babylon_dome");
-  testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
+                                                 "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   const nlohmann::json line = testing::RunViewerPage("dome_babylon.html", dir, dir + "/babylon.png", "");
   ASSERT_FALSE(line.is_null());

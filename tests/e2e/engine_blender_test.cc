@@ -30,14 +30,13 @@ struct Probe {
 // `turn_deg`: the Mapping node's rotation about +Z before the texture (none when empty).
 Probe RunBlender(const std::string& dir, const std::string& latlong, const std::string& turn_deg = "") {
   const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
-                              "/tests/engines/blender_sun_check.py' -- '" + dir + "/sky.glb' '" + dir + "/" +
-                              latlong + "' '" + dir + "' " + turn_deg;
+                              "/tests/engines/blender_sun_check.py' -- '" + dir + "/sky.glb' '" + dir + "/" + latlong +
+                              "' '" + dir + "' " + turn_deg;
   auto [code, output] = testing::RunCommand(command);
   Probe probe;
   EXPECT_EQ(code, 0) << command << "\n" << output;
   const size_t at = output.find("RESULT ");
-  EXPECT_NE(at, std::string::npos) << "blender (Debian package, installed by .ci/setup) printed no result:\n"
-                                   << output;
+  EXPECT_NE(at, std::string::npos) << "blender (Debian package, installed by .ci/setup) printed no result:\n" << output;
   if (at == std::string::npos) return probe;
   const std::string line = output.substr(at + 7, output.find('\n', at) - at - 7);
   nlohmann::json result = nlohmann::json::parse(line);
@@ -51,21 +50,22 @@ TEST(EngineBlenderTest, SkysSunIsAlongTheImportedSunLight) {
   const std::string dir = testing::FreshTempDir("engine_blender");
   testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
                                                  "/configs/default.toml --size 128 -q --vulkan-validation "
-                                                 "--engine blender --out " + dir);
+                                                 "--engine blender --out " +
+                                                 dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
 
   const Probe preset = RunBlender(dir, "sky_blender_latlong.exr");
   ASSERT_EQ(preset.radiance.size(), 4u);
   const double others = std::max({preset.radiance[1], preset.radiance[2], preset.radiance[3]});
-  std::printf("blender preset: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
-              preset.radiance[0], preset.radiance[1], preset.radiance[2], preset.radiance[3]);
+  std::printf("blender preset: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n", preset.radiance[0],
+              preset.radiance[1], preset.radiance[2], preset.radiance[3]);
   EXPECT_GT(preset.radiance[0], 2.0 * others) << "the sky's Sun is not along Blender's imported sun light";
 
   // The OpenEXR latlong: the Sun a quarter turn away, as users found.
   const Probe openexr = RunBlender(dir, "sky_latlong.exr");
   ASSERT_EQ(openexr.radiance.size(), 4u);
-  std::printf("OpenEXR latlong: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n",
-              openexr.radiance[0], openexr.radiance[1], openexr.radiance[2], openexr.radiance[3]);
+  std::printf("OpenEXR latlong: along the sun light %.6g, turned 90/180/270 deg %.6g %.6g %.6g\n", openexr.radiance[0],
+              openexr.radiance[1], openexr.radiance[2], openexr.radiance[3]);
   EXPECT_GT(openexr.radiance[1], 2.0 * std::max({openexr.radiance[0], openexr.radiance[2], openexr.radiance[3]}));
 
   // The OpenEXR latlong turned as docs/engines.md says (Texture Coordinate
@@ -102,9 +102,9 @@ TEST(EngineBlenderTest, SkyAndSunShowOneExposure) {
   testing::SkyAndSun bake;
   ASSERT_TRUE(testing::BakeSkyAndSun("engine_blender_sun_sky", bake));
   struct Mode {
-    std::string lighting_mode;     // the importer's convert_lighting_mode
-    double background_strength;    // the World's, so that the sky is in the sun's units
-    double strength_per_lux;       // the imported sun's Strength per glTF lux
+    std::string lighting_mode;   // the importer's convert_lighting_mode
+    double background_strength;  // the World's, so that the sky is in the sun's units
+    double strength_per_lux;     // the imported sun's Strength per glTF lux
   };
   for (const Mode& mode : {Mode{"SPEC", 1.0 / 683.0, 1.0 / 683.0}, Mode{"COMPAT", 1.0, 1.0}}) {
     SCOPED_TRACE(mode.lighting_mode);
@@ -145,8 +145,8 @@ TEST(EngineBlenderTest, DomeIsInsideTheStartupCamerasClipRange) {
   auto [which, where] = testing::RunCommand("command -v blender");
   ASSERT_EQ(which, 0) << "blender is missing: run .ci/setup (Debian package blender)";
   const std::string dir = testing::FreshTempDir("engine_blender_dome");
-  testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
+                                                 "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   const std::string command = "blender -b --factory-startup --python '" + testing::SourceDir() +
                               "/tests/engines/blender_dome_check.py' -- '" + dir + "/sky.glb' '" + dir + "'";

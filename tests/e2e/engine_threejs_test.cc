@@ -38,7 +38,8 @@ TEST(EngineThreejsTest, SkysSunIsAlongTheSceneSunLight) {
   const std::string dir = testing::FreshTempDir("engine_threejs");
   testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
                                                  "/configs/default.toml --size 128 -q --vulkan-validation "
-                                                 "--engine threejs --out " + dir);
+                                                 "--engine threejs --out " +
+                                                 dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   nlohmann::json report = RunPage("engine_threejs.html", dir);
   ASSERT_TRUE(report.is_object()) << report.dump();
@@ -69,15 +70,19 @@ TEST(EngineThreejsTest, TestPatternIsWhereItSaysInThreejs) {
   testing::CommandRun r = testing::RunSkybake("testpattern --engine threejs --size 128 --out " + dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   // Face axes 10 degrees below the horizon (the horizon line and the letters are above or on it).
-  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0}, {-1, -0.18, 0}, {0, 1, 0}, {0, -1, 0}, {0, -0.18, 1},
+  const std::vector<glm::dvec3> dirs = {{1, -0.18, 0},
+                                        {-1, -0.18, 0},
+                                        {0, 1, 0},
+                                        {0, -1, 0},
+                                        {0, -0.18, 1},
                                         {0, -0.18, -1},
-                                        {1, 0, 0.5},                                  // on the +X face's horizon
-                                        {1, 0.2, 0.5},                                // beside it, above
+                                        {1, 0, 0.5},    // on the +X face's horizon
+                                        {1, 0.2, 0.5},  // beside it, above
                                         {0, std::sin(6.0 * M_PI / 180.0), -std::cos(6.0 * M_PI / 180.0)}};  // N
   std::string query = "pattern=1&dirs=";
   for (size_t i = 0; i < dirs.size(); ++i)
-    query += (i ? ";" : "") + std::to_string(dirs[i].x) + "," + std::to_string(dirs[i].y) + "," +
-             std::to_string(dirs[i].z);
+    query +=
+        (i ? ";" : "") + std::to_string(dirs[i].x) + "," + std::to_string(dirs[i].y) + "," + std::to_string(dirs[i].z);
   nlohmann::json report = RunPage("engine_threejs.html", dir, query);
   ASSERT_TRUE(report.is_object()) << report.dump();
   ASSERT_EQ(report.value("ok", false), true) << report.dump();
@@ -129,9 +134,9 @@ TEST_P(EngineThreejsKtx2Test, CubeLoadsWithEveryLevelTheRightWayRound) {
     std::string ktx2;
     std::vector<std::string> exrs;  // level by level, six faces stacked
   };
-  for (const File& f : std::vector<File>{
-           {"sky_specular.ktx2", {"sky_specular_m0.exr", "sky_specular_m1.exr", "sky_specular_m2.exr"}},
-           {"sky_irradiance.ktx2", {"sky_irradiance.exr"}}}) {
+  for (const File& f :
+       std::vector<File>{{"sky_specular.ktx2", {"sky_specular_m0.exr", "sky_specular_m1.exr", "sky_specular_m2.exr"}},
+                         {"sky_irradiance.ktx2", {"sky_irradiance.exr"}}}) {
     SCOPED_TRACE(f.ktx2);
     // The probes: per level, the brightest texel and a texel off the middle
     // of each face; their EXR values.
@@ -148,8 +153,8 @@ TEST_P(EngineThreejsKtx2Test, CubeLoadsWithEveryLevelTheRightWayRound) {
         if (rgb[3 * i] + rgb[3 * i + 1] + rgb[3 * i + 2] >
             rgb[3 * brightest] + rgb[3 * brightest + 1] + rgb[3 * brightest + 2])
           brightest = i;
-      std::vector<std::array<int, 3>> texels = {{int(brightest / (width * width)), int(brightest % width),
-                                                 int(brightest / width % width)}};
+      std::vector<std::array<int, 3>> texels = {
+          {int(brightest / (width * width)), int(brightest % width), int(brightest / width % width)}};
       for (int face = 0; face < 6; ++face) texels.push_back({face, width / 4, width * 3 / 4});
       for (const auto& [face, x, y] : texels) {
         const glm::dvec3 d = VulkanCubeTexelDirection(face, x, y, width);
@@ -184,7 +189,7 @@ TEST_P(EngineThreejsKtx2Test, CubeLoadsWithEveryLevelTheRightWayRound) {
         // As in ktx2_test.cc: equal for rgba16f (the GPU reads the same
         // half); within half a step of the packed format otherwise.
         const double want = expected[p][size_t(c)];
-        const double tolerance = format == "rgba16f"    ? 1e-6 * want
+        const double tolerance = format == "rgba16f"     ? 1e-6 * want
                                  : format == "b10g11r11" ? (c == 2 ? 1.0 / 64 : 1.0 / 128) * want + 1e-3 * want
                                                          : max_want / 512.0 + 1e-3 * want;
         EXPECT_NEAR(seen[p][size_t(c)], want, tolerance) << "probe " << p << " channel " << c;
@@ -237,8 +242,8 @@ TEST(EngineThreejsTest, SkyAndSunShowOneExposure) {
 // from the origin, looking along each axis, the dome covers every pixel.
 TEST(EngineThreejsTest, DomeIsInsideTheDefaultCamerasRange) {
   const std::string dir = testing::FreshTempDir("engine_threejs_dome");
-  testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
+  testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
+                                                 "/configs/default.toml --size 16 -q --vulkan-validation --out " + dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   nlohmann::json report = RunPage("dome_threejs.html", dir);
   ASSERT_TRUE(report.is_object()) << report.dump();

@@ -56,7 +56,8 @@ std::vector<GoldenBake> Bakes() {
        "bake configs/default.toml --schedule tests/golden/five_frames.toml --size 16 --shard 2/2 -q --out {out}"},
       {"five_frames_merged",
        "bake configs/default.toml --schedule tests/golden/five_frames.toml --size 16 --shard 1/2 -q --out {out} && "
-       "{bin} bake configs/default.toml --schedule tests/golden/five_frames.toml --size 16 --shard 2/2 -q --out {out} && "
+       "{bin} bake configs/default.toml --schedule tests/golden/five_frames.toml --size 16 --shard 2/2 -q --out {out} "
+       "&& "
        "{bin} merge-manifest {out}"},
   };
 }
@@ -84,7 +85,8 @@ std::map<std::string, std::string> BakeAll(const std::string& root) {
     for (auto [key, value] : {std::pair<std::string, std::string>{"{out}", out}, {"{bin}", SKYBAKE_BINARY}}) {
       for (size_t at; (at = args.find(key)) != std::string::npos;) args.replace(at, key.size(), value);
     }
-    const testing::CommandRun run = RunSkybake(args, "cd '" + testing::SourceDir() + "' && export SKYBAKE_VULKAN_VALIDATION=1 &&");
+    const testing::CommandRun run =
+        RunSkybake(args, "cd '" + testing::SourceDir() + "' && export SKYBAKE_VULKAN_VALIDATION=1 &&");
     EXPECT_EQ(run.exit_code, 0) << bake.name << ": " << run.output;
     if (run.exit_code != 0) continue;
     for (const auto& entry : fs::directory_iterator(out)) {

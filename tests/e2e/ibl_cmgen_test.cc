@@ -101,16 +101,26 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   // Spectral radiance: well below cmgen's clamp at 256.
   testing::CommandRun bake = testing::RunSkybake(
       "bake " + testing::SourceDir() +
-      "/configs/default.toml -q --size 16 --set render.latlong_height=512 --set effects.sun_disc=false --set output.units=spectral "
+      "/configs/default.toml -q --size 16 --set render.latlong_height=512 --set effects.sun_disc=false --set "
+      "output.units=spectral "
       "--set output.pixel_type=float --set gltf.enabled=false --set output.preview=false "
       "--set output.faces=false --set output.cube_strip=false --set ibl.size=128 --set ibl.specular=true "
-      "--set ibl.levels=1 --out " + dir);
+      "--set ibl.levels=1 --out " +
+      dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   std::string out;
-  ASSERT_EQ(RunShell("cd '" + dir + "' && cmgen --quiet --no-mirror --size=128 --format=exr --ibl-samples=1024 "
-                "--ibl-ld=cmgen sky_latlong.exr", &out), 0) << out;
-  ASSERT_EQ(RunShell("cd '" + dir + "' && cmgen --quiet --size=128 --format=exr --ibl-samples=1024 "
-                "--ibl-ld=cmgen_mirror sky_latlong.exr", &out), 0) << out;
+  ASSERT_EQ(RunShell("cd '" + dir +
+                         "' && cmgen --quiet --no-mirror --size=128 --format=exr --ibl-samples=1024 "
+                         "--ibl-ld=cmgen sky_latlong.exr",
+                     &out),
+            0)
+      << out;
+  ASSERT_EQ(RunShell("cd '" + dir +
+                         "' && cmgen --quiet --size=128 --format=exr --ibl-samples=1024 "
+                         "--ibl-ld=cmgen_mirror sky_latlong.exr",
+                     &out),
+            0)
+      << out;
 
   // skybake's cube of the same sky: level 0 of its specular chain.
   Image m0 = Read(dir + "/sky_specular_m0.exr");
@@ -201,8 +211,8 @@ TEST(IblCmgenTest, PrefilteredLevelsAgreeWithCmgen) {
   for (int level = 0; level < levels; ++level) {
     const double d = level_difference("cmgen_mirror", level, kSame);
     const double sky = level_difference("cmgen_mirror", level, kSame, true);
-    std::printf("level %d, roughness %.4f, %d^2: mean relative difference %.4f; above 3 deg, relative L1 %.4f\n",
-                level, request.roughness[level], n >> level, d, sky);
+    std::printf("level %d, roughness %.4f, %d^2: mean relative difference %.4f; above 3 deg, relative L1 %.4f\n", level,
+                request.roughness[level], n >> level, d, sky);
     RecordProperty("level" + std::to_string(level), std::to_string(d));
     EXPECT_LE(d, previous + 0.01) << "level " << level << " differs more than the sharper level before it";
     EXPECT_LE(d, kMeanBound[level]) << "level " << level;

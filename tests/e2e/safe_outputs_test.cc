@@ -31,8 +31,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::CommandRun;
-using testing::FreshTempDir;
 using testing::FileNames;
+using testing::FreshTempDir;
 using testing::ReadFileBytes;
 using testing::RunSkybake;
 using testing::WriteFile;
@@ -89,8 +89,8 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
   ASSERT_GE(pid, 0);
   if (pid == 0) {
     if (chdir((root + "/killed").c_str()) != 0) _exit(127);
-    execl(SKYBAKE_BINARY, "skybake", "bake", Style().c_str(), "--schedule", schedule.c_str(), "--size", "16",
-          "-q", "--out", "out", static_cast<char*>(nullptr));
+    execl(SKYBAKE_BINARY, "skybake", "bake", Style().c_str(), "--schedule", schedule.c_str(), "--size", "16", "-q",
+          "--out", "out", static_cast<char*>(nullptr));
     _exit(127);
   }
   // Kill once the fifth frame's first file is in place (frames 1-4 done).
@@ -144,12 +144,13 @@ TEST(SafeOutputs, KilledSequenceResumesToIdenticalBytes) {
 
   // Another style: no frame matches its recorded style_sha256, so --resume
   // bakes all twenty again.
-  CommandRun changed = RunSkybake("bake '" + Style() + "' --schedule '" + schedule +
-                                      "' --size 16 --out out --resume --set atmosphere.mie.g=0.7",
-                                  "cd '" + root + "/killed' &&");
+  CommandRun changed = RunSkybake(
+      "bake '" + Style() + "' --schedule '" + schedule + "' --size 16 --out out --resume --set atmosphere.mie.g=0.7",
+      "cd '" + root + "/killed' &&");
   ASSERT_EQ(changed.exit_code, 0) << changed.output;
   size_t rendered = 0;
-  for (size_t at = changed.output.find(" 8 views"); at != std::string::npos; at = changed.output.find(" 8 views", at + 1))
+  for (size_t at = changed.output.find(" 8 views"); at != std::string::npos;
+       at = changed.output.find(" 8 views", at + 1))
     ++rendered;
   EXPECT_EQ(rendered, 20u) << changed.output;
   EXPECT_NE(ReadFileBytes(killed + "/sky_px.0001.exr"), ReadFileBytes(root + "/whole/out/sky_px.0001.exr"));
@@ -168,7 +169,8 @@ TEST(SafeOutputs, PlantedTemporaryLinksAreNeverFollowed) {
   const std::string victims = root + "/victims";
   fs::create_directories(out);
   fs::create_directories(victims);
-  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string schedule =
+      WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
   std::vector<std::string> names = {"manifest.json", "timings.json", "sky.gltf", "sky.bin", "sky.glb"};
   for (const char* frame : {"0001", "0002"}) {
     for (const char* face : {"px", "nx", "py", "ny", "pz", "nz", "cube", "latlong"})
@@ -268,8 +270,8 @@ TEST(OutputLockTest, AHeldMutexIsWaitedForABoundedTimeThenNamed) {
   EXPECT_EQ(bake.exit_code, 6) << bake.output;
   EXPECT_NE(bake.output.find("held for more than 0 s by pid 4242 on farm-node-7"), std::string::npos) << bake.output;
   for (const char* bad : {"nan", "-1", "1e9", "soon"}) {
-    CommandRun refused =
-        RunSkybake("bake '" + Style() + "' --size 8 -q --out '" + dir + "'", std::string("SKYBAKE_LOCK_WAIT_SECONDS=") + bad);
+    CommandRun refused = RunSkybake("bake '" + Style() + "' --size 8 -q --out '" + dir + "'",
+                                    std::string("SKYBAKE_LOCK_WAIT_SECONDS=") + bad);
     EXPECT_EQ(refused.exit_code, 2) << bad << ": " << refused.output;
   }
   // Released: the next claim proceeds and leaves the holder's name behind.
@@ -314,7 +316,8 @@ bool WaitForClaim(const std::string& dir, pid_t child) {
 pid_t Spawn(const std::string& args) {
   pid_t pid = fork();
   if (pid == 0) {
-    execl("/bin/bash", "bash", "-c", (std::string("exec '") + SKYBAKE_BINARY + "' " + args + " >/dev/null 2>&1").c_str(),
+    execl("/bin/bash", "bash", "-c",
+          (std::string("exec '") + SKYBAKE_BINARY + "' " + args + " >/dev/null 2>&1").c_str(),
           static_cast<char*>(nullptr));
     _exit(127);
   }
@@ -364,10 +367,15 @@ TEST(SafeOutputs, SecondBakeIntoTheSameFilesIsRefusedWhileTheFirstRuns) {
     OutputLock held = OutputLock::Claim(out, {"sky_px.0007.exr"});
     CommandRun refused = RunSkybake(SlowSequenceBake(schedule, out, "--force"));
     EXPECT_EQ(refused.exit_code, 6) << refused.output;
-    EXPECT_EQ(refused.output.rfind(fmt::format("skybake: error: {} is being written by another skybake (pid {} on ",
-                                               out, getpid()), 0), 0u) << refused.output;
-    EXPECT_NE(refused.output.find("which writes " + out + "/sky_px.0007.exr too: wait for it to end, or choose "
-                                  "another --out"), std::string::npos) << refused.output;
+    EXPECT_EQ(refused.output.rfind(
+                  fmt::format("skybake: error: {} is being written by another skybake (pid {} on ", out, getpid()), 0),
+              0u)
+        << refused.output;
+    EXPECT_NE(refused.output.find("which writes " + out +
+                                  "/sky_px.0007.exr too: wait for it to end, or choose "
+                                  "another --out"),
+              std::string::npos)
+        << refused.output;
     EXPECT_EQ(refused.output.find("skybake: device"), std::string::npos) << "no GPU work";
     EXPECT_EQ(FileNames(out).size(), 1u) << "nothing written but the holder's claim";
   }
@@ -428,7 +436,8 @@ TEST(SafeOutputs, KilledBakesLockIsReleased) {
 // manifest.json (a whole bake running) refuses it, and it writes nothing.
 TEST(SafeOutputs, MergeTakesTheLockOnWhatItWrites) {
   const std::string root = FreshTempDir("lockmerge");
-  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string schedule =
+      WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
   const std::string out = root + "/out";
   for (const char* shard : {"1/2", "2/2"}) {
     CommandRun part = RunSkybake("bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out +
@@ -453,7 +462,8 @@ TEST(SafeOutputs, MergeTakesTheLockOnWhatItWrites) {
 // bake gives the frame (same style) stops it (exit 8) before it is opened.
 TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   const std::string root = FreshTempDir("resumein");
-  const std::string schedule = WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
+  const std::string schedule =
+      WriteFile(root, "two.toml", "[schedule]\nsun = { elevation_deg = [10, 20], azimuth_deg = 135 }\n");
   const std::string out = root + "/out";
   const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 8 -q --out '" + out + "'";
   ASSERT_EQ(RunSkybake(bake).exit_code, 0);
@@ -464,16 +474,19 @@ TEST(SafeOutputs, ResumeRefusesManifestsItCannotTrust) {
   fs::create_directory(manifest_path);
   CommandRun directory = RunSkybake(bake + " --resume");
   EXPECT_EQ(directory.exit_code, 6) << directory.output;
-  EXPECT_EQ(directory.output, "skybake: error: " + manifest_path + " is a directory, not a manifest, so --resume "
-                              "cannot tell which frames are done: move it away, or pass --force instead to bake every "
-                              "frame again\n");
+  EXPECT_EQ(directory.output,
+            "skybake: error: " + manifest_path +
+                " is a directory, not a manifest, so --resume "
+                "cannot tell which frames are done: move it away, or pass --force instead to bake every "
+                "frame again\n");
   fs::remove(manifest_path);
 
   std::ofstream(manifest_path) << "not json";
   CommandRun garbage = RunSkybake(bake + " --resume");
   EXPECT_EQ(garbage.exit_code, 6) << garbage.output;
-  EXPECT_EQ(garbage.output, "skybake: error: " + manifest_path + " is not valid JSON, so --resume cannot tell which "
-                            "frames are done: pass --force instead to bake every frame again\n");
+  EXPECT_EQ(garbage.output, "skybake: error: " + manifest_path +
+                                " is not valid JSON, so --resume cannot tell which "
+                                "frames are done: pass --force instead to bake every frame again\n");
 
   // `command` --resume after the good manifest's value at `pointer` is
   // changed to `value`.
@@ -521,7 +534,8 @@ TEST(SafeOutputs, GalleryNeedsForceAndNeverWritesThroughALink) {
   const std::string styles = root + "/styles";
   fs::create_directories(styles);
   for (const char* name : {"a", "b"})
-    fs::copy_file(testing::SourceDir() + "/configs/styles/" + (std::string(name) == "a" ? "ambiguous_yellow.toml" : "crystal_blue.toml"),
+    fs::copy_file(testing::SourceDir() + "/configs/styles/" +
+                      (std::string(name) == "a" ? "ambiguous_yellow.toml" : "crystal_blue.toml"),
                   styles + "/" + name + ".toml");
   const std::string out = root + "/out";
   const std::string gallery = "gallery '" + styles + "' --size 8 -q --out '" + out + "'";
@@ -530,8 +544,9 @@ TEST(SafeOutputs, GalleryNeedsForceAndNeverWritesThroughALink) {
   const std::string sheet = ReadFileBytes(out + "/gallery.png");
   CommandRun again = RunSkybake(gallery);
   EXPECT_EQ(again.exit_code, 6) << again.output;
-  EXPECT_EQ(again.output, "skybake: error: " + out + "/gallery.png already exists: pass --force to replace the "
-                          "gallery, or choose another --out\n");
+  EXPECT_EQ(again.output, "skybake: error: " + out +
+                              "/gallery.png already exists: pass --force to replace the "
+                              "gallery, or choose another --out\n");
   fs::remove(out + "/gallery.png");
   std::ofstream(root + "/victim") << "victim";
   fs::create_symlink(root + "/victim", out + "/gallery.png");
@@ -576,8 +591,9 @@ TEST(SafeOutputs, OutputsThatCannotBeWrittenAreFoundBeforeRendering) {
   fs::create_directory(out + "/sky.glb");
   CommandRun directory = RunSkybake(bake + " --force");
   EXPECT_EQ(directory.exit_code, 5) << directory.output;
-  EXPECT_EQ(directory.output, "skybake: error: " + out + "/sky.glb is a directory: an output file cannot replace "
-                              "it; move it away, or choose another --out\n");
+  EXPECT_EQ(directory.output, "skybake: error: " + out +
+                                  "/sky.glb is a directory: an output file cannot replace "
+                                  "it; move it away, or choose another --out\n");
   EXPECT_EQ(ReadFileBytes(out + "/sky_px.exr"), px);
   fs::remove(out + "/sky.glb");
 
@@ -591,8 +607,9 @@ TEST(SafeOutputs, OutputsThatCannotBeWrittenAreFoundBeforeRendering) {
   std::ofstream(root + "/file") << "x";
   CommandRun file = RunSkybake("bake '" + Style() + "' --size 8 --out '" + root + "/file'");
   EXPECT_EQ(file.exit_code, 5) << file.output;
-  EXPECT_EQ(file.output, "skybake: error: --out " + root + "/file is not a folder: give a folder (it is created when "
-                         "missing)\n");
+  EXPECT_EQ(file.output, "skybake: error: --out " + root +
+                             "/file is not a folder: give a folder (it is created when "
+                             "missing)\n");
   fs::remove_all(root);
 }
 
@@ -605,8 +622,8 @@ TEST(SafeOutputs, FullDiskIsReportedAndLeavesNoPartialFile) {
                               "ulimit -f 16;");
   EXPECT_EQ(run.exit_code, 5) << run.output;
   EXPECT_EQ(run.output, "skybake: error: cannot write " + out + "/sky_px.exr (writing " + out + "/.sky_px.exr.tmp" +
-                            run.output.substr(run.output.find(".tmp") + 4, run.output.find(": File") -
-                                                                               run.output.find(".tmp") - 4) +
+                            run.output.substr(run.output.find(".tmp") + 4,
+                                              run.output.find(": File") - run.output.find(".tmp") - 4) +
                             ": File too large): the file is larger than the file-size limit (ulimit -f) or the "
                             "file system allows\n");
   EXPECT_TRUE(FileNames(out).empty()) << "left: " << *FileNames(out).begin();
@@ -651,9 +668,10 @@ TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
   CommandRun run = RunSkybake(bake + "--out '" + out + "'");
   EXPECT_EQ(run.exit_code, 7) << run.output;
   EXPECT_NE(run.output.find("the sequence needs an estimated "), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("for what it keeps of its 1000 frames (their styles and the scene's per-frame data), above the "
-                            "budget of 10 MiB: bake it in parts"),
-            std::string::npos)
+  EXPECT_NE(
+      run.output.find("for what it keeps of its 1000 frames (their styles and the scene's per-frame data), above the "
+                      "budget of 10 MiB: bake it in parts"),
+      std::string::npos)
       << run.output;
   EXPECT_EQ(run.output.find("skybake: device"), std::string::npos) << "no GPU work";
   EXPECT_TRUE(FileNames(out).empty());
@@ -666,11 +684,12 @@ TEST(SafeOutputs, MemoryBudgetCountsTheSequence) {
 // steps = 2.41e11 samples, at lavapipe's measured 1.2e7 samples/s. (The
 // default sky-view LUT reads each texel once: 1.1 s for the default style.)
 TEST(SafeOutputs, TimeBudgetRefusesWithTheEstimate) {
-  ExpectCheckRefuses("--set render.cube_size=2048 --set render.latlong_height=2048 --set quality.view_steps=4096 "
-                     "--set quality.sky_view_lut=false",
-                     "the bake needs an estimated 2.41e+11 ray-march samples per frame, about 20044 s of lavapipe "
-                     "time, above the budget of 3600 s per frame: lower quality.view_steps, quality.light_steps or "
-                     "the sizes, or raise --max-frame-seconds (README \"Limits\")");
+  ExpectCheckRefuses(
+      "--set render.cube_size=2048 --set render.latlong_height=2048 --set quality.view_steps=4096 "
+      "--set quality.sky_view_lut=false",
+      "the bake needs an estimated 2.41e+11 ray-march samples per frame, about 20044 s of lavapipe "
+      "time, above the budget of 3600 s per frame: lower quality.view_steps, quality.light_steps or "
+      "the sizes, or raise --max-frame-seconds (README \"Limits\")");
   CommandRun ok = RunSkybake("check '" + Style() + "'");
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_NE(ok.output.find("estimate per frame: 142 MiB of memory (budget 4096), 0.9 s of lavapipe time"),
@@ -682,8 +701,10 @@ TEST(SafeOutputs, TimeBudgetRefusesWithTheEstimate) {
 // 128 MiB) is refused with the sizes, not a crash or a validation error.
 TEST(SafeOutputs, ViewBeyondTheDeviceLimitIsAClearVulkanError) {
   const std::string root = FreshTempDir("devicelimit");
-  CommandRun run = RunSkybake("bake '" + Style() + "' --size 2048 --set output.faces=false --set output.latlong=false "
-                              "--set output.preview=false --set gltf.enabled=false --out '" + root + "/out'");
+  CommandRun run = RunSkybake("bake '" + Style() +
+                              "' --size 2048 --set output.faces=false --set output.latlong=false "
+                              "--set output.preview=false --set gltf.enabled=false --out '" +
+                              root + "/out'");
   EXPECT_EQ(run.exit_code, 4) << run.output;
   EXPECT_NE(run.output.find("skybake: error: Vulkan: a 2048x12288 view needs 384 MiB in one storage buffer; "),
             std::string::npos)
@@ -701,7 +722,8 @@ TEST(SafeOutputs, ViewBeyondTheDeviceLimitIsAClearVulkanError) {
 // the validation layer.
 TEST(SafeOutputs, ViewsAboveTheDeviceLimitTogetherAreRenderedInGroups) {
   const std::string root = FreshTempDir("groups");
-  CommandRun run = RunSkybake("bake '" + Style() + "' --size 1024 --set quality.view_steps=4 --set output.latlong=false "
+  CommandRun run = RunSkybake("bake '" + Style() +
+                              "' --size 1024 --set quality.view_steps=4 --set output.latlong=false "
                               "--set gltf.enabled=false --set output.preview=false --vulkan-validation -q --out '" +
                               root + "/out'");
   EXPECT_EQ(run.exit_code, 0) << run.output;

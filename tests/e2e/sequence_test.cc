@@ -38,7 +38,6 @@ using testing::kDay24;
 // Small and quick: 16^3 cube faces, a 32 x 16 latlong.
 const std::vector<std::string> kSmall = {"render.cube_size=16", "render.latlong_height=16", "gltf.segments=32"};
 
-
 std::string ViewerDir() { return testing::SourceDir() + "/tests/viewer"; }
 
 class Sequence : public ::testing::Test {
@@ -133,8 +132,7 @@ TEST_F(Sequence, ManifestListsEveryFileWithMatchingChecksum) {
     const ScheduleFrame& expected = schedule_->frames[i];
     EXPECT_EQ(frame["frame"].get<int>(), expected.number);
     EXPECT_EQ(frame["time"].get<std::string>(), expected.time->Iso8601());
-    for (int c = 0; c < 3; ++c)
-      EXPECT_DOUBLE_EQ(frame["sun"]["direction"][c].get<double>(), expected.sun_direction[c]);
+    for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(frame["sun"]["direction"][c].get<double>(), expected.sun_direction[c]);
     EXPECT_EQ(frame["sh_irradiance_with_sun"].size(), 9u);
     EXPECT_EQ(frame["sh_irradiance_without_sun"][0].size(), 3u);
     EXPECT_EQ(timings["frames"][i]["frame"].get<int>(), expected.number);
@@ -319,8 +317,8 @@ TEST_F(Sequence, ThreeJsRendersTheDomeInHeadlessChromium) {
     EXPECT_GT(top[2], top[0] + 20.0) << "the top of the frame is not sky blue";
   }
   // The sequence's scene animates the sun.
-  auto [status, output] = RunCommand("cd '" + ViewerDir() + "' && node view.mjs '" + out_dir_ + "/sequence/sky.gltf' '" +
-                              out_dir_ + "/sequence/sky.gltf.screenshot.png'");
+  auto [status, output] = RunCommand("cd '" + ViewerDir() + "' && node view.mjs '" + out_dir_ +
+                                     "/sequence/sky.gltf' '" + out_dir_ + "/sequence/sky.gltf.screenshot.png'");
   EXPECT_EQ(status, 0) << output;
   EXPECT_NE(output.find("\"animations\":\"1\""), std::string::npos) << output;
 }
@@ -336,7 +334,9 @@ longitude_deg = -76.48163
 utc_offset_hours = -4.0
 times = {{ start = 09:00:00, end = {}, step_minutes = 15 }}
 [schedule.per_hour]
-{})", end, per_hour), name);
+{})",
+                                   end, per_hour),
+                       name);
 }
 
 // A bake into a fresh temporary folder under the validation layer.
@@ -376,7 +376,8 @@ TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
   ASSERT_NO_FATAL_FAILURE(BakeDrift("09:30:00", R"(
 "atmosphere.mie.scattering_per_km" = 0.004
 "atmosphere.mie.extinction_per_km" = 0.0044
-)", kSmall, "drift", drift));
+)",
+                                    kSmall, "drift", drift));
   const BakeResult& result = drift.result;
   ASSERT_EQ(result.frames.size(), 3u);
   EXPECT_EQ(result.renderer_builds, 1);
@@ -398,9 +399,11 @@ TEST(SequenceDrift, AtmosphereDriftKeepsThePipelines) {
 TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact) {
   // The disc pruned in the first frame (strength 0), on from the second.
   DriftBake drift;
-  ASSERT_NO_FATAL_FAILURE(BakeDrift("09:45:00", R"(
+  ASSERT_NO_FATAL_FAILURE(BakeDrift(
+      "09:45:00", R"(
 "effects.sun_disc_strength" = 1.5
-)", {"render.cube_size=128", "render.latlong_height=128", "effects.sun_disc_strength=0"}, "variants", drift));
+)",
+      {"render.cube_size=128", "render.latlong_height=128", "effects.sun_disc_strength=0"}, "variants", drift));
   const BakeResult& whole = drift.result;
   const BakeOptions& options = drift.options;
   ASSERT_EQ(whole.frames.size(), 4u);
@@ -414,8 +417,7 @@ TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact)
     const std::vector<BakedFile>& a = whole.frames[size_t(number - 1)].files;
     const std::vector<BakedFile>& b = part.frames[0].files;
     ASSERT_EQ(a.size(), b.size());
-    for (size_t i = 0; i < a.size(); ++i)
-      EXPECT_EQ(a[i].sha256, b[i].sha256) << "frame " << number << " " << a[i].path;
+    for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].sha256, b[i].sha256) << "frame " << number << " " << a[i].path;
     fs::remove_all(alone.out_dir);
   }
   fs::remove_all(options.out_dir);
@@ -428,15 +430,18 @@ TEST(SequenceDrift, NewShaderVariantMidSequenceLeavesTheFrameBeingWrittenIntact)
 TEST(SequenceCost, ProgressManifestsAddUpToAFewFinalManifests) {
   const std::string root = testing::FreshTempDir("manifestcost");
   const std::string schedule = root + "/hundred.toml";
-  std::ofstream(schedule) << "[schedule]\nsun = { elevation_deg = { start = 0, end = 49.5, step = 0.5 }, azimuth_deg = 135 }\n";
-  testing::CommandRun run = testing::RunSkybake("bake '" + testing::SourceDir() + "/configs/default.toml' --schedule '" +
-                                                schedule + "' --size 1 -q --out '" + root + "/out'");
+  std::ofstream(schedule)
+      << "[schedule]\nsun = { elevation_deg = { start = 0, end = 49.5, step = 0.5 }, azimuth_deg = 135 }\n";
+  testing::CommandRun run =
+      testing::RunSkybake("bake '" + testing::SourceDir() + "/configs/default.toml' --schedule '" + schedule +
+                          "' --size 1 -q --out '" + root + "/out'");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   nlohmann::json timings = nlohmann::json::parse(std::ifstream(root + "/out/timings.json"));
   const double seconds = timings["total_s"].get<double>();
   const uint64_t final_bytes = std::filesystem::file_size(root + "/out/manifest.json");
   EXPECT_LE(timings["manifest_writes"].get<int>(), 40 + int(seconds / 30.0)) << "100 before";
-  EXPECT_LE(timings["manifest_bytes_written"].get<uint64_t>(), (14 + uint64_t(seconds / 30.0)) * final_bytes) << "about 50 times before";
+  EXPECT_LE(timings["manifest_bytes_written"].get<uint64_t>(), (14 + uint64_t(seconds / 30.0)) * final_bytes)
+      << "about 50 times before";
   std::filesystem::remove_all(root);
 }
 
@@ -449,7 +454,8 @@ TEST(SequenceCost, BakeWithoutFrameRecordsWritesTheSameManifest) {
   DriftBake drift;
   ASSERT_NO_FATAL_FAILURE(BakeDrift("09:45:00", R"(
 "atmosphere.ground_albedo" = 0.05
-)", kSmall, "records-kept", drift));
+)",
+                                    kSmall, "records-kept", drift));
   const std::vector<SkyStyle>& styles = drift.styles.styles;
   const Schedule& schedule = drift.schedule.schedule;
   const BakeOptions& kept = drift.options;

@@ -42,5 +42,4 @@ inline void CheckCatalogue(const std::string& text) {
   if (faintest != catalogue->faintest_magnitude) FailInput("the faintest magnitude is not the largest star's");
 }
 
-
 }  // namespace skybake::fuzz

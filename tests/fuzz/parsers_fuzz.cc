@@ -3,7 +3,8 @@
 // .ci/fuzz builds and runs it:
 //
 //   CC=clang CXX=clang++ cmake -S . -B build-fuzz -DSKYBAKE_FUZZ=ON && cmake --build build-fuzz -j2
-//   build-fuzz/tests/fuzz/parsers_fuzz -max_total_time=60 build-fuzz/corpus configs configs/schedules tests/fuzz/regressions
+//   build-fuzz/tests/fuzz/parsers_fuzz -max_total_time=60 build-fuzz/corpus configs configs/schedules
+//   tests/fuzz/regressions
 //
 // A crash writes crash-<sha1> in the working folder: copy it into
 // tests/fuzz/regressions/ (tests/e2e/fuzz_regression_test.cc replays it in every build)

@@ -29,8 +29,8 @@ double NadirRadiance(const std::string& layers) {
   ConfigResult parsed = ParseSkyStyle(toml, "cloud_band_shadow_test.toml");
   EXPECT_TRUE(parsed.ok()) << (parsed.errors.empty() ? "" : parsed.errors[0].Format());
   const SkyStyle style = PrunedStyle(parsed.style);
-  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
-                       style.effects, OutputScale(style.output.units), false,
+  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                       OutputScale(style.output.units), false,
                        ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
                        ToCloudInputs(style.clouds, style.aoas.seed, "", 0.0));
   const glm::dvec3 sun = SunDirectionFromElevationAzimuth(45.0, 135.0);
@@ -41,8 +41,9 @@ double NadirRadiance(const std::string& layers) {
 // A flat, closed slab: coverage 1, no shape, no detail.
 std::string Slab(double altitude_m, double thickness_m, double density_per_m) {
   return "[[cloud_layer]]\ntype = \"custom\"\nprofile = [0.0, 0.0, 1.0, 1.0]\ncoverage = 1.0\nshape_amount = 0.0\n"
-         "detail_amount = 0.0\naltitude_m = " + std::to_string(altitude_m) + "\nthickness_m = " +
-         std::to_string(thickness_m) + "\ndensity_per_m = " + std::to_string(density_per_m) + "\n";
+         "detail_amount = 0.0\naltitude_m = " +
+         std::to_string(altitude_m) + "\nthickness_m = " + std::to_string(thickness_m) +
+         "\ndensity_per_m = " + std::to_string(density_per_m) + "\n";
 }
 
 TEST(CloudBandShadow, AnUpperDeckDarkensTheSunlightOfTheLowerOne) {

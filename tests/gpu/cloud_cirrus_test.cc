@@ -53,7 +53,8 @@ density_per_m = 0.002
 shape_size_m = 5000.0
 detail_amount = 0.8
 detail_size_m = 900.0
-type = ")" + type + "\"\nwind_m_s = " + wind + "\nshear_m_s_per_km = " + shear + "\n";
+type = ")" + type +
+                           "\"\nwind_m_s = " + wind + "\nshear_m_s_per_km = " + shear + "\n";
   ConfigResult r = ParseSkyStyle(toml, "cloud_cirrus_test.toml");
   EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].Format());
   return PrunedStyle(r.style);
@@ -217,8 +218,9 @@ TEST(Cirrus, TheCirrusStyleIsThin) {
     if (tau > 0.03) ++cloudy, tau_sum += tau;
   }
   const double cloudy_fraction = double(cloudy) / map.size();
-  std::printf("cirrus_uncinus: vertical optical depth max %.3f, mean where > 0.03: %.3f, over %.1f%% of 80 km x 80 km\n",
-              tau_max, cloudy ? tau_sum / cloudy : 0.0, 100.0 * cloudy_fraction);
+  std::printf(
+      "cirrus_uncinus: vertical optical depth max %.3f, mean where > 0.03: %.3f, over %.1f%% of 80 km x 80 km\n",
+      tau_max, cloudy ? tau_sum / cloudy : 0.0, 100.0 * cloudy_fraction);
   EXPECT_LE(tau_max, 3.0);
   EXPECT_GT(tau_max, 0.3);  // the thickest fibres reach the opaque end
   EXPECT_GT(cloudy_fraction, 0.1);

@@ -59,10 +59,10 @@ SkyStyle Style(const std::string& toml) {
 }
 
 std::unique_ptr<SkyRenderer> MakeRenderer(const SkyStyle& style) {
-  return std::make_unique<SkyRenderer>(
-      testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-      OutputScale(style.output.units), false, ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
-      ToCloudInputs(style.clouds, style.aoas.seed, "", 0.0));
+  return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
+                                       style.effects, OutputScale(style.output.units), false,
+                                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                                       ToCloudInputs(style.clouds, style.aoas.seed, "", 0.0));
 }
 
 // Mean of |a - b| over the mean of b (RGB), every value clamped at 20 times

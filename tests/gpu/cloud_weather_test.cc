@@ -88,9 +88,9 @@ OIIO::ImageBuf Centred(const std::vector<float>& map, int n, int size, bool hann
   OIIO::ImageBufAlgo::zero(buf);
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
-      const double w = hann ? (0.5 - 0.5 * std::cos(2.0 * M_PI * (x + 0.5) / n)) *
-                                  (0.5 - 0.5 * std::cos(2.0 * M_PI * (y + 0.5) / n))
-                            : 1.0;
+      const double w =
+          hann ? (0.5 - 0.5 * std::cos(2.0 * M_PI * (x + 0.5) / n)) * (0.5 - 0.5 * std::cos(2.0 * M_PI * (y + 0.5) / n))
+               : 1.0;
       const float v = float((map[size_t(y) * n + x] - mean) * w);
       buf.setpixel(x, y, &v);
     }
@@ -186,8 +186,8 @@ TEST(WeatherWithoutRepetition, ShadowMapOf300KmHasNoRepeatAndNoLattice) {
   const Peak tiled_ac = MaxAutocorrelation(tiled_map, kN, kTexelKm, 5.0);
   const Peak free_peak = LatticePeakRatio(free_map, kN, kTexelKm);
   const Peak tiled_peak = LatticePeakRatio(tiled_map, kN, kTexelKm);
-  std::printf("non-repeating: autocorrelation max %.3f at %.1f km, lattice peak ratio %.1f at %.2f km\n",
-              free_ac.value, free_ac.shift_km, free_peak.value, free_peak.shift_km);
+  std::printf("non-repeating: autocorrelation max %.3f at %.1f km, lattice peak ratio %.1f at %.2f km\n", free_ac.value,
+              free_ac.shift_km, free_peak.value, free_peak.shift_km);
   std::printf("tiling:        autocorrelation max %.3f at %.1f km, lattice peak ratio %.1f at %.2f km\n",
               tiled_ac.value, tiled_ac.shift_km, tiled_peak.value, tiled_peak.shift_km);
   EXPECT_LT(free_ac.value, 0.3);

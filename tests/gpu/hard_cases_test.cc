@@ -66,54 +66,54 @@ TEST_P(HardCaseTest, FiniteNonNegativeAndGpuMatchesDouble) {
   QualitySettings ray_march;
   ray_march.sky_view_lut = false;
   for (const QualitySettings& quality : {QualitySettings{}, ray_march}) {
-  const std::vector<glm::dvec3> suns = {glm::dvec3(0.0, 1.0, 0.0),  // exactly at the zenith
-                                        SunDirectionFromElevationAzimuth(30.0, 120.0),
-                                        SunDirectionFromElevationAzimuth(2.0, 250.0),
-                                        // twilight (the presets' twilight frames, the Sun below
-                                        // 3 deg): the horizon towards the Sun, the Earth's shadow
-                                        SunDirectionFromElevationAzimuth(0.5, 200.0),
-                                        SunDirectionFromElevationAzimuth(-3.0, 160.0),
-                                        SunDirectionFromElevationAzimuth(-18.0, 300.0)};
-  const std::vector<glm::dvec3> dirs = CaseDirections(suns);
-  SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, hc.effects, {1, 1, 1});
-  ReferenceModel reference(atmosphere, quality, hc.effects, {1, 1, 1});
-  reference.PrecomputeLuts();
-  for (size_t s = 0; s < suns.size(); ++s) {
-    std::vector<float> gpu = renderer.RenderDirections(suns[s], dirs);
-    std::vector<glm::dvec3> ref(dirs.size());
-    double max_value = 0.0;
-    for (size_t i = 0; i < dirs.size(); ++i) {
-      ref[i] = reference.Radiance(dirs[i], suns[s]);
-      for (int c = 0; c < 3; ++c) {
-        ASSERT_TRUE(std::isfinite(ref[i][c]) && ref[i][c] >= 0.0) << hc.name << " reference, sun " << s << " dir " << i;
-        ASSERT_TRUE(std::isfinite(gpu[4 * i + c]) && gpu[4 * i + c] >= 0.0f)
-            << hc.name << " GPU, sun " << s << " dir " << i << " value " << gpu[4 * i + c];
-        max_value = std::max(max_value, ref[i][c]);
-      }
-    }
-    // Values below 1e-30 count as black: float32 intermediates of such
-    // values approach the denormal range, which lavapipe flushes to zero
-    // (shaderDenormPreserveFloat32 = false). There the GPU must be black too.
-    const double kBlack = 1e-30;
-    double worst = 0.0;
-    size_t worst_index = 0;
-    for (size_t i = 0; i < dirs.size(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        if (ref[i][c] > std::max(1e-4 * max_value, kBlack)) {
-          double e = std::abs(gpu[4 * i + c] - ref[i][c]) / ref[i][c];
-          if (e > worst) {
-            worst = e;
-            worst_index = i;
-          }
-        } else if (ref[i][c] <= kBlack) {
-          EXPECT_LE(gpu[4 * i + c], 2 * kBlack) << hc.name << " black in double but not on the GPU";
+    const std::vector<glm::dvec3> suns = {
+        glm::dvec3(0.0, 1.0, 0.0),  // exactly at the zenith
+        SunDirectionFromElevationAzimuth(30.0, 120.0), SunDirectionFromElevationAzimuth(2.0, 250.0),
+        // twilight (the presets' twilight frames, the Sun below
+        // 3 deg): the horizon towards the Sun, the Earth's shadow
+        SunDirectionFromElevationAzimuth(0.5, 200.0), SunDirectionFromElevationAzimuth(-3.0, 160.0),
+        SunDirectionFromElevationAzimuth(-18.0, 300.0)};
+    const std::vector<glm::dvec3> dirs = CaseDirections(suns);
+    SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, hc.effects, {1, 1, 1});
+    ReferenceModel reference(atmosphere, quality, hc.effects, {1, 1, 1});
+    reference.PrecomputeLuts();
+    for (size_t s = 0; s < suns.size(); ++s) {
+      std::vector<float> gpu = renderer.RenderDirections(suns[s], dirs);
+      std::vector<glm::dvec3> ref(dirs.size());
+      double max_value = 0.0;
+      for (size_t i = 0; i < dirs.size(); ++i) {
+        ref[i] = reference.Radiance(dirs[i], suns[s]);
+        for (int c = 0; c < 3; ++c) {
+          ASSERT_TRUE(std::isfinite(ref[i][c]) && ref[i][c] >= 0.0)
+              << hc.name << " reference, sun " << s << " dir " << i;
+          ASSERT_TRUE(std::isfinite(gpu[4 * i + c]) && gpu[4 * i + c] >= 0.0f)
+              << hc.name << " GPU, sun " << s << " dir " << i << " value " << gpu[4 * i + c];
+          max_value = std::max(max_value, ref[i][c]);
         }
       }
-    EXPECT_LE(worst, 1e-3) << hc.name << " sun " << s << " worst at direction (" << dirs[worst_index].x << ", "
-                           << dirs[worst_index].y << ", " << dirs[worst_index].z << ")";
-    std::printf("%-34s %s sun %zu: max %.3e, GPU vs double max relative error %.2e\n", hc.name.c_str(),
-                quality.sky_view_lut ? "sky-view " : "ray-march", s, max_value, worst);
-  }
+      // Values below 1e-30 count as black: float32 intermediates of such
+      // values approach the denormal range, which lavapipe flushes to zero
+      // (shaderDenormPreserveFloat32 = false). There the GPU must be black too.
+      const double kBlack = 1e-30;
+      double worst = 0.0;
+      size_t worst_index = 0;
+      for (size_t i = 0; i < dirs.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+          if (ref[i][c] > std::max(1e-4 * max_value, kBlack)) {
+            double e = std::abs(gpu[4 * i + c] - ref[i][c]) / ref[i][c];
+            if (e > worst) {
+              worst = e;
+              worst_index = i;
+            }
+          } else if (ref[i][c] <= kBlack) {
+            EXPECT_LE(gpu[4 * i + c], 2 * kBlack) << hc.name << " black in double but not on the GPU";
+          }
+        }
+      EXPECT_LE(worst, 1e-3) << hc.name << " sun " << s << " worst at direction (" << dirs[worst_index].x << ", "
+                             << dirs[worst_index].y << ", " << dirs[worst_index].z << ")";
+      std::printf("%-34s %s sun %zu: max %.3e, GPU vs double max relative error %.2e\n", hc.name.c_str(),
+                  quality.sky_view_lut ? "sky-view " : "ray-march", s, max_value, worst);
+    }
   }
   const QualitySettings quality;
 
@@ -177,9 +177,10 @@ INSTANTIATE_TEST_SUITE_P(
         HardCase{"observer at the top of the atmosphere",
                  [](AtmosphereParams& a) { a.observer_altitude_m = 1e3 * (a.top_radius_km - a.bottom_radius_km); },
                  EffectSettings{}},
-        HardCase{"observer 1000 km above the top (space)",
-                 [](AtmosphereParams& a) { a.observer_altitude_m = 1e3 * (a.top_radius_km - a.bottom_radius_km + 1000.0); },
-                 EffectSettings{}},
+        HardCase{
+            "observer 1000 km above the top (space)",
+            [](AtmosphereParams& a) { a.observer_altitude_m = 1e3 * (a.top_radius_km - a.bottom_radius_km + 1000.0); },
+            EffectSettings{}},
         HardCase{"planet radius 1 km",
                  [](AtmosphereParams& a) {
                    a.bottom_radius_km = 1.0;
@@ -192,9 +193,7 @@ INSTANTIATE_TEST_SUITE_P(
                    a.top_radius_km = 1e5 + 100.0;
                  },
                  EffectSettings{}},
-        HardCase{"atmosphere 1000x denser",
-                 ThousandTimesDenser,
-                 NoDisc()},
+        HardCase{"atmosphere 1000x denser", ThousandTimesDenser, NoDisc()},
         HardCase{"atmosphere 1000x denser, observer at 60 km",
                  [](AtmosphereParams& a) {
                    a.observer_altitude_m = 60e3;
@@ -271,9 +270,10 @@ void ExpectNoSeamAtTheTwilightBandTop(double observer_altitude_m) {
       const double reference_step = expected[k + 1][c] - expected[k][c];
       worst_seam = std::max(worst_seam, std::abs(step - reference_step) / expected[k][c]);
     }
-  std::printf("%.0f m, sun -6 deg, band top at %.1f deg elevation: each side against the reference %.2e, "
-              "the step across it against the reference's %.2e\n",
-              observer_altitude_m, top, worst_side, worst_seam);
+  std::printf(
+      "%.0f m, sun -6 deg, band top at %.1f deg elevation: each side against the reference %.2e, "
+      "the step across it against the reference's %.2e\n",
+      observer_altitude_m, top, worst_side, worst_seam);
   EXPECT_LT(worst_side, 1e-2);
   EXPECT_LT(worst_seam, 1e-2);
   testing::ExpectNoValidationMessages();
@@ -431,7 +431,8 @@ TEST(HardCaseNightTest, NightSkyFiniteAndNonNegative) {
       EXPECT_EQ(bad, 0u) << c.name;
       EXPECT_TRUE(std::isfinite(night.moon_illuminance_lux) && night.moon_illuminance_lux >= 0.0) << c.name;
       // Splatted into a latlong and a cube strip: finite, non-negative texels.
-      for (const ViewRequest& v : {ViewRequest{MAPPING_LATLONG, 128, 64, 0}, ViewRequest{MAPPING_CUBE_STRIP, 32, 192, 0}})
+      for (const ViewRequest& v :
+           {ViewRequest{MAPPING_LATLONG, 128, 64, 0}, ViewRequest{MAPPING_CUBE_STRIP, 32, 192, 0}})
         for (const TexelAdd& a : SplatPointSources(v, night.sources))
           for (float x : a.rgb) EXPECT_TRUE(std::isfinite(x) && x >= 0.0f) << c.name;
     }

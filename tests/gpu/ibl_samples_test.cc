@@ -41,7 +41,8 @@ TEST(IblSamplesTest, PlanAndFilesNameEachLevelsCount) {
   const std::string dir = testing::FreshTempDir("ibl_samples");
   testing::CommandRun bake = testing::RunSkybake("bake " + Style() +
                                                  " --size 16 -q --vulkan-validation --set ibl.specular=true "
-                                                 "--set ibl.size=64 --set ibl.full_samples_roughness=0.5 --out " + dir);
+                                                 "--set ibl.size=64 --set ibl.full_samples_roughness=0.5 --out " +
+                                                 dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   auto in = OIIO::ImageInput::open(dir + "/sky_specular_m1.exr");
   ASSERT_TRUE(in);

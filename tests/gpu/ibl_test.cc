@@ -359,8 +359,8 @@ TEST(IblCliTest, PlanShowsThePassesOnlyWhenAsked) {
   testing::CommandRun off = testing::RunSkybake("plan " + Style());
   EXPECT_EQ(off.exit_code, 0) << off.output;
   EXPECT_EQ(off.output.find("IBL"), std::string::npos) << off.output;
-  testing::CommandRun on =
-      testing::RunSkybake("plan " + Style() + " --set ibl.specular=true --set ibl.irradiance=true --set ibl.dfg_lut=true");
+  testing::CommandRun on = testing::RunSkybake(
+      "plan " + Style() + " --set ibl.specular=true --set ibl.irradiance=true --set ibl.dfg_lut=true");
   EXPECT_EQ(on.exit_code, 0) << on.output;
   EXPECT_NE(on.output.find("IBL specular 6 levels"), std::string::npos) << on.output;
   EXPECT_NE(on.output.find("IBL irradiance"), std::string::npos) << on.output;
@@ -374,7 +374,7 @@ TEST(IblCliTest, PrunedWhenNotAskedForByteIdentical) {
   const std::string common = " --size 16 --set render.latlong_height=16 -q --set gltf.enabled=false";
   testing::CommandRun ra = testing::RunSkybake("bake " + Style() + common + " --out " + a);
   testing::CommandRun rb = testing::RunSkybake("bake " + Style() + common + " --out " + b +
-                                              " --set ibl.size=64 --set ibl.samples=7 --set ibl.ktx2=true");
+                                               " --set ibl.size=64 --set ibl.samples=7 --set ibl.ktx2=true");
   ASSERT_EQ(ra.exit_code, 0) << ra.output;
   ASSERT_EQ(rb.exit_code, 0) << rb.output;
   ASSERT_EQ(testing::FileNames(a), testing::FileNames(b));
@@ -396,8 +396,8 @@ TEST(IblCliTest, BadInputIsRefusedBeforeGpuWork) {
            {"ibl.ktx2_format=bc6h", "'bc6h' is not one of 'rgba16f', 'b10g11r11' or 'e5b9g9r9'"},
        }) {
     const std::string dir = testing::FreshTempDir("ibl_bad");
-    testing::CommandRun r = testing::RunSkybake("bake " + Style() + " --set ibl.specular=true --set " + c.set +
-                                                " --out " + dir);
+    testing::CommandRun r =
+        testing::RunSkybake("bake " + Style() + " --set ibl.specular=true --set " + c.set + " --out " + dir);
     EXPECT_EQ(r.exit_code, 3) << c.set << "\n" << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << c.set << "\n" << r.output;
     EXPECT_EQ(r.output.find("device"), std::string::npos) << "no GPU work: " << r.output;
@@ -412,7 +412,8 @@ TEST(IblCliTest, BakeWritesEveryLevel) {
   testing::CommandRun r = testing::RunSkybake(
       "bake " + Style() +
       " --size 32 --set render.latlong_height=16 -q --set ibl.size=32 --set ibl.specular=true "
-      "--set ibl.irradiance=true --set ibl.irradiance_size=8 --set ibl.dfg_lut=true --set ibl.dfg_size=16 --out " + dir);
+      "--set ibl.irradiance=true --set ibl.irradiance_size=8 --set ibl.dfg_lut=true --set ibl.dfg_size=16 --out " +
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   for (int level = 0; level < 3; ++level) {
     auto in = OIIO::ImageInput::open(dir + "/sky_specular_m" + std::to_string(level) + ".exr");
@@ -449,7 +450,8 @@ TEST(IblCliTest, SequenceWithTheSunInTheMapsFitsItsHalfScale) {
   testing::CommandRun r = testing::RunSkybake(
       "bake " + Style() + " --schedule " + testing::SourceDir() +
       "/configs/schedules/day.toml --frames 20:21 --size 16 --set render.latlong_height=16 -q "
-      "--set ibl.size=512 --set ibl.levels=1 --set ibl.specular=true --set ibl.include_sun=true --out " + dir);
+      "--set ibl.size=512 --set ibl.levels=1 --set ibl.specular=true --set ibl.include_sun=true --out " +
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(std::filesystem::exists(dir + "/sky_specular_m0.0020.exr"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/sky_specular_m0.0021.exr"));

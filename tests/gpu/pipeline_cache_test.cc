@@ -144,10 +144,10 @@ TEST(PipelineCacheTest, DamagedOrForeignFilesAreIgnoredSilentlyAndReplaced) {
   std::vector<uint8_t> flipped = EncodePipelineCacheFile(VulkanPayload(device, 64));
   flipped[40] ^= 0x10;
   const std::vector<std::vector<uint8_t>> files = {
-      {},                                                   // empty
-      std::vector<uint8_t>(4096, 0xa5),                     // garbage
-      flipped,                                              // a bit flipped (checksum)
-      EncodePipelineCacheFile(VulkanPayload(other, 64)),   // another driver's, well formed
+      {},                                                 // empty
+      std::vector<uint8_t>(4096, 0xa5),                   // garbage
+      flipped,                                            // a bit flipped (checksum)
+      EncodePipelineCacheFile(VulkanPayload(other, 64)),  // another driver's, well formed
   };
   for (size_t i = 0; i < files.size(); ++i) {
     WriteBytes(path, files[i]);
@@ -178,7 +178,8 @@ TEST(PipelineCacheTest, HostileFilesInASharedFolderAreIgnoredNotFollowed) {
   };
   const std::vector<Planted> cases = {
       {[&] { ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0); }, "it is a FIFO (named pipe), not a regular file"},
-      {[&] { std::filesystem::create_symlink("/dev/zero", path); }, "it is a symbolic link, which is not followed here"},
+      {[&] { std::filesystem::create_symlink("/dev/zero", path); },
+       "it is a symbolic link, which is not followed here"},
   };
   for (const Planted& c : cases) {
     std::filesystem::remove(path);

@@ -81,8 +81,8 @@ TEST(SkyRendererTest, GpuMatchesDoubleReference) {
     // The criterion must cover the sky, not only a few texels: at least the
     // upper hemisphere (the unlit ground below a set sun may fall under the floor).
     EXPECT_GE(compared * 5, total * 2) << "elevation " << elevation;
-    std::printf("sun elevation %5.1f deg: max relative error %.3g over %zu of %zu values\n",
-                elevation, worst, compared, total);
+    std::printf("sun elevation %5.1f deg: max relative error %.3g over %zu of %zu values\n", elevation, worst, compared,
+                total);
   }
   EXPECT_EQ(renderer.counters().transmittance_lut_builds, 1);
   EXPECT_EQ(renderer.counters().multiscattering_lut_builds, 1);
@@ -96,31 +96,31 @@ TEST(SkyRendererTest, GrazingRaysMatchReference) {
   QualitySettings sky_view;
   sky_view.sky_view_lut = true;
   for (const QualitySettings& quality : {QualitySettings{}, sky_view}) {
-  EffectSettings effects;
-  effects.sun_disc = false;
-  SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
-  ReferenceModel reference(atmosphere, quality, effects, {1, 1, 1});
-  reference.PrecomputeLuts();
-  std::vector<glm::dvec3> dirs;
-  for (double azimuth = 0.0; azimuth < 360.0; azimuth += 30.0) {
-    for (double elevation_rad : {0.0, 1e-6, -1e-6, 1e-3, -1e-3, 0.02}) {
-      dirs.push_back(SunDirectionFromElevationAzimuth(elevation_rad * 180.0 / M_PI, azimuth));
+    EffectSettings effects;
+    effects.sun_disc = false;
+    SkyRenderer renderer(testing::Vulkan(), atmosphere, quality, effects, {1, 1, 1});
+    ReferenceModel reference(atmosphere, quality, effects, {1, 1, 1});
+    reference.PrecomputeLuts();
+    std::vector<glm::dvec3> dirs;
+    for (double azimuth = 0.0; azimuth < 360.0; azimuth += 30.0) {
+      for (double elevation_rad : {0.0, 1e-6, -1e-6, 1e-3, -1e-3, 0.02}) {
+        dirs.push_back(SunDirectionFromElevationAzimuth(elevation_rad * 180.0 / M_PI, azimuth));
+      }
     }
-  }
-  for (double sun_elevation : {60.0, 2.0, -4.0}) {
-    glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 100.0);
-    reference.PrepareSun(sun);
-    std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
-    ExpectFiniteNonNegative(gpu, "grazing");
-    std::vector<double> ref;
-    for (const glm::dvec3& d : dirs) {
-      glm::dvec3 l = reference.Radiance(glm::dvec3(glm::vec3(d)), sun);  // same float-rounded direction
-      ref.insert(ref.end(), {l.x, l.y, l.z, 1.0});
+    for (double sun_elevation : {60.0, 2.0, -4.0}) {
+      glm::dvec3 sun = SunDirectionFromElevationAzimuth(sun_elevation, 100.0);
+      reference.PrepareSun(sun);
+      std::vector<float> gpu = renderer.RenderDirections(sun, dirs);
+      ExpectFiniteNonNegative(gpu, "grazing");
+      std::vector<double> ref;
+      for (const glm::dvec3& d : dirs) {
+        glm::dvec3 l = reference.Radiance(glm::dvec3(glm::vec3(d)), sun);  // same float-rounded direction
+        ref.insert(ref.end(), {l.x, l.y, l.z, 1.0});
+      }
+      Comparison c = Compare(gpu, ref, 1e-4);
+      EXPECT_LE(c.max_relative_error, 1e-3)
+          << "sun elevation " << sun_elevation << " sky-view " << quality.sky_view_lut;
     }
-    Comparison c = Compare(gpu, ref, 1e-4);
-    EXPECT_LE(c.max_relative_error, 1e-3) << "sun elevation " << sun_elevation << " sky-view "
-                                          << quality.sky_view_lut;
-  }
   }
   testing::ExpectNoValidationMessages();
 }
@@ -188,9 +188,9 @@ TEST(SkyRendererTest, CubeSeamsAreAsSmoothAsFaceInteriors) {
             double sc = 2.0 * (xs + 0.5) / n - 1.0, tc = 2.0 * (ys + 0.5) / n - 1.0;
             // Face basis from the table: direction = major + sc * S + tc * T.
             static const double kBasis[6][3][3] = {
-                {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},  {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
-                {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},    {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
-                {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},   {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}}};
+                {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}}, {{-1, 0, 0}, {0, 0, 1}, {0, -1, 0}},
+                {{0, 1, 0}, {1, 0, 0}, {0, 0, 1}},   {{0, -1, 0}, {1, 0, 0}, {0, 0, -1}},
+                {{0, 0, 1}, {1, 0, 0}, {0, -1, 0}},  {{0, 0, -1}, {-1, 0, 0}, {0, -1, 0}}};
             glm::dvec3 major(kBasis[face][0][0], kBasis[face][0][1], kBasis[face][0][2]);
             glm::dvec3 S(kBasis[face][1][0], kBasis[face][1][1], kBasis[face][1][2]);
             glm::dvec3 T(kBasis[face][2][0], kBasis[face][2][1], kBasis[face][2][2]);
@@ -273,8 +273,8 @@ TEST(SkyRendererTest, IntegratorsAndSkyViewPathMatchReference) {
       std::vector<float> gpu = renderer.Render(sun, {view})[0];
       ExpectFiniteNonNegative(gpu, "variant");
       Comparison c = Compare(gpu, reference.RenderView(sun, view), 1e-4);
-      EXPECT_LE(c.max_relative_error, 1e-3) << "integrator " << q.integrator << " sky-view " << q.sky_view_lut
-                                            << " elevation " << elevation;
+      EXPECT_LE(c.max_relative_error, 1e-3)
+          << "integrator " << q.integrator << " sky-view " << q.sky_view_lut << " elevation " << elevation;
     }
   }
   testing::ExpectNoValidationMessages();
@@ -310,8 +310,7 @@ TEST(SkyRendererTest, ShaderVariantsMatchGenericShaders) {
                            CloudInputs(), shaders);
       EXPECT_EQ(renderer.counters().variant_pipelines, generic ? 0 : renderer.counters().pipelines);
       for (double elevation : {45.0, 0.3, -3.0, -12.0})
-        for (std::vector<float>& image :
-             renderer.Render(SunDirectionFromElevationAzimuth(elevation, 135.0), views))
+        for (std::vector<float>& image : renderer.Render(SunDirectionFromElevationAzimuth(elevation, 135.0), views))
           images[generic].push_back(std::move(image));
     }
     ASSERT_EQ(images[0].size(), images[1].size());
@@ -378,8 +377,10 @@ TEST(SkyRendererTest, TexelsNearDirectionHoldEveryTexelWithinTheAngle) {
 // the range (every texel checked), and for a narrow range near the horizon
 // leaves most rows of the views out (the test is not vacuous).
 TEST(SkyRendererTest, RowsReachingElevationsHoldEveryRowWithATexelInRange) {
-  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 256, 128, 0}, {MAPPING_CUBE_STRIP, 64, 384, 0},
-                                    {MAPPING_CUBE_STRIP, 1000, 6000, 0}, {MAPPING_VULKAN_FACE, 7, 7, 4}};
+  std::vector<ViewRequest> views = {{MAPPING_LATLONG, 256, 128, 0},
+                                    {MAPPING_CUBE_STRIP, 64, 384, 0},
+                                    {MAPPING_CUBE_STRIP, 1000, 6000, 0},
+                                    {MAPPING_VULKAN_FACE, 7, 7, 4}};
   for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, 300, 300, face});
   const double deg = M_PI / 180.0;
   for (const auto& [low, high] : std::vector<std::pair<double, double>>{
@@ -438,8 +439,8 @@ TEST(SkyRendererTest, TwilightRowsKeepTheBytesOfTheWholeTwilightPass) {
       auto renderer = [&](const QualitySettings& q, bool rows) {
         ShaderSwitches shaders;
         shaders.twilight_rows = rows;
-        return std::make_unique<SkyRenderer>(testing::Vulkan(), atmosphere, q, EffectSettings(), Rgb{1, 1, 1},
-                                             false, AoasInputs(), CloudInputs(), shaders);
+        return std::make_unique<SkyRenderer>(testing::Vulkan(), atmosphere, q, EffectSettings(), Rgb{1, 1, 1}, false,
+                                             AoasInputs(), CloudInputs(), shaders);
       };
       std::unique_ptr<SkyRenderer> split = renderer(quality, true), whole = renderer(quality, false);
       std::unique_ptr<SkyRenderer> lut = renderer(no_band, true);
@@ -449,8 +450,8 @@ TEST(SkyRendererTest, TwilightRowsKeepTheBytesOfTheWholeTwilightPass) {
         const std::vector<std::vector<float>> a = split->Render(sun, views), b = whole->Render(sun, views);
         const std::vector<std::vector<float>> c = lut->Render(sun, views);
         for (size_t v = 0; v < views.size(); ++v) {
-          EXPECT_TRUE(a[v] == b[v]) << altitude_m << " m, band " << band << " deg, Sun " << elevation
-                                    << " deg, view " << v;
+          EXPECT_TRUE(a[v] == b[v]) << altitude_m << " m, band " << band << " deg, Sun " << elevation << " deg, view "
+                                    << v;
           marched = marched || a[v] != c[v];
         }
       }
@@ -483,10 +484,10 @@ TEST(SkyRendererTest, SunDiscPassMatchesDiscInTheSkyPass) {
     for (int face = 0; face < 6; ++face) v.push_back({MAPPING_VULKAN_FACE, 128, 128, face});
     return v;
   }();
-  const std::vector<glm::dvec3> suns = {glm::normalize(glm::dvec3(1, 1, 1)),       // cube corner
-                                        glm::normalize(glm::dvec3(1, 0.2, -1)),    // +X/-Z edge
-                                        glm::normalize(glm::dvec3(0, 0.3, -1)),    // latlong seam
-                                        glm::normalize(glm::dvec3(0.01, 1, 0.02)), // near the zenith
+  const std::vector<glm::dvec3> suns = {glm::normalize(glm::dvec3(1, 1, 1)),        // cube corner
+                                        glm::normalize(glm::dvec3(1, 0.2, -1)),     // +X/-Z edge
+                                        glm::normalize(glm::dvec3(0, 0.3, -1)),     // latlong seam
+                                        glm::normalize(glm::dvec3(0.01, 1, 0.02)),  // near the zenith
                                         SunDirectionFromElevationAzimuth(0.1, 70.0),
                                         SunDirectionFromElevationAzimuth(-0.4, 250.0)};
   for (double altitude_m : {0.0, 150000.0}) {
@@ -523,8 +524,8 @@ TEST(SkyRendererTest, RenderInPlaceHoldsTexelsUntilReleased) {
   QualitySettings quality;  // production: the sky-view LUT and the sun-disc pass
   EffectSettings effects;
   SkyRenderer renderer(testing::Vulkan(), AtmosphereParams(), quality, effects, {1, 1, 1});
-  const std::vector<ViewRequest> views = {{MAPPING_LATLONG, 256, 128, 0}, {MAPPING_CUBE_STRIP, 64, 384, 0},
-                                          {MAPPING_VULKAN_FACE, 64, 64, 2}};
+  const std::vector<ViewRequest> views = {
+      {MAPPING_LATLONG, 256, 128, 0}, {MAPPING_CUBE_STRIP, 64, 384, 0}, {MAPPING_VULKAN_FACE, 64, 64, 2}};
   const glm::dvec3 noon = SunDirectionFromElevationAzimuth(60.0, 180.0);
   const glm::dvec3 dusk = SunDirectionFromElevationAzimuth(2.0, 290.0);
   const auto copied_noon = renderer.Render(noon, views);
@@ -532,7 +533,8 @@ TEST(SkyRendererTest, RenderInPlaceHoldsTexelsUntilReleased) {
   auto same = [&](const RenderedViews& r, const std::vector<std::vector<float>>& copies, const char* what) {
     ASSERT_EQ(r.views.size(), copies.size()) << what;
     for (size_t v = 0; v < copies.size(); ++v)
-      EXPECT_EQ(std::memcmp(r.views[v], copies[v].data(), copies[v].size() * sizeof(float)), 0) << what << " view " << v;
+      EXPECT_EQ(std::memcmp(r.views[v], copies[v].data(), copies[v].size() * sizeof(float)), 0)
+          << what << " view " << v;
   };
   EXPECT_FALSE(renderer.HoldsFrames());
   RenderedViews first = renderer.RenderInPlace(noon, views);

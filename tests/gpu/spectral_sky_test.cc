@@ -288,8 +288,8 @@ TEST(SpectralSkyTest, NightFloorAddsTheNeutralOfThreeWavelengths) {
           const double want = (1.0 - k) * without[4 * t + c] + (above ? k * floor : 0.0);
           // Float rounding of the blend and the colour scale's two steps,
           // a few 2^-24 (seen: 2.4e-7).
-          worst = std::max(worst, std::abs(with[4 * t + c] - want) /
-                                      ((1.0 - k) * std::abs(without[4 * t + c]) + k * floor));
+          worst = std::max(worst,
+                           std::abs(with[4 * t + c] - want) / ((1.0 - k) * std::abs(without[4 * t + c]) + k * floor));
         }
         if (above && y == 0) sky_luminance += without[4 * t + 1] / view.width;
       }
@@ -316,7 +316,8 @@ TEST(SpectralSkyTest, NightFloorAddsTheNeutralOfThreeWavelengths) {
 // ------------------------------------------- the colour principles and cloud layers
 
 // A cumulus deck that hides part of the sky (clouds_test.cc's), appended to a style.
-const char* kCumulusLayer = "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ntype = \"cumulus\"\ncoverage = 0.5\n";
+const char* kCumulusLayer =
+    "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ntype = \"cumulus\"\ncoverage = 0.5\n";
 
 // A latlong of a style (TOML) as a bake renders it (renderer_cache.cc),
 // with or without the cumulus deck, at 3 wavelengths or N bins; or its
@@ -328,8 +329,8 @@ std::vector<float> LayeredLatlong(const std::string& toml, int wavelengths, bool
   EXPECT_TRUE(r.ok()) << (r.errors.empty() ? "" : r.errors[0].Format());
   const SkyStyle style = PrunedStyle(r.style);
   const Rgb scale = OutputScale(OutputUnits::kLuminance);
-  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
-                       style.effects, scale, false, ToAoasInputs(style.aoas, scale),
+  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                       scale, false, ToAoasInputs(style.aoas, scale),
                        ToCloudInputs(style.clouds, style.aoas.seed, "", 0.0));
   if (!directions.empty()) return renderer.RenderDirections(sun, directions);
   return renderer.Render(sun, {{MAPPING_LATLONG, 96, 48, 0}})[0];
@@ -391,8 +392,8 @@ ChangeUnderDeck TransmittanceOfTheChange(const LayeredSkies& s, const std::strin
   EXPECT_LE(worst_fit, 2e-6) << what << ": the change under the deck is not the clear sky's change times one factor";
   EXPECT_LE(worst_range, 2e-6) << what << ": the factor is not a transmittance in [0, 1]";
   EXPECT_LE(worst_still, 2e-6) << what << ": the styling changed a texel under the deck more than its clear sky";
-  std::printf("%s: fit residual %.3g, outside [0, 1] %.3g, small changes %.3g (of the texel's colour)\n",
-              what.c_str(), worst_fit, worst_range, worst_still);
+  std::printf("%s: fit residual %.3g, outside [0, 1] %.3g, small changes %.3g (of the texel's colour)\n", what.c_str(),
+              worst_fit, worst_range, worst_still);
   return out;
 }
 
@@ -446,11 +447,12 @@ void ExpectStyledBehindTheClouds(const std::string& styled, const std::string& p
   const double styled_gap = MeanRelativeDifference(skies[8].on, skies[3].on);
   const double plain_gap = MeanRelativeDifference(skies[8].off, skies[3].off);
   // Seen: 0.083 against 0.084 (saturation clouds and shapes), 0.199 against 0.210 (night floor).
-  EXPECT_LE(styled_gap, 1.05 * plain_gap) << what << ": styled 8 bins against 3 wavelengths, the unstyled pair "
-                                         << plain_gap;
-  std::printf("%s: t compared at %d texels (%d behind the deck, %d clear), |t8 - t3| |R| <= %.3g; "
-              "8 bins against 3 wavelengths, mean relative difference: styled %.4g, unstyled %.4g\n",
-              what.c_str(), compared, hidden, clear, worst, styled_gap, plain_gap);
+  EXPECT_LE(styled_gap, 1.05 * plain_gap)
+      << what << ": styled 8 bins against 3 wavelengths, the unstyled pair " << plain_gap;
+  std::printf(
+      "%s: t compared at %d texels (%d behind the deck, %d clear), |t8 - t3| |R| <= %.3g; "
+      "8 bins against 3 wavelengths, mean relative difference: styled %.4g, unstyled %.4g\n",
+      what.c_str(), compared, hidden, clear, worst, styled_gap, plain_gap);
   testing::ExpectNoValidationMessages();
 }
 
@@ -530,8 +532,8 @@ TEST(SpectralSkyTest, BadSpectralSettingsAreRefusedWithTheirPlace) {
     EXPECT_EQ(styled.style.quality.wavelengths, 8) << principle;
   }
   // With cloud layers too: the style pass acts on the sky behind them (*BehindCloudLayers).
-  ConfigResult layered = errors(
-      "[quality]\nwavelengths = 8\n[effects]\nnight_dimming = true\n[[cloud_layer]]\ntype = \"cumulus\"\n");
+  ConfigResult layered =
+      errors("[quality]\nwavelengths = 8\n[effects]\nnight_dimming = true\n[[cloud_layer]]\ntype = \"cumulus\"\n");
   EXPECT_TRUE(layered.ok()) << (layered.errors.empty() ? "" : layered.errors[0].message);
   EXPECT_TRUE(layered.warnings.empty()) << layered.warnings[0].message;
   EXPECT_EQ(layered.style.quality.wavelengths, 8);
@@ -566,9 +568,9 @@ TEST(SpectralSkyTest, CommandLineRefusesOutOfRangeBins) {
   EXPECT_NE(run.output.find("quality.wavelengths"), std::string::npos) << run.output;
   EXPECT_NE(run.output.find("out of range [3, 48]"), std::string::npos) << run.output;
   const std::string out = testing::FreshTempDir("spectral_bad");
-  const testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
-      " --set quality.wavelengths=2 --set effects.night_dimming=true");
+  const testing::CommandRun bake =
+      testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
+                          " --set quality.wavelengths=2 --set effects.night_dimming=true");
   EXPECT_EQ(bake.exit_code, 3) << bake.output;
   EXPECT_TRUE(testing::FileNames(out).empty()) << "nothing written";
 }
@@ -576,9 +578,9 @@ TEST(SpectralSkyTest, CommandLineRefusesOutOfRangeBins) {
 // The night floor and the AOAS saturation clouds bake in the spectral mode.
 TEST(SpectralSkyTest, CommandLineBakesTheColourPrinciplesSpectrally) {
   const std::string out = testing::FreshTempDir("spectral_styled");
-  const testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
-      " --set quality.wavelengths=4 --set effects.night_dimming=true --set clouds.enabled=true");
+  const testing::CommandRun bake =
+      testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml -q --size 8 --out " + out +
+                          " --set quality.wavelengths=4 --set effects.night_dimming=true --set clouds.enabled=true");
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   EXPECT_FALSE(testing::FileNames(out).empty());
 }
@@ -647,7 +649,8 @@ TEST(SpectralSkyTest, StudyQuickRunWritesItsTablesAndPictures) {
   options.quick = true;
   options.out_dir = testing::FreshTempDir("spectral_study");
   const std::string md = RunSpectralStudy(testing::Vulkan(), options);
-  for (const char* file : {"spectral.csv", "spectral_results.md", "spectral_twilight_rgb3.png", "spectral_twilight_48.png"})
+  for (const char* file :
+       {"spectral.csv", "spectral_results.md", "spectral_twilight_rgb3.png", "spectral_twilight_48.png"})
     EXPECT_FALSE(testing::ReadFileBytes(options.out_dir + "/" + file).empty()) << file;
   const std::string csv = testing::ReadFileBytes(options.out_dir + "/spectral.csv");
   EXPECT_NE(csv.find("\n48,-4,"), std::string::npos) << csv;
@@ -691,7 +694,8 @@ TEST(SpectralSkyTest, SunOfASpectralBakeIsTheSpectralSun) {
   std::map<int, json> manifests, gltfs;
   for (int n : {3, 16}) {
     const std::string out = testing::FreshTempDir(fmt::format("spectral_sun_{}", n));
-    const testing::CommandRun run = testing::RunSkybake(args + fmt::format(" --set quality.wavelengths={} --out ", n) + out);
+    const testing::CommandRun run =
+        testing::RunSkybake(args + fmt::format(" --set quality.wavelengths={} --out ", n) + out);
     ASSERT_EQ(run.exit_code, 0) << run.output;
     manifests[n] = json::parse(std::ifstream(out + "/manifest.json"));
     gltfs[n] = json::parse(std::ifstream(out + "/sky.gltf"));
@@ -718,8 +722,9 @@ TEST(SpectralSkyTest, SunOfASpectralBakeIsTheSpectralSun) {
     EXPECT_NEAR(light["color"][c].get<double>(), expected[c] / peak, 0.01) << "channel " << c;
     // The SH's sun (band 0) is the same colour.
     const double sh_sun = sh_with[c].get<double>() - sh_without[c].get<double>();
-    EXPECT_NEAR(sh_sun / irradiance, (sh_with[1].get<double>() - sh_without[1].get<double>()) /
-                                         sun["irradiance"][1].get<double>(), 1e-4 * sh_sun / irradiance)
+    EXPECT_NEAR(sh_sun / irradiance,
+                (sh_with[1].get<double>() - sh_without[1].get<double>()) / sun["irradiance"][1].get<double>(),
+                1e-4 * sh_sun / irradiance)
         << "channel " << c;
   }
   // Three wavelengths give the Sun the spectral mode's colour too: its light
@@ -729,8 +734,8 @@ TEST(SpectralSkyTest, SunOfASpectralBakeIsTheSpectralSun) {
   const json& sun3 = manifests[3]["frames"][0]["sun"]["irradiance"];
   const double ratio3 = sun3[2].get<double>() / sun3[0].get<double>();
   const double ratio16 = sun["irradiance"][2].get<double>() / sun["irradiance"][0].get<double>();
-  std::printf("sun at %.0f deg, blue / red: 3 wavelengths %.4f, 16 bins %.4f, expected %.4f\n", elevation_deg,
-              ratio3, ratio16, expected[2] / expected[0]);
+  std::printf("sun at %.0f deg, blue / red: 3 wavelengths %.4f, 16 bins %.4f, expected %.4f\n", elevation_deg, ratio3,
+              ratio16, expected[2] / expected[0]);
   EXPECT_LT(std::abs(ratio3 / ratio16 - 1.0), 0.02);
 }
 

@@ -22,8 +22,11 @@ TEST(VulkanContextTest, ChoosesAUsableComputeDevice) {
   ASSERT_FALSE(devices.empty());
   // The chosen device is the best-ranked usable one.
   auto rank = [](const std::string& type) {
-    return type == "discrete GPU" ? 0 : type == "integrated GPU" ? 1 : type == "virtual GPU" ? 2
-           : type == "CPU" ? 3 : 4;
+    return type == "discrete GPU"     ? 0
+           : type == "integrated GPU" ? 1
+           : type == "virtual GPU"    ? 2
+           : type == "CPU"            ? 3
+                                      : 4;
   };
   for (const DeviceInfo& d : devices) {
     if (d.usable) {
@@ -82,7 +85,7 @@ TEST(VulkanDriversTest, LavapipeGetsTwiceTheHardwareThreadsUnlessTheUserSetACoun
   EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", ""}}, 2), "4");  // empty: as if unset
   EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "3"}}, 2), "");  // the user's count stays
   EXPECT_EQ(LavapipeThreadCount({{"LP_NUM_THREADS", "0"}}, 8), "");
-  EXPECT_EQ(LavapipeThreadCount({}, 0), "");                         // hardware threads unknown
+  EXPECT_EQ(LavapipeThreadCount({}, 0), "");  // hardware threads unknown
   DeviceInfo device;
   device.name = "llvmpipe (LLVM 15.0.6, 256 bits)";
   EXPECT_TRUE(IsLavapipe(device));  // the count is reported only with lavapipe's device
@@ -106,8 +109,9 @@ TEST(VulkanDriversTest, LavapipeThreadCountChangesNoByte) {
   EXPECT_EQ(users.output.find("(lavapipe:"), std::string::npos) << users.output;
 
   const std::string dir = testing::FreshTempDir("lavapipe_threads");
-  const std::string style = testing::SourceDir() +
-                            "/configs/styles/cumulus_sunset.toml --size 48 --vulkan-validation --set output.preview=false";
+  const std::string style =
+      testing::SourceDir() +
+      "/configs/styles/cumulus_sunset.toml --size 48 --vulkan-validation --set output.preview=false";
   const std::vector<std::pair<std::string, std::string>> runs = {
       {"one", "LP_NUM_THREADS=1"}, {"chosen", "LP_NUM_THREADS="}, {"five", "LP_NUM_THREADS=5"}};
   for (const auto& [name, environment] : runs) {

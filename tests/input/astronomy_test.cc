@@ -155,14 +155,14 @@ TEST(Astronomy, MoonParallaxAgainstVectorSubtraction) {
     const glm::dvec3 moon = m.geocentric_distance_km *
                             glm::dvec3(std::cos(dec) * std::cos(ra), std::cos(dec) * std::sin(ra), std::sin(dec));
     const double lst = (MeeusMeanSiderealDeg(jd) + lon) * kDeg;
-    const glm::dvec3 observer =
-        6378.14 * glm::dvec3(std::cos(lat * kDeg) * std::cos(lst), std::cos(lat * kDeg) * std::sin(lst),
-                             std::sin(lat * kDeg));
+    const glm::dvec3 observer = 6378.14 * glm::dvec3(std::cos(lat * kDeg) * std::cos(lst),
+                                                     std::cos(lat * kDeg) * std::sin(lst), std::sin(lat * kDeg));
     const glm::dvec3 topo = moon - observer;
     const Equatorial e{Wrap360(std::atan2(topo.y, topo.x) / kDeg), std::asin(topo.z / glm::length(topo)) / kDeg};
     const Horizontal h = MeeusHorizontal(e, jd, lat, lon);
     EXPECT_NEAR(m.sky.elevation_deg, h.elevation_deg, 0.03) << hour;
-    EXPECT_LT(AngleDifference(m.sky.azimuth_deg, h.compass_azimuth_deg), 0.05 / std::max(0.2, std::cos(h.elevation_deg * kDeg)));
+    EXPECT_LT(AngleDifference(m.sky.azimuth_deg, h.compass_azimuth_deg),
+              0.05 / std::max(0.2, std::cos(h.elevation_deg * kDeg)));
     EXPECT_NEAR(m.distance_km, glm::length(topo), 5.0);
     // The parallax lowers the Moon by about 0.95 deg x cos(elevation).
     EXPECT_NEAR(m.geocentric_elevation_deg - m.sky.elevation_deg, 0.95 * std::cos(m.sky.elevation_deg * kDeg), 0.1);
@@ -230,7 +230,8 @@ TEST(Astronomy, MoonBrightLimbFacesTheSun) {
 TEST(Astronomy, LunarEphemerisMatchesLibnovaFrom1900To2100) {
   double worst_distance = 0.0, worst_phase = 0.0, worst_limb = 0.0;
   for (int i = 0; i < 200; ++i) {
-    const double jd = 2415020.5 + i * 365.2422 + 0.137 * i * i;  // 1900-01-01 + about a year, drifting through the month
+    const double jd =
+        2415020.5 + i * 365.2422 + 0.137 * i * i;  // 1900-01-01 + about a year, drifting through the month
     const LunarEphemeris e = ComputeLunarEphemeris(jd);
     ln_equ_posn moon_equ{}, sun_equ{};
     ln_get_lunar_equ_coords(jd, &moon_equ);
@@ -275,7 +276,7 @@ TEST(Astronomy, MoonAngularSizeFromItsDistance) {
   const double jd = JulianDay(2024, 4, 23, 23, 49);
   const MoonState m = ComputeMoon(jd, {-15.0, 0.0}, 0.0);
   const double sdiam_rad = ln_get_lunar_sdiam(jd) / 3600.0 * kDeg;  // geocentric semi-diameter, arcsec
-  EXPECT_NEAR(m.angular_radius_rad / sdiam_rad, 1.0, 0.02);  // topocentric: up to 1.7% larger overhead
+  EXPECT_NEAR(m.angular_radius_rad / sdiam_rad, 1.0, 0.02);         // topocentric: up to 1.7% larger overhead
   EXPECT_GT(m.angular_radius_rad, 0.0042);
   EXPECT_LT(m.angular_radius_rad, 0.0049);
 }

@@ -82,11 +82,11 @@ TEST(ConfigTest, AllErrorsAreReportedAtOnce) {
       "[output]\n"
       "pixel_type = \"double\"\n",
       "bad.toml");
-  EXPECT_EQ(Messages(r), (std::vector<std::string>{
-                "bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range [1, 1000000]",
-                "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)",
-                "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]",
-                "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'"}));
+  EXPECT_EQ(Messages(r),
+            (std::vector<std::string>{"bad.toml:2:20: atmosphere.bottom_radius_km: -1 is out of range [1, 1000000]",
+                                      "bad.toml:4:5: atmosphere.mie.g: 1 is out of range (-1, 1)",
+                                      "bad.toml:6:13: render.cube_size: 0 is out of range [1, 8192]",
+                                      "bad.toml:8:14: output.pixel_type: 'double' is not one of 'half' or 'float'"}));
 }
 
 TEST(ConfigTest, TopRadiusMustBeAboveBottom) {
@@ -101,11 +101,11 @@ TEST(ConfigTest, WrongTypesAndNonFiniteNumbers) {
       "[atmosphere]\nground_albedo = [0.1, 0.2]\n",
       "t.toml");
   EXPECT_EQ(Messages(r), (std::vector<std::string>{
-                "t.toml:7:17: atmosphere.ground_albedo: expected a number or an array of 3 numbers "
-                "[680 nm, 550 nm, 440 nm]",
-                "t.toml:2:17: sun.elevation_deg: expected a number, got a string",
-                "t.toml:3:15: sun.azimuth_deg: must be a finite number (got nan)",
-                "t.toml:5:12: effects.sun_disc: expected true or false, got an integer"}));
+                             "t.toml:7:17: atmosphere.ground_albedo: expected a number or an array of 3 numbers "
+                             "[680 nm, 550 nm, 440 nm]",
+                             "t.toml:2:17: sun.elevation_deg: expected a number, got a string",
+                             "t.toml:3:15: sun.azimuth_deg: must be a finite number (got nan)",
+                             "t.toml:5:12: effects.sun_disc: expected true or false, got an integer"}));
 }
 
 TEST(ConfigTest, OutputNamesCannotEscapeTheOutputFolder) {
@@ -114,8 +114,8 @@ TEST(ConfigTest, OutputNamesCannotEscapeTheOutputFolder) {
     ASSERT_EQ(r.errors.size(), 1u) << name;
     EXPECT_EQ(r.errors[0].key, "output.basename");
   }
-  ConfigResult faces = ParseSkyStyle(
-      "[output]\nface_names = [\"px\", \"nx\", \"../py\", \"ny\", \"pz\", \"nz\"]\n", "f.toml");
+  ConfigResult faces =
+      ParseSkyStyle("[output]\nface_names = [\"px\", \"nx\", \"../py\", \"ny\", \"pz\", \"nz\"]\n", "f.toml");
   ASSERT_EQ(faces.errors.size(), 1u);
   EXPECT_EQ(faces.errors[0].key, "output.face_names[2]");
 }
@@ -130,8 +130,8 @@ TEST(ConfigTest, SyntaxErrorIsLocated) {
 TEST(ConfigTest, BadOverrideIsReported) {
   ConfigResult r = ParseSkyStyle("", "s.toml", {"sun.elevation_deg", "sun.elevation_deg=200"});
   EXPECT_EQ(Messages(r), (std::vector<std::string>{
-                "--set: sun.elevation_deg: expected key.path=value, e.g. --set sun.elevation_deg=10",
-                "--set sun.elevation_deg=200:1:5: sun.elevation_deg: 200 is out of range [-90, 90]"}));
+                             "--set: sun.elevation_deg: expected key.path=value, e.g. --set sun.elevation_deg=10",
+                             "--set sun.elevation_deg=200:1:5: sun.elevation_deg: 200 is out of range [-90, 90]"}));
 }
 
 TEST(ConfigTest, MissingFileIsReported) {

@@ -219,14 +219,15 @@ TEST(EnginePresetCliTest, BakeWritesThePresetsFiles) {
   const std::string dir = testing::FreshTempDir("engine_bake");
   for (const std::string engine : {"threejs", "exrenvmap"}) {
     const std::string out = dir + "/" + engine;
-    testing::CommandRun r = testing::RunSkybake("bake " + Style() + " --size 16 -q --vulkan-validation --set "
-                                                "output.pixel_type=float --engine " + engine + " --out " + out);
+    testing::CommandRun r = testing::RunSkybake("bake " + Style() +
+                                                " --size 16 -q --vulkan-validation --set "
+                                                "output.pixel_type=float --engine " +
+                                                engine + " --out " + out);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const std::string manifest = testing::ReadFileBytes(out + "/manifest.json");
-    std::vector<std::string> names =
-        engine == "threejs"
-            ? std::vector<std::string>{"px", "nx", "py", "ny", "pz", "nz", "latlong"}
-            : std::vector<std::string>{"latlong", "cube"};
+    std::vector<std::string> names = engine == "threejs"
+                                         ? std::vector<std::string>{"px", "nx", "py", "ny", "pz", "nz", "latlong"}
+                                         : std::vector<std::string>{"latlong", "cube"};
     size_t last = 0;
     for (const std::string& s : names) {
       const std::string file = "sky_" + engine + "_" + s + ".exr";
@@ -276,9 +277,8 @@ TEST(EnginePresetCliTest, SeveralPresetsInOneBakeComeFromOneRender) {
 
   const std::string manifest = testing::ReadFileBytes(dir + "/several/manifest.json");
   size_t last = 0;
-  for (const char* file :
-       {"sky_threejs_px.exr", "sky_threejs_nz.exr", "sky_threejs_latlong.exr", "sky_babylon_px.exr",
-        "sky_babylon_nz.exr", "sky_blender_latlong.exr"}) {
+  for (const char* file : {"sky_threejs_px.exr", "sky_threejs_nz.exr", "sky_threejs_latlong.exr", "sky_babylon_px.exr",
+                           "sky_babylon_nz.exr", "sky_blender_latlong.exr"}) {
     const size_t at = manifest.find("\"" + std::string(file) + "\"");
     ASSERT_NE(at, std::string::npos) << file << "\n" << manifest;
     EXPECT_GT(at, last) << file << " in the order the presets are named";
@@ -296,8 +296,7 @@ TEST(EnginePresetCliTest, SeveralPresetsInOneBakeComeFromOneRender) {
   EXPECT_EQ(pixels("several", "sky_threejs_latlong.exr"), pixels("several", "sky_blender_latlong.exr"))
       << "three.js's and Blender's equirects differ";
   for (const char* engine : {"threejs", "babylon"}) {
-    testing::CommandRun alone =
-        testing::RunSkybake(common + " -q --engine " + engine + " --out " + dir + "/" + engine);
+    testing::CommandRun alone = testing::RunSkybake(common + " -q --engine " + engine + " --out " + dir + "/" + engine);
     ASSERT_EQ(alone.exit_code, 0) << alone.output;
     SkyStyle style;  // basename "sky", as configs/default.toml
     style.output.engine = engine;
@@ -310,13 +309,14 @@ TEST(EnginePresetCliTest, SeveralPresetsInOneBakeComeFromOneRender) {
 // command line with exit code 2 and the names, in output.engine with exit
 // code 3 and the key.
 TEST(EnginePresetCliTest, BadNamesAmongSeveralAreRefusedBeforeGpuWork) {
-  for (const std::string args : {"--engine threejs,unreal5", "--engine threejs --engine unreal5",
-                                  "--engine threejs,", "--engine none"}) {
+  for (const std::string args :
+       {"--engine threejs,unreal5", "--engine threejs --engine unreal5", "--engine threejs,", "--engine none"}) {
     const std::string dir = testing::FreshTempDir("engine_several_bad");
     testing::CommandRun r = testing::RunSkybake("bake " + Style() + " " + args + " --out " + dir);
     EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find("unity,unreal,godot,blender,threejs,babylon,filament,exrenvmap"), std::string::npos)
-        << args << "\n" << r.output;
+        << args << "\n"
+        << r.output;
     EXPECT_EQ(r.output.find("device"), std::string::npos) << "no GPU work: " << r.output;
     EXPECT_TRUE(testing::FileNames(dir).empty()) << args;
   }
@@ -357,9 +357,10 @@ TEST(EnginePresetTest, EngineFileScaleIsTheBakesUnlessTheyNeedASmallerOne) {
 TEST(EnginePresetCliTest, PresetKeepsTheHalfScaleOfTheBakesOwnFiles) {
   const std::string dir = testing::FreshTempDir("engine_scale");
   // The disc in the maps (output.sun = "map"): the panorama's texels inside it need a scale.
-  const std::string sizes = " --set output.latlong=false --set output.preview=false --set output.cube_strip=false "
-                            "--set gltf.enabled=false --set render.cube_size=16 --set render.latlong_height=1024 "
-                            "--set output.sun=map";
+  const std::string sizes =
+      " --set output.latlong=false --set output.preview=false --set output.cube_strip=false "
+      "--set gltf.enabled=false --set render.cube_size=16 --set render.latlong_height=1024 "
+      "--set output.sun=map";
   for (const char* engine : {"", "godot"}) {
     const std::string out = dir + "/" + (*engine ? engine : "none");
     testing::CommandRun r = testing::RunSkybake("bake " + Style() + sizes + " -q --out " + out +
@@ -370,7 +371,8 @@ TEST(EnginePresetCliTest, PresetKeepsTheHalfScaleOfTheBakesOwnFiles) {
   EXPECT_NE(testing::ReadFileBytes(none + "/manifest.json").find("\"half_scale\": 1.0"), std::string::npos);
   EXPECT_NE(testing::ReadFileBytes(godot + "/manifest.json").find("\"half_scale\": 1.0"), std::string::npos);
   for (const char* face : {"px", "nx", "py", "ny", "pz", "nz"}) {
-    Exr a = ReadExr(none + "/sky_" + std::string(face) + ".exr"), b = ReadExr(godot + "/sky_" + std::string(face) + ".exr");
+    Exr a = ReadExr(none + "/sky_" + std::string(face) + ".exr"),
+        b = ReadExr(godot + "/sky_" + std::string(face) + ".exr");
     EXPECT_EQ(b.attributes["skybake:scale"], "1") << face;
     EXPECT_EQ(a.rgb, b.rgb) << face << ": the same pixels with the preset as without";
   }
@@ -394,8 +396,8 @@ TEST(EnginePresetCliTest, ResumeVerifiesTheEngineFiles) {
   const std::string schedule = testing::WriteFile(
       dir, "schedule.toml",
       "[schedule]\nsun = { elevation_deg = { start = 20, end = 30, step = 10 }, azimuth_deg = 135 }\n");
-  const std::string args = "bake " + Style() + " --schedule " + schedule + " --size 8 --engine godot --out " + dir +
-                           "/out";
+  const std::string args =
+      "bake " + Style() + " --schedule " + schedule + " --size 8 --engine godot --out " + dir + "/out";
   testing::CommandRun first = testing::RunSkybake(args);
   ASSERT_EQ(first.exit_code, 0) << first.output;
   EXPECT_TRUE(testing::FileNames(dir + "/out").count("sky_godot_latlong.0002.exr"));

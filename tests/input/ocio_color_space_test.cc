@@ -73,8 +73,8 @@ OCIO::ConstCPUProcessorRcPtr ToRec709(const std::string& space) {
 // Each built-in matrix against OpenColorIO on colours in Rec.709's gamut
 // (the Rec.2020 display path clamps what is outside its own).
 TEST(OcioColorSpace, BuiltinMatricesAreOpenColorIOs) {
-  const std::vector<std::array<double, 3>> colours = {
-      {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}, {0.18, 0.18, 0.18}, {0.9, 0.5, 0.1}, {0.2, 0.4, 0.8}};
+  const std::vector<std::array<double, 3>> colours = {{1, 0, 0},          {0, 1, 0},       {0, 0, 1},      {1, 1, 1},
+                                                      {0.18, 0.18, 0.18}, {0.9, 0.5, 0.1}, {0.2, 0.4, 0.8}};
   for (const NamedColorSpace& n : BuiltinColorSpaces()) {
     if (n.space == ColorSpace::kRec709) continue;
     const OCIO::ConstCPUProcessorRcPtr back = ToRec709(n.name);
@@ -134,7 +134,8 @@ Map ReadMap(const std::string& path) {
 std::string Bake(const std::string& space, const std::string& dir, const std::string& extra = "") {
   const std::string out = dir + "/" + std::to_string(std::hash<std::string>()(space));
   const testing::CommandRun r = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml -q --size 16 --vulkan-validation --set output.faces=false "
+      "bake " + testing::SourceDir() +
+      "/configs/default.toml -q --size 16 --vulkan-validation --set output.faces=false "
       "--set output.cube_strip=false --set gltf.enabled=false --set output.preview=false --set 'output.color_space=\"" +
       space + "\"'" + extra + " --out " + out);
   EXPECT_EQ(r.exit_code, 0) << r.output;
@@ -195,10 +196,11 @@ TEST(OcioColorSpace, IblFilesFollowTheMapsSpace) {
   std::map<std::string, std::string> out;
   for (const std::string space : {"rec709", "acescg"}) {
     out[space] = dir + "/" + space;
-    const testing::CommandRun r = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/default.toml -q --size 16 --vulkan-validation --set "
-        "output.faces=false --set output.cube_strip=false --set 'output.color_space=\"" + space + "\"'" + ibl +
-        " --out " + out[space]);
+    const testing::CommandRun r =
+        testing::RunSkybake("bake " + testing::SourceDir() +
+                            "/configs/default.toml -q --size 16 --vulkan-validation --set "
+                            "output.faces=false --set output.cube_strip=false --set 'output.color_space=\"" +
+                            space + "\"'" + ibl + " --out " + out[space]);
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   const Map rec = ReadMap(out["rec709"] + "/sky_irradiance.exr");
@@ -248,17 +250,21 @@ TEST(OcioColorSpace, UnknownOrNonLinearSpacesAreRefusedWithTheNames) {
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("'Linear P3-D65'"), std::string::npos) << "the config's names: " << r.output;
 
-  r = testing::RunSkybake("check " + style + " --set 'output.color_space=\"Gamma 2.2 ACEScg\"' --set "
-                          "'output.ocio_config=\"" + TestConfig() + "\"'");
+  r = testing::RunSkybake("check " + style +
+                          " --set 'output.color_space=\"Gamma 2.2 ACEScg\"' --set "
+                          "'output.ocio_config=\"" +
+                          TestConfig() + "\"'");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("not a linear space"), std::string::npos) << r.output;
 
-  r = testing::RunSkybake("check " + style + " --set 'output.color_space=\"Linear P3-D65\"' --set "
+  r = testing::RunSkybake("check " + style +
+                          " --set 'output.color_space=\"Linear P3-D65\"' --set "
                           "'output.ocio_config=\"/nonexistent/config.ocio\"'");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("cannot be read"), std::string::npos) << r.output;
   // A device is not read (it would never end).
-  r = testing::RunSkybake("check " + style + " --set 'output.color_space=\"Linear P3-D65\"' --set "
+  r = testing::RunSkybake("check " + style +
+                          " --set 'output.color_space=\"Linear P3-D65\"' --set "
                           "'output.ocio_config=\"/dev/zero\"'");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("not a regular file"), std::string::npos) << r.output;

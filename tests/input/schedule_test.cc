@@ -105,7 +105,8 @@ colour = "red"
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.errors[0].Format().find("clock times need schedule.date"), std::string::npos);
 
-  ScheduleResult steps = ParseSchedule("[schedule]\nsun = { elevation_deg = { start = 0, end = 10, step = -1 }, azimuth_deg = 0 }\n", "s.toml");
+  ScheduleResult steps = ParseSchedule(
+      "[schedule]\nsun = { elevation_deg = { start = 0, end = 10, step = -1 }, azimuth_deg = 0 }\n", "s.toml");
   ASSERT_FALSE(steps.ok());
   EXPECT_NE(steps.errors[0].Format().find("s.toml:2:25"), std::string::npos) << steps.errors[0].Format();
 }
@@ -123,11 +124,13 @@ ramp = { "atmosphere.ground_albedo" = [[0.1, 0.2], 0.3] }
   std::string all;
   for (const ConfigError& e : r.errors) all += e.Format() + "\n";
   EXPECT_NE(all.find("n.toml:2:26: schedule.sun.elevation_deg[0]: expected a number, got a string\n"),
-            std::string::npos) << all;
+            std::string::npos)
+      << all;
   EXPECT_NE(all.find("schedule.sun.azimuth_deg: must be a finite number (got nan)\n"), std::string::npos) << all;
   EXPECT_NE(all.find("n.toml:3:40: schedule.ramp.atmosphere.ground_albedo[0]: expected a number or an array of 3 "
                      "numbers [680 nm, 550 nm, 440 nm]\n"),
-            std::string::npos) << all;
+            std::string::npos)
+      << all;
 }
 
 // A schedule typo gets the same answer as a style typo: located, with the
@@ -148,9 +151,11 @@ sun_colour = "red"
   std::string all;
   for (const ConfigError& e : r.errors) all += e.Format() + "\n";
   EXPECT_NE(all.find("typo.toml:6:9: schedule.tiems: unknown key 'tiems' (did you mean 'times'?) (expected "),
-            std::string::npos) << all;
+            std::string::npos)
+      << all;
   EXPECT_NE(all.find("typo.toml:7:15: schedule.frist_frame: unknown key 'frist_frame' (did you mean 'first_frame'?)"),
-            std::string::npos) << all;
+            std::string::npos)
+      << all;
   EXPECT_NE(all.find("schedule.sun_colour: unknown key 'sun_colour' (expected "), std::string::npos) << all;
 
   ScheduleResult sun = ParseSchedule("[schedule]\nsun = { elevation_deg = 10, azimuht_deg = 135 }\n", "sun.toml");

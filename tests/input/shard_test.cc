@@ -24,8 +24,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using testing::CommandRun;
-using testing::FreshTempDir;
 using testing::FileNames;
+using testing::FreshTempDir;
 using testing::ReadFileBytes;
 using testing::RunSkybake;
 
@@ -108,7 +108,8 @@ TEST_F(Shard, ThreeShardsInOneFolderMergeToTheUnshardedBake) {
   for (const char* name : {"manifest.shard-0011-0012.json", "manifest.shard-0013-0014.json",
                            "manifest.shard-0015-0016.json", "timings.shard-0013-0014.json"})
     EXPECT_TRUE(names.count(name)) << name;
-  for (const char* name : {"manifest.json", "sky.gltf", "sky.glb", "timings.json"}) EXPECT_FALSE(names.count(name)) << name;
+  for (const char* name : {"manifest.json", "sky.gltf", "sky.glb", "timings.json"})
+    EXPECT_FALSE(names.count(name)) << name;
   nlohmann::json part = nlohmann::json::parse(std::ifstream(out + "/manifest.shard-0013-0014.json"));
   EXPECT_EQ(part["part"], nlohmann::json({{"first_frame", 13}, {"last_frame", 14}, {"frames", 2}, {"of_frames", 6}}));
   ASSERT_EQ(part["frames"].size(), 2u);
@@ -161,7 +162,8 @@ TEST_F(Shard, FrameRangesInSeparateFoldersCopiedTogetherMergeToTheUnshardedBake)
   const std::string together = root_ + "/together";
   fs::create_directories(together);
   for (const std::string& dir : {a, b, c})
-    for (const auto& e : fs::directory_iterator(dir)) fs::copy_file(e.path(), together + "/" + e.path().filename().string());
+    for (const auto& e : fs::directory_iterator(dir))
+      fs::copy_file(e.path(), together + "/" + e.path().filename().string());
   CommandRun merge = RunSkybake("merge-manifest '" + together + "'");
   ASSERT_EQ(merge.exit_code, 0) << merge.output;
   ExpectSameAsWhole(together);
@@ -188,7 +190,8 @@ TEST_F(Shard, MergeRefusesMissingFramesAndPartsOfAnotherBake) {
   CommandRun mixed = RunSkybake("merge-manifest --sizes-only '" + out + "'");
   EXPECT_EQ(mixed.exit_code, 8) << mixed.output;
   EXPECT_NE(mixed.output.find("come from different bakes"), std::string::npos) << mixed.output;
-  EXPECT_NE(mixed.output.find("manifest.shard-0013-0014.json"), std::string::npos) << "names the file: " << mixed.output;
+  EXPECT_NE(mixed.output.find("manifest.shard-0013-0014.json"), std::string::npos)
+      << "names the file: " << mixed.output;
   EXPECT_FALSE(fs::exists(out + "/manifest.json"));
 
   // A listed file that is gone is named, with the part it belongs to.
@@ -219,7 +222,9 @@ struct ManifestEdit {
 // Names from the manifests that would leave the folder or name another
 // file, and values skybake never writes.
 std::vector<ManifestEdit> HostileManifestEdits() {
-  auto file = [](int n) { return [n](nlohmann::json& m) -> nlohmann::json& { return m["frames"][0]["files"][n]["file"]; }; };
+  auto file = [](int n) {
+    return [n](nlohmann::json& m) -> nlohmann::json& { return m["frames"][0]["files"][n]["file"]; };
+  };
   return {
       {"gltf name escapes", "0001-0001", [](nlohmann::json& m) { m["gltf"]["name"] = "../evil"; },
        "gltf.name: '../evil' is not a plain file name"},
@@ -231,7 +236,8 @@ std::vector<ManifestEdit> HostileManifestEdits() {
        "frame 1: '../../../etc/passwd' is not the face file skybake names for frame 1 (....0001.exr)"},
       {"frame file absolute", "0001-0001", [file](nlohmann::json& m) { file(6)(m) = "/etc/passwd"; },
        "frame 1: '/etc/passwd' is not the cube strip file skybake names for frame 1"},
-      {"frame file in a sub-folder", "0001-0001", [file](nlohmann::json& m) { file(7)(m) = "sub/sky_latlong.0001.exr"; },
+      {"frame file in a sub-folder", "0001-0001",
+       [file](nlohmann::json& m) { file(7)(m) = "sub/sky_latlong.0001.exr"; },
        "frame 1: 'sub/sky_latlong.0001.exr' is not the latlong file skybake names for frame 1"},
       {"frame file with a newline", "0001-0001", [file](nlohmann::json& m) { file(1)(m) = "sky_nx.0001.exr\nX"; },
        "frame 1: 'sky_nx.0001.exr\\nX' is not the face file skybake names for frame 1"},
@@ -250,8 +256,7 @@ std::vector<ManifestEdit> HostileManifestEdits() {
       {"edited style hash", "0001-0001",
        [](nlohmann::json& m) { m["frames"][0]["style_sha256"] = std::string(64, '0'); },
        "do not give their sequence_sha256: a manifest was edited"},
-      {"edited sun", "0002-0002",
-       [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][1] = 0.5; },
+      {"edited sun", "0002-0002", [](nlohmann::json& m) { m["frames"][0]["sun"]["direction"][1] = 0.5; },
        "do not give their sequence_sha256"},
       {"face label edited", "0001-0001", [](nlohmann::json& m) { m["frames"][0]["files"][0]["face"] = "-X"; },
        "frame 1: '-X' is not the face of the frame's face file 1 (+X: +X, -X, +Y, -Y, +Z, -Z in that order)"},
@@ -437,8 +442,8 @@ TEST(FrameNumbering, EveryFrameOfASequenceHasTheWidthOfItsLastFrame) {
         last - 5);
     const std::string out = fmt::format("{}/out{}", root, last);
     // Names only: no validation layer, which makes lavapipe several times slower.
-    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule + "' --size 1 --frames 9998:" +
-                             std::to_string(last) + " --out '" + out + "'";
+    const std::string bake = "bake '" + Style() + "' --schedule '" + schedule +
+                             "' --size 1 --frames 9998:" + std::to_string(last) + " --out '" + out + "'";
     CommandRun run = RunSkybake(bake + " -q");
     ASSERT_EQ(run.exit_code, 0) << run.output;
     std::set<std::string> faces;

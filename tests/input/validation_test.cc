@@ -22,7 +22,7 @@ struct BadInput {
   const char* schedule;  // schedule.toml given with --schedule; nullptr: none; "MISSING": given, absent
   const char* args;      // more arguments
   int exit_code;
-  const char* message;   // the whole output
+  const char* message;  // the whole output
 };
 
 void PrintTo(const BadInput& c, std::ostream* os) { *os << c.name; }
@@ -45,16 +45,16 @@ std::string ManyPartKey() {
   return key;
 }
 const std::string kManyPartSet = "--set " + ManyPartKey() + "=1";
-const std::string kManyPartFrameSet = "[schedule]\n[[schedule.frames]]\nelevation_deg = 10\nazimuth_deg = 135\nset = { \"" +
-                                      ManyPartKey() + "\" = 1 }\n";
+const std::string kManyPartFrameSet =
+    "[schedule]\n[[schedule.frames]]\nelevation_deg = 10\nazimuth_deg = 135\nset = { \"" + ManyPartKey() + "\" = 1 }\n";
 const std::string kManyPartRamp =
     "[schedule]\nsun = { elevation_deg = [0, 10], azimuth_deg = 135 }\n[schedule.ramp]\n\"" + ManyPartKey() +
     "\" = [0, 1]\n";
 const std::string kManyPartRate =
     "[schedule]\ndate = 2013-05-27\nlatitude_deg = 42.4\nlongitude_deg = -76.5\nutc_offset_hours = -4.0\n"
     "times = [09:00:00, 10:00:00]\n"
-    "[schedule.per_hour]\n\"" + ManyPartKey() +
-    "\" = 1\n";
+    "[schedule.per_hour]\n\"" +
+    ManyPartKey() + "\" = 1\n";
 
 // clang-format off
 const BadInput kBadInputs[] = {
@@ -614,7 +614,8 @@ TEST(BadInputs, EscapeSequencesInNamesAreNotPrintedRaw) {
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   EXPECT_NE(ok.output.find("\nsky\\x1b[2J\\x07.toml: ok\n"), std::string::npos) << ok.output;
   EXPECT_EQ(ok.output.find('\x1b'), std::string::npos) << ok.output;
-  testing::CommandRun bad = testing::RunSkybake("check '" + name + "' --set sun.elevation_deg=100", "cd '" + dir + "' &&");
+  testing::CommandRun bad =
+      testing::RunSkybake("check '" + name + "' --set sun.elevation_deg=100", "cd '" + dir + "' &&");
   EXPECT_EQ(bad.exit_code, 3) << bad.output;
   EXPECT_EQ(bad.output.find('\x1b'), std::string::npos) << bad.output;
   EXPECT_EQ(bad.output.find('\x07'), std::string::npos) << bad.output;
@@ -640,11 +641,15 @@ TEST(BadInputs, ScheduleRampOverASetKeyIsWarnedOf) {
   const std::string dir = testing::FreshTempDir("rampset");
   std::ofstream(dir + "/s.toml") << "[schedule]\nsun = { elevation_deg = [0, 10], azimuth_deg = 135 }\n"
                                     "[schedule.ramp]\n\"atmosphere.mie.g\" = [0.7, 0.8]\n";
-  testing::CommandRun run = testing::RunSkybake("check '" + testing::SourceDir() + "/configs/default.toml' --schedule "
-                                                "s.toml --set atmosphere.mie.g=0.5", "cd '" + dir + "' &&");
+  testing::CommandRun run = testing::RunSkybake("check '" + testing::SourceDir() +
+                                                    "/configs/default.toml' --schedule "
+                                                    "s.toml --set atmosphere.mie.g=0.5",
+                                                "cd '" + dir + "' &&");
   EXPECT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("skybake: warning: s.toml:4:22: atmosphere.mie.g: the schedule sets this key per frame, "
-                            "so --set atmosphere.mie.g=0.5 has no effect on it\n"), std::string::npos) << run.output;
+                            "so --set atmosphere.mie.g=0.5 has no effect on it\n"),
+            std::string::npos)
+      << run.output;
   fs::remove_all(dir);
 }
 
@@ -652,11 +657,14 @@ TEST(BadInputs, ScheduleRampOverASetKeyIsWarnedOf) {
 // them apart ("needs 3 MiB ... above the budget of 3 MiB" before).
 TEST(BadInputs, BudgetMessageTellsCloseNumbersApart) {
   const std::string style = testing::SourceDir() + "/configs/default.toml";
-  testing::CommandRun run = testing::RunSkybake("check '" + style + "' --set render.cube_size=64 --set "
+  testing::CommandRun run = testing::RunSkybake("check '" + style +
+                                                "' --set render.cube_size=64 --set "
                                                 "render.latlong_height=64 --max-memory-mib 3");
   EXPECT_EQ(run.exit_code, 7) << run.output;
   EXPECT_NE(run.output.find("an estimated 3.031 MiB of memory per frame (cube 64, latlong 128x64), above the budget "
-                            "of 3.000 MiB"), std::string::npos) << run.output;
+                            "of 3.000 MiB"),
+            std::string::npos)
+      << run.output;
 }
 
 // --dry-run plans the part of the sequence that --frames / --shard select.

@@ -57,24 +57,22 @@ namespace {
 // 13, 15), an explicit loop over the 8 cell corners with weights fade(f) or
 // 1 - fade(f) per axis.
 const int kPublishedPermutation[256] = {
-    151, 160, 137, 91,  90,  15,  131, 13,  201, 95,  96,  53,  194, 233, 7,   225, 140, 36,  103,
-    30,  69,  142, 8,   99,  37,  240, 21,  10,  23,  190, 6,   148, 247, 120, 234, 75,  0,   26,
-    197, 62,  94,  252, 219, 203, 117, 35,  11,  32,  57,  177, 33,  88,  237, 149, 56,  87,  174,
-    20,  125, 136, 171, 168, 68,  175, 74,  165, 71,  134, 139, 48,  27,  166, 77,  146, 158, 231,
-    83,  111, 229, 122, 60,  211, 133, 230, 220, 105, 92,  41,  55,  46,  245, 40,  244, 102, 143,
-    54,  65,  25,  63,  161, 1,   216, 80,  73,  209, 76,  132, 187, 208, 89,  18,  169, 200, 196,
-    135, 130, 116, 188, 159, 86,  164, 100, 109, 198, 173, 186, 3,   64,  52,  217, 226, 250, 124,
-    123, 5,   202, 38,  147, 118, 126, 255, 82,  85,  212, 207, 206, 59,  227, 47,  16,  58,  17,
-    182, 189, 28,  42,  223, 183, 170, 213, 119, 248, 152, 2,   44,  154, 163, 70,  221, 153, 101,
-    155, 167, 43,  172, 9,   129, 22,  39,  253, 19,  98,  108, 110, 79,  113, 224, 232, 178, 185,
-    112, 104, 218, 246, 97,  228, 251, 34,  242, 193, 238, 210, 144, 12,  191, 179, 162, 241, 81,
-    51,  145, 235, 249, 14,  239, 107, 49,  192, 214, 31,  181, 199, 106, 157, 184, 84,  204, 176,
-    115, 121, 50,  45,  127, 4,   150, 254, 138, 236, 205, 93,  222, 114, 67,  29,  24,  72,  243,
-    141, 128, 195, 78,  66,  215, 61,  156, 180};
+    151, 160, 137, 91,  90,  15,  131, 13,  201, 95,  96,  53,  194, 233, 7,   225, 140, 36,  103, 30,  69,  142,
+    8,   99,  37,  240, 21,  10,  23,  190, 6,   148, 247, 120, 234, 75,  0,   26,  197, 62,  94,  252, 219, 203,
+    117, 35,  11,  32,  57,  177, 33,  88,  237, 149, 56,  87,  174, 20,  125, 136, 171, 168, 68,  175, 74,  165,
+    71,  134, 139, 48,  27,  166, 77,  146, 158, 231, 83,  111, 229, 122, 60,  211, 133, 230, 220, 105, 92,  41,
+    55,  46,  245, 40,  244, 102, 143, 54,  65,  25,  63,  161, 1,   216, 80,  73,  209, 76,  132, 187, 208, 89,
+    18,  169, 200, 196, 135, 130, 116, 188, 159, 86,  164, 100, 109, 198, 173, 186, 3,   64,  52,  217, 226, 250,
+    124, 123, 5,   202, 38,  147, 118, 126, 255, 82,  85,  212, 207, 206, 59,  227, 47,  16,  58,  17,  182, 189,
+    28,  42,  223, 183, 170, 213, 119, 248, 152, 2,   44,  154, 163, 70,  221, 153, 101, 155, 167, 43,  172, 9,
+    129, 22,  39,  253, 19,  98,  108, 110, 79,  113, 224, 232, 178, 185, 112, 104, 218, 246, 97,  228, 251, 34,
+    242, 193, 238, 210, 144, 12,  191, 179, 162, 241, 81,  51,  145, 235, 249, 14,  239, 107, 49,  192, 214, 31,
+    181, 199, 106, 157, 184, 84,  204, 176, 115, 121, 50,  45,  127, 4,   150, 254, 138, 236, 205, 93,  222, 114,
+    67,  29,  24,  72,  243, 141, 128, 195, 78,  66,  215, 61,  156, 180};
 
-const int kGradients[16][3] = {{1, 1, 0},  {-1, 1, 0}, {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
+const int kGradients[16][3] = {{1, 1, 0},  {-1, 1, 0},  {1, -1, 0}, {-1, -1, 0}, {1, 0, 1},  {-1, 0, 1},
                                {1, 0, -1}, {-1, 0, -1}, {0, 1, 1},  {0, -1, 1},  {0, 1, -1}, {0, -1, -1},
-                               {1, 1, 0},  {0, -1, 1}, {-1, 1, 0}, {0, -1, -1}};
+                               {1, 1, 0},  {0, -1, 1},  {-1, 1, 0}, {0, -1, -1}};
 
 double IndependentPerlin(double x, double y, double z) {
   auto perm = [](int i) { return kPublishedPermutation[i % 256]; };
@@ -116,8 +114,7 @@ TEST(PerlinNoiseTest, MatchesTheReferenceDefinition) {
   EXPECT_NEAR(f64::ImprovedPerlinNoise(f64::vec3(3.14, 42.0, 7.0)), 0.13691995878400012, 1e-15);
   // Gradient noise is zero on the lattice.
   for (int x = -3; x <= 3; ++x)
-    for (int y = -3; y <= 3; ++y)
-      EXPECT_EQ(f64::ImprovedPerlinNoise(f64::vec3(x, y, 2 * x - y)), 0.0) << x << "," << y;
+    for (int y = -3; y <= 3; ++y) EXPECT_EQ(f64::ImprovedPerlinNoise(f64::vec3(x, y, 2 * x - y)), 0.0) << x << "," << y;
   // And the shared code equals the transcription everywhere, negative
   // coordinates and the period 256 included.
   std::mt19937_64 rng(7);
@@ -125,12 +122,10 @@ TEST(PerlinNoiseTest, MatchesTheReferenceDefinition) {
   double worst = 0.0;
   for (int i = 0; i < 200000; ++i) {
     double x = u(rng), y = u(rng), z = u(rng);
-    worst = std::max(worst, std::abs(f64::ImprovedPerlinNoise(f64::vec3(x, y, z)) -
-                                     IndependentPerlin(x, y, z)));
+    worst = std::max(worst, std::abs(f64::ImprovedPerlinNoise(f64::vec3(x, y, z)) - IndependentPerlin(x, y, z)));
   }
   EXPECT_LT(worst, 1e-12);
-  EXPECT_NEAR(f64::ImprovedPerlinNoise(f64::vec3(3.14 + 256, 42.0 - 512, 7.0)), 0.13691995878400012,
-              1e-12);
+  EXPECT_NEAR(f64::ImprovedPerlinNoise(f64::vec3(3.14 + 256, 42.0 - 512, 7.0)), 0.13691995878400012, 1e-12);
 }
 
 TEST(PerlinNoiseTest, StaysWithinItsDocumentedRange) {
@@ -144,8 +139,7 @@ TEST(PerlinNoiseTest, StaysWithinItsDocumentedRange) {
     double n = f64::ImprovedPerlinNoise(p);
     lo = std::min(lo, n);
     hi = std::max(hi, n);
-    if (i % 10 == 0)
-      fractal_extreme = std::max(fractal_extreme, std::abs(f64::FractalPerlinNoise(p, 5)));
+    if (i % 10 == 0) fractal_extreme = std::max(fractal_extreme, std::abs(f64::FractalPerlinNoise(p, 5)));
   }
   // Every cell centre of one period plane, where the extremes sit.
   for (int x = 0; x < 256; ++x)
@@ -207,8 +201,7 @@ TEST(AoasHelpersTest, TargetColourGivesItsHueAndKeepsTheLuminanceWeight) {
   Rgb beta = RayleighForTargetColor(target, physical, k);
   // beta_c E_c K_c is proportional to the target ...
   double s0 = beta[0] * physical.solar_irradiance[0] * k[0] / target[0];
-  for (int c = 1; c < 3; ++c)
-    EXPECT_NEAR(beta[c] * physical.solar_irradiance[c] * k[c] / target[c] / s0, 1.0, 1e-12);
+  for (int c = 1; c < 3; ++c) EXPECT_NEAR(beta[c] * physical.solar_irradiance[c] * k[c] / target[c] / s0, 1.0, 1e-12);
   // ... with the physical luminance-weighted thickness.
   const double w[3] = {0.2126, 0.7152, 0.0722};
   double a = 0, b = 0;
@@ -245,9 +238,8 @@ multiscattering_lut_size = 16
 
 std::vector<std::vector<float>> RenderGpu(const SkyStyle& style, const std::vector<ViewRequest>& views) {
   const Rgb scale = OutputScale(style.output.units);
-  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
-                       style.effects, scale, false,
-                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)));
+  SkyRenderer renderer(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
+                       scale, false, ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)));
   glm::dvec3 sun = SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg);
   auto images = renderer.Render(sun, views);
   testing::ExpectNoValidationMessages();
@@ -256,8 +248,7 @@ std::vector<std::vector<float>> RenderGpu(const SkyStyle& style, const std::vect
 
 ReferenceModel Reference(const SkyStyle& style) {
   ReferenceModel model(StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-                       OutputScale(style.output.units),
-                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)));
+                       OutputScale(style.output.units), ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)));
   model.PrecomputeLuts();
   return model;
 }
@@ -337,8 +328,8 @@ TEST(SkydomeTest, OffAxisViewerSeesTheSkyOfItsApex) {
   // 0.5 thicknesses = 50 km up (eq. 2). Looking along its apex it sees the
   // zenith of a 50 km observer whose Sun is as high above its local horizon
   // as the dome's Sun is above the plane normal to the apex.
-  SkyStyle dome = Style(std::string(kFastQuality) +
-                        "[skydome]\nenabled = true\nradius = 2.0\nviewer_position = [0.6, 0.8, 0.0]\n");
+  SkyStyle dome =
+      Style(std::string(kFastQuality) + "[skydome]\nenabled = true\nradius = 2.0\nviewer_position = [0.6, 0.8, 0.0]\n");
   SkyStyle physical = Style(std::string(kFastQuality) + "[atmosphere]\nobserver_altitude_m = 50000.0\n");
   ReferenceModel a = Reference(dome), b = Reference(physical);
   const glm::dvec3 apex(0.6, 0.8, 0.0);
@@ -357,12 +348,11 @@ TEST(SkydomeTest, ScalingTheDomeDoesNotChangeTheSky) {
   // 16-texel cube strip.
   auto style_at = [](double scale) {
     glm::dvec3 viewer = glm::dvec3(0.12, 0.3, -0.05) * scale;
-    return Style(std::string(kFastQuality) +
-                 fmt::format("[skydome]\nenabled = true\nradius = {:.17g}\n"
-                             "viewer_position = [{:.17g}, {:.17g}, {:.17g}]\n"
-                             "[ambiguity]\nenabled = true\nl_pt = 0.03\ngrain = 0.02\n"
-                             "[clouds]\nenabled = true\ns_noise = 0.2\n",
-                             scale, viewer.x, viewer.y, viewer.z));
+    return Style(std::string(kFastQuality) + fmt::format("[skydome]\nenabled = true\nradius = {:.17g}\n"
+                                                         "viewer_position = [{:.17g}, {:.17g}, {:.17g}]\n"
+                                                         "[ambiguity]\nenabled = true\nl_pt = 0.03\ngrain = 0.02\n"
+                                                         "[clouds]\nenabled = true\ns_noise = 0.2\n",
+                                                         scale, viewer.x, viewer.y, viewer.z));
   };
   std::vector<ViewRequest> views = {{MAPPING_LATLONG, 64, 32, 0}, {MAPPING_CUBE_STRIP, 16, 96, 0}};
   auto base = RenderGpu(style_at(1.0), views);
@@ -416,7 +406,8 @@ enabled = true
 kind = "spline"
 points = [[20.0, 150.0], [35.0, 180.0], [20.0, 210.0]]
 radius_deg = 8.0
-)", seed);
+)",
+                                                 seed);
 }
 
 TEST(AoasDeterminismTest, SeedDeterminesTheSkyOnGpuAndCpu) {
@@ -430,8 +421,8 @@ TEST(AoasDeterminismTest, SeedDeterminesTheSkyOnGpuAndCpu) {
   // lavapipe (float) against the double reference, texel by texel.
   SkyStyle style = Style(NoisyStyle(5));
   ReferenceModel reference = Reference(style);
-  std::vector<double> cpu = reference.RenderView(
-      SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg), views[0]);
+  std::vector<double> cpu =
+      reference.RenderView(SunDirectionFromElevationAzimuth(style.sun.elevation_deg, style.sun.azimuth_deg), views[0]);
   double worst = 0.0, sum = 0.0;
   for (size_t i = 0; i < first.size(); ++i) {
     if (i % 4 == 3) continue;
@@ -451,9 +442,9 @@ TEST(AoasDeterminismTest, SeedDeterminesTheSkyOnGpuAndCpu) {
 TEST(AoasDeterminismTest, StyledSkyOverTheSkyViewLutAgreesWithTheReference) {
   // With quality.sky_view_lut the physical radiance comes from the sky-view
   // LUT; the principles apply on top of it the same way on both sides.
-  ConfigResult config = ParseSkyStyle(NoisyStyle(5), "test.toml",
-                                      {"quality.sky_view_lut=true", "quality.sky_view_lut_width=96",
-                                       "quality.sky_view_lut_height=54"});
+  ConfigResult config =
+      ParseSkyStyle(NoisyStyle(5), "test.toml",
+                    {"quality.sky_view_lut=true", "quality.sky_view_lut_width=96", "quality.sky_view_lut_height=54"});
   ASSERT_TRUE(config.ok());
   const SkyStyle& style = config.style;
   ViewRequest view{MAPPING_LATLONG, 96, 48, 0};
@@ -496,8 +487,8 @@ grain = 0.02
   std::vector<glm::dvec3> dirs = ViewDirections(strip);
   std::map<std::array<long, 3>, std::vector<size_t>> by_direction;
   for (size_t i = 0; i < dirs.size(); ++i)
-    by_direction[{std::lround(dirs[i].x * 1e6), std::lround(dirs[i].y * 1e6), std::lround(dirs[i].z * 1e6)}]
-        .push_back(i);
+    by_direction[{std::lround(dirs[i].x * 1e6), std::lround(dirs[i].y * 1e6), std::lround(dirs[i].z * 1e6)}].push_back(
+        i);
   int seam_pairs = 0;
   double worst = 0.0;
   for (const auto& [key, texels] : by_direction) {
@@ -662,21 +653,18 @@ TEST(AoasConfigTest, ReportsMistakesWithTheirPlace) {
     for (const ConfigError& e : r.errors) all += e.Format() + "\n";
     return all;
   };
-  EXPECT_NE(errors("[hue]\ncolor = \"ffcc33\"\n").find("s.toml:2:9: hue.color: expected a colour"),
-            std::string::npos);
+  EXPECT_NE(errors("[hue]\ncolor = \"ffcc33\"\n").find("s.toml:2:9: hue.color: expected a colour"), std::string::npos);
   EXPECT_NE(errors("[skydome]\nenabled = true\nviewer_position = [0.0, 1.5, 0.0]\n")
                 .find("the viewer must be inside the dome"),
             std::string::npos);
-  EXPECT_NE(errors("[skydome]\nenabled = true\nviewer_position = [0.0, -0.1, 0.0]\n")
-                .find("above the ground plane"),
+  EXPECT_NE(errors("[skydome]\nenabled = true\nviewer_position = [0.0, -0.1, 0.0]\n").find("above the ground plane"),
             std::string::npos);
   EXPECT_NE(errors("[clouds]\nocatves = 3\n").find("did you mean 'clouds.octaves'"), std::string::npos);
   EXPECT_NE(errors("[clouds]\nthreshold = 1.0\n").find("out of range"), std::string::npos);
   EXPECT_NE(errors("[[shapes.shape]]\nkind = \"point\"\npoints = [[10.0, 20.0]]\nradius = 3\n")
                 .find("shapes.shape[0].radius: unknown key"),
             std::string::npos);
-  EXPECT_NE(errors("[[shapes.shape]]\nkind = \"spline\"\npoints = [[10.0, 20.0]]\n")
-                .find("at least 2 points"),
+  EXPECT_NE(errors("[[shapes.shape]]\nkind = \"spline\"\npoints = [[10.0, 20.0]]\n").find("at least 2 points"),
             std::string::npos);
   EXPECT_NE(errors("[[shapes.shape]]\npoints = [[100.0, 20.0]]\n").find("shapes.shape[0].points[0]"),
             std::string::npos);

@@ -148,17 +148,17 @@ TEST(AtmosphereTransmittanceTest, VerticalTransmittanceEqualsClosedForm) {
   model.PrecomputeLuts();
   const double thickness = a.top_radius_km - a.bottom_radius_km;
   for (int c = 0; c < 3; ++c) {
-    double tau = a.rayleigh_scattering_per_km[c] * a.rayleigh_scale_height_km *
-                     (1 - std::exp(-thickness / a.rayleigh_scale_height_km)) +
-                 a.mie_extinction_per_km[c] * a.mie_scale_height_km *
-                     (1 - std::exp(-thickness / a.mie_scale_height_km)) +
-                 a.ozone_absorption_per_km[c] * a.ozone_half_width_km;
+    double tau =
+        a.rayleigh_scattering_per_km[c] * a.rayleigh_scale_height_km *
+            (1 - std::exp(-thickness / a.rayleigh_scale_height_km)) +
+        a.mie_extinction_per_km[c] * a.mie_scale_height_km * (1 - std::exp(-thickness / a.mie_scale_height_km)) +
+        a.ozone_absorption_per_km[c] * a.ozone_half_width_km;
     double exact = std::exp(-tau);
     EXPECT_NEAR(model.TransmittanceDirect(0.0, 1.0, 4096)[c] / exact, 1.0, 1e-6) << c;
     // The LUT's first texel sits exactly at (ground, zenith), so reading it
     // returns that texel's own quadrature ...
-    EXPECT_NEAR(model.TransmittanceFromLut(0.0, 1.0)[c],
-                model.TransmittanceDirect(0.0, 1.0, q.transmittance_steps)[c], 1e-12);
+    EXPECT_NEAR(model.TransmittanceFromLut(0.0, 1.0)[c], model.TransmittanceDirect(0.0, 1.0, q.transmittance_steps)[c],
+                1e-12);
     // ... whose midpoint-rule error with h = 100/256 km is about
     // tau_Mie h^2 / (24 H_Mie^2) ~ 2.4e-5 here: bound it by 1e-4.
     EXPECT_NEAR(model.TransmittanceFromLut(0.0, 1.0)[c] / exact, 1.0, 1e-4) << c;

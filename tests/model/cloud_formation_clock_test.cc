@@ -64,8 +64,7 @@ smoothing_steps = 64
   const testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size 16 -q --out '" + root + "/out'");
   EXPECT_EQ(run.exit_code, int(kExitBudget)) << run.output;
   EXPECT_NE(run.output.find("MiB of it the cloud formations' lattices"), std::string::npos) << run.output;
-  EXPECT_NE(run.output.find("lower [cloud_layer.formation] cells or smoothing_steps"), std::string::npos)
-      << run.output;
+  EXPECT_NE(run.output.find("lower [cloud_layer.formation] cells or smoothing_steps"), std::string::npos) << run.output;
   EXPECT_FALSE(fs::exists(root + "/out/manifest.json"));
   fs::remove_all(root);
 }
@@ -326,8 +325,8 @@ TEST(CloudFormationClock, CoverHoldsOverQuarterAndHalfHours) {
   const AfternoonMaps density = BakeAfternoon("density = true\nsmoothing_steps = 20");
   const AfternoonMaps shipped = BakeAfternoon();
   auto print = [](const char* what, const AfternoonMaps& m) {
-    std::printf("%s: consecutive shadow maps correlate %.3f at 15 min, %.3f at 30 min\n", what,
-                MeanCorrelation(m, 1), MeanCorrelation(m, 2));
+    std::printf("%s: consecutive shadow maps correlate %.3f at 15 min, %.3f at 30 min\n", what, MeanCorrelation(m, 1),
+                MeanCorrelation(m, 2));
   };
   print("wind-only layer", wind);
   print("formation, whole density, smoothing_steps 20", density);
@@ -346,8 +345,8 @@ TEST(CloudFormationClock, ShadowMapsHoldNoLattice) {
   const AfternoonMaps formation = BakeAfternoon();
   ASSERT_EQ(formation.maps.size(), 9u);
   const std::pair<double, int> peak = LatticePeak(formation.maps, formation.n);
-  std::printf("afternoon formation: lattice peak %.1f x its ring's median (ring %d of %d)\n", peak.first,
-              peak.second, formation.n / 2);
+  std::printf("afternoon formation: lattice peak %.1f x its ring's median (ring %d of %d)\n", peak.first, peak.second,
+              formation.n / 2);
   EXPECT_LT(peak.first, kLatticePeakRatio);
 }
 

@@ -97,8 +97,13 @@ TEST(CloudFormationRules, NeighbourhoodIsDobashis) {
 // rest as CloudFormation's defaults.
 CloudFormation Formation(std::array<int, 3> cells, double steps_per_hour, int warmup_steps, double extinction,
                          double humidity, double phase) {
-  return {.enabled = true, .cells = cells, .steps_per_hour = steps_per_hour, .warmup_steps = warmup_steps,
-          .extinction_probability = extinction, .humidity_probability = humidity, .phase_probability = phase};
+  return {.enabled = true,
+          .cells = cells,
+          .steps_per_hour = steps_per_hour,
+          .warmup_steps = warmup_steps,
+          .extinction_probability = extinction,
+          .humidity_probability = humidity,
+          .phase_probability = phase};
 }
 
 // Most tests': 32 x 32 x 6 cells from step 0, half of them humid.
@@ -120,7 +125,8 @@ TEST(CloudFormationRules, ExtremesOfTheProbabilities) {
   cleared.extinction_probability = 1.0;
   cleared.phase_probability = 1.0;
   cleared.humidity_probability = 1.0;
-  for (uint64_t steps : {1u, 2u, 5u, 40u}) EXPECT_EQ(Count(SimulateFormation(cleared, nullptr, 7, steps).cld), 0u) << steps;
+  for (uint64_t steps : {1u, 2u, 5u, 40u})
+    EXPECT_EQ(Count(SimulateFormation(cleared, nullptr, 7, steps).cld), 0u) << steps;
   const FormationCoverage c = FormationCoverageAt(cleared, nullptr, 7, 1234.0, 32);
   EXPECT_EQ(*std::max_element(c.map.begin(), c.map.end()), 0.0f);
 
@@ -210,7 +216,6 @@ TEST(CloudFormationRules, ClockTimeStepsAndDrift) {
   EXPECT_NE(a.map, c.map);
   for (size_t i = 0; i < a.map.size(); ++i) EXPECT_NEAR(b.map[i], 0.5f * (a.map[i] + c.map[i]), 1e-6f) << i;
 }
-
 
 // The mask's channels: where blue (extinction) is 1 and Pext is 1 no cloud
 // stays; where red (humidity) and green (readiness) are 0 none forms; where
@@ -338,12 +343,13 @@ TEST(CloudFormationConfig, KeysAreCheckedAndOffIsUnchanged) {
   ASSERT_EQ(e.size(), 1u);
   EXPECT_NE(e[0].find("beyond the last of the mask's 1 layer(s)"), std::string::npos) << e[0];
   const ConfigResult plain = ParseSkyStyle("[[cloud_layer]]\ncoverage = 0.4\n", "f.toml");
-  const ConfigResult off = ParseSkyStyle("[[cloud_layer]]\ncoverage = 0.4\n[cloud_layer.formation]\nenabled = false\n",
-                                         "f.toml");
+  const ConfigResult off =
+      ParseSkyStyle("[[cloud_layer]]\ncoverage = 0.4\n[cloud_layer.formation]\nenabled = false\n", "f.toml");
   ASSERT_TRUE(plain.ok() && off.ok());
   EXPECT_EQ(plain.style.resolved_toml, off.style.resolved_toml);
   const ConfigResult on = ParseSkyStyle(
-      "[[cloud_layer]]\ncoverage = 0.4\n[cloud_layer.formation]\nenabled = true\nphase_probability = 0.002\n", "f.toml");
+      "[[cloud_layer]]\ncoverage = 0.4\n[cloud_layer.formation]\nenabled = true\nphase_probability = 0.002\n",
+      "f.toml");
   ASSERT_TRUE(on.ok());
   EXPECT_TRUE(on.style.clouds.layers[0].formation.enabled);
   EXPECT_EQ(on.style.clouds.layers[0].formation.phase_probability, 0.002);

@@ -39,10 +39,10 @@ SkyStyle Style(const std::string& toml) {
 
 std::unique_ptr<SkyRenderer> RendererOf(const SkyStyle& unpruned, double time_s = 0.0) {
   const SkyStyle style = PrunedStyle(unpruned);
-  return std::make_unique<SkyRenderer>(
-      testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-      OutputScale(style.output.units), false, ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
-      ToCloudInputs(style.clouds, style.aoas.seed, "", time_s));
+  return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
+                                       style.effects, OutputScale(style.output.units), false,
+                                       ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                                       ToCloudInputs(style.clouds, style.aoas.seed, "", time_s));
 }
 
 glm::dvec3 Sun(double elevation_deg, double azimuth_deg = 135.0) {
@@ -62,7 +62,8 @@ altitude_m = 1000
 thickness_m = 500
 type = "custom"
 profile = [0.0, 0.0, 1.0, 1.0]
-coverage = )" + coverage + "\ndensity_per_m = " + density_per_m + "\nshape_amount = " + shape_amount +
+coverage = )" +
+         coverage + "\ndensity_per_m = " + density_per_m + "\nshape_amount = " + shape_amount +
          "\ndetail_amount = 0.0\n";
 }
 
@@ -88,7 +89,8 @@ TEST(CloudShadow, UniformLayerCastsExpOfTauOverCosine) {
   // A receiver inside the slab, 250 m above its base: half the optical depth.
   s.strength = 1.0;
   s.receiver_altitude_m = 1250.0;
-  for (float t : r->RenderCloudShadow(Sun(45.0), s)) ASSERT_NEAR(t, std::exp(-0.5 / std::sin(glm::radians(45.0))), 2e-5);
+  for (float t : r->RenderCloudShadow(Sun(45.0), s))
+    ASSERT_NEAR(t, std::exp(-0.5 / std::sin(glm::radians(45.0))), 2e-5);
   // A receiver above the layer: nothing above it, all ones.
   s.receiver_altitude_m = 2000.0;
   for (float t : r->RenderCloudShadow(Sun(45.0), s)) ASSERT_EQ(t, 1.0f);
@@ -373,8 +375,8 @@ extent_m = 2000.0
 center_east_m = 100.0
 receiver_altitude_m = 20.0
 )";
-  testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size 16 -q --vulkan-validation --out '" + root +
-                                                "/out'");
+  testing::CommandRun run =
+      testing::RunSkybake("bake '" + style + "' --size 16 -q --vulkan-validation --out '" + root + "/out'");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string path = root + "/out/sky_cloudshadow.exr";
   auto in = OIIO::ImageInput::open(path);
@@ -428,8 +430,10 @@ receiver_altitude_m = 20.0
 TEST(CloudShadowFile, GltfGroundPlaneCarriesTheMap) {
   const std::string root = testing::FreshTempDir("cloud_shadow_gltf");
   const std::string style = testing::SourceDir() + "/configs/styles/afternoon_buildup.toml";
-  testing::CommandRun run = testing::RunSkybake("bake '" + style + "' --size 16 -q --vulkan-validation "
-                                                "--set cloud_shadow.resolution=32 --out '" + root + "/out'");
+  testing::CommandRun run = testing::RunSkybake("bake '" + style +
+                                                "' --size 16 -q --vulkan-validation "
+                                                "--set cloud_shadow.resolution=32 --out '" +
+                                                root + "/out'");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const std::string out = root + "/out";
   auto [status, report] = testing::RunCommand("cd '" + testing::SourceDir() + "/tests/viewer' && node validate.mjs '" +
@@ -441,7 +445,8 @@ TEST(CloudShadowFile, GltfGroundPlaneCarriesTheMap) {
   const nlohmann::json manifest = nlohmann::json::parse(std::ifstream(out + "/manifest.json"));
   const nlohmann::json& info = manifest["frames"][0]["cloud_shadow"];
   bool listed = false;
-  for (const nlohmann::json& f : manifest["scene"]) listed = listed || (f["file"] == "sky_ground.png" && f["kind"] == "gltf_ground");
+  for (const nlohmann::json& f : manifest["scene"])
+    listed = listed || (f["file"] == "sky_ground.png" && f["kind"] == "gltf_ground");
   EXPECT_TRUE(listed) << manifest["scene"].dump();
 
   const nlohmann::json gltf = nlohmann::json::parse(std::ifstream(out + "/sky.gltf"));
@@ -475,9 +480,9 @@ TEST(CloudShadowFile, GltfGroundPlaneCarriesTheMap) {
   const double extent = info["extent_m"];
   for (int k = 0; k < 4; ++k)
     for (int c = 0; c < 3; ++c) {
-      const double expected = info["origin_m"][c].get<double>() +
-                              extent * (uvs[2 * k] * info["axis_u"][c].get<double>() +
-                                        uvs[2 * k + 1] * info["axis_v"][c].get<double>());
+      const double expected =
+          info["origin_m"][c].get<double>() +
+          extent * (uvs[2 * k] * info["axis_u"][c].get<double>() + uvs[2 * k + 1] * info["axis_v"][c].get<double>());
       EXPECT_NEAR(positions[3 * k + c], expected, 1e-3 * extent) << "corner " << k << " axis " << c;
     }
   using Uv = std::pair<float, float>;
@@ -516,8 +521,8 @@ TEST(CloudShadowFile, GltfGroundPlaneCarriesTheMap) {
   EXPECT_LT(lo, hi) << "the map has structure (broken clouds)";
 
   // Without the shadow map: no ground plane, no PNG.
-  testing::CommandRun off = testing::RunSkybake("bake '" + style + "' --size 16 -q --set cloud_shadow.enabled=false --out '" +
-                                                root + "/off'");
+  testing::CommandRun off = testing::RunSkybake(
+      "bake '" + style + "' --size 16 -q --set cloud_shadow.enabled=false --out '" + root + "/off'");
   ASSERT_EQ(off.exit_code, 0) << off.output;
   EXPECT_FALSE(std::filesystem::exists(root + "/off/sky_ground.png"));
   const std::string off_gltf = nlohmann::json::parse(std::ifstream(root + "/off/sky.gltf")).dump();
@@ -547,7 +552,8 @@ extent_m = 8000.0
   }
   EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_cloudshadow.0001.exr"),
             testing::ReadFileBytes(root + "/whole/sky_cloudshadow.0002.exr"));
-  EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"), testing::ReadFileBytes(root + "/whole/manifest.json"));
+  EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"),
+            testing::ReadFileBytes(root + "/whole/manifest.json"));
   std::filesystem::remove_all(root);
 }
 

@@ -55,10 +55,10 @@ coverage = 0.5
 struct StyleRenderer {
   explicit StyleRenderer(const SkyStyle& unpruned, double time_s = 0.0) {
     const SkyStyle style = PrunedStyle(unpruned);
-    renderer = std::make_unique<SkyRenderer>(
-        testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality, style.effects,
-        OutputScale(style.output.units), false, ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
-        ToCloudInputs(style.clouds, style.aoas.seed, "", time_s));
+    renderer = std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas),
+                                             style.quality, style.effects, OutputScale(style.output.units), false,
+                                             ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
+                                             ToCloudInputs(style.clouds, style.aoas.seed, "", time_s));
   }
   std::unique_ptr<SkyRenderer> renderer;
 };
@@ -106,10 +106,10 @@ tiling = true
   // The seed falls back to aoas.seed; wind x time moves the layer (east = +x, north = -z).
   CloudInputs in = ToCloudInputs(s.clouds, s.aoas.seed, "", 100.0);
   EXPECT_EQ(in.uniform.layers[0].noise.w, 9);
-  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.x, 1.0f);   // 10 m/s x 100 s = 1 km
-  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.y, 0.5f);   // 5 m/s south
-  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.z, 0.2f);   // 2 m/s per km x 100 s
-  EXPECT_FLOAT_EQ(in.uniform.layers[0].shell.z, 20.0f);        // 0.02 /m = 20 /km
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.x, 1.0f);  // 10 m/s x 100 s = 1 km
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.y, 0.5f);  // 5 m/s south
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].wind_offset.z, 0.2f);  // 2 m/s per km x 100 s
+  EXPECT_FLOAT_EQ(in.uniform.layers[0].shell.z, 20.0f);       // 0.02 /m = 20 /km
   // A tiling layer reads its tiles as they are (no warp: weather_origin.zw
   // 0); by default the warp of the 20 km weather tile and three weather reads.
   EXPECT_EQ(in.uniform.layers[0].weather_origin.z, 0.0f);
@@ -143,8 +143,8 @@ TEST(CloudStyle, PresetsSetTheCloudSampling) {
   EXPECT_EQ(CloudQualityPreset("reference").light_volume_columns, 0) << "the reference marches every light sample";
   EXPECT_GT(CloudQualityPreset("production").light_volume_columns, 0);
   EXPECT_EQ(Style("[quality]\ncloud_light_volume_columns = 64\n").clouds.quality.light_volume_columns, 64);
-  for (const char* bad : {"cloud_light_volume_columns = 2000", "cloud_light_volume_slices = 1",
-                          "cloud_light_volume_near_steps = -1"}) {
+  for (const char* bad :
+       {"cloud_light_volume_columns = 2000", "cloud_light_volume_slices = 1", "cloud_light_volume_near_steps = -1"}) {
     std::vector<std::string> errors = Errors(std::string("[quality]\n") + bad + "\n");
     ASSERT_EQ(errors.size(), 1u) << bad;
     EXPECT_NE(errors[0].find("clouds_test.toml:2:"), std::string::npos) << errors[0];
@@ -191,8 +191,10 @@ TEST(CloudStyle, BadLayersAreLocated) {
   EXPECT_TRUE(has(e, "cloud_layer[4]: 5 cloud layers; at most 4 fit")) << e[0];
   e = Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n[[cloud_layer]]\n");
   ASSERT_EQ(e.size(), 1u);
-  EXPECT_TRUE(has(e, "clouds_test.toml:3:21: quality.cloud_light_steps: 1 cloud layer(s) x 768 view steps x 128 "
-                     "light steps may run")) << e[0];
+  EXPECT_TRUE(has(e,
+                  "clouds_test.toml:3:21: quality.cloud_light_steps: 1 cloud layer(s) x 768 view steps x 128 "
+                  "light steps may run"))
+      << e[0];
   EXPECT_TRUE(Errors("[quality]\ncloud_view_steps = 768\ncloud_light_steps = 128\n").empty())
       << "without layers the cloud settings run nothing";
   e = Errors("[[cloud_layer]]\nweather_image = \"no_such_weather.png\"\n");
@@ -273,8 +275,7 @@ TEST(CloudPass, PrunedLayerIsByteIdenticalToNoLayer) {
     EXPECT_EQ(r.renderer->counters().pipelines, StyleRenderer(plain).renderer->counters().pipelines) << layer;
     const std::vector<std::vector<float>> images = RenderAll(pruned, sun, 16);
     ASSERT_EQ(images.size(), expected.size());
-    for (size_t i = 0; i < images.size(); ++i)
-      EXPECT_TRUE(images[i] == expected[i]) << layer << ", view " << i;
+    for (size_t i = 0; i < images.size(); ++i) EXPECT_TRUE(images[i] == expected[i]) << layer << ", view " << i;
   }
   // The same layer with coverage does change the sky (the test is not vacuous).
   const std::vector<std::vector<float>> cloudy = RenderAll(Style(std::string(kFast) + kCumulus), sun, 16);
@@ -326,10 +327,10 @@ wind_m_s = [80.0, 0.0]
 
 struct CloudCase {
   std::string name;
-  std::string toml;                 // after kFast
-  std::vector<double> suns_deg;     // sun elevations
+  std::string toml;              // after kFast
+  std::vector<double> suns_deg;  // sun elevations
   int cube = 24;
-  bool dim_not_black = false;       // overcast: the sky under it is dim but not black
+  bool dim_not_black = false;  // overcast: the sky under it is dim but not black
 };
 
 void CheckFiniteNonNegative(const std::vector<float>& image, const std::string& what) {
@@ -417,17 +418,25 @@ struct StyleAtSun {
 INSTANTIATE_TEST_SUITE_P(
     Cases, CloudHardCase,
     ::testing::Values(
-        CloudCase{"overcast_coverage_1", Layer(1000, 800, "type = \"stratus\"\ncoverage = 1.0\ndensity_per_m = 0.05"),
-                  {45.0}, 24, true},
+        CloudCase{"overcast_coverage_1",
+                  Layer(1000, 800, "type = \"stratus\"\ncoverage = 1.0\ndensity_per_m = 0.05"),
+                  {45.0},
+                  24,
+                  true},
         CloudCase{"extinction_1_per_m", Layer(1500, 1500, "coverage = 0.6\ndensity_per_m = 1.0"), {30.0}},
-        CloudCase{"thin_layer_at_10_km", Layer(10000, 100, "type = \"cirrus\"\ncoverage = 0.7\ndensity_per_m = 0.002"),
+        CloudCase{"thin_layer_at_10_km",
+                  Layer(10000, 100, "type = \"cirrus\"\ncoverage = 0.7\ndensity_per_m = 0.002"),
                   {30.0}},
-        CloudCase{"overlapping_layers", Layer(1000, 2000, "coverage = 0.5") + Layer(2500, 1500, "type = \"stratocumulus\"\ncoverage = 0.4\nseed = 7"),
+        CloudCase{"overlapping_layers",
+                  Layer(1000, 2000, "coverage = 0.5") +
+                      Layer(2500, 1500, "type = \"stratocumulus\"\ncoverage = 0.4\nseed = 7"),
                   {30.0}},
         CloudCase{"observer_inside_a_layer",
-                  "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+                  "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.6"),
+                  {30.0}},
         CloudCase{"observer_2_km_above_the_top_layer",
-                  "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.6"), {30.0}},
+                  "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.6"),
+                  {30.0}},
         CloudCase{"sun_at_zenith_horizon_and_minus_6_deg", Layer(1500, 1500, "coverage = 0.5"), {90.0, 0.0, -6.0}},
         CloudCase{"cube_size_16", Layer(1500, 1500, "coverage = 0.5"), {30.0}, 16}),
     [](const ::testing::TestParamInfo<CloudCase>& info) { return info.param.name; });
@@ -436,8 +445,8 @@ INSTANTIATE_TEST_SUITE_P(
 // draft preset with 8 view and 2 light steps to keep the case within a
 // minute on lavapipe; no NaN, Inf or negative value.
 TEST(CloudPass, CubeSize2048) {
-  const SkyStyle style = Style(std::string(kFast) + "cloud_view_steps = 8\ncloud_light_steps = 2\n" +
-                               Layer(1500, 1500, "coverage = 0.5"));
+  const SkyStyle style =
+      Style(std::string(kFast) + "cloud_view_steps = 8\ncloud_light_steps = 2\n" + Layer(1500, 1500, "coverage = 0.5"));
   StyleRenderer r(style);
   for (int face : {0, 2}) {
     std::vector<float> image = r.renderer->Render(Sun(30.0), {{MAPPING_VULKAN_FACE, 2048, 2048, face}})[0];
@@ -456,8 +465,10 @@ TEST(CloudPass, SunDiscHiddenByThickCloudsSeenThroughThin) {
     return with_disc - without;
   };
   const double clear = disc("");
-  const double thick = disc(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"));
-  const double thin = disc(Layer(9000, 300, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.001"));
+  const double thick =
+      disc(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"));
+  const double thin =
+      disc(Layer(9000, 300, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.001"));
   EXPECT_GT(clear, 0.0);
   // The march stops once the clouds' transmittance is below 1e-3 and drops
   // what lies behind: no disc at all.
@@ -484,7 +495,8 @@ TEST(CloudSequence, ShardsAndResumeAreByteIdentical) {
   std::set<std::string> whole = testing::FileNames(root + "/whole");
   EXPECT_GT(whole.size(), 30u);
   whole.erase("timings.json");
-  for (const std::string& dir : {root + "/shards", root + "/resumed"}) testing::ExpectSameBytes(dir, root + "/whole", whole);
+  for (const std::string& dir : {root + "/shards", root + "/resumed"})
+    testing::ExpectSameBytes(dir, root + "/whole", whole);
   // The wind moved the clouds between frames: the frames differ.
   EXPECT_NE(testing::ReadFileBytes(root + "/whole/sky_latlong.0001.exr"),
             testing::ReadFileBytes(root + "/whole/sky_latlong.0002.exr"));
@@ -505,7 +517,8 @@ TEST(CloudWeather, ImageCoverageIsWhereTheImageSays) {
   WriteImage(dir + "/west.png", 64, 64, 3, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
   WriteImage(dir + "/west.exr", 64, 64, 1, [](int x, int) { return x < 32 ? 1.0f : 0.0f; });
   const glm::dvec3 sun = Sun(50.0, 180.0);
-  const glm::dvec3 west = SunDirectionFromElevationAzimuth(30.0, 270.0), east = SunDirectionFromElevationAzimuth(30.0, 90.0);
+  const glm::dvec3 west = SunDirectionFromElevationAzimuth(30.0, 270.0),
+                   east = SunDirectionFromElevationAzimuth(30.0, 90.0);
   StyleRenderer clear(Style(kFast));
   const std::vector<float> sky = clear.renderer->RenderDirections(sun, {west, east}, false);
   for (const char* image : {"west.png", "west.exr"}) {
@@ -520,7 +533,8 @@ coverage = 0.5
 weather_image = "{}"
 weather_extent_m = [20000.0, 20000.0]
 weather_origin_m = [-10000.0, -10000.0]
-)", image);
+)",
+                                                              image);
     ConfigResult r = ParseSkyStyle(toml, dir + "/style.toml");
     ASSERT_TRUE(r.ok()) << r.errors[0].Format();
     const SkyStyle style = PrunedStyle(r.style);
@@ -566,8 +580,8 @@ TEST(CloudBake, ShIrradianceAndPreviewIncludeTheClouds) {
     return r;
   };
   const BakeResult clear = bake("", "clear");
-  const BakeResult overcast =
-      bake(Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"), "overcast");
+  const BakeResult overcast = bake(
+      Layer(1000, 1000, "type = \"stratus\"\ncoverage = 1.0\nshape_amount = 0.0\ndensity_per_m = 0.05"), "overcast");
   ASSERT_EQ(clear.frames.size(), 1u);
   ASSERT_EQ(overcast.frames.size(), 1u);
   EXPECT_GT(clear.frames[0].sun_illuminance_lux, 1e4);
@@ -615,7 +629,10 @@ TEST(CloudConvergence, PresetStepsApproachTheConvergedMarch) {
   const auto error = UpperHemisphereGreenError;
   const std::vector<float> converged = render(400, 50);
   const double half = error(render(200, 25), converged);
-  struct Setting { const char* name; int view, light; };
+  struct Setting {
+    const char* name;
+    int view, light;
+  };
   std::vector<double> errors;
   for (Setting s : {Setting{"draft", 32, 6}, Setting{"production", 48, 6}, Setting{"reference", 192, 32}}) {
     errors.push_back(error(render(s.view, s.light), converged));
@@ -755,7 +772,8 @@ TEST(CloudSkip, CellMaximaBoundEveryReadOfTheirCell) {
         for (int x = 0; x < sc; ++x) {
           float m = 0.0f;
           for (int k = 0; k < 8; ++k)
-            m = std::max(m, volume[(wrap(z + (k >> 2), 9) * 9 + wrap(y + ((k >> 1) & 1), 9)) * 9 + wrap(x + (k & 1), 9)]);
+            m = std::max(m,
+                         volume[(wrap(z + (k >> 2), 9) * 9 + wrap(y + ((k >> 1) & 1), 9)) * 9 + wrap(x + (k & 1), 9)]);
           EXPECT_EQ(shape_map[(z * sc + y) * sc + x], m);
         }
     EXPECT_GT(below_one, 0) << "the bounds are maxima, not 1";
@@ -773,8 +791,10 @@ TEST(CloudSkip, SkippingEmptySpaceKeepsTheBytes) {
       {"W3 cumulus", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"), 30.0},
       {"W3 cumulus, low sun", Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45"), 4.0},
       {"overcast stratus", Layer(800, 600, "type = \"stratus\"\ncoverage = 1.0"), 45.0},
-      {"overlapping, shear", Layer(1500, 1500, "coverage = 0.6\nshear_m_s_per_km = [20.0, 5.0]\nwind_m_s = [10.0, 0.0]") +
-                                 Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4"), 20.0},
+      {"overlapping, shear",
+       Layer(1500, 1500, "coverage = 0.6\nshear_m_s_per_km = [20.0, 5.0]\nwind_m_s = [10.0, 0.0]") +
+           Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4"),
+       20.0},
       {"thin cirrus at 10 km", Layer(10000, 300, "type = \"cirrus\"\ncoverage = 0.35"), -3.0},
       {"observer inside", "[atmosphere]\nobserver_altitude_m = 2000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
       {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
@@ -881,8 +901,8 @@ CloudInputs CloudsAt600s(const SkyStyle& style) {
   return clouds;
 }
 std::unique_ptr<SkyRenderer> RendererWithSwitches(const SkyStyle& style, const ShaderSwitches& shaders) {
-  return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas),
-                                       style.quality, style.effects, OutputScale(style.output.units), false,
+  return std::make_unique<SkyRenderer>(testing::Vulkan(), StyledAtmosphere(style.atmosphere, style.aoas), style.quality,
+                                       style.effects, OutputScale(style.output.units), false,
                                        ToAoasInputs(style.aoas, OutputScale(OutputUnits::kLuminance)),
                                        CloudsAt600s(style), shaders);
 }
@@ -913,12 +933,13 @@ TEST(CloudTexelViews, StorageBufferReadsKeepTheBytes) {
   const std::vector<StyleAtSun> cases = {
       {"clear, day", "", 30.0},
       {"clear, twilight", "", -4.0},
-      {"W3 cumulus, ground shadow", "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
-                                         Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
+      {"W3 cumulus, ground shadow",
+       "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
+           Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
        20.0},
-      {"two bands and a cirrus, twilight", Layer(1500, 1500, "coverage = 0.6") +
-                                               Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4") +
-                                               Layer(8000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
+      {"two bands and a cirrus, twilight",
+       Layer(1500, 1500, "coverage = 0.6") + Layer(2500, 2000, "type = \"stratocumulus\"\ncoverage = 0.4") +
+           Layer(8000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
        -2.0},
       {"observer above", "[atmosphere]\nobserver_altitude_m = 5000\n" + Layer(1500, 1500, "coverage = 0.45"), 30.0},
   };
@@ -969,11 +990,12 @@ TEST(CloudFormationRead, CompiledOutWithoutAFormationKeepsTheBytes) {
     out->close();
   }
   const std::vector<StyleAtSun> cases = {
-      {"W3 cumulus, ground shadow", "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
-                                         Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
+      {"W3 cumulus, ground shadow",
+       "[cloud_shadow]\nenabled = true\nresolution = 16\n" +
+           Layer(1500, 1500, "type = \"cumulus\"\ncoverage = 0.45\nwind_m_s = [8.0, 2.0]"),
        30.0},
-      {"two bands, weather image", Layer(1500, 1000, "weather_image = \"" + image + "\"") +
-                                       Layer(6000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
+      {"two bands, weather image",
+       Layer(1500, 1000, "weather_image = \"" + image + "\"") + Layer(6000, 500, "type = \"cirrus\"\ncoverage = 0.5"),
        20.0},
   };
   for (const StyleAtSun& c : cases) {

@@ -78,8 +78,8 @@ TEST(EnvmapTest, VulkanFacesRoundTripThroughTheSpecTable) {
 
 TEST(EnvmapTest, GpuMappingsMatchOpenExrAndVulkan) {
   VulkanContext& vulkan = testing::Vulkan();
-  SkyRenderer renderer(vulkan, AtmosphereParams{}, QualitySettings{}, EffectSettings{},
-                       {1.0, 1.0, 1.0}, /*output_directions=*/true);
+  SkyRenderer renderer(vulkan, AtmosphereParams{}, QualitySettings{}, EffectSettings{}, {1.0, 1.0, 1.0},
+                       /*output_directions=*/true);
   const int h = 64, n = 32;
   std::vector<ViewRequest> views = {{MAPPING_LATLONG, 2 * h, h, 0}, {MAPPING_CUBE_STRIP, n, 6 * n, 0}};
   for (int face = 0; face < 6; ++face) views.push_back({MAPPING_VULKAN_FACE, n, n, face});

@@ -26,9 +26,8 @@ std::vector<std::vector<float>> MakeFaces(int n, F radiance) {
 }
 
 ShRgb Project(const std::vector<std::vector<float>>& faces, int n) {
-  return ProjectCubeFaces({faces[0].data(), faces[1].data(), faces[2].data(), faces[3].data(),
-                           faces[4].data(), faces[5].data()},
-                          n);
+  return ProjectCubeFaces(
+      {faces[0].data(), faces[1].data(), faces[2].data(), faces[3].data(), faces[4].data(), faces[5].data()}, n);
 }
 
 TEST(Sh, TexelSolidAnglesCoverTheSphere) {

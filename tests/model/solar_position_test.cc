@@ -88,8 +88,7 @@ TEST(SolarPosition, KiderCapturesIthaca2013) {
     ++rows;
   }
   EXPECT_EQ(rows, 15);
-  std::printf("worst error over %d captures: zenith %.4f deg, azimuth %.4f deg\n", rows,
-              worst_zenith, worst_azimuth);
+  std::printf("worst error over %d captures: zenith %.4f deg, azimuth %.4f deg\n", rows, worst_zenith, worst_azimuth);
 }
 
 TEST(SolarPosition, NrelSpaExampleGolden2003) {
@@ -100,8 +99,8 @@ TEST(SolarPosition, NrelSpaExampleGolden2003) {
   double apparent_zenith = 90.0 - (p.elevation_deg + SpaRefractionDeg(p.elevation_deg, 820.0, 11.0));
   EXPECT_NEAR(apparent_zenith, 50.111622, kToleranceDeg);
   EXPECT_LE(AngleDifferenceDeg(p.azimuth_deg, 194.340241), kToleranceDeg);
-  std::printf("Golden 2003: zenith error %.4f deg, azimuth error %.4f deg\n",
-              std::abs(apparent_zenith - 50.111622), AngleDifferenceDeg(p.azimuth_deg, 194.340241));
+  std::printf("Golden 2003: zenith error %.4f deg, azimuth error %.4f deg\n", std::abs(apparent_zenith - 50.111622),
+              AngleDifferenceDeg(p.azimuth_deg, 194.340241));
 }
 
 struct SpaRow {
@@ -126,16 +125,15 @@ TEST(SolarPosition, NrelSpaReferenceRows) {
   double worst_zenith = 0.0, worst_azimuth = 0.0;
   for (const SpaRow& row : rows) {
     SolarPosition p = ComputeSolarPosition(row.utc, {row.latitude, row.longitude});
-    double apparent_zenith =
-        90.0 - (p.elevation_deg + SpaRefractionDeg(p.elevation_deg, 1000.0, 10.0));
+    double apparent_zenith = 90.0 - (p.elevation_deg + SpaRefractionDeg(p.elevation_deg, 1000.0, 10.0));
     EXPECT_NEAR(apparent_zenith, row.zenith, kToleranceDeg) << row.place << " " << row.utc.Iso8601();
     EXPECT_LE(AngleDifferenceDeg(p.azimuth_deg, row.azimuth), kToleranceDeg)
         << row.place << " " << row.utc.Iso8601() << " azimuth " << p.azimuth_deg;
     worst_zenith = std::max(worst_zenith, std::abs(apparent_zenith - row.zenith));
     worst_azimuth = std::max(worst_azimuth, AngleDifferenceDeg(p.azimuth_deg, row.azimuth));
   }
-  std::printf("worst error over %zu SPA rows: zenith %.4f deg, azimuth %.4f deg\n",
-              std::size(rows), worst_zenith, worst_azimuth);
+  std::printf("worst error over %zu SPA rows: zenith %.4f deg, azimuth %.4f deg\n", std::size(rows), worst_zenith,
+              worst_azimuth);
 }
 
 TEST(SolarPosition, OffsetOnlyShiftsTheInstant) {

@@ -156,9 +156,9 @@ TEST(ExrIoTest, DeflateEncoderDecodesLikeOpenExrEncoder) {
         for (PixelType type : {PixelType::kHalf, PixelType::kFloat}) {
           std::string one_thread;
           for (int threads : {1, 3}) {
-            SCOPED_TRACE(::testing::Message() << k.w << "x" << k.h << (k.noisy ? " noise " : " ramp ") << compression
-                                              << " level " << level << (type == PixelType::kHalf ? " half" : " float")
-                                              << " threads " << threads);
+            SCOPED_TRACE(::testing::Message()
+                         << k.w << "x" << k.h << (k.noisy ? " noise " : " ramp ") << compression << " level " << level
+                         << (type == PixelType::kHalf ? " half" : " float") << " threads " << threads);
             SetExrThreads(threads);
             ExrWriteOptions options;
             options.pixel_type = type;
@@ -250,8 +250,7 @@ TEST(ExrIoTest, FilesEncodedTogetherAreTheBytesOfEachAlone) {
   // bytes EncodeExr gives it alone, whatever else is in the call: other
   // sizes, codecs, levels and pixel types, OpenEXR's encoder, an empty list.
   const std::vector<RgbaImage> images = {Ramp(512, 40, 3.0e4f), Ramp(37, 33, 3.0e4f), NoisyImage(300, 45, 5),
-                                         Ramp(1, 1, 2.0f),
-                                         Ramp(2048, 17, 3.0e4f)};
+                                         Ramp(1, 1, 2.0f), Ramp(2048, 17, 3.0e4f)};
   std::vector<ExrFile> files;
   int k = 0;
   for (const RgbaImage& image : images) {

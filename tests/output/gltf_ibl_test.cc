@@ -28,7 +28,8 @@ std::string Style() { return testing::SourceDir() + "/configs/default.toml"; }
 // image-based light, into `dir`; `extra` after -q.
 testing::CommandRun BakeWithImageBasedLight(const std::string& dir, const std::string& extra = "") {
   return testing::RunSkybake("bake " + Style() + " --size 32 -q " + extra +
-                             "--set ibl.specular=true --set ibl.size=32 --set gltf.image_based_light=true --out " + dir);
+                             "--set ibl.specular=true --set ibl.size=32 --set gltf.image_based_light=true --out " +
+                             dir);
 }
 
 struct Image {

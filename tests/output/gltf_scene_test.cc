@@ -98,8 +98,8 @@ TEST(GltfScene, FlatteningAndHemisphere) {
     top = std::max(top, p.y), bottom = std::min(bottom, p.y);
     widest = std::max(widest, std::hypot(p.x, p.z));
   }
-  EXPECT_NEAR(top, 125.0, 1e-3);     // (1 - 0.75) * 500
-  EXPECT_NEAR(bottom, 0.0, 1e-3);    // a hemisphere stops at the horizon
+  EXPECT_NEAR(top, 125.0, 1e-3);   // (1 - 0.75) * 500
+  EXPECT_NEAR(bottom, 0.0, 1e-3);  // a hemisphere stops at the horizon
   EXPECT_NEAR(widest, 500.0, 1e-3);
 }
 

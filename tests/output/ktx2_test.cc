@@ -40,7 +40,6 @@ using testing::RunCommand;
 
 using nlohmann::json;
 
-
 // Decoders written from the Vulkan specification, independently of the encoder.
 float DecodeUnsignedFloat(uint32_t bits, int mantissa_bits) {
   const uint32_t e = bits >> mantissa_bits, m = bits & ((1u << mantissa_bits) - 1);
@@ -98,9 +97,9 @@ struct Ktx2Header {
 };
 Ktx2Header ReadKtx2Header(const std::string& bytes) {
   Ktx2Header h;
-  uint32_t* words[] = {&h.vk_format, &h.type_size, &h.width,      &h.height,     &h.depth,
-                       &h.layers,    &h.faces,     &h.levels,     &h.supercompression,
-                       &h.dfd_offset, &h.dfd_length, &h.kvd_offset, &h.kvd_length};
+  uint32_t* words[] = {&h.vk_format,  &h.type_size,  &h.width,     &h.height,           &h.depth,
+                       &h.layers,     &h.faces,      &h.levels,    &h.supercompression, &h.dfd_offset,
+                       &h.dfd_length, &h.kvd_offset, &h.kvd_length};
   for (size_t i = 0; i < std::size(words); ++i) *words[i] = Word32(bytes, 12 + 4 * i);
   h.sgd_offset = Word64(bytes, 64);
   h.sgd_length = Word64(bytes, 72);
@@ -142,25 +141,33 @@ std::string TinyCube(KtxFormat format, int zstd_level = 0) {
 // sampleUpper.
 std::vector<uint32_t> KtxSoftwareDfdWords(uint32_t vk_format) {
   const uint32_t kOne = 0x3F800000, kMinusOne = 0xBF800000;  // 1.0f, -1.0f
-  const std::vector<uint32_t> rgba16f = {
-      92, 0, 2 | (88 << 16), 0x00010101, 0, 8, 0,
-      0xC00F0000, 0, kMinusOne, kOne,   // R: 16 bits at 0, FLOAT | SIGNED
-      0xC10F0010, 0, kMinusOne, kOne,   // G: at 16
-      0xC20F0020, 0, kMinusOne, kOne,   // B: at 32
-      0xCF0F0030, 0, kMinusOne, kOne};  // A (15): at 48
-  const std::vector<uint32_t> b10g11r11 = {
-      76, 0, 2 | (72 << 16), 0x00010101, 0, 4, 0,
-      0x800A0000, 0, 0, kOne,   // R: 11 bits at 0, FLOAT, 0.0f to 1.0f
-      0x810A000B, 0, 0, kOne,   // G: 11 bits at 11
-      0x82090016, 0, 0, kOne};  // B: 10 bits at 22
-  const std::vector<uint32_t> e5b9g9r9 = {
-      124, 0, 2 | (120 << 16), 0x00010101, 0, 4, 0,
-      0x00080000, 0, 0, 8448,  // R mantissa: 9 bits at 0, no qualifier, 0 to 8448
-      0x2004001B, 0, 15, 31,   // R exponent: 5 bits at 27, EXPONENT, 15 to 31
-      0x01080009, 0, 0, 8448,  // G mantissa at 9
-      0x2104001B, 0, 15, 31,   // G exponent
-      0x02080012, 0, 0, 8448,  // B mantissa at 18
-      0x2204001B, 0, 15, 31};  // B exponent
+  const std::vector<uint32_t> rgba16f = {92,         0, 2 | (88 << 16), 0x00010101, 0, 8, 0,
+                                         0xC00F0000, 0, kMinusOne,      kOne,   // R: 16 bits at 0, FLOAT | SIGNED
+                                         0xC10F0010, 0, kMinusOne,      kOne,   // G: at 16
+                                         0xC20F0020, 0, kMinusOne,      kOne,   // B: at 32
+                                         0xCF0F0030, 0, kMinusOne,      kOne};  // A (15): at 48
+  const std::vector<uint32_t> b10g11r11 = {76,         0,          2 | (72 << 16),
+                                           0x00010101, 0,          4,
+                                           0,          0x800A0000, 0,
+                                           0,          kOne,  // R: 11 bits at 0, FLOAT, 0.0f to 1.0f
+                                           0x810A000B, 0,          0,
+                                           kOne,  // G: 11 bits at 11
+                                           0x82090016, 0,          0,
+                                           kOne};  // B: 10 bits at 22
+  const std::vector<uint32_t> e5b9g9r9 = {124,        0,          2 | (120 << 16),
+                                          0x00010101, 0,          4,
+                                          0,          0x00080000, 0,
+                                          0,          8448,  // R mantissa: 9 bits at 0, no qualifier, 0 to 8448
+                                          0x2004001B, 0,          15,
+                                          31,  // R exponent: 5 bits at 27, EXPONENT, 15 to 31
+                                          0x01080009, 0,          0,
+                                          8448,  // G mantissa at 9
+                                          0x2104001B, 0,          15,
+                                          31,  // G exponent
+                                          0x02080012, 0,          0,
+                                          8448,  // B mantissa at 18
+                                          0x2204001B, 0,          15,
+                                          31};  // B exponent
   return vk_format == 97 ? rgba16f : vk_format == 122 ? b10g11r11 : e5b9g9r9;
 }
 
@@ -305,12 +312,12 @@ TEST(Ktx2Test, ConformanceReaderCatchesBrokenFiles) {
     b[at] = value;
     return Ktx2Problems(b);
   };
-  EXPECT_FALSE(broken(16, 2).empty());                                            // typeSize
-  EXPECT_FALSE(broken(ReadKtx2Header(good).dfd_offset + 20, 8).empty());           // bytesPlane0
-  EXPECT_FALSE(broken(ReadKtx2Header(good).dfd_offset + 28 + 4, 1).empty());       // sample position
-  EXPECT_FALSE(broken(ReadKtx2Header(good).kvd_offset + 4, 'a').empty());          // key order
-  EXPECT_FALSE(broken(80, char(ReadKtx2Header(good).dfd_offset + 1)).empty());     // level offset
-  EXPECT_FALSE(Ktx2Problems(good + "x").empty());                                 // trailing bytes
+  EXPECT_FALSE(broken(16, 2).empty());                                          // typeSize
+  EXPECT_FALSE(broken(ReadKtx2Header(good).dfd_offset + 20, 8).empty());        // bytesPlane0
+  EXPECT_FALSE(broken(ReadKtx2Header(good).dfd_offset + 28 + 4, 1).empty());    // sample position
+  EXPECT_FALSE(broken(ReadKtx2Header(good).kvd_offset + 4, 'a').empty());       // key order
+  EXPECT_FALSE(broken(80, char(ReadKtx2Header(good).dfd_offset + 1)).empty());  // level offset
+  EXPECT_FALSE(Ktx2Problems(good + "x").empty());                               // trailing bytes
 }
 
 struct Level {
@@ -333,8 +340,8 @@ TEST_P(Ktx2BakeTest, EveryTexelMatchesTheExr) {
       "bake " + testing::SourceDir() +
       "/configs/default.toml --size 16 --set render.latlong_height=16 -q --set gltf.enabled=false "
       "--set ibl.size=32 --set ibl.specular=true --set ibl.irradiance=true --set ibl.irradiance_size=8 "
-      "--set ibl.dfg_lut=true --set ibl.dfg_size=16 --set ibl.ktx2=true --set ibl.ktx2_format=" + format +
-      " --set ibl.ktx2_zstd_level=" + std::to_string(zstd) + " --out " + dir);
+      "--set ibl.dfg_lut=true --set ibl.dfg_size=16 --set ibl.ktx2=true --set ibl.ktx2_format=" +
+      format + " --set ibl.ktx2_zstd_level=" + std::to_string(zstd) + " --out " + dir);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const uint32_t vk_format = format == "rgba16f" ? 97 : format == "b10g11r11" ? 122 : 123;
   struct File {
@@ -344,17 +351,20 @@ TEST_P(Ktx2BakeTest, EveryTexelMatchesTheExr) {
     uint32_t vk_format;
     int size;  // level 0's width
   };
-  for (const File& f : std::vector<File>{
-           {"sky_specular.ktx2", {"sky_specular_m0.exr", "sky_specular_m1.exr", "sky_specular_m2.exr"}, 6, vk_format, 32},
-           {"sky_irradiance.ktx2", {"sky_irradiance.exr"}, 6, vk_format, 8},
-           {"sky_dfg.ktx2", {"sky_dfg.exr"}, 1, 97, 16}}) {
+  for (const File& f : std::vector<File>{{"sky_specular.ktx2",
+                                          {"sky_specular_m0.exr", "sky_specular_m1.exr", "sky_specular_m2.exr"},
+                                          6,
+                                          vk_format,
+                                          32},
+                                         {"sky_irradiance.ktx2", {"sky_irradiance.exr"}, 6, vk_format, 8},
+                                         {"sky_dfg.ktx2", {"sky_dfg.exr"}, 1, 97, 16}}) {
     SCOPED_TRACE(f.ktx2);
     const std::string bytes = testing::ReadFileBytes(dir + "/" + f.ktx2);
     EXPECT_EQ(Ktx2Problems(bytes), std::vector<std::string>{});
     EXPECT_EQ(DfdWords(bytes), KtxSoftwareDfdWords(f.vk_format));
     const std::string prefix = dir + "/dump_" + f.ktx2;
-    auto [status, output] = RunCommand("cd '" + testing::SourceDir() + "/tests/viewer' && node ktx2_dump.mjs '" +
-                                       dir + "/" + f.ktx2 + "' '" + prefix + "'");
+    auto [status, output] = RunCommand("cd '" + testing::SourceDir() + "/tests/viewer' && node ktx2_dump.mjs '" + dir +
+                                       "/" + f.ktx2 + "' '" + prefix + "'");
     ASSERT_EQ(status, 0) << output;
     json k = json::parse(output);
     EXPECT_EQ(k["vkFormat"], f.vk_format);

@@ -197,9 +197,11 @@ TEST(UsdLayerTest, RotationTurnsPlusZTowardsTheSource) {
 TEST(UsdLayerTest, SingleBakeParsesWithItsLightsAndTheSunOnTheBrightestTexel) {
   const std::string dir = testing::FreshTempDir("usd_single");
   const testing::CommandRun bake = testing::RunSkybake(
-      "bake " + testing::SourceDir() + "/configs/default.toml --size 512 --usd -q --vulkan-validation "
+      "bake " + testing::SourceDir() +
+      "/configs/default.toml --size 512 --usd -q --vulkan-validation "
       "--set output.sun=\"map\" --set output.faces=false --set output.cube_strip=false --set sun.azimuth_deg=230 "
-      "--out " + dir);
+      "--out " +
+      dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.output;
   EXPECT_NE(bake.output.find(dir + "/sky.usda"), std::string::npos) << "the layer is not listed:\n" << bake.output;
 
@@ -243,8 +245,7 @@ TEST(UsdLayerTest, SingleBakeParsesWithItsLightsAndTheSunOnTheBrightestTexel) {
   // The Sun: lux, colour, angular diameter, normalize.
   const std::string sun = PrimBlock(text, "def DistantLight \"Sun\"");
   ASSERT_FALSE(sun.empty()) << text;
-  ExpectDistantLight(ValueOf(sun, "float inputs:intensity"), ValueOf(sun, "color3f inputs:color"), frame["sun"],
-                     "sun");
+  ExpectDistantLight(ValueOf(sun, "float inputs:intensity"), ValueOf(sun, "color3f inputs:color"), frame["sun"], "sun");
   EXPECT_EQ(Number(ValueOf(sun, "float inputs:exposure")), 0.0);
   EXPECT_EQ(ValueOf(sun, "bool inputs:normalize"), "1");
   ExpectRelativelyNear(Number(ValueOf(sun, "float inputs:angle")),
@@ -363,9 +364,10 @@ TEST(UsdLayerTest, EveryColourSpaceNamesTheDomeTexturesSpace) {
   for (const auto& [space, token] : spaces) {
     EXPECT_EQ(UsdColorSpaceToken(space), token);
     const std::string dir = root + "/" + space;
-    const testing::CommandRun bake = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 --usd -q --vulkan-validation "
-        "--set output.color_space=\"" + space + "\" --out " + dir);
+    const testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() +
+                                                         "/configs/default.toml --size 16 --usd -q --vulkan-validation "
+                                                         "--set output.color_space=\"" +
+                                                         space + "\" --out " + dir);
     ASSERT_EQ(bake.exit_code, 0) << space << ": " << bake.output;
     const json report = ReadWithTinyUsdz(dir);
     ASSERT_TRUE(report.is_object());
@@ -394,10 +396,11 @@ TEST(UsdLayerTest, EveryColourSpaceNamesTheDomeTexturesSpace) {
   // A space of an OpenColorIO config keeps the config's name.
   {
     const std::string dir = root + "/config";
-    const testing::CommandRun bake = testing::RunSkybake(
-        "bake " + testing::SourceDir() + "/configs/default.toml --size 16 --usd -q --vulkan-validation "
-        "--set 'output.color_space=\"Linear P3-D65\"' --set 'output.ocio_config=\"" + testing::SourceDir() +
-        "/tests/colour/ocio/test_config.ocio\"' --out " + dir);
+    const testing::CommandRun bake =
+        testing::RunSkybake("bake " + testing::SourceDir() +
+                            "/configs/default.toml --size 16 --usd -q --vulkan-validation "
+                            "--set 'output.color_space=\"Linear P3-D65\"' --set 'output.ocio_config=\"" +
+                            testing::SourceDir() + "/tests/colour/ocio/test_config.ocio\"' --out " + dir);
     ASSERT_EQ(bake.exit_code, 0) << bake.output;
     const json report = ReadWithTinyUsdz(dir);
     ASSERT_TRUE(report.is_object());
@@ -486,7 +489,8 @@ azimuth_deg = 220.0
   const std::string whole = testing::ReadFileBytes(root + "/whole/sky.usda");
   ASSERT_FALSE(whole.empty());
   EXPECT_EQ(testing::ReadFileBytes(root + "/parts/sky.usda"), whole);
-  EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"), testing::ReadFileBytes(root + "/whole/manifest.json"));
+  EXPECT_EQ(testing::ReadFileBytes(root + "/parts/manifest.json"),
+            testing::ReadFileBytes(root + "/whole/manifest.json"));
 
   fs::remove(root + "/whole/sky_latlong.0002.exr");
   testing::BakeSequence16(style, schedule, root + "/whole", "--usd --resume");
@@ -534,8 +538,9 @@ TEST(UsdLayerTest, OffByDefaultAndBadInputWritesNothing) {
   const testing::CommandRun folder =
       testing::RunSkybake("bake " + style + " --size 8 --usd --vulkan-validation --out " + out);
   EXPECT_EQ(folder.exit_code, 5) << folder.output;
-  EXPECT_EQ(folder.output, "skybake: error: " + out + "/sky.usda is a directory: an output file cannot replace it; "
-                           "move it away, or choose another --out\n");
+  EXPECT_EQ(folder.output, "skybake: error: " + out +
+                               "/sky.usda is a directory: an output file cannot replace it; "
+                               "move it away, or choose another --out\n");
   EXPECT_EQ(testing::FileNames(out), std::set<std::string>{"sky.usda"});
   EXPECT_TRUE(testing::FileNames(out + "/sky.usda").empty());
 

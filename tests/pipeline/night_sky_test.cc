@@ -81,7 +81,8 @@ glm::dvec3 Energy(const ViewRequest& view, const std::vector<TexelAdd>& adds) {
 
 TEST(NightSky, TexelSolidAnglesCoverTheSphere) {
   for (int n : {4, 64, 257}) {
-    for (const ViewRequest& v : {ViewRequest{MAPPING_CUBE_STRIP, n, 6 * n, 0}, ViewRequest{MAPPING_LATLONG, 2 * n, n, 0}}) {
+    for (const ViewRequest& v :
+         {ViewRequest{MAPPING_CUBE_STRIP, n, 6 * n, 0}, ViewRequest{MAPPING_LATLONG, 2 * n, n, 0}}) {
       double sum = 0.0;
       for (int y = 0; y < v.height; ++y)
         for (int x = 0; x < v.width; ++x) sum += ViewTexelSolidAngle(v, x, y);
@@ -99,7 +100,7 @@ TEST(NightSky, TexelSolidAnglesCoverTheSphere) {
 // every layout; its splat's centroid is its direction.
 TEST(NightSky, StarEnergyIsTheSameAtEveryResolution) {
   const std::vector<glm::dvec3> directions = {
-      glm::normalize(glm::dvec3(0.3, 0.8, -0.2)), glm::normalize(glm::dvec3(1.0, 0.999, 0.2)),  // near a cube edge
+      glm::normalize(glm::dvec3(0.3, 0.8, -0.2)), glm::normalize(glm::dvec3(1.0, 0.999, 0.2)),      // near a cube edge
       glm::normalize(glm::dvec3(-0.5, 0.05, 0.9)), glm::normalize(glm::dvec3(0.001, 1.0, -0.002)),  // near the pole
       glm::normalize(glm::dvec3(-1e-4, 0.3, -1.0))};  // at the latlong's seam
   for (const glm::dvec3& d : directions) {
@@ -141,7 +142,8 @@ TEST(NightSky, MovingStarDoesNotAlias) {
     const std::vector<TexelAdd> adds = SplatPointSources(v, {star});
     EXPECT_NEAR(Energy(v, adds).y, 1.0, 1e-6);
     double peak = 0.0;
-    for (const TexelAdd& a : adds) peak = std::max(peak, double(a.rgb[1]) * ViewTexelSolidAngle(v, int(a.texel % v.width), int(a.texel / v.width)));
+    for (const TexelAdd& a : adds)
+      peak = std::max(peak, double(a.rgb[1]) * ViewTexelSolidAngle(v, int(a.texel % v.width), int(a.texel / v.width)));
     if (previous_peak >= 0.0) largest_jump = std::max(largest_jump, std::abs(peak - previous_peak));
     previous_peak = peak;
   }
@@ -210,7 +212,8 @@ TEST(NightSky, AirglowBrightensTowardsTheHorizon) {
   const double r = 6360.0 / 6450.0;
   const double v60 = 1.0 / std::sqrt(1.0 - r * r * 0.75);
   const Rgb t60 = t.At(0.5), t0 = t.At(1.0);
-  const double expected = 1.7e-4 * v60 * (0.2126 * t60[0] / t0[0] * 1 + 0.7152 * t60[1] / t0[1] + 0.0722 * t60[2] / t0[2]);
+  const double expected =
+      1.7e-4 * v60 * (0.2126 * t60[0] / t0[0] * 1 + 0.7152 * t60[1] / t0[1] + 0.0722 * t60[2] / t0[2]);
   EXPECT_NEAR(luminance(0.5) / expected, 1.0, 2e-3);
   EXPECT_GT(luminance(std::sin(15.0 * M_PI / 180.0)), 1.5 * luminance(1.0));
   EXPECT_EQ(luminance(-0.01), 0.0);
@@ -319,7 +322,7 @@ TEST_F(NightBake, NoNanInfOrNegativeAtMidnightDuskAndMoonOnTheHorizon) {
   EXPECT_LT(elevation(1, "sun"), 0.0);  // the Sun just down, the Moon up: both lights
   EXPECT_GT(elevation(1, "sun"), -10.0);
   EXPECT_GT(elevation(1, "moon"), 30.0);
-  EXPECT_LT(elevation(3, "sun"), -60.0);  // after midnight
+  EXPECT_LT(elevation(3, "sun"), -60.0);           // after midnight
   EXPECT_LT(std::abs(elevation(4, "moon")), 1.0);  // the Moon on the horizon
   for (int frame = 1; frame <= 5; ++frame)
     for (const char* name : {"sky_latlong", "sky_cube", "sky_px", "sky_nz", "sky_py"}) {
@@ -343,7 +346,8 @@ TEST_F(NightBake, ManifestRecordsTheMoonPerFrame) {
   EXPECT_GT(moon["illuminance_lux"].get<double>(), 0.1);
   EXPECT_LT(moon["illuminance_lux"].get<double>(), 0.3);
   EXPECT_TRUE(moon["light"].get<bool>());
-  glm::dvec3 d(moon["direction"][0].get<double>(), moon["direction"][1].get<double>(), moon["direction"][2].get<double>());
+  glm::dvec3 d(moon["direction"][0].get<double>(), moon["direction"][1].get<double>(),
+               moon["direction"][2].get<double>());
   EXPECT_NEAR(glm::length(d), 1.0, 1e-9);
   // The SH with the lights has the Moon in it: brighter towards the Moon than without.
   const json& f = manifest["frames"][2];
@@ -403,16 +407,17 @@ TEST_F(NightBake, GltfHasTheMoonAsASecondLightAndValidates) {
     targets.insert(channel["target"]["path"] == "pointer"
                        ? channel["target"]["extensions"]["KHR_animation_pointer"]["pointer"].get<std::string>()
                        : channel["target"]["path"].get<std::string>());
-  EXPECT_EQ(targets, (std::multiset<std::string>{"rotation", "rotation",
-                                                 "/extensions/KHR_lights_punctual/lights/0/intensity",
-                                                 "/extensions/KHR_lights_punctual/lights/0/color",
-                                                 "/extensions/KHR_lights_punctual/lights/1/intensity",
-                                                 "/extensions/KHR_lights_punctual/lights/1/color"}));
+  EXPECT_EQ(targets,
+            (std::multiset<std::string>{"rotation", "rotation", "/extensions/KHR_lights_punctual/lights/0/intensity",
+                                        "/extensions/KHR_lights_punctual/lights/0/color",
+                                        "/extensions/KHR_lights_punctual/lights/1/intensity",
+                                        "/extensions/KHR_lights_punctual/lights/1/color"}));
   auto [status, output] = RunCommand("cd '" + SourceDir() + "/tests/viewer' && node validate.mjs '" + dir_ +
                                      "/out/sky.gltf' '" + dir_ + "/out/sky.glb'");
   EXPECT_EQ(status, 0) << output << "\n(install with: bash .ci/setup)";
   size_t count = 0;
-  for (size_t p = output.find("0 errors, 0 warnings"); p != std::string::npos; p = output.find("0 errors, 0 warnings", p + 1))
+  for (size_t p = output.find("0 errors, 0 warnings"); p != std::string::npos;
+       p = output.find("0 errors, 0 warnings", p + 1))
     ++count;
   EXPECT_EQ(count, 2u) << output;
 }
@@ -423,9 +428,10 @@ TEST_F(NightBake, ShardsMergeWithTheMoon) {
   ASSERT_EQ(run_.exit_code, 0) << run_.output;
   const std::string shards = dir_ + "/shards";
   for (const char* part : {"1/2", "2/2"}) {
-    testing::CommandRun r = RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 "
-                                                   "--out '{1}' --quiet --shard {2}",
-                                                   dir_, shards, part));
+    testing::CommandRun r =
+        RunSkybake(fmt::format("bake '{0}/style.toml' --schedule '{0}/night.toml' --size 64 "
+                               "--out '{1}' --quiet --shard {2}",
+                               dir_, shards, part));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   testing::CommandRun merge = RunSkybake(fmt::format("merge-manifest '{}'", shards));
@@ -441,15 +447,17 @@ TEST_F(NightBake, RefusesBadInputWithTheFix) {
   testing::CommandRun single = RunSkybake(fmt::format("bake '{}' --out '{}/x'", style, dir_));
   EXPECT_EQ(single.exit_code, 3) << single.output;
   EXPECT_NE(single.output.find("style.toml:4:9: night.stars: the night sky needs each frame's date, time and place"),
-            std::string::npos) << single.output;
+            std::string::npos)
+      << single.output;
   EXPECT_NE(single.output.find("--schedule"), std::string::npos);
   // A schedule of sun positions has no clock time either.
   std::ofstream(dir_ + "/suns.toml") << "[schedule]\nsun = { elevation_deg = [-20.0, -30.0], azimuth_deg = 90.0 }\n";
   testing::CommandRun suns = RunSkybake(fmt::format("check '{}' --schedule '{}/suns.toml'", style, dir_));
   EXPECT_EQ(suns.exit_code, 3) << suns.output;
   EXPECT_NE(suns.output.find("suns.toml gives sun positions only"), std::string::npos) << suns.output;
-  testing::CommandRun missing = RunSkybake(fmt::format(
-      "bake '{}' --schedule '{}' --out '{}/y' --set night.star_catalogue='\"/no/such/stars.json\"'", style, schedule, dir_));
+  testing::CommandRun missing = RunSkybake(
+      fmt::format("bake '{}' --schedule '{}' --out '{}/y' --set night.star_catalogue='\"/no/such/stars.json\"'", style,
+                  schedule, dir_));
   EXPECT_EQ(missing.exit_code, 3) << missing.output;
   EXPECT_NE(missing.output.find("cannot read the star catalogue '/no/such/stars.json'"), std::string::npos)
       << missing.output;
@@ -460,9 +468,9 @@ TEST_F(NightBake, RefusesBadInputWithTheFix) {
             0u)
       << missing.output;
   // A relative path given with --set is taken from the working directory.
-  testing::CommandRun relative = RunSkybake(
-      fmt::format("check '{}' --schedule '{}' --set night.star_catalogue=night.toml", style, schedule),
-      fmt::format("cd '{}' &&", dir_));
+  testing::CommandRun relative =
+      RunSkybake(fmt::format("check '{}' --schedule '{}' --set night.star_catalogue=night.toml", style, schedule),
+                 fmt::format("cd '{}' &&", dir_));
   EXPECT_EQ(relative.exit_code, 3) << relative.output;
   EXPECT_NE(relative.output.find("--set night.star_catalogue=night.toml:1:1: night.star_catalogue:"), std::string::npos)
       << relative.output;
@@ -481,15 +489,16 @@ TEST_F(NightBake, OffIsByteIdenticalAndPrunedInThePlan) {
   const std::string style = dir_ + "/style.toml";
   const std::string schedule = dir_ + "/night.toml";
   const std::string off = "--set night.stars=false --set night.moon=false --set night.moonlight=false";
-  testing::CommandRun a = RunSkybake(fmt::format("bake '{}' --schedule '{}' --size 16 --frames 2:2 --out '{}/off' --quiet {}",
-                                                 style, schedule, dir_, off));
+  testing::CommandRun a = RunSkybake(fmt::format(
+      "bake '{}' --schedule '{}' --size 16 --frames 2:2 --out '{}/off' --quiet {}", style, schedule, dir_, off));
   std::ofstream(dir_ + "/bare.toml") << "[effects]\nnight_dimming = true\n[output]\npixel_type = \"float\"\n";
-  testing::CommandRun b = RunSkybake(fmt::format("bake '{}/bare.toml' --schedule '{}' --size 16 --frames 2:2 --out '{}/bare' --quiet",
-                                                 dir_, schedule, dir_));
+  testing::CommandRun b = RunSkybake(fmt::format(
+      "bake '{}/bare.toml' --schedule '{}' --size 16 --frames 2:2 --out '{}/bare' --quiet", dir_, schedule, dir_));
   ASSERT_EQ(a.exit_code, 0) << a.output;
   ASSERT_EQ(b.exit_code, 0) << b.output;
   for (const char* name : {"sky_latlong.0002.exr", "sky_cube.0002.exr", "sky_px.0002.exr", "sky_latlong.0002.png"}) {
-    const std::string x = testing::ReadFileBytes(dir_ + "/off/" + name), y = testing::ReadFileBytes(dir_ + "/bare/" + name);
+    const std::string x = testing::ReadFileBytes(dir_ + "/off/" + name),
+                      y = testing::ReadFileBytes(dir_ + "/bare/" + name);
     ASSERT_FALSE(x.empty()) << name;
     // The EXR headers record the style's path, which differs: compare the
     // pixels by decoding (EXR) and the PNG bytes.
@@ -518,7 +527,8 @@ TEST(NightSky, PlanSaysWhatPrunesTheSplatByDay) {
   const FrameStyles resolved = ResolveFrameStyles(root + "/configs/night/moonlit.toml", {}, schedule.schedule);
   ASSERT_TRUE(resolved.ok());
   const std::vector<SkyStyle>& frames = resolved.styles;
-  const int day = int(std::count_if(frames.begin(), frames.end(), [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
+  const int day =
+      int(std::count_if(frames.begin(), frames.end(), [](const SkyStyle& f) { return f.sun.elevation_deg > 0.0; }));
   ASSERT_GT(day, 10);
   ASSERT_LT(day, int(frames.size()) - 10);
   const PassPlan plan = PlanPasses(frames);
@@ -549,9 +559,10 @@ TEST(NightSky, PlanSaysWhatPrunesTheSplatByDay) {
 // (19:30, the Sun 10 deg down) places its stars and shows them.
 TEST_F(NightBake, DayFramePlacesNoStarAndTwilightDoes) {
   const std::string root = SourceDir();
-  const std::string common = fmt::format("bake '{0}/configs/night/moonlit.toml' --schedule '{0}/configs/schedules/24h.toml' "
-                                         "--size 64 --set output.preview=false --set gltf.enabled=false",
-                                         root);
+  const std::string common = fmt::format(
+      "bake '{0}/configs/night/moonlit.toml' --schedule '{0}/configs/schedules/24h.toml' "
+      "--size 64 --set output.preview=false --set gltf.enabled=false",
+      root);
   auto night_line = [](const std::string& output, int frame) {
     const std::string key = fmt::format("frame {}: ", frame);
     std::istringstream lines(output);
@@ -559,14 +570,14 @@ TEST_F(NightBake, DayFramePlacesNoStarAndTwilightDoes) {
       if (line.find("night sky") != std::string::npos && line.find(key) != std::string::npos) return line;
     return std::string();
   };
-  const testing::CommandRun day = RunSkybake(common + fmt::format(" --frames 26:26 --out '{}/day'", dir_),
-                                             "SKYBAKE_VULKAN_VALIDATION=1");
-  const testing::CommandRun day_off = RunSkybake(
-      common + fmt::format(" --frames 26:26 --out '{}/day_off' --quiet --set night.stars=false", dir_));
-  const testing::CommandRun dusk = RunSkybake(common + fmt::format(" --frames 40:40 --out '{}/dusk'", dir_),
-                                              "SKYBAKE_VULKAN_VALIDATION=1");
-  const testing::CommandRun dusk_off = RunSkybake(
-      common + fmt::format(" --frames 40:40 --out '{}/dusk_off' --quiet --set night.stars=false", dir_));
+  const testing::CommandRun day =
+      RunSkybake(common + fmt::format(" --frames 26:26 --out '{}/day'", dir_), "SKYBAKE_VULKAN_VALIDATION=1");
+  const testing::CommandRun day_off =
+      RunSkybake(common + fmt::format(" --frames 26:26 --out '{}/day_off' --quiet --set night.stars=false", dir_));
+  const testing::CommandRun dusk =
+      RunSkybake(common + fmt::format(" --frames 40:40 --out '{}/dusk'", dir_), "SKYBAKE_VULKAN_VALIDATION=1");
+  const testing::CommandRun dusk_off =
+      RunSkybake(common + fmt::format(" --frames 40:40 --out '{}/dusk_off' --quiet --set night.stars=false", dir_));
   ASSERT_EQ(day.exit_code, 0) << day.output;
   ASSERT_EQ(day_off.exit_code, 0) << day_off.output;
   ASSERT_EQ(dusk.exit_code, 0) << dusk.output;
@@ -606,13 +617,18 @@ TEST_F(NightBake, DayFramePlacesNoStarAndTwilightDoes) {
 // towards the horizon.
 TEST_F(NightBake, AirglowReplacesTheFlatFloor) {
   const std::string style = dir_ + "/style.toml";
-  const std::string base = "--set night.stars=false --set night.moon=false --set night.moonlight=false --set output.faces=false";
+  const std::string base =
+      "--set night.stars=false --set night.moon=false --set night.moonlight=false --set output.faces=false";
   testing::CommandRun flat = RunSkybake(fmt::format(
       "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/flat' --quiet {} "
-      "--set night.airglow=false", style, SourceDir(), dir_, base));
-  testing::CommandRun glow = RunSkybake(fmt::format(
-      "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/glow' --quiet {} "
-      "--set night.airglow=true", style, SourceDir(), dir_, base), "SKYBAKE_VULKAN_VALIDATION=1");
+      "--set night.airglow=false",
+      style, SourceDir(), dir_, base));
+  testing::CommandRun glow = RunSkybake(
+      fmt::format(
+          "bake '{}' --schedule '{}/configs/schedules/moonless.toml' --size 64 --frames 2:2 --out '{}/glow' --quiet {} "
+          "--set night.airglow=true",
+          style, SourceDir(), dir_, base),
+      "SKYBAKE_VULKAN_VALIDATION=1");
   ASSERT_EQ(flat.exit_code, 0) << flat.output;
   ASSERT_EQ(glow.exit_code, 0) << glow.output;
   int w = 0, h = 0;
@@ -650,7 +666,8 @@ TEST(NightSkyGpu, MoonlightIsBelowHalfFloatResolutionWhileTheSunIsUp) {
                          0.7152 * atmosphere.solar_irradiance[1] * k_lum[1] +
                          0.0722 * atmosphere.solar_irradiance[2] * k_lum[2];
   const double k = MoonIlluminanceLux(0.0, 356500.0) / sun_lux;  // a full moon at perigee
-  const std::vector<float> sunlit = renderer.RenderDirections(SunDirectionFromElevationAzimuth(0.0, 270.0), directions, false);
+  const std::vector<float> sunlit =
+      renderer.RenderDirections(SunDirectionFromElevationAzimuth(0.0, 270.0), directions, false);
   for (double moon_elevation : {10.0, 45.0, 85.0}) {
     const std::vector<float> moonlit =
         renderer.RenderDirections(SunDirectionFromElevationAzimuth(moon_elevation, 90.0), directions, false);
@@ -763,12 +780,13 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
       }
       // For the record (docs/performance.md), not a target: the frame
       // (ComputeNightFrame: stars placed, or waiting) and its additions.
-      std::printf("%s: thread CPU, frame %.2f ms + additions with both bounds %.1f ms, SplatBound alone %.1f ms, "
-                  "whole %.1f ms; %zu of %zu views skipped (%zu by the tiles), %zu changed; stars placed on need: "
-                  "frame %.2f ms + additions %.1f ms, %zu of %zu views cleared before placement, stars %s; the "
-                  "Moon's ephemeris alone %.2f ms\n",
-                  what.c_str(), p1 - p0, t1 - t0, t2 - t1, t3 - t2, skipped, views.size(), by_tiles, changed, p3 - p2,
-                  t4 - t3, cleared, views.size(), placed ? "placed" : "not placed", m1 - m0);
+      std::printf(
+          "%s: thread CPU, frame %.2f ms + additions with both bounds %.1f ms, SplatBound alone %.1f ms, "
+          "whole %.1f ms; %zu of %zu views skipped (%zu by the tiles), %zu changed; stars placed on need: "
+          "frame %.2f ms + additions %.1f ms, %zu of %zu views cleared before placement, stars %s; the "
+          "Moon's ephemeris alone %.2f ms\n",
+          what.c_str(), p1 - p0, t1 - t0, t2 - t1, t3 - t2, skipped, views.size(), by_tiles, changed, p3 - p2, t4 - t3,
+          cleared, views.size(), placed ? "placed" : "not placed", m1 - m0);
       if (elevation >= 50.0 && !up) {
         // High noon with the Moon down: no star is placed, nothing splatted.
         EXPECT_EQ(cleared, views.size()) << what;
@@ -792,7 +810,7 @@ TEST(NightSkyGpu, SplatBoundChangesNoByte) {
         EXPECT_GE(by_tiles, views.size() - 4) << what;
         EXPECT_EQ(changed, 0u) << what;
       } else if (elevation >= 20.0) {
-        EXPECT_GT(changed, 0u) << what;  // the Moon in daylight
+        EXPECT_GT(changed, 0u) << what;   // the Moon in daylight
         EXPECT_GT(by_tiles, 0u) << what;  // the faces without it
       } else if (elevation < -15.0) {
         // Stars (and the glow) on every view but the faces below the
@@ -830,7 +848,8 @@ TEST(NightSkyGpu, DaylitW1MapsPlaceNoStarWhereNoneShows) {
   const std::optional<StarCatalogue> catalogue = DefaultCatalogue();
   ASSERT_TRUE(catalogue);
   const TransmittanceTable table(style.atmosphere, style.quality, style.effects);
-  SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects, OutputScale(style.output.units));
+  SkyRenderer renderer(testing::Vulkan(), style.atmosphere, style.quality, style.effects,
+                       OutputScale(style.output.units));
   NightSkyRenderer deferred(testing::Vulkan()), whole(testing::Vulkan());
   whole.set_splat_bound(false);
   const StarGrid grid(*catalogue, style.night.star_magnitude_limit, style.output.units);
@@ -846,13 +865,15 @@ TEST(NightSkyGpu, DaylitW1MapsPlaceNoStarWhereNoneShows) {
     std::optional<double> sun_elevation;  // none: the real Sun's
   };
   std::vector<Case> cases;
-  for (int frame = 23; frame <= 26; ++frame) cases.push_back({2460423.5 + (4.0 + 0.5 * (frame - 1)) / 24.0, std::nullopt});
+  for (int frame = 23; frame <= 26; ++frame)
+    cases.push_back({2460423.5 + (4.0 + 0.5 * (frame - 1)) / 24.0, std::nullopt});
   cases.push_back({2460324.5 + 4.0 / 24.0, 45.0});
   int none_shows = 0, some_show = 0;
   for (const Case& c : cases) {
     const LunarEphemeris e = ComputeLunarEphemeris(c.julian_day_ut);
-    const glm::dvec3 sun = c.sun_elevation ? SunDirectionFromElevationAzimuth(*c.sun_elevation, 290.0)
-                                           : HorizontalFromJ2000(e.sun_ra_deg, e.sun_dec_deg, c.julian_day_ut, paranal).direction;
+    const glm::dvec3 sun = c.sun_elevation
+                               ? SunDirectionFromElevationAzimuth(*c.sun_elevation, 290.0)
+                               : HorizontalFromJ2000(e.sun_ra_deg, e.sun_dec_deg, c.julian_day_ut, paranal).direction;
     const std::string what = fmt::format("jd {:.4f}, sun {:.1f} deg", c.julian_day_ut, std::asin(sun.y) * 180.0 / M_PI);
     ASSERT_GT(sun.y, std::sin(40.0 * M_PI / 180.0)) << what;
     const std::vector<std::vector<float>> sky = renderer.Render(sun, views);
@@ -919,8 +940,10 @@ TEST(NightSky, SplatTilesHoldTheirSmallestSolidAngle) {
         }
       for (int t = 0; t < tiles.count(); ++t) {
         EXPECT_GT(texels[size_t(t)], 0);
-        EXPECT_LE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 + 1e-12)) << n << " " << view.mapping << " " << t;
-        EXPECT_GE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 - 1e-12)) << n << " " << view.mapping << " " << t;
+        EXPECT_LE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 + 1e-12))
+            << n << " " << view.mapping << " " << t;
+        EXPECT_GE(tiles.min_solid_angle(t), smallest[size_t(t)] * (1.0 - 1e-12))
+            << n << " " << view.mapping << " " << t;
       }
     }
 }
@@ -1010,7 +1033,8 @@ TEST(NightSky, WeightedTexelLoadBoundsEachAddition) {
       // SplatBound's load: every source that lands on the texel, at weight 1.
       double unweighted = 0.0;
       for (const PointSource& p : sources)
-        if (WeightedTexelLoad(view, {p}, x, y) > 0.0) unweighted += std::max({p.irradiance[0], p.irradiance[1], p.irradiance[2]});
+        if (WeightedTexelLoad(view, {p}, x, y) > 0.0)
+          unweighted += std::max({p.irradiance[0], p.irradiance[1], p.irradiance[2]});
       EXPECT_LE(load, unweighted * (1.0 + 1e-12)) << view.mapping << " " << x << " " << y;
       below_unweighted += load < 0.9 * unweighted;
       ++checked;
@@ -1114,10 +1138,11 @@ TEST(NightSky, SplatBoundKeepsExactlyWhatIsApplied) {
       SplatBound bound;
       const std::vector<TexelAdd> bounded = BoundedSplat(view, sources, rgba.data(), kNightSplatMinRelative, &bound);
       std::vector<float> whole = rgba, kept = rgba, tiled = rgba;
-      const size_t applied = ApplyTexelAdds(SplatPointSources(view, sources), rgba.data(), whole.data(),
-                                            kNightSplatMinRelative);
+      const size_t applied =
+          ApplyTexelAdds(SplatPointSources(view, sources), rgba.data(), whole.data(), kNightSplatMinRelative);
       ApplyTexelAdds(bounded, rgba.data(), kept.data(), kNightSplatMinRelative);
-      EXPECT_EQ(std::memcmp(whole.data(), kept.data(), whole.size() * sizeof(float)), 0) << trial << " " << view.mapping;
+      EXPECT_EQ(std::memcmp(whole.data(), kept.data(), whole.size() * sizeof(float)), 0)
+          << trial << " " << view.mapping;
       // The tile bound in front: its sources alone through SplatBound give
       // the same bytes, and it skips only views where nothing is applied.
       std::vector<float> mu(size_t(view.width) * view.height);
@@ -1257,8 +1282,8 @@ TEST(NightGallery, NightTilesShowStarsAndMoonlight) {
   const std::string common = fmt::format("gallery '{0}/styles' --size 128 --columns 3 --vulkan-validation -q", dir);
   testing::CommandRun on = RunSkybake(common + fmt::format(" --out '{}/on'", dir));
   ASSERT_EQ(on.exit_code, 0) << on.output;
-  testing::CommandRun off = RunSkybake(
-      common + fmt::format(" --out '{}/off' --set night.stars=false --set night.moonlight=false", dir));
+  testing::CommandRun off =
+      RunSkybake(common + fmt::format(" --out '{}/off' --set night.stars=false --set night.moonlight=false", dir));
   ASSERT_EQ(off.exit_code, 0) << off.output;
   // The labels name the night sky's parts and the clock time.
   EXPECT_NE(on.output.find("stars, moonlight, airglow, sun -37.0 deg, 2024-04-23 21:00"), std::string::npos)

@@ -41,8 +41,8 @@ const EffectDecision& Effect(const PassPlan& plan, const std::string& name) {
   return missing;
 }
 
-const std::vector<std::string> kRenderPasses = {"render face 0", "render face 1", "render face 2",
-                                                "render face 3", "render face 4", "render face 5",
+const std::vector<std::string> kRenderPasses = {"render face 0",     "render face 1", "render face 2",
+                                                "render face 3",     "render face 4", "render face 5",
                                                 "render cube strip", "render latlong"};
 
 std::vector<std::string> With(std::vector<std::string> head, const std::vector<std::string>& tail) {
@@ -52,13 +52,12 @@ std::vector<std::string> With(std::vector<std::string> head, const std::vector<s
 
 TEST(PassPlanTest, DefaultStyleRunsEveryPhysicalPass) {
   PassPlan plan = PlanPasses({Style("[atmosphere]\nground_albedo = 0.1\n")});
-  EXPECT_EQ(PassNames(plan), With(With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"},
-                                       kRenderPasses),
-                                  {"sun disc"}));
+  EXPECT_EQ(PassNames(plan),
+            With(With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"}, kRenderPasses), {"sun disc"}));
   for (const char* e : {"multiple scattering", "Mie (aerosols)", "ozone", "ground bounce", "sun disc"})
     EXPECT_TRUE(Effect(plan, e).on) << e;
-  for (const char* e : {"skydome (AOAS 3.2)", "hue override", "ambiguity (eq. 5-6)", "cloud noise (eq. 7-8)",
-                        "cloud shapes"})
+  for (const char* e :
+       {"skydome (AOAS 3.2)", "hue override", "ambiguity (eq. 5-6)", "cloud noise (eq. 7-8)", "cloud shapes"})
     EXPECT_FALSE(Effect(plan, e).on) << e;
   EXPECT_NE(plan.variant.find("multiple_scattering=true"), std::string::npos) << plan.variant;
   EXPECT_NE(plan.variant.find("sky_render from the built-in sky-view variant"), std::string::npos) << plan.variant;
@@ -195,26 +194,26 @@ TEST(PassPlanTest, UnreadLutsAreNotComputed) {
   PassPlan march = PlanPasses({Style("[quality]\nsky_view_lut = false\n")});
   EXPECT_EQ(PassNames(march), With({"transmittance LUT", "multiple-scattering LUT"}, kRenderPasses));
   // Sun transmittance marched and nothing else reading the transmittance LUT.
-  PassPlan marched = PlanPasses({Style(
-      "[quality]\nsky_view_lut = false\nlight_steps = 8\n[effects]\nmultiple_scattering = false\n"
-      "sun_disc = false\nground = false\n")});
+  PassPlan marched =
+      PlanPasses({Style("[quality]\nsky_view_lut = false\nlight_steps = 8\n[effects]\nmultiple_scattering = false\n"
+                        "sun_disc = false\nground = false\n")});
   EXPECT_EQ(PassNames(marched), kRenderPasses);
   // The skydome moves the observer: its texels ray-march, no sky-view LUT.
   PassPlan dome = PlanPasses({Style("[skydome]\nenabled = true\nviewer_position = [0.0, 0.3, 0.0]\n")});
   EXPECT_EQ(PassNames(dome), With({"transmittance LUT", "multiple-scattering LUT"}, kRenderPasses));
   // Only a latlong requested: one render pass.
   PassPlan latlong = PlanPasses({Style("[output]\nfaces = false\ncube_strip = false\n")});
-  EXPECT_EQ(PassNames(latlong), With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"},
-                                     {"render latlong", "sun disc"}));
+  EXPECT_EQ(PassNames(latlong),
+            With({"transmittance LUT", "multiple-scattering LUT", "sky-view LUT"}, {"render latlong", "sun disc"}));
 }
 
 TEST(PassPlanTest, ZeroStrengthEffectsArePrunedWithTheirReason) {
-  PassPlan plan = PlanPasses({Style(
-      "[atmosphere]\nground_albedo = 0.0\n[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0\n"
-      "[atmosphere.ozone]\nabsorption_per_km = 0.0\n[effects]\nmultiple_scattering_strength = 0.0\n"
-      "sun_disc_strength = 0.0\n[clouds]\nenabled = true\nstrength = 0.0\n")});
-  for (const char* e : {"multiple scattering", "Mie (aerosols)", "ozone", "ground bounce", "sun disc",
-                        "cloud noise (eq. 7-8)"}) {
+  PassPlan plan = PlanPasses(
+      {Style("[atmosphere]\nground_albedo = 0.0\n[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0\n"
+             "[atmosphere.ozone]\nabsorption_per_km = 0.0\n[effects]\nmultiple_scattering_strength = 0.0\n"
+             "sun_disc_strength = 0.0\n[clouds]\nenabled = true\nstrength = 0.0\n")});
+  for (const char* e :
+       {"multiple scattering", "Mie (aerosols)", "ozone", "ground bounce", "sun disc", "cloud noise (eq. 7-8)"}) {
     EXPECT_TRUE(Effect(plan, e).requested) << e;
     EXPECT_FALSE(Effect(plan, e).on) << e;
   }
@@ -281,8 +280,9 @@ struct Equivalence {
 // panorama is 256 x 128 and, from the ground, marches rows 0 to 64 (row 65's
 // cosine, -0.037, is past the 0.02 margin below the horizon).
 TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
-  const std::string layer = "[render]\ncube_size = 64\nlatlong_height = 128\n"
-                            "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = COVERAGE\n";
+  const std::string layer =
+      "[render]\ncube_size = 64\nlatlong_height = 128\n"
+      "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = COVERAGE\n";
   auto style = [&](const std::string& coverage, const std::string& more = "") {
     std::string t = layer;
     t.replace(t.find("COVERAGE"), 8, coverage);
@@ -351,8 +351,9 @@ TEST(PassPlanTest, CloudPanoramaIsListedWithItsRowsAndCost) {
 // with SKYBAKE_SHADOWED_CLOUDS=0 (ShaderSwitches::shadowed_clouds) or when no
 // frame is that dark. `skybake plan` prints the same.
 TEST(PassPlanTest, CloudFramesInTheEarthsShadowAreListed) {
-  const std::string layer = "[render]\ncube_size = 64\nlatlong_height = 128\n"
-                            "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = 0.45\n";
+  const std::string layer =
+      "[render]\ncube_size = 64\nlatlong_height = 128\n"
+      "[[cloud_layer]]\naltitude_m = 1500\nthickness_m = 1500\ncoverage = 0.45\n";
   auto at = [&](double elevation_deg) { return Style(layer, {"sun.elevation_deg=" + std::to_string(elevation_deg)}); };
   auto pass = [](const PassPlan& p, const std::string& name) -> const PlannedPass* {
     for (const PlannedPass& x : p.passes)
@@ -404,7 +405,8 @@ TEST(PassPlanTest, TwilightBandEstimateReachesTheHorizonFromAltitude) {
     return nullptr;
   };
   const PassPlan ground = PlanPasses({Style("[sun]\nelevation_deg = -3.0\n")});
-  const PassPlan high = PlanPasses({Style("[sun]\nelevation_deg = -3.0\n[atmosphere]\nobserver_altitude_m = 8000.0\n")});
+  const PassPlan high =
+      PlanPasses({Style("[sun]\nelevation_deg = -3.0\n[atmosphere]\nobserver_altitude_m = 8000.0\n")});
   const PassPlan day = PlanPasses({Style("[sun]\nelevation_deg = 20.0\n")});
   ASSERT_NE(band(ground), nullptr) << FormatPlan(ground, "frames");
   ASSERT_NE(band(high), nullptr) << FormatPlan(high, "frames");
@@ -491,7 +493,6 @@ warmup_steps = 5
   EXPECT_TRUE(Effect(no_ground, "cloud shadow map").on);
 }
 
-
 class PruningEquivalenceTest : public ::testing::TestWithParam<Equivalence> {};
 
 TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
@@ -524,8 +525,8 @@ TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
     // Float rounding, a handful of ulps of float32, which the sky-view LUT
     // may turn into one step of its stored precision.
     EXPECT_LE(worst, testing::kSkyViewLutStorageStep) << eq.effect << " at sun " << elevation;
-    std::printf("%-22s sun %4.1f: pruned vs zero strength max relative difference %.2e\n", eq.effect.c_str(),
-                elevation, worst);
+    std::printf("%-22s sun %4.1f: pruned vs zero strength max relative difference %.2e\n", eq.effect.c_str(), elevation,
+                worst);
   }
   const EffectSettings& z = zero.effects;
   const EffectSettings& p = pruned.effects;
@@ -541,19 +542,18 @@ TEST_P(PruningEquivalenceTest, ZeroStrengthEqualsCompiledOut) {
 
 INSTANTIATE_TEST_SUITE_P(
     Effects, PruningEquivalenceTest,
-    ::testing::Values(
-        Equivalence{"multiple_scattering", "[effects]\nmultiple_scattering_strength = 0.0"},
-        Equivalence{"mie", "[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0"},
-        Equivalence{"ozone", "[atmosphere.ozone]\nabsorption_per_km = 0.0"},
-        Equivalence{"ground", "[effects]\nground = true\n[atmosphere]\nground_albedo = 0.0"},
-        Equivalence{"sun_disc", "[effects]\nsun_disc_strength = 0.0"},
-        Equivalence{"night_dimming", "[effects]\nnight_dimming = true\nnight_dimming_strength = 0.0"},
-        Equivalence{"hue", "[hue]\nenabled = true\ncolor = \"#ff3300\"\nstrength = 0.0"},
-        Equivalence{"ambiguity", "[ambiguity]\nenabled = true\nl_pt = 0.0"},
-        Equivalence{"cloud_noise", "[clouds]\nenabled = true\nstrength = 0.0"},
-        Equivalence{"cloud_shapes",
-                    "[shapes]\nenabled = true\nstrength = 0.0\n[[shapes.shape]]\nkind = \"point\"\n"
-                    "points = [[30.0, 160.0]]"}),
+    ::testing::Values(Equivalence{"multiple_scattering", "[effects]\nmultiple_scattering_strength = 0.0"},
+                      Equivalence{"mie", "[atmosphere.mie]\nscattering_per_km = 0.0\nextinction_per_km = 0.0"},
+                      Equivalence{"ozone", "[atmosphere.ozone]\nabsorption_per_km = 0.0"},
+                      Equivalence{"ground", "[effects]\nground = true\n[atmosphere]\nground_albedo = 0.0"},
+                      Equivalence{"sun_disc", "[effects]\nsun_disc_strength = 0.0"},
+                      Equivalence{"night_dimming", "[effects]\nnight_dimming = true\nnight_dimming_strength = 0.0"},
+                      Equivalence{"hue", "[hue]\nenabled = true\ncolor = \"#ff3300\"\nstrength = 0.0"},
+                      Equivalence{"ambiguity", "[ambiguity]\nenabled = true\nl_pt = 0.0"},
+                      Equivalence{"cloud_noise", "[clouds]\nenabled = true\nstrength = 0.0"},
+                      Equivalence{"cloud_shapes",
+                                  "[shapes]\nenabled = true\nstrength = 0.0\n[[shapes.shape]]\nkind = \"point\"\n"
+                                  "points = [[30.0, 160.0]]"}),
     [](const ::testing::TestParamInfo<Equivalence>& info) { return info.param.effect; });
 
 }  // namespace

@@ -116,8 +116,7 @@ TEST(ProgressTest, LiveLineOnATerminal) {
   // Set-up and closing stages on lines of their own; the frames on one line
   // rewritten after a carriage return, the files printed above it.
   EXPECT_EQ(text.rfind("skybake: LUTs          5.000 s  transmittance 256x64\n\r", 0), 0u) << text;
-  EXPECT_NE(text.find("\rskybake: frame 2 of 3 (#12), 10.0 s/frame, 20s left, rendering"), std::string::npos)
-      << text;
+  EXPECT_NE(text.find("\rskybake: frame 2 of 3 (#12), 10.0 s/frame, 20s left, rendering"), std::string::npos) << text;
   EXPECT_NE(text.find("\rskybake: frame 2 of 3 (#12), 10.0 s/frame, 12s left, render done"), std::string::npos)
       << "the rate of the frames done, the time left counting down: " << text;
   EXPECT_NE(text.find("face  out/sky_px.exr  100 bytes\n"), std::string::npos) << text;
@@ -148,8 +147,7 @@ TEST(ProgressTest, JsonLines) {
 TEST(ProgressCliTest, FiveFramesOffATerminalAndAsJson) {
   const std::string dir = testing::FreshTempDir("progress_lines");
   const std::string events_path = dir + "/progress.jsonl";
-  testing::CommandRun run =
-      testing::RunSkybake(FiveFrames() + " --out " + dir + "/out --progress-json " + events_path);
+  testing::CommandRun run = testing::RunSkybake(FiveFrames() + " --out " + dir + "/out --progress-json " + events_path);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   for (char c : run.output)
     EXPECT_TRUE(c == '\n' || (static_cast<unsigned char>(c) >= 0x20 && c != 0x7f)) << "control character " << int(c);
@@ -210,8 +208,7 @@ TEST(ProgressCliTest, FiveFramesOffATerminalAndAsJson) {
 TEST(ProgressCliTest, FiveFramesOnATerminal) {
   const std::string dir = testing::FreshTempDir("progress_tty");
   const std::string command = std::string(SKYBAKE_BINARY) + " " + FiveFrames() + " --out " + dir + "/out";
-  auto [status, output] =
-      testing::RunCommand("script -qec '" + command + " > " + dir + "/stdout.txt' /dev/null");
+  auto [status, output] = testing::RunCommand("script -qec '" + command + " > " + dir + "/stdout.txt' /dev/null");
   ASSERT_EQ(status, 0) << output;
   EXPECT_NE(output.find("\rskybake: frame 1 of 5 (#1), rendering"), std::string::npos) << output;
   EXPECT_NE(output.find("\rskybake: frame 5 of 5 (#5), "), std::string::npos) << output;

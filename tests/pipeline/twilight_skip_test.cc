@@ -51,10 +51,10 @@ times = [03:00:00, 03:15:00, 12:00:00]
 )");
   const std::string common = testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule +
                              " --size 96 --set output.cube_strip=false";
-  const testing::CommandRun skipped = testing::RunSkybake("bake " + common + " --force --out " + dir + "/skipped", "SKYBAKE_TWILIGHT_SKIP=1");
+  const testing::CommandRun skipped =
+      testing::RunSkybake("bake " + common + " --force --out " + dir + "/skipped", "SKYBAKE_TWILIGHT_SKIP=1");
   ASSERT_EQ(skipped.exit_code, 0) << skipped.output;
-  const testing::CommandRun marched =
-      testing::RunSkybake("bake " + common + " --force --out " + dir + "/marched");
+  const testing::CommandRun marched = testing::RunSkybake("bake " + common + " --force --out " + dir + "/marched");
   ASSERT_EQ(marched.exit_code, 0) << marched.output;
   EXPECT_EQ(marched.output.find("twilight probe"), std::string::npos) << marched.output;
   // The probe runs from the lowest Sun up and stops at the first frame the march changes.
@@ -65,8 +65,8 @@ times = [03:00:00, 03:15:00, 12:00:00]
   std::set<int> unmarched_frames;
   std::stringstream runs(line.substr(28, line.find(" (") - 28));
   for (std::string run; std::getline(runs, run, ',');) {
-    const int first = std::stoi(run), last = run.find('-') == std::string::npos ? first
-                                                                                  : std::stoi(run.substr(run.find('-') + 1));
+    const int first = std::stoi(run),
+              last = run.find('-') == std::string::npos ? first : std::stoi(run.substr(run.find('-') + 1));
     for (int f = first; f <= last; ++f) unmarched_frames.insert(f);
   }
   EXPECT_EQ(unmarched_frames, std::set<int>{1}) << line;
@@ -91,9 +91,8 @@ times = [03:00:00, 03:15:00, 12:00:00]
   EXPECT_EQ(testing::RunSkybake("plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule)
                 .output.find("probed at the exposure stage"),
             std::string::npos);
-  const testing::CommandRun plan =
-      testing::RunSkybake("plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule,
-                          "SKYBAKE_TWILIGHT_SKIP=1");
+  const testing::CommandRun plan = testing::RunSkybake(
+      "plan " + testing::SourceDir() + "/configs/benchmark/w1.toml --schedule " + schedule, "SKYBAKE_TWILIGHT_SKIP=1");
   EXPECT_NE(plan.output.find("probed at the exposure stage"), std::string::npos) << plan.output;
 }
 

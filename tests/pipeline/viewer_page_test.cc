@@ -99,8 +99,11 @@ void BakeAndViewSunSequence(const std::string& dir, int step_deg) {
   const std::string schedule = dir + "/schedule.toml";
   FILE* f = std::fopen(schedule.c_str(), "w");
   ASSERT_TRUE(f);
-  std::fputs(fmt::format("[schedule]\nsun = {{ elevation_deg = {{ start = 30, end = -10, step = {} }}, azimuth_deg = 135 }}\n",
-                         step_deg).c_str(), f);
+  std::fputs(
+      fmt::format("[schedule]\nsun = {{ elevation_deg = {{ start = 30, end = -10, step = {} }}, azimuth_deg = 135 }}\n",
+                  step_deg)
+          .c_str(),
+      f);
   std::fclose(f);
   testing::CommandRun bake = testing::RunSkybake("bake " + testing::SourceDir() + "/configs/default.toml --schedule " +
                                                  schedule + " --size 32 -q --out " + dir + "/out");
@@ -211,9 +214,9 @@ TEST(ViewerPageTest, HostileManifestNamesAndFilesAreRefused) {
                         Case{"fifo.exr", 5, "fifo.exr': it is a FIFO (named pipe), not a regular file"},
                         Case{"text.exr", 5, "text.exr' is not an OpenEXR file"}}) {
     SCOPED_TRACE(c.name);
-    testing::WriteFile(dir, "manifest.json",
-                       std::string(R"({"frames": [{"frame": 1, "files": [{"kind": "latlong", "file": ")") + c.name +
-                           "\"}]}]}");
+    testing::WriteFile(
+        dir, "manifest.json",
+        std::string(R"({"frames": [{"frame": 1, "files": [{"kind": "latlong", "file": ")") + c.name + "\"}]}]}");
     testing::CommandRun r = testing::RunSkybake("view " + dir);
     EXPECT_EQ(r.exit_code, c.exit_code) << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;

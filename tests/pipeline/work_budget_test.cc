@@ -38,12 +38,11 @@ std::string LargeFormationStyle(const std::string& dir) {
 std::string Schedule() { return testing::SourceDir() + "/configs/schedules/afternoon_buildup.toml"; }
 
 TEST(WorkBudget, CheckReportsTheFormationsBusiestFrame) {
-  CommandRun run = RunSkybake("check '" + testing::SourceDir() + "/configs/styles/afternoon_buildup.toml' --schedule '" +
-                              Schedule() + "'");
+  CommandRun run = RunSkybake("check '" + testing::SourceDir() +
+                              "/configs/styles/afternoon_buildup.toml' --schedule '" + Schedule() + "'");
   EXPECT_EQ(run.exit_code, 0) << run.output;
   // The first frame: 20 warm-up steps of 64 x 64 x 8 cells.
-  EXPECT_NE(run.output.find("cloud formation: 6.55e+05 cell updates in its busiest frame (frame 1)"),
-            std::string::npos)
+  EXPECT_NE(run.output.find("cloud formation: 6.55e+05 cell updates in its busiest frame (frame 1)"), std::string::npos)
       << run.output;
 }
 
@@ -99,8 +98,8 @@ TEST(WorkBudget, ATestPatternOverTheMemoryBudgetIsRefusedBeforeAnyFile) {
   EXPECT_EQ(fits.exit_code, 0) << fits.output;
   EXPECT_TRUE(fs::is_regular_file(dir + "/small/sky_latlong.exr")) << fits.output;
   for (const char* bad : {"nan", "0", "-1", "inf"}) {
-    CommandRun run = RunSkybake(std::string("testpattern --size 64 --max-memory-mib ") + bad + " --out '" + dir +
-                                "/bad'");
+    CommandRun run =
+        RunSkybake(std::string("testpattern --size 64 --max-memory-mib ") + bad + " --out '" + dir + "/bad'");
     EXPECT_EQ(run.exit_code, 2) << bad << ": " << run.output;
   }
   fs::remove_all(dir);
@@ -114,11 +113,12 @@ TEST(WorkBudget, AGalleryWithAStyleOverBudgetIsRefusedBeforeAnyBake) {
   fs::create_directory(dir + "/styles");
   fs::copy_file(testing::SourceDir() + "/configs/default.toml", dir + "/styles/a.toml");
   const std::string large = testing::ReadFileBytes(LargeFormationStyle(dir));
-  testing::WriteFile(dir + "/styles", "b.toml", std::regex_replace(large, std::regex("warmup_steps = 20"),
-                                                                    "warmup_steps = 100000"));
+  testing::WriteFile(dir + "/styles", "b.toml",
+                     std::regex_replace(large, std::regex("warmup_steps = 20"), "warmup_steps = 100000"));
   CommandRun run = RunSkybake("gallery '" + dir + "/styles' --size 16 --out '" + dir + "/out'");
   EXPECT_EQ(run.exit_code, 7) << run.output;
-  EXPECT_NE(run.output.find("gallery style " + dir + "/styles/b.toml: render: the cloud formation needs an estimated "
+  EXPECT_NE(run.output.find("gallery style " + dir +
+                            "/styles/b.toml: render: the cloud formation needs an estimated "
                             "1.68e+12 cell updates (100000 steps of 512 x 512 x 64 cells"),
             std::string::npos)
       << run.output;

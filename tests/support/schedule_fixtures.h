@@ -20,7 +20,8 @@ times = { start = 06:00:00, end = 11:45:00, step_minutes = 15 }
 // "hh:mm:ss") every `step_minutes`.
 inline std::string IthacaSchedule(const std::string& start, const std::string& end, int step_minutes) {
   return "[schedule]\ndate = 2013-05-27\nlatitude_deg = 42.44337\nlongitude_deg = -76.48163\nutc_offset_hours = -4.0\n"
-         "times = { start = " + start + ", end = " + end + ", step_minutes = " + std::to_string(step_minutes) + " }\n";
+         "times = { start = " +
+         start + ", end = " + end + ", step_minutes = " + std::to_string(step_minutes) + " }\n";
 }
 
 }  // namespace skybake::testing

@@ -98,9 +98,7 @@ std::string SkyProbeQuery() {
   return q;
 }
 
-double SkyAndSun::SunHorizontalLux() const {
-  return sun_illuminance_lux * std::sin(sun_elevation_deg * M_PI / 180.0);
-}
+double SkyAndSun::SunHorizontalLux() const { return sun_illuminance_lux * std::sin(sun_elevation_deg * M_PI / 180.0); }
 
 double SkyAndSun::GltfLightHorizontalLux() const {
   return light_intensity * Luminance({light_color.r, light_color.g, light_color.b}) *
@@ -114,8 +112,10 @@ bool BakeSkyAndSun(const std::string& name, SkyAndSun& out) {
   out.half_dir = dir + "/half";
   out.float_dir = dir + "/float";
   for (const auto& [type, folder] : {std::pair{"half", out.half_dir}, std::pair{"float", out.float_dir}}) {
-    const CommandRun r = RunSkybake("bake " + SourceDir() + "/configs/default.toml --size 64 -q --vulkan-validation "
-                                    "--set output.pixel_type=" + std::string(type) + " --out " + folder);
+    const CommandRun r = RunSkybake("bake " + SourceDir() +
+                                    "/configs/default.toml --size 64 -q --vulkan-validation "
+                                    "--set output.pixel_type=" +
+                                    std::string(type) + " --out " + folder);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     if (r.exit_code != 0) return false;
   }

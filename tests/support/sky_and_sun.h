@@ -41,7 +41,7 @@ struct SkyAndSun {
   // The float32 bake's manifest, frames[0].sun.
   double sun_illuminance_lux = 0.0;  // at normal incidence
   double sun_elevation_deg = 0.0;
-  glm::dvec3 sun_irradiance{0.0};    // Rec.709, per channel, lux-like (its Y is illuminance_lux)
+  glm::dvec3 sun_irradiance{0.0};  // Rec.709, per channel, lux-like (its Y is illuminance_lux)
 
   // The half bake's glTF sun as written (KHR_lights_punctual): intensity, lux, and linear colour.
   double light_intensity = 0.0;

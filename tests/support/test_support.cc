@@ -55,7 +55,7 @@ std::string SharedDir() {
 
 CommandRun RunSkybake(const std::string& args, const std::string& shell_prefix) {
   std::string script = shell_prefix + " '" + SKYBAKE_BINARY + "' " + args + " 2>&1";
-  std::string command = "bash -c \"" ;
+  std::string command = "bash -c \"";
   for (char c : script) {
     if (c == '"' || c == '\\' || c == '$' || c == '`') command += '\\';
     command += c;

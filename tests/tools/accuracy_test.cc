@@ -40,10 +40,11 @@ TEST(ConvergedReferenceTest, VerticalTransmittanceEqualsClosedForm) {
   ConvergedReference ref(a, 4.0);
   const double thickness = a.top_radius_km - a.bottom_radius_km;
   for (int c = 0; c < 3; ++c) {
-    double tau = a.rayleigh_scattering_per_km[c] * a.rayleigh_scale_height_km *
-                     (1 - std::exp(-thickness / a.rayleigh_scale_height_km)) +
-                 a.mie_extinction_per_km[c] * a.mie_scale_height_km * (1 - std::exp(-thickness / a.mie_scale_height_km)) +
-                 a.ozone_absorption_per_km[c] * a.ozone_half_width_km;
+    double tau =
+        a.rayleigh_scattering_per_km[c] * a.rayleigh_scale_height_km *
+            (1 - std::exp(-thickness / a.rayleigh_scale_height_km)) +
+        a.mie_extinction_per_km[c] * a.mie_scale_height_km * (1 - std::exp(-thickness / a.mie_scale_height_km)) +
+        a.ozone_absorption_per_km[c] * a.ozone_half_width_km;
     EXPECT_NEAR(ref.Transmittance(0.0, 1.0)[c] / std::exp(-tau), 1.0, 1e-12) << c;
   }
 }
@@ -118,8 +119,8 @@ TEST(ConvergedReferenceTest, TwilightSkyViewAndRayMarchAgainstIt) {
   const glm::dvec3 sun = SunDirectionFromElevationAzimuth(-3.0, 180.0);
   std::vector<glm::dvec3> dirs;
   for (double elevation : {0.5, 2.0, 3.0, 5.0, 10.0})
-    for (double azimuth : {0.0, 30.0, 50.0, 70.0, 90.0}) dirs.push_back(glm::dvec3(glm::vec3(
-        SunDirectionFromElevationAzimuth(elevation, azimuth))));
+    for (double azimuth : {0.0, 30.0, 50.0, 70.0, 90.0})
+      dirs.push_back(glm::dvec3(glm::vec3(SunDirectionFromElevationAzimuth(elevation, azimuth))));
   std::vector<glm::dvec3> expected;
   for (const glm::dvec3& d : dirs) expected.push_back(ref.Radiance(d, sun));
   struct Bound {

@@ -21,7 +21,7 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
   // spectral_results.md); --only kider-spectral: Kider 2014 by wavelength alone.
   if (options.study == "spectral" || options.only == "spectral") return RunSpectralStudy(context);
   if (options.only == "kider-spectral") return RunKiderSpectralStudy(context);  // kider2014_spectral.csv
-  if (options.study == "twilight") {  // twilight.csv, twilight_results.md
+  if (options.study == "twilight") {                                            // twilight.csv, twilight_results.md
     const std::string md = RunTwilightStudy(context);
     WriteFileAtomically(options.out_dir + "/twilight_results.md", md);
     return md;
@@ -32,7 +32,8 @@ std::string RunAccuracyStudy(const AccuracyStudyOptions& options) {
     md += RunKiderSpectralStudy(context);  // kider2014_spectral.csv
   }
   if (options.study == "all") md += RunTwilightStudy(context);  // twilight.csv
-  if (options.study == "all" && options.only.empty()) md += RunSpectralStudy(context);  // spectral.csv, spectral_twilight_*.png
+  if (options.study == "all" && options.only.empty())
+    md += RunSpectralStudy(context);                                // spectral.csv, spectral_twilight_*.png
   if (options.study != "sky") md += RunCloudQualityStudy(context);  // cloud_study.csv, cloud_study.png
   for (const std::string& note : context.notes) md += "\n" + note + "\n";
   WriteFileAtomically(options.out_dir + "/accuracy_results.md", md);

@@ -60,9 +60,15 @@ Scene StudyScene() {
 CloudQuality MakeQuality(int view, int light, int shape, int detail, int weather, int octaves = 8,
                          double panorama_scale = 0.0) {
   // Every light sample trilinear, unless a case says otherwise.
-  return {.view_steps = view, .light_steps = light, .light_trilinear_steps = 256, .octaves = octaves,
-          .shape_resolution = shape, .detail_resolution = detail, .weather_resolution = weather,
-          .panorama_scale = panorama_scale, .light_volume_columns = 0};
+  return {.view_steps = view,
+          .light_steps = light,
+          .light_trilinear_steps = 256,
+          .octaves = octaves,
+          .shape_resolution = shape,
+          .detail_resolution = detail,
+          .weather_resolution = weather,
+          .panorama_scale = panorama_scale,
+          .light_volume_columns = 0};
 }
 
 std::string CaseName(const CloudQuality& q) {
@@ -210,7 +216,7 @@ Renders RenderCase(Renderers& renderers, const CloudQuality& q, const std::vecto
 
 // The worst error over the sun elevations.
 StudyError WorstError(const std::vector<Images>& a, const std::vector<Images>& ref,
-                 const std::vector<std::vector<char>>& masks) {
+                      const std::vector<std::vector<char>>& masks) {
   StudyError worst;
   for (size_t s = 0; s < ref.size(); ++s) {
     StudyError e = Compare(a[s], ref[s], masks);
@@ -248,18 +254,30 @@ std::vector<CloudQuality> MarchCases(bool quick) {
   for (int octaves : {2, 4}) cases.push_back(MakeQuality(48, 12, 64, 32, 256, octaves));
   // The light march's far samples at the nearest voxel
   // (quality.cloud_light_trilinear_steps): the first k trilinear.
-  for (auto [view, light, trilinear] : {std::tuple{48, 24, 4}, {48, 24, 8}, {48, 24, 12}, {24, 12, 3}, {24, 12, 6},
-                                        {32, 16, 4}, {32, 24, 6}, {48, 16, 4}}) {
+  for (auto [view, light, trilinear] : {std::tuple{48, 24, 4},
+                                        {48, 24, 8},
+                                        {48, 24, 12},
+                                        {24, 12, 3},
+                                        {24, 12, 6},
+                                        {32, 16, 4},
+                                        {32, 24, 6},
+                                        {48, 16, 4}}) {
     CloudQuality q = MakeQuality(view, light, 64, 32, 256);
     q.light_trilinear_steps = trilinear;
     cases.push_back(q);
   }
   // The light volume (quality.cloud_light_volume_*): columns / slices / exact
   // near steps, at production's and draft's steps.
-  for (auto [view, light, trilinear, columns, slices, near] :
-       {std::tuple{48, 24, 8, 512, 32, 2}, {48, 24, 8, 512, 16, 2}, {48, 24, 8, 384, 16, 2}, {48, 24, 8, 256, 32, 2},
-        {48, 24, 8, 256, 16, 2}, {48, 24, 8, 256, 16, 1}, {48, 24, 8, 512, 32, 0}, {48, 24, 8, 1024, 32, 2},
-        {24, 12, 3, 256, 16, 1}, {24, 12, 3, 512, 32, 2}}) {
+  for (auto [view, light, trilinear, columns, slices, near] : {std::tuple{48, 24, 8, 512, 32, 2},
+                                                               {48, 24, 8, 512, 16, 2},
+                                                               {48, 24, 8, 384, 16, 2},
+                                                               {48, 24, 8, 256, 32, 2},
+                                                               {48, 24, 8, 256, 16, 2},
+                                                               {48, 24, 8, 256, 16, 1},
+                                                               {48, 24, 8, 512, 32, 0},
+                                                               {48, 24, 8, 1024, 32, 2},
+                                                               {24, 12, 3, 256, 16, 1},
+                                                               {24, 12, 3, 512, 32, 2}}) {
     CloudQuality q = MakeQuality(view, light, 64, 32, 256);
     q.light_trilinear_steps = trilinear;
     q.light_volume_columns = columns;
@@ -302,8 +320,7 @@ struct Study {
   }
 };
 
-Study SetUpStudy(const CloudStudyOptions& options, const Scene& scene, Renderers& renderers,
-                 CloudStudyResult& result) {
+Study SetUpStudy(const CloudStudyOptions& options, const Scene& scene, Renderers& renderers, CloudStudyResult& result) {
   Study study(options, renderers);
   study.height = options.latlong_height > 0 ? options.latlong_height : (options.quick ? 24 : 128);
   study.timing_runs = options.timing_runs > 0 ? options.timing_runs : (options.quick ? 1 : 2);
@@ -482,8 +499,9 @@ std::string CasesMarkdown(const CloudStudyResult& result) {
   md += "| change | mean relative difference | relative RMSE |\n| --- | ---: | ---: |\n";
   for (const CloudConvergence& c : result.convergence)
     md += fmt::format("| {} | {:.2e} | {:.2e} |\n", c.change, c.mean_error, c.rmse);
-  md += "\n| case (view/light steps, volumes shape/detail/weather) | CPU ms per megapixel | cloud passes' GPU ms "
-        "per megapixel | mean relative error | relative RMSE | Pareto |\n| --- | ---: | ---: | ---: | ---: | :---: |\n";
+  md +=
+      "\n| case (view/light steps, volumes shape/detail/weather) | CPU ms per megapixel | cloud passes' GPU ms "
+      "per megapixel | mean relative error | relative RMSE | Pareto |\n| --- | ---: | ---: | ---: | ---: | :---: |\n";
   for (const CloudStudyCase& c : result.cases)
     md += fmt::format("| {} | {} | {} | {:.2e} | {:.2e} | {} |\n", c.name, Fixed(c.cpu_ms_per_mp, 0),
                       Fixed(c.ms_per_mp, 0), c.mean_error, c.rmse, c.pareto ? "yes" : "");
@@ -496,8 +514,9 @@ std::string PresetsAndPanoramaMarkdown(const CloudStudyResult& result) {
       "\n### Cloud presets chosen from the front\n\nThe cheapest case of the front within each bound; cases of the "
       "front within {:g}% of its CPU time are ties, and the lowest error among them is chosen.\n\n",
       kCloudTimeNoise * 100);
-  md += "| preset | bound (mean relative error) | case | mean relative error | "
-        "CPU ms per megapixel |\n| --- | --- | --- | ---: | ---: |\n";
+  md +=
+      "| preset | bound (mean relative error) | case | mean relative error | "
+      "CPU ms per megapixel |\n| --- | --- | --- | ---: | ---: |\n";
   for (const CloudPresetChoice& p : result.presets) {
     if (p.choice >= 0) {
       const CloudStudyCase& c = result.cases[size_t(p.choice)];

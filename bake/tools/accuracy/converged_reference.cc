@@ -72,8 +72,8 @@ const Quadrature& GL() {
 
 // Distances along the ray (r, altitude, mu) in (0, t_max) where the altitude
 // crosses `a` km.
-void AddAltitudeCrossings(const AtmosphereParameters& atm, double r, double altitude, double mu,
-                          double a, double t_max, std::vector<double>& out) {
+void AddAltitudeCrossings(const AtmosphereParameters& atm, double r, double altitude, double mu, double a, double t_max,
+                          std::vector<double>& out) {
   double ra = atm.bottom_radius + a;
   double c = (altitude - a) * (r + ra);  // r^2 - ra^2
   double disc = (r * mu) * (r * mu) - c;
@@ -85,8 +85,8 @@ void AddAltitudeCrossings(const AtmosphereParameters& atm, double r, double alti
 
 // Breakpoints of the piecewise-smooth integrand along a ray: ozone corners
 // and the closest approach to the planet centre.
-std::vector<double> RayBreakpoints(const AtmosphereParameters& atm, double r, double altitude,
-                                   double mu, double t_max) {
+std::vector<double> RayBreakpoints(const AtmosphereParameters& atm, double r, double altitude, double mu,
+                                   double t_max) {
   std::vector<double> points = {0.0, t_max};
   for (double a : {atm.ozone_peak_altitude - atm.ozone_half_width, atm.ozone_peak_altitude,
                    atm.ozone_peak_altitude + atm.ozone_half_width})
@@ -107,14 +107,12 @@ glm::dvec3 Integrate(double a, double b, double segment, F f) {
   double h = (b - a) / pieces;
   for (int p = 0; p < pieces; ++p) {
     double c = a + p * h;
-    for (int k = 0; k < kGaussOrder; ++k)
-      sum += q.weights[k] * 0.5 * h * f(c + 0.5 * h * (q.nodes[k] + 1.0));
+    for (int k = 0; k < kGaussOrder; ++k) sum += q.weights[k] * 0.5 * h * f(c + 0.5 * h * (q.nodes[k] + 1.0));
   }
   return sum;
 }
 
-glm::dvec3 OpticalDepth(const AtmosphereParameters& atm, double r, double altitude, double mu,
-                        double segment) {
+glm::dvec3 OpticalDepth(const AtmosphereParameters& atm, double r, double altitude, double mu, double segment) {
   double t_max = glsl::DistanceToTopBoundary(atm, r, altitude, mu);
   std::vector<double> points = RayBreakpoints(atm, r, altitude, mu, t_max);
   glm::dvec3 depth(0.0);
@@ -129,12 +127,11 @@ glm::dvec3 OpticalDepth(const AtmosphereParameters& atm, double r, double altitu
 // Sun transmittance with the same physics as the model: the transmittance to
 // the top (along the horizon when the Sun is below it) times the visible
 // fraction of the solar disc.
-glm::dvec3 SunTransmittance(const AtmosphereParameters& atm, double r_t, double h, double mu_s,
-                            double segment) {
+glm::dvec3 SunTransmittance(const AtmosphereParameters& atm, double r_t, double h, double mu_s, double segment) {
   double sin_theta_h = atm.bottom_radius / r_t;
   double cos_theta_h = -std::sqrt(std::max(h * (r_t + atm.bottom_radius), 0.0)) / r_t;
-  double visible = glm::smoothstep(-sin_theta_h * atm.sun_angular_radius,
-                                   sin_theta_h * atm.sun_angular_radius, mu_s - cos_theta_h);
+  double visible =
+      glm::smoothstep(-sin_theta_h * atm.sun_angular_radius, sin_theta_h * atm.sun_angular_radius, mu_s - cos_theta_h);
   if (visible <= 0.0) return glm::dvec3(0.0);
   double mu_eff = std::max(mu_s, cos_theta_h);
   return glm::exp(-OpticalDepth(atm, r_t, h, mu_eff, segment)) * visible;
@@ -199,8 +196,8 @@ glm::dvec3 ConvergedReference::Radiance(const glm::dvec3& view, const glm::dvec3
     altitude = atm.top_radius - atm.bottom_radius;
   }
   bool ground = glsl::RayIntersectsGround(atm, r, altitude, mu);
-  double t_max = ground ? glsl::DistanceToBottomBoundary(atm, r, altitude, mu)
-                        : glsl::DistanceToTopBoundary(atm, r, altitude, mu);
+  double t_max =
+      ground ? glsl::DistanceToBottomBoundary(atm, r, altitude, mu) : glsl::DistanceToTopBoundary(atm, r, altitude, mu);
   std::vector<double> points = RayBreakpoints(atm, r, altitude, mu, t_max);
   AddShadowEdges(atm, r, altitude, mu, mu_s, nu, t_max, points);
   std::sort(points.begin(), points.end());

@@ -20,12 +20,13 @@ namespace {
 
 std::vector<StudyCase> StudyCases(bool quick) {
   std::vector<StudyCase> cases;
-  const std::vector<std::pair<int, int>> paper = quick ? std::vector<std::pair<int, int>>{{16, 8}, {128, 64}}
-                                                       : std::vector<std::pair<int, int>>{
-                                                             {16, 8}, {32, 16}, {64, 32}, {128, 64}, {512, 256}};
+  const std::vector<std::pair<int, int>> paper =
+      quick ? std::vector<std::pair<int, int>>{{16, 8}, {128, 64}}
+            : std::vector<std::pair<int, int>>{{16, 8}, {32, 16}, {64, 32}, {128, 64}, {512, 256}};
   for (int integrator : {INTEGRATOR_MIDPOINT, INTEGRATOR_TRAPEZOID, INTEGRATOR_SIMPSON, INTEGRATOR_ANALYTIC})
     for (auto [v, l] : paper) cases.push_back(MakeCase(integrator, v, l));
-  const std::vector<int> lut_steps = quick ? std::vector<int>{16, 64} : std::vector<int>{8, 16, 24, 32, 48, 64, 128, 256};
+  const std::vector<int> lut_steps =
+      quick ? std::vector<int>{16, 64} : std::vector<int>{8, 16, 24, 32, 48, 64, 128, 256};
   for (int v : lut_steps) {
     cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0));
     cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0, false, 0, 0, STEPS_QUADRATIC));
@@ -54,8 +55,9 @@ std::vector<StudyCase> StudyCases(bool quick) {
   }
   // The sky-view LUT: its resolution against its steps per texel (a frame
   // of a time-lapse pays for one LUT, whatever its output size).
-  for (auto [w, h] : quick ? std::vector<std::pair<int, int>>{{192, 108}}
-                           : std::vector<std::pair<int, int>>{{192, 108}, {192, 216}, {256, 144}, {320, 180}, {384, 216}})
+  for (auto [w, h] : quick
+                         ? std::vector<std::pair<int, int>>{{192, 108}}
+                         : std::vector<std::pair<int, int>>{{192, 108}, {192, 216}, {256, 144}, {320, 180}, {384, 216}})
     for (int v : quick ? std::vector<int>{48} : std::vector<int>{24, 32, 48})
       cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, v, 0, true, w, h, STEPS_QUADRATIC));
   if (!quick) cases.push_back(MakeCase(INTEGRATOR_ANALYTIC, 48, 0, true, 768, 432, STEPS_QUADRATIC));
@@ -152,8 +154,8 @@ struct CaseResult {
 
 // The GPU's radiance `gpu` (RGBA per direction) against the reference's
 // `ref` for one case at one sun elevation.
-CaseResult CompareWithReference(const StudyCase& c, double elevation, double ms_per_mp,
-                                const std::vector<float>& gpu, const std::vector<glm::dvec3>& ref) {
+CaseResult CompareWithReference(const StudyCase& c, double elevation, double ms_per_mp, const std::vector<float>& gpu,
+                                const std::vector<glm::dvec3>& ref) {
   const Rgb to_luminance = OutputScale(OutputUnits::kLuminance);
   double max_value = 0.0, log_sum = 0.0;
   for (const glm::dvec3& l : ref) {
@@ -173,8 +175,7 @@ CaseResult CompareWithReference(const StudyCase& c, double elevation, double ms_
     for (int ch = 0; ch < 3; ++ch) {
       double diff = g[ch] - ref[i][ch];
       sum_sq += diff * diff;
-      if (ref[i][ch] > 1e-4 * max_value)
-        r.max_relative = std::max(r.max_relative, std::abs(diff) / ref[i][ch]);
+      if (ref[i][ch] > 1e-4 * max_value) r.max_relative = std::max(r.max_relative, std::abs(diff) / ref[i][ch]);
     }
     glm::dvec3 lab_g = DisplayLab(g, to_luminance, exposure), lab_r = DisplayLab(ref[i], to_luminance, exposure);
     r.max_delta_e = std::max(r.max_delta_e, glm::length(lab_g - lab_r));
@@ -185,8 +186,7 @@ CaseResult CompareWithReference(const StudyCase& c, double elevation, double ms_
 
 // Every case on the GPU, timed, against the reference: one result per case
 // and sun elevation.
-std::vector<CaseResult> MeasureCases(StudyContext& context, const StudySetup& setup,
-                                     const ReferenceSkies& reference) {
+std::vector<CaseResult> MeasureCases(StudyContext& context, const StudySetup& setup, const ReferenceSkies& reference) {
   std::vector<CaseResult> results;
   for (const StudyCase& c : setup.cases) {
     SkyRenderer renderer(context.vulkan, setup.atmosphere, c.quality, setup.single, {1, 1, 1});
@@ -253,12 +253,11 @@ void WriteResultsCsv(const StudyContext& context, const std::vector<CaseResult>&
   csv << "case,integrator,view_steps,light_steps,sky_view_lut,sun_elevation_deg,rmse_mW_m2_sr_nm,"
          "max_relative_error,max_delta_e76,ms_per_megapixel\n";
   for (const CaseResult& r : results)
-    csv << fmt::format("{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g}\n", r.name,
-                       IntegratorName(r.quality.integrator), r.quality.view_steps, r.quality.light_steps,
-                       r.quality.sky_view_lut ? fmt::format("{}x{}", r.quality.sky_view_width,
-                                                            r.quality.sky_view_height)
-                                              : "no",
-                       r.elevation, r.rmse_mw, r.max_relative, r.max_delta_e, r.ms_per_mp);
+    csv << fmt::format(
+        "{},{},{},{},{},{},{:.6g},{:.6g},{:.6g},{:.6g}\n", r.name, IntegratorName(r.quality.integrator),
+        r.quality.view_steps, r.quality.light_steps,
+        r.quality.sky_view_lut ? fmt::format("{}x{}", r.quality.sky_view_width, r.quality.sky_view_height) : "no",
+        r.elevation, r.rmse_mw, r.max_relative, r.max_delta_e, r.ms_per_mp);
   WriteFileAtomically(context.OutPath("accuracy.csv"), csv.str());
 }
 
@@ -266,32 +265,38 @@ void WriteResultsCsv(const StudyContext& context, const std::vector<CaseResult>&
 void PlotFront(StudyContext& context, const std::vector<Summary>& summaries) {
   std::vector<PlotPoint> points;
   for (const Summary& s : summaries) points.push_back({s.ms_per_mp, s.day_error, s.pareto, s.name});
-  const std::string status =
-      PlotParetoFront(context.options.out_dir, "accuracy", points,
-                      {"lavapipe time per megapixel (ms, 2 cores)", "max relative error, upper hemisphere, sun 3..90 deg",
-                       "skybake: what accuracy costs (single scattering vs converged reference)"});
+  const std::string status = PlotParetoFront(
+      context.options.out_dir, "accuracy", points,
+      {"lavapipe time per megapixel (ms, 2 cores)", "max relative error, upper hemisphere, sun 3..90 deg",
+       "skybake: what accuracy costs (single scattering vs converged reference)"});
   context.notes.push_back(fmt::format("Plot {}: {}/accuracy.png", status, context.options.out_dir));
 }
 
 std::string Markdown(const AccuracyStudyOptions& options, const std::vector<Summary>& summaries,
                      const std::vector<PresetChoice>& presets, const ReferenceSkies& reference) {
   std::string md;
-  md += fmt::format("## Cases (observer at {} m; worst over sun elevations 3..90 deg; every elevation in accuracy.csv)\n\n",
-                    options.observer_altitude_m);
-  md += "| case | ms per megapixel | max relative error | max Delta-E76 | worst incl. twilight (sun 1 .. -10 deg) | Pareto |\n";
+  md += fmt::format(
+      "## Cases (observer at {} m; worst over sun elevations 3..90 deg; every elevation in accuracy.csv)\n\n",
+      options.observer_altitude_m);
+  md +=
+      "| case | ms per megapixel | max relative error | max Delta-E76 | worst incl. twilight (sun 1 .. -10 deg) | "
+      "Pareto |\n";
   md += "| --- | ---: | ---: | ---: | ---: | :---: |\n";
   for (const Summary& s : summaries)
     md += fmt::format("| {} | {:.1f} | {:.2e} | {:.3f} | {:.2e} | {} |\n", s.name, s.ms_per_mp, s.day_error,
                       s.day_delta_e, s.all_error, s.pareto ? "yes" : "");
-  md += "\n## Presets chosen from the front\n\n| preset | bound | case | max relative error | ms per megapixel |\n| --- | --- | --- | ---: | ---: |\n";
+  md +=
+      "\n## Presets chosen from the front\n\n| preset | bound | case | max relative error | ms per megapixel |\n| --- "
+      "| --- | --- | ---: | ---: |\n";
   for (const PresetChoice& p : presets) {
     if (p.choice)
       md += fmt::format("| `{}` | <= {:g}% | {} | {:.2e} | {:.1f} |\n", p.preset, p.bound * 100, p.choice->name,
                         p.choice->day_error, p.choice->ms_per_mp);
-    else
-      md += fmt::format("| `{}` | <= {:g}% | none of the cases meets it | | |\n", p.preset, p.bound * 100);
+    else md += fmt::format("| `{}` | <= {:g}% | none of the cases meets it | | |\n", p.preset, p.bound * 100);
   }
-  md += "\n## Reference convergence (segment 8 km vs 4 km, max relative difference)\n\n| sun elevation (deg) | max relative difference |\n| ---: | ---: |\n";
+  md +=
+      "\n## Reference convergence (segment 8 km vs 4 km, max relative difference)\n\n| sun elevation (deg) | max "
+      "relative difference |\n| ---: | ---: |\n";
   for (const std::string& row : reference.convergence_rows) md += row + "\n";
   return md;
 }

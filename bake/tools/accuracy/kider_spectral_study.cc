@@ -128,8 +128,9 @@ std::string RunKiderSpectralStudy(StudyContext& context) {
       "| model | captures | RMSE mW/(m2 sr nm) |\n| --- | ---: | ---: |\n";
   for (const KiderSpectralScore& s : ScoreKiderSpectral(context.vulkan, context.options))
     md += fmt::format("| {} | {} | {:.1f} |\n", s.model, s.captures, s.rmse_mw);
-  md += "| Galaj & Wojciechowski 2019, single scattering 16/8 | | 31.3-33.7 |\n"
-        "| Galaj & Wojciechowski 2019, single scattering 512/256 | | 25.6 |\n";
+  md +=
+      "| Galaj & Wojciechowski 2019, single scattering 16/8 | | 31.3-33.7 |\n"
+      "| Galaj & Wojciechowski 2019, single scattering 512/256 | | 25.6 |\n";
   return md;
 }
 

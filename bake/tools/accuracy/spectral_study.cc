@@ -105,8 +105,9 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
   const Settings settings;
   const int height = options.quick ? 32 : 256, width = 2 * height;
   const std::vector<ViewRequest> views = {{MAPPING_LATLONG, width, height, 0}};
-  const std::vector<double> elevations =
-      options.quick ? std::vector<double>{30.0, -4.0} : std::vector<double>{60.0, 30.0, 10.0, 3.0, 0.0, -2.0, -4.0, -6.0};
+  const std::vector<double> elevations = options.quick
+                                             ? std::vector<double>{30.0, -4.0}
+                                             : std::vector<double>{60.0, 30.0, 10.0, 3.0, 0.0, -2.0, -4.0, -6.0};
   const int repeats = options.quick ? 1 : 3;
 
   // Every count at every elevation; the time is the fastest of `repeats`
@@ -126,7 +127,8 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
       Render r;
       r.frame_ms = 1e30;
       for (int k = 0; k < repeats; ++k) {
-        if (k > 0) renderer.Render(SunDirectionFromElevationAzimuth(elevation + 1.0, 180.0), {{MAPPING_LATLONG, 4, 2, 0}});
+        if (k > 0)
+          renderer.Render(SunDirectionFromElevationAzimuth(elevation + 1.0, 180.0), {{MAPPING_LATLONG, 4, 2, 0}});
         start = Clock::now();
         r.rgba = renderer.Render(sun, views)[0];
         r.frame_ms = std::min(r.frame_ms, std::chrono::duration<double, std::milli>(Clock::now() - start).count());
@@ -138,8 +140,9 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
   }
 
   // Errors against 48 bins, one exposure per elevation: the reference's.
-  std::string csv = "wavelengths,sun_elevation_deg,ev100,mean_delta_e2000,p95_delta_e2000,max_delta_e2000,"
-                    "mean_relative_luminance_error,max_relative_luminance_error,frame_ms,lut_ms\n";
+  std::string csv =
+      "wavelengths,sun_elevation_deg,ev100,mean_delta_e2000,p95_delta_e2000,max_delta_e2000,"
+      "mean_relative_luminance_error,max_relative_luminance_error,frame_ms,lut_ms\n";
   std::map<int, ColourError> worst;
   std::map<int, double> mean_frame_ms;
   std::map<double, double> ev100;
@@ -194,10 +197,11 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
       list.push_back({"spectral_twilight_48_no_ozone.png", "48 bins, ozone off", &no_ozone_rgba});
       list.push_back({"spectral_twilight_rgb3_no_ozone.png", "3 wavelengths, ozone off", &no_ozone3});
     }
-    pictures += fmt::format("Sun {} deg, observer at {} m, latlong {} x {} (the Sun below its "
-                            "centre: azimuth 180 deg, South), one exposure for all: EV100 {:.2f} (metered on the "
-                            "48-bin sky), ACES filmic, sRGB.\n\n| picture | zenith |\n| --- | --- |\n",
-                            twilight, options.observer_altitude_m, width, height, ev);
+    pictures += fmt::format(
+        "Sun {} deg, observer at {} m, latlong {} x {} (the Sun below its "
+        "centre: azimuth 180 deg, South), one exposure for all: EV100 {:.2f} (metered on the "
+        "48-bin sky), ACES filmic, sRGB.\n\n| picture | zenith |\n| --- | --- |\n",
+        twilight, options.observer_altitude_m, width, height, ev);
     for (const Picture& p : list) {
       WritePng(options.out_dir + "/" + p.file, width, height, TonemapToSrgb8(*p.rgba, width, height, exposure));
       pictures += fmt::format("| {} (`{}`) | {} |\n", p.label, p.file, ZenithColour(*p.rgba, width));
@@ -216,8 +220,8 @@ std::string RunSpectralStudy(VulkanContext& vulkan, const AccuracyStudyOptions& 
   for (int n : Counts(options.quick)) {
     const ColourError& w = worst[n];
     md += fmt::format("| {}{} | {:.2f} | {:.2f} | {:.2f} | {:.2e} | {:.2e} | {:.0f} | {:.0f} |\n", n,
-                      n == 3 ? " (680/550/440 nm)" : "", w.mean_delta_e, w.p95_delta_e, w.max_delta_e,
-                      w.mean_luminance, w.max_luminance, mean_frame_ms[n], lut_ms[n]);
+                      n == 3 ? " (680/550/440 nm)" : "", w.mean_delta_e, w.p95_delta_e, w.max_delta_e, w.mean_luminance,
+                      w.max_luminance, mean_frame_ms[n], lut_ms[n]);
   }
   md += "\n## Twilight pictures\n\n" + pictures;
   WriteFileAtomically(options.out_dir + "/spectral_results.md", md);

@@ -88,9 +88,8 @@ double Median(std::vector<double> v);
 // GPU time of one render per megapixel (lavapipe, GPU timestamps, median of
 // 3 renders, each with its Sun moved 0.5 deg from `sun_elevation_deg`), with a
 // latlong sized to the cost.
-double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere,
-                        const QualitySettings& quality, const EffectSettings& effects,
-                        double sun_elevation_deg = 45.0);
+double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                        const EffectSettings& effects, double sun_elevation_deg = 45.0);
 
 std::vector<std::string> SplitCsv(const std::string& line);
 
@@ -121,7 +120,7 @@ struct PlotLabels {
 // STEM_plot.dat, STEM_front.dat and STEM.gnuplot written into `out_dir`,
 // which draw STEM.png there. Returns what became of the plot: "written", or
 // "not written (...)" and why.
-std::string PlotParetoFront(const std::string& out_dir, const std::string& stem,
-                            const std::vector<PlotPoint>& points, const PlotLabels& labels);
+std::string PlotParetoFront(const std::string& out_dir, const std::string& stem, const std::vector<PlotPoint>& points,
+                            const PlotLabels& labels);
 
 }  // namespace skybake

@@ -16,10 +16,14 @@ namespace skybake {
 
 std::string IntegratorName(int integrator) {
   switch (integrator) {
-    case INTEGRATOR_MIDPOINT: return "midpoint";
-    case INTEGRATOR_TRAPEZOID: return "trapezoid";
-    case INTEGRATOR_SIMPSON: return "simpson";
-    default: return "analytic";
+    case INTEGRATOR_MIDPOINT:
+      return "midpoint";
+    case INTEGRATOR_TRAPEZOID:
+      return "trapezoid";
+    case INTEGRATOR_SIMPSON:
+      return "simpson";
+    default:
+      return "analytic";
   }
 }
 
@@ -58,9 +62,8 @@ double Median(std::vector<double> v) {
   return v.empty() ? 0.0 : v[v.size() / 2];
 }
 
-double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere,
-                        const QualitySettings& quality, const EffectSettings& effects,
-                        double sun_elevation_deg) {
+double TimePerMegapixel(VulkanContext& vulkan, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+                        const EffectSettings& effects, double sun_elevation_deg) {
   SkyRenderer renderer(vulkan, atmosphere, quality, effects, {1, 1, 1});
   renderer.PrecomputeLuts();
   double cost = double(quality.view_steps + 1) * double(std::max(quality.light_steps, 1));
@@ -87,8 +90,8 @@ std::vector<std::string> SplitCsv(const std::string& line) {
   return out;
 }
 
-std::string PlotParetoFront(const std::string& out_dir, const std::string& stem,
-                            const std::vector<PlotPoint>& points, const PlotLabels& labels) {
+std::string PlotParetoFront(const std::string& out_dir, const std::string& stem, const std::vector<PlotPoint>& points,
+                            const PlotLabels& labels) {
   std::ostringstream data, front;
   for (const PlotPoint& p : points)
     data << fmt::format("{:.6g} {:.6g} {} \"{}\"\n", p.cost, std::max(p.error, 1e-7), p.pareto ? 1 : 0, p.name);

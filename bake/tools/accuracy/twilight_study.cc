@@ -106,16 +106,15 @@ std::vector<TwilightCase> TwilightCases() {
   return cases;
 }
 
-double Budget(const std::string& preset) {
-  return preset == "draft" ? 0.05 : preset == "production" ? 0.01 : 0.001;
-}
+double Budget(const std::string& preset) { return preset == "draft" ? 0.05 : preset == "production" ? 0.01 : 0.001; }
 
 // The low sky, where the shadow's edge is, on one side of the Sun's
 // vertical plane (the sky is symmetric about it), and the zenith: the
 // directions of accuracy_test's PresetsAgainstTheirBudgetsAtTwilight.
 std::vector<glm::dvec3> TwilightDirections(bool quick, std::vector<glm::dvec2>& elevation_azimuth) {
-  const std::vector<double> elevations = quick ? std::vector<double>{0.0, 1.0, 3.0, 6.0, 30.0}
-                                               : std::vector<double>{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 15.0, 20.0, 30.0};
+  const std::vector<double> elevations =
+      quick ? std::vector<double>{0.0, 1.0, 3.0, 6.0, 30.0}
+            : std::vector<double>{0.0, 1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 15.0, 20.0, 30.0};
   const std::vector<double> azimuths = quick ? std::vector<double>{0.0, 90.0, 180.0}
                                              : std::vector<double>{0.0, 30.0, 60.0, 75.0, 90.0, 120.0, 150.0, 180.0};
   std::vector<glm::dvec3> dirs;
@@ -168,8 +167,7 @@ std::string RunTwilightStudy(StudyContext& context) {
   const std::vector<double> suns = TwilightSunElevations(options.quick);
   std::vector<TwilightCase> cases = TwilightCases();
   if (options.quick) cases.resize(2);  // draft, production
-  if (options.only == "presets")
-    std::erase_if(cases, [&](const TwilightCase& c) { return c.name != c.preset; });
+  if (options.only == "presets") std::erase_if(cases, [&](const TwilightCase& c) { return c.name != c.preset; });
   else if (!options.only.empty())
     std::erase_if(cases, [&](const TwilightCase& c) { return c.name.find(options.only) == std::string::npos; });
 

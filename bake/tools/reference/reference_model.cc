@@ -99,9 +99,8 @@ glsl::AoasParameters AoasFromUniform(const gpu::GpuAoas& g, const AoasSwitches& 
 
 }  // namespace
 
-ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings& q,
-                               const EffectSettings& effects, const Rgb& output_scale,
-                               const AoasInputs& aoas_inputs)
+ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings& q, const EffectSettings& effects,
+                               const Rgb& output_scale, const AoasInputs& aoas_inputs)
     : impl_(new Impl) {
   impl_->gpu_aoas = aoas_inputs.uniform;
   impl_->aoas = AoasFromUniform(aoas_inputs.uniform, aoas_inputs.switches);
@@ -113,9 +112,7 @@ ReferenceModel::ReferenceModel(const AtmosphereParams& a, const QualitySettings&
 }
 
 ReferenceModel::~ReferenceModel() { delete impl_; }
-ReferenceModel::ReferenceModel(ReferenceModel&& other) noexcept : impl_(other.impl_) {
-  other.impl_ = nullptr;
-}
+ReferenceModel::ReferenceModel(ReferenceModel&& other) noexcept : impl_(other.impl_) { other.impl_ = nullptr; }
 
 void ReferenceModel::PrecomputeLuts() {
   const glsl::AtmosphereParameters& atm = impl_->atm;
@@ -126,8 +123,7 @@ void ReferenceModel::PrecomputeLuts() {
   if (atm.multiple_scattering) {
     int mw = atm.multiscattering_width;
     ParallelFor(impl_->multiscattering.size(), impl_, [&](size_t i) {
-      impl_->multiscattering[i] =
-          glsl::ComputeMultipleScatteringLutTexel(atm, int(i % mw), int(i / mw));
+      impl_->multiscattering[i] = glsl::ComputeMultipleScatteringLutTexel(atm, int(i % mw), int(i / mw));
     });
   }
 }
@@ -140,9 +136,8 @@ void ReferenceModel::PrepareSun(const glm::dvec3& sun) const {
   const glsl::AtmosphereParameters& atm = impl_->atm;
   impl_->skyview.assign(size_t(atm.sky_view_width) * atm.sky_view_height, glm::dvec3(0.0));
   int w = atm.sky_view_width;
-  ParallelFor(impl_->skyview.size(), impl_, [&](size_t i) {
-    impl_->skyview[i] = glsl::ComputeSkyViewLutTexel(atm, int(i % w), int(i / w), sun.y);
-  });
+  ParallelFor(impl_->skyview.size(), impl_,
+              [&](size_t i) { impl_->skyview[i] = glsl::ComputeSkyViewLutTexel(atm, int(i % w), int(i / w), sun.y); });
 }
 
 double ReferenceModel::TwilightMarchWeight(const glm::dvec3& view, const glm::dvec3& sun) const {
@@ -186,8 +181,8 @@ std::vector<double> ReferenceModel::RenderView(const glm::dvec3& sun, const View
   std::vector<double> image(dirs.size() * 4);
   const glsl::AtmosphereParameters atm = impl_->ForSun(sun);
   ParallelFor(dirs.size(), impl_, [&](size_t i) {
-    glm::dvec3 l = glsl::ComputeStyledSkyRadiance(atm, impl_->aoas, dirs[i], sun, impl_->use_skyview) *
-                   impl_->output_scale;
+    glm::dvec3 l =
+        glsl::ComputeStyledSkyRadiance(atm, impl_->aoas, dirs[i], sun, impl_->use_skyview) * impl_->output_scale;
     image[4 * i + 0] = l.x;
     image[4 * i + 1] = l.y;
     image[4 * i + 2] = l.z;
@@ -208,8 +203,6 @@ glm::dvec3 ReferenceModel::TransmittanceDirect(double altitude_km, double mu, in
 }
 
 const std::vector<glm::dvec3>& ReferenceModel::transmittance_lut() const { return impl_->transmittance; }
-const std::vector<glm::dvec3>& ReferenceModel::multiscattering_lut() const {
-  return impl_->multiscattering;
-}
+const std::vector<glm::dvec3>& ReferenceModel::multiscattering_lut() const { return impl_->multiscattering; }
 
 }  // namespace skybake

@@ -37,8 +37,8 @@ struct OiioModule {
   // values as stored (no colour conversion). Refused from its header, before
   // any pixel is decoded, when width x height x channels exceeds
   // `max_samples`.
-  bool (*read_image)(const std::string& name, const std::string& bytes, uint64_t max_samples, int& width,
-                     int& height, int& channels, std::vector<float>& pixels, std::string& error);
+  bool (*read_image)(const std::string& name, const std::string& bytes, uint64_t max_samples, int& width, int& height,
+                     int& channels, std::vector<float>& pixels, std::string& error);
 };
 
 // Loads the module once (thread-safe); throws OutputError naming the file

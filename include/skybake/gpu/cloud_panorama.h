@@ -24,7 +24,7 @@
 namespace skybake {
 
 struct CloudPanorama {
-  int width = 0;   // 0: no panorama, every view marches its own texels
+  int width = 0;  // 0: no panorama, every view marches its own texels
   int height = 0;
   size_t texels() const { return size_t(width) * size_t(height); }
 };

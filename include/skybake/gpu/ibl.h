@@ -90,7 +90,7 @@ struct IblRequest {
   // disc is, like the Sun's, left out of the filtered source.
   bool moon = false;
   glm::dvec3 moon_direction{0, 1, 0};
-  Rgb moon_irradiance{0, 0, 0};       // after the atmosphere, output units x sr
+  Rgb moon_irradiance{0, 0, 0};  // after the atmosphere, output units x sr
 };
 
 struct IblMaps {

@@ -18,12 +18,12 @@ struct RenderCounters {
   int multiscattering_lut_builds = 0;
   int skyview_lut_builds = 0;
   int frames = 0;
-  int pipelines = 0;  // compute pipelines compiled
-  int variant_pipelines = 0;  // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
-  int sun_disc_dispatches = 0;  // dispatches of the sun-disc pass
-  int cloud_noise_builds = 0;   // noise volumes generated (once per renderer unless seeds change)
-  int cloud_table_builds = 0;   // aerial-perspective LUT and ambient table (once per sun position)
-  int cloud_dispatches = 0;     // dispatches of the cloud pass
+  int pipelines = 0;              // compute pipelines compiled
+  int variant_pipelines = 0;      // of which from the fixed-quality variants (SKYBAKE_GENERIC_SHADERS=1: none)
+  int sun_disc_dispatches = 0;    // dispatches of the sun-disc pass
+  int cloud_noise_builds = 0;     // noise volumes generated (once per renderer unless seeds change)
+  int cloud_table_builds = 0;     // aerial-perspective LUT and ambient table (once per sun position)
+  int cloud_dispatches = 0;       // dispatches of the cloud pass
   int shadowed_cloud_frames = 0;  // frames whose cloud march ran without the Sun's light (every band in the shadow)
   long long sun_disc_texels = 0;  // texels they covered
   long long twilight_texels = 0;  // texels of the views' sky pass rendered by the twilight pipeline

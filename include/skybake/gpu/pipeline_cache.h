@@ -37,14 +37,14 @@ namespace skybake {
 // What happened to the cache in this process (reported with the pipelines
 // stage; the tests read it instead of timing anything).
 struct PipelineCacheStatus {
-  bool enabled = false;        // a folder was given
-  std::string path;            // the file, when enabled
-  bool loaded = false;         // a valid file's data was given to the driver (a hit)
-  size_t loaded_bytes = 0;     // the driver's data in it
-  std::string ignored_because; // why a file that exists was not used ("" when loaded or absent)
-  bool saved = false;          // written this process
+  bool enabled = false;         // a folder was given
+  std::string path;             // the file, when enabled
+  bool loaded = false;          // a valid file's data was given to the driver (a hit)
+  size_t loaded_bytes = 0;      // the driver's data in it
+  std::string ignored_because;  // why a file that exists was not used ("" when loaded or absent)
+  bool saved = false;           // written this process
   size_t saved_bytes = 0;
-  std::string save_error;      // why saving failed ("" otherwise); the bake goes on
+  std::string save_error;  // why saving failed ("" otherwise); the bake goes on
 };
 
 // The file's name for a device and shader digest (no folder).

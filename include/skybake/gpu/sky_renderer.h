@@ -21,8 +21,8 @@
 
 namespace skybake {
 
-class SpectralSky;      // spectral_sky.h
-struct CloudPanorama;   // cloud_panorama.h
+class SpectralSky;     // spectral_sky.h
+struct CloudPanorama;  // cloud_panorama.h
 
 // Texels [x0, x1) x [y0, y1) of a view.
 struct TexelRect {
@@ -94,9 +94,8 @@ class SkyRenderer {
   // principle is already in `atmosphere` (StyledAtmosphere).
   // With quality.wavelengths above 3 it is the spectral mode (spectral_sky.h):
   // views are linear Rec.709 in cd/m^2 and `output_scale` is not used.
-  SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere,
-              const QualitySettings& quality, const EffectSettings& effects,
-              const Rgb& output_scale, bool output_directions = false,
+  SkyRenderer(VulkanContext& context, const AtmosphereParams& atmosphere, const QualitySettings& quality,
+              const EffectSettings& effects, const Rgb& output_scale, bool output_directions = false,
               const AoasInputs& aoas = AoasInputs(), const CloudInputs& clouds = CloudInputs(),
               const ShaderSwitches& shaders = ShaderSwitches());
   ~SkyRenderer();
@@ -125,8 +124,8 @@ class SkyRenderer {
   // returns one RGBA float image per view, rows from the top.
   // With `sun_disc` false, the same pipeline renders without the disc (a
   // push constant), from the same LUTs.
-  std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction,
-                                         const std::vector<ViewRequest>& views, bool sun_disc = true);
+  std::vector<std::vector<float>> Render(const glm::dvec3& sun_direction, const std::vector<ViewRequest>& views,
+                                         bool sun_disc = true);
 
   // Render without the copy: the texels stay where the device wrote them,
   // for as long as the result's `hold` lives (a bake's writer thread reads
@@ -154,8 +153,8 @@ class SkyRenderer {
   bool HoldsFrames() const;
 
   // Radiance (RGBA) along each unit direction.
-  std::vector<float> RenderDirections(const glm::dvec3& sun_direction,
-                                      const std::vector<glm::dvec3>& directions, bool sun_disc = true);
+  std::vector<float> RenderDirections(const glm::dvec3& sun_direction, const std::vector<glm::dvec3>& directions,
+                                      bool sun_disc = true);
 
   // Replaces the atmosphere (a scheduled drift of its constants, say)
   // without new pipelines: the LUTs are rebuilt by the next Render. False
@@ -259,7 +258,7 @@ class SkyRenderer {
   TexelRange TexelViewRange(int i) const;
   void DestroyBuffer(Buffer& buffer);
   void EnsureOutputCapacity(VkDeviceSize bytes);
-  void EnsureCloudLutCapacity(size_t texels);  // the cloud tables and the panorama after them
+  void EnsureCloudLutCapacity(size_t texels);      // the cloud tables and the panorama after them
   void EnsureDispatchCapacity(size_t dispatches);  // room for a submission's SkyPush constants
   void UpdateDescriptors();
   // Points one storage-buffer binding of the descriptor set at `buffer`.
@@ -310,8 +309,8 @@ class SkyRenderer {
   void BindOutput(const Buffer& target);
   // The sky-view LUT when the Sun moved, the views at `offsets` (texels) of
   // `target`, the sun-disc pass; submitted and waited for.
-  void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views,
-                   bool sun_disc, const std::vector<size_t>& offsets, FramePart part = FramePart::kWhole);
+  void SubmitViews(const Buffer& target, const glm::dvec3& sun, const std::vector<ViewRequest>& views, bool sun_disc,
+                   const std::vector<size_t>& offsets, FramePart part = FramePart::kWhole);
   // Its parts: the views' sky-pass dispatches with the day pipeline (whose
   // constants the cloud pass's reuse; AddSkyRows submits them), the sun-disc
   // pass over them, the cloud pass over them.
@@ -346,15 +345,15 @@ class SkyRenderer {
   AoasSwitches aoas_switches_;
   bool output_directions_ = false;
   bool style_pass_ = false;  // StylePass: style_pipeline_ is its only pipeline
-  bool disc_pass_ = false;  // UsesSunDiscPass
+  bool disc_pass_ = false;   // UsesSunDiscPass
   bool luts_ready_ = false;
   bool skyview_ready_ = false;
   glm::dvec3 skyview_sun_{0.0};  // the sun the sky-view LUT holds
   gpu::GpuClouds gpu_clouds_{};
-  int cloud_layers_ = 0;           // 0: no cloud pass, no cloud pipelines
+  int cloud_layers_ = 0;  // 0: no cloud pass, no cloud pipelines
   bool cloud_noise_ready_ = false;
   bool cloud_tables_ready_ = false;
-  glm::dvec3 cloud_sun_{0.0};      // the sun the cloud tables hold
+  glm::dvec3 cloud_sun_{0.0};        // the sun the cloud tables hold
   bool cloud_light_volume_ = false;  // cloud_pipeline_ reads the light volume (CloudLightVolumeOn)
   bool cloud_formation_ = false;     // the cloud pipelines read a formation's density (CloudFormationRead)
   bool cloud_cirrus_ = false;        // some layer is cirrus: streaks and the ice phase (SPEC_CLOUD_CIRRUS)
@@ -376,10 +375,10 @@ class SkyRenderer {
   // (SPEC_TEXEL_VIEWS; off, each is one texel, never read).
   VkBufferView texel_views_[TEXEL_VIEW_COUNT] = {};
   bool texel_views_whole_ = false;
-  Buffer cloud_lut_buffer_;    // aerial-perspective LUT and ambient table
-  Buffer dispatch_buffer_;     // a submission's SkyPush constants, one per dispatch (BINDING_DISPATCH)
+  Buffer cloud_lut_buffer_;  // aerial-perspective LUT and ambient table
+  Buffer dispatch_buffer_;   // a submission's SkyPush constants, one per dispatch (BINDING_DISPATCH)
   std::vector<std::unique_ptr<FrameSlot>> frame_slots_;  // RenderInPlace
-  VkBuffer bound_output_ = VK_NULL_HANDLE;                // what the output binding points at
+  VkBuffer bound_output_ = VK_NULL_HANDLE;               // what the output binding points at
 
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
@@ -393,19 +392,19 @@ class SkyRenderer {
   VkPipeline cloud_lut_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_pipeline_ = VK_NULL_HANDLE;
   VkPipeline cloud_resample_pipeline_ = VK_NULL_HANDLE;  // views from the cloud panorama
-  VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;  // built on the first RenderCloudShadow
-  VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;  // built on the first frame that marches the twilight band
+  VkPipeline cloud_shadow_pipeline_ = VK_NULL_HANDLE;    // built on the first RenderCloudShadow
+  VkPipeline twilight_sky_pipeline_ = VK_NULL_HANDLE;    // built on the first frame that marches the twilight band
   VkPipeline shadowed_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the Sun's light (CloudsInEarthShadow)
   VkPipeline marched_light_cloud_pipeline_ = VK_NULL_HANDLE;  // cloud_render without the light volume
-  bool shadowed_clouds_ = true;                          // ShaderSwitches::shadowed_clouds
-  bool twilight_march_allowed_ = true;                   // set_twilight_march
-  bool twilight_rows_ = true;                            // ShaderSwitches::twilight_rows
-  bool texel_views_allowed_ = true;                      // ShaderSwitches::texel_views
-  bool formation_read_always_ = false;                   // ShaderSwitches::formation_read_always
+  bool shadowed_clouds_ = true;                               // ShaderSwitches::shadowed_clouds
+  bool twilight_march_allowed_ = true;                        // set_twilight_march
+  bool twilight_rows_ = true;                                 // ShaderSwitches::twilight_rows
+  bool texel_views_allowed_ = true;                           // ShaderSwitches::texel_views
+  bool formation_read_always_ = false;                        // ShaderSwitches::formation_read_always
   // TwilightRows per view shape (mapping, width, height, face).
   std::vector<std::pair<ViewRequest, std::vector<RowRange>>> twilight_row_runs_;
-  VkPipeline style_pipeline_ = VK_NULL_HANDLE;         // StylePass
-  bool sky_view_variant_ = false;                      // sky_pipeline_ is the built-in sky-view variant
+  VkPipeline style_pipeline_ = VK_NULL_HANDLE;  // StylePass
+  bool sky_view_variant_ = false;               // sky_pipeline_ is the built-in sky-view variant
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer command_buffer_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;

@@ -25,22 +25,20 @@ namespace skybake {
 // A Vulkan call failed (out of memory, device lost, ...).
 class VulkanError : public Error {
  public:
-  VulkanError(const std::string& what, VkResult result)
-      : Error(what, kExitVulkan), result(result) {}
+  VulkanError(const std::string& what, VkResult result) : Error(what, kExitVulkan), result(result) {}
   std::string message() const override { return std::string("Vulkan: ") + what(); }
   VkResult result;
 };
 
 const char* VkResultName(VkResult result);
 
-#define VK_CHECK(call)                                                                   \
-  do {                                                                                   \
-    VkResult vk_check_result_ = (call);                                                  \
-    if (vk_check_result_ != VK_SUCCESS)                                                  \
-      throw ::skybake::VulkanError(std::string(#call) + " failed with " +                \
-                                       ::skybake::VkResultName(vk_check_result_) + " at " + \
-                                       __FILE__ + ":" + std::to_string(__LINE__),        \
-                                   vk_check_result_);                                    \
+#define VK_CHECK(call)                                                                                                \
+  do {                                                                                                                \
+    VkResult vk_check_result_ = (call);                                                                               \
+    if (vk_check_result_ != VK_SUCCESS)                                                                               \
+      throw ::skybake::VulkanError(std::string(#call) + " failed with " + ::skybake::VkResultName(vk_check_result_) + \
+                                       " at " + __FILE__ + ":" + std::to_string(__LINE__),                            \
+                                   vk_check_result_);                                                                 \
   } while (0)
 
 struct DeviceInfo {
@@ -116,9 +114,9 @@ VkPipeline CreateComputePipeline(VkDevice device, const uint32_t* code, size_t b
                                  VkPipelineCache cache = VK_NULL_HANDLE);
 
 struct VulkanOptions {
-  int device_index = -1;      // -1: choose the best usable device
-  bool validation = false;    // load VK_LAYER_KHRONOS_validation
-  bool print_messages = true; // print validation messages to stderr
+  int device_index = -1;       // -1: choose the best usable device
+  bool validation = false;     // load VK_LAYER_KHRONOS_validation
+  bool print_messages = true;  // print validation messages to stderr
   // The VK_LOADER_DRIVERS_SELECT main set (SoftwareDriverSelection), or ""
   // when every driver is loaded; reported with the device.
   std::string software_driver_selection;
@@ -168,13 +166,12 @@ class VulkanContext {
   const std::vector<std::string>& validation_messages() const { return messages_; }
 
   // Memory type with all `required` flags among `type_bits`; prefers `preferred` too.
-  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required,
-                          VkMemoryPropertyFlags preferred) const;
+  uint32_t FindMemoryType(uint32_t type_bits, VkMemoryPropertyFlags required, VkMemoryPropertyFlags preferred) const;
 
  private:
-  static VKAPI_ATTR VkBool32 VKAPI_CALL DebugCallback(
-      VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT types,
-      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
+  static VKAPI_ATTR VkBool32 VKAPI_CALL DebugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                      VkDebugUtilsMessageTypeFlagsEXT types,
+                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user);
 
   VkInstance instance_ = VK_NULL_HANDLE;
   VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;

@@ -88,8 +88,8 @@ std::string DefaultStarCataloguePath();
 
 // A direction in the observer's sky.
 struct SkyDirection {
-  double elevation_deg = 0.0;  // above the horizon, no refraction
-  double azimuth_deg = 0.0;    // compass bearing, clockwise from North, [0, 360)
+  double elevation_deg = 0.0;           // above the horizon, no refraction
+  double azimuth_deg = 0.0;             // compass bearing, clockwise from North, [0, 360)
   glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, skybake's frame (+Y up, North -Z, East +X)
 };
 
@@ -139,33 +139,33 @@ std::vector<PlacedStar> PlaceStars(const StarCatalogue& catalogue, double magnit
                                    const GeoLocation& place, double min_elevation_deg);
 
 struct MoonState {
-  SkyDirection sky;                  // topocentric
-  double phase_angle_deg = 0.0;      // Sun-Moon-Earth, 0 = full, 180 = new (libnova, degrees)
-  double illuminated_fraction = 0.0; // (1 + cos phase) / 2
-  double bright_limb_deg = 0.0;      // position angle of the bright limb's midpoint, from celestial north through east
-  double distance_km = 0.0;          // topocentric
-  double angular_radius_rad = 0.0;   // from the Moon's radius and the topocentric distance
-  double illuminance_lux = 0.0;      // outside the atmosphere, Krisciunas & Schaefer 1991 eq. 8
+  SkyDirection sky;                   // topocentric
+  double phase_angle_deg = 0.0;       // Sun-Moon-Earth, 0 = full, 180 = new (libnova, degrees)
+  double illuminated_fraction = 0.0;  // (1 + cos phase) / 2
+  double bright_limb_deg = 0.0;       // position angle of the bright limb's midpoint, from celestial north through east
+  double distance_km = 0.0;           // topocentric
+  double angular_radius_rad = 0.0;    // from the Moon's radius and the topocentric distance
+  double illuminance_lux = 0.0;       // outside the atmosphere, Krisciunas & Schaefer 1991 eq. 8
   double geocentric_elevation_deg = 0.0;  // without the parallax, for tests
   double geocentric_ra_deg = 0.0;         // of date, for tests
   double geocentric_dec_deg = 0.0;
   double geocentric_distance_km = 0.0;
-  double ecliptic_elongation_deg = 0.0;   // Moon minus Sun ecliptic longitude, [0, 360)
+  double ecliptic_elongation_deg = 0.0;  // Moon minus Sun ecliptic longitude, [0, 360)
 };
 
 // The Moon of one baked frame, as FrameResult and the manifest record it.
 struct MoonRecord {
   glm::dvec3 direction{0.0, 1.0, 0.0};  // unit, towards the Moon (topocentric)
   double elevation_deg = 0.0;
-  double azimuth_deg = 0.0;             // clockwise from North
-  double phase_angle_deg = 0.0;         // 0 = full, 180 = new
+  double azimuth_deg = 0.0;      // clockwise from North
+  double phase_angle_deg = 0.0;  // 0 = full, 180 = new
   double illuminated_fraction = 0.0;
   double bright_limb_deg = 0.0;
   double angular_radius_rad = 0.0;
-  double top_illuminance_lux = 0.0;     // outside the atmosphere (Krisciunas & Schaefer 1991)
-  double illuminance_lux = 0.0;         // at the observer, after the atmosphere (0 below the horizon)
-  Rgb irradiance{0.0, 0.0, 0.0};        // the same in output units x sr
-  bool light = false;                   // night.moonlight: a light of the scene (glTF, SH)
+  double top_illuminance_lux = 0.0;  // outside the atmosphere (Krisciunas & Schaefer 1991)
+  double illuminance_lux = 0.0;      // at the observer, after the atmosphere (0 below the horizon)
+  Rgb irradiance{0.0, 0.0, 0.0};     // the same in output units x sr
+  bool light = false;                // night.moonlight: a light of the scene (glTF, SH)
 };
 
 MoonState ComputeMoon(double julian_day_ut, const GeoLocation& place, double observer_altitude_m);

@@ -20,9 +20,9 @@ namespace skybake {
 // A user error located in an input file.
 struct ConfigError {
   std::string file;
-  int line = 0;    // 1-based; 0 when unknown
-  int column = 0;  // 1-based; 0 when unknown
-  std::string key; // dotted key path, e.g. "atmosphere.mie.g"
+  int line = 0;     // 1-based; 0 when unknown
+  int column = 0;   // 1-based; 0 when unknown
+  std::string key;  // dotted key path, e.g. "atmosphere.mie.g"
   std::string message;
   std::string Format() const;  // "file:line:col: key: message"
 };
@@ -31,8 +31,7 @@ struct ConfigError {
 // its errors (the gallery's styles): the CLI prints every located error.
 class ConfigFailure : public Error {
  public:
-  ConfigFailure(const std::string& what, std::vector<ConfigError> e)
-      : Error(what, kExitConfig), errors(std::move(e)) {}
+  ConfigFailure(const std::string& what, std::vector<ConfigError> e) : Error(what, kExitConfig), errors(std::move(e)) {}
   std::vector<ConfigError> errors;
 };
 
@@ -84,6 +83,5 @@ std::optional<ConfigError> DeepKeyError(std::string_view text, const std::string
 // `--set` key and of a quoted key in a schedule's `set`, `ramp` or
 // `per_hour` ("a.b.c" = 1), both of which skybake splits at the dots.
 bool KeyHasTooManyParts(std::string_view key);
-
 
 }  // namespace skybake

@@ -24,23 +24,23 @@ namespace skybake {
 
 // One image of a preset: its file suffix and the direction of every texel.
 struct EngineImage {
-  std::string suffix;      // "px", "Left", "latlong", ...
-  std::string kind;        // "face" or "latlong" or "cube strip"
+  std::string suffix;  // "px", "Left", "latlong", ...
+  std::string kind;    // "face" or "latlong" or "cube strip"
   int width = 0, height = 0;
-  int envmap = -1;         // EXR envmap attribute: -1 none, 0 latlong, 1 cube
-  std::string mapping;     // the lookup the texels follow, for the file's skybake:engine_mapping
+  int envmap = -1;                     // EXR envmap attribute: -1 none, 0 latlong, 1 cube
+  std::string mapping;                 // the lookup the texels follow, for the file's skybake:engine_mapping
   std::vector<glm::dvec3> directions;  // row-major from the top row, unit, skybake's world
 };
 
 struct EnginePreset {
-  std::string name;          // as given to --engine
-  std::string title;         // "three.js", "Blender (Cycles, EEVEE)"
-  std::string frame;         // the engine's world frame: handedness, up, forward
-  std::string import;        // how a glTF scene's axes land in the engine (the Sun light with them)
+  std::string name;                // as given to --engine
+  std::string title;               // "three.js", "Blender (Cycles, EEVEE)"
+  std::string frame;               // the engine's world frame: handedness, up, forward
+  std::string import;              // how a glTF scene's axes land in the engine (the Sun light with them)
   std::vector<std::string> faces;  // file suffixes of its six faces in load order (empty: none)
-  bool latlong = false;      // writes an equirect panorama
-  bool cube_strip = false;   // writes an OpenEXR cube strip (exrenvmap)
-  std::string formats;       // what the engine reads of what skybake writes
+  bool latlong = false;            // writes an equirect panorama
+  bool cube_strip = false;         // writes an OpenEXR cube strip (exrenvmap)
+  std::string formats;             // what the engine reads of what skybake writes
 };
 
 // Every preset, in --help order.
@@ -85,8 +85,8 @@ namespace engine_lookup {
 glm::dvec3 CubeTexel(int face, int x, int y, int size);
 // Equirect texel centre (x, y) of a w x h image whose u = offset +
 // atan2(dot(d, a), dot(d, b)) / 2 pi (wrapped) and top row along `up`.
-glm::dvec3 EquirectTexel(int x, int y, int w, int h, const glm::dvec3& a, const glm::dvec3& b,
-                         const glm::dvec3& up, double offset);
+glm::dvec3 EquirectTexel(int x, int y, int w, int h, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& up,
+                         double offset);
 }  // namespace engine_lookup
 
 }  // namespace skybake

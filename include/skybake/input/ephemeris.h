@@ -22,15 +22,15 @@ namespace skybake {
 struct LunarEphemeris {
   double ecliptic_longitude_deg = 0.0;  // [0, 360), as ln_get_lunar_ecl_coords
   double ecliptic_latitude_deg = 0.0;
-  double distance_km = 0.0;             // Earth's centre to the Moon's
-  double ra_deg = 0.0;                  // [0, 360), as ln_get_lunar_equ_coords (not precessed)
+  double distance_km = 0.0;  // Earth's centre to the Moon's
+  double ra_deg = 0.0;       // [0, 360), as ln_get_lunar_equ_coords (not precessed)
   double dec_deg = 0.0;
-  double sun_ra_deg = 0.0;              // as ln_get_solar_equ_coords
+  double sun_ra_deg = 0.0;  // as ln_get_solar_equ_coords
   double sun_dec_deg = 0.0;
-  double phase_angle_deg = 0.0;         // Sun-Moon-Earth, [0, 180]
+  double phase_angle_deg = 0.0;  // Sun-Moon-Earth, [0, 180]
   double illuminated_fraction = 0.0;
-  double bright_limb_deg = 0.0;         // [0, 360), from celestial north through east
-  double ecliptic_elongation_deg = 0.0; // Moon minus Sun ecliptic longitude, [0, 360)
+  double bright_limb_deg = 0.0;          // [0, 360), from celestial north through east
+  double ecliptic_elongation_deg = 0.0;  // Moon minus Sun ecliptic longitude, [0, 360)
 };
 LunarEphemeris ComputeLunarEphemeris(double julian_day_ut);
 

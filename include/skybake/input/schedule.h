@@ -35,12 +35,12 @@ struct FrameOverride {
 };
 
 struct ScheduleFrame {
-  int number = 1;                  // in file names: name.0001.exr
-  std::optional<CivilTime> time;   // when the frame is a clock time
-  double hours_from_start = 0.0;   // since the first frame (0 without clock times)
-  double fraction = 0.0;           // 0 at the first frame, 1 at the last (time, else index)
+  int number = 1;                 // in file names: name.0001.exr
+  std::optional<CivilTime> time;  // when the frame is a clock time
+  double hours_from_start = 0.0;  // since the first frame (0 without clock times)
+  double fraction = 0.0;          // 0 at the first frame, 1 at the last (time, else index)
   double elevation_deg = 0.0;
-  double azimuth_deg = 0.0;        // clockwise from North
+  double azimuth_deg = 0.0;  // clockwise from North
   glm::dvec3 sun_direction{0.0, 1.0, 0.0};
   std::vector<FrameOverride> overrides;  // from the frame's own `set` table
 };
@@ -65,7 +65,7 @@ struct Schedule {
   std::vector<ScheduleFrame> frames;
   std::vector<ScheduleRamp> ramps;
   std::vector<ScheduleRate> rates;
-  bool clock_times = false;          // every frame has a time
+  bool clock_times = false;  // every frame has a time
 };
 
 struct ScheduleResult {
@@ -89,8 +89,7 @@ bool TextHasSchedule(std::string_view toml_text, const std::string& name);
 // `base_style`), then the frame's own overrides. Errors (a ramp on a key the
 // style does not have as a number) go to `errors`.
 std::vector<FrameOverride> FrameStyleOverrides(const Schedule& schedule, const ScheduleFrame& frame,
-                                               const SkyStyle& base_style,
-                                               std::vector<ConfigError>& errors);
+                                               const SkyStyle& base_style, std::vector<ConfigError>& errors);
 
 // Reads `style_path` once per frame with `overrides` then the frame's
 // assignments on top. An error in a frame's assignment is reported at its

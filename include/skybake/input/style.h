@@ -34,8 +34,8 @@ struct SkyStyle {
   RenderSettings render;
   OutputSettings output;
   PreviewSettings preview;
-  AoasSettings aoas;          // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
-  CloudSettings clouds;       // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
+  AoasSettings aoas;                 // the aesthetic principles (skydome, hue, ambiguity, clouds, shapes)
+  CloudSettings clouds;              // volumetric [[cloud_layer]] tables and their sampling (clouds.h)
   CloudShadowSettings cloud_shadow;  // [cloud_shadow]: the frame's cloud shadow map (cloud_shadow.h)
   GltfSettings gltf;
   UsdSettings usd;

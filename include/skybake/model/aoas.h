@@ -30,7 +30,7 @@ constexpr int kAoasSplineSubdivisions = 8;
 // Section 3.2: the single atmosphere skydome.
 struct SkydomeSettings {
   bool enabled = false;
-  double radius = 1.0;                        // dome radius R, scene units (> 0)
+  double radius = 1.0;                           // dome radius R, scene units (> 0)
   glm::dvec3 viewer_position = {0.0, 0.0, 0.0};  // P^s_v, scene units, |P| < R, y >= 0
 };
 
@@ -54,10 +54,10 @@ struct AmbiguitySettings {
 // Cloud complexity, eq. 7-8: Improved Perlin noise scaling HSV saturation.
 struct CloudNoiseSettings {
   bool enabled = false;
-  double s_noise = 0.25;    // feature size S_noise, dome radii
-  int octaves = 4;          // fractal octaves
-  double threshold = 0.0;   // noise below this gives no cloud, in [-1, 1)
-  double strength = 0.8;    // saturation removed at the noise peaks, [0, 1]
+  double s_noise = 0.25;               // feature size S_noise, dome radii
+  int octaves = 4;                     // fractal octaves
+  double threshold = 0.0;              // noise below this gives no cloud, in [-1, 1)
+  double strength = 0.8;               // saturation removed at the noise peaks, [0, 1]
   glm::dvec3 drift = {0.0, 0.0, 0.0};  // offset of the noise field, in S_noise units
 };
 
@@ -67,9 +67,9 @@ enum class ShapeKind { kPoint, kPolyline, kSpline };
 struct CloudShape {
   ShapeKind kind = ShapeKind::kPoint;
   std::vector<std::array<double, 2>> points;  // [elevation_deg, azimuth_deg]
-  bool closed = false;      // polyline/spline: join the last point to the first
-  double radius_deg = 3.0;  // distance at which the cloud has faded to nothing
-  double strength = 1.0;    // saturation removed on the shape, [0, 1]
+  bool closed = false;                        // polyline/spline: join the last point to the first
+  double radius_deg = 3.0;                    // distance at which the cloud has faded to nothing
+  double strength = 1.0;                      // saturation removed on the shape, [0, 1]
 };
 struct CloudShapeSettings {
   bool enabled = false;
@@ -110,8 +110,7 @@ bool ParseHexColor(const std::string& text, Rgb& linear_rgb);
 // irradiance, K: display_scale) gives the target hue; k makes the
 // luminance-weighted optical thickness sum_c Y_c beta_c E_c K_c equal to the
 // physical one, which keeps the sky's brightness and its gradient.
-Rgb RayleighForTargetColor(const Rgb& target_linear_rgb, const AtmosphereParams& physical,
-                           const Rgb& display_scale);
+Rgb RayleighForTargetColor(const Rgb& target_linear_rgb, const AtmosphereParams& physical, const Rgb& display_scale);
 
 // The atmosphere with the hue principle applied (the Rayleigh constants
 // mixed towards the hue vector by hue.strength).

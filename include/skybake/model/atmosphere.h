@@ -21,9 +21,9 @@ namespace skybake {
 using Rgb = std::array<double, 3>;
 
 struct AtmosphereParams {
-  double bottom_radius_km = 6360.0;  // Hillaire 2020 and Bruneton 2017
-  double top_radius_km = 6460.0;     // Hillaire 2020 (Bruneton 2017: 6420)
-  double observer_altitude_m = 0.0;  // above bottom_radius_km
+  double bottom_radius_km = 6360.0;     // Hillaire 2020 and Bruneton 2017
+  double top_radius_km = 6460.0;        // Hillaire 2020 (Bruneton 2017: 6420)
+  double observer_altitude_m = 0.0;     // above bottom_radius_km
   Rgb ground_albedo = {0.1, 0.1, 0.1};  // Bruneton 2017 (Hillaire 2020: 0)
 
   Rgb rayleigh_scattering_per_km = {5.802e-3, 13.558e-3, 33.100e-3};  // both papers
@@ -35,7 +35,7 @@ struct AtmosphereParams {
   double mie_g = 0.8;  // Cornette-Shanks anisotropy, Bruneton 2017
 
   Rgb ozone_absorption_per_km = {0.650e-3, 1.881e-3, 0.085e-3};  // at the peak, both papers
-  double ozone_peak_altitude_km = 25.0;  // tent: 0 at 10 km, 1 at 25 km, 0 at 40 km
+  double ozone_peak_altitude_km = 25.0;                          // tent: 0 at 10 km, 1 at 25 km, 0 at 40 km
   double ozone_half_width_km = 15.0;
 
   // Solar irradiance at the top of the atmosphere, W m^-2 nm^-1
@@ -57,7 +57,7 @@ struct QualitySettings {
   int multiscattering_sqrt_dirs = 8;  // 64 directions, Hillaire 2020
   int transmittance_width = 256;      // Hillaire 2020: 256 x 64
   int transmittance_height = 64;
-  int multiscattering_size = 32;      // Hillaire 2020: 32 x 32
+  int multiscattering_size = 32;  // Hillaire 2020: 32 x 32
   int integrator = INTEGRATOR_ANALYTIC;
   // Sun transmittance at each view sample: 0 reads the transmittance LUT,
   // N > 0 marches N midpoint steps towards the Sun (Galaj 2019's light samples).
@@ -119,9 +119,9 @@ std::vector<std::string> QualityPresetNames();
 struct EffectSettings {
   bool multiple_scattering = true;
   bool sun_disc = true;
-  bool ground = true;            // the sunlit ground and its bounce into multiple scattering
-  bool mie = true;               // aerosols
-  bool ozone = true;             // ozone absorption
+  bool ground = true;                         // the sunlit ground and its bounce into multiple scattering
+  bool mie = true;                            // aerosols
+  bool ozone = true;                          // ozone absorption
   double multiple_scattering_strength = 1.0;  // artistic multiplier of Hillaire's Psi_ms
   double sun_disc_strength = 1.0;             // artistic multiplier of the disc radiance
   // Twilight and night dimming: from sun -6 deg to -18 deg the sky blends to a
@@ -146,8 +146,7 @@ glm::dvec3 SunDirectionFromElevationAzimuth(double elevation_deg, double azimuth
 
 // Packs the parameters into the uniform block the shaders read. `output_scale`
 // multiplies radiance per channel (see OutputUnits in config.h).
-gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& atmosphere,
-                                   const QualitySettings& quality,
+gpu::GpuAtmosphere ToGpuAtmosphere(const AtmosphereParams& atmosphere, const QualitySettings& quality,
                                    const EffectSettings& effects, const Rgb& output_scale);
 
 }  // namespace skybake

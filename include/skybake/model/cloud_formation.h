@@ -59,11 +59,11 @@ struct CloudLayer;
 // The [cloud_layer.formation] table of a cloud layer (off by default).
 struct CloudFormation {
   bool enabled = false;
-  std::array<int, 3> cells = {64, 64, 8};             // lattice cells east, north, up
-  std::array<double, 2> size_m = {30000.0, 30000.0};  // lattice extent east, north; up spans the layer's thickness
+  std::array<int, 3> cells = {64, 64, 8};                 // lattice cells east, north, up
+  std::array<double, 2> size_m = {30000.0, 30000.0};      // lattice extent east, north; up spans the layer's thickness
   std::array<double, 2> origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner at time 0
-  double steps_per_hour = 30.0;        // automaton steps per hour of clock time
-  int warmup_steps = 30;               // steps simulated before time 0 (the day's start)
+  double steps_per_hour = 30.0;                           // automaton steps per hour of clock time
+  int warmup_steps = 30;                                  // steps simulated before time 0 (the day's start)
   // The temporal box filter (Dobashi 2000, section 4, smooths the density
   // over neighbouring steps as over cells): the density at step s is the
   // mean over the steps s - smoothing_steps .. s, 0..64 (0: step s alone).
@@ -157,9 +157,9 @@ double FormationTimeSeconds(const CloudFormation& f, std::optional<double> local
 // to resolution^2 texels (row 0 north), and where it lies.
 struct FormationCoverage {
   std::vector<float> map;
-  double step = 0.0;                  // the automaton's (fractional) step at the time
-  std::array<double, 2> origin_m{};   // [east, north] of the south-west corner, drift included
-  std::array<double, 2> extent_m{};   // = size_m
+  double step = 0.0;                 // the automaton's (fractional) step at the time
+  std::array<double, 2> origin_m{};  // [east, north] of the south-west corner, drift included
+  std::array<double, 2> extent_m{};  // = size_m
 };
 FormationCoverage FormationCoverageAt(const CloudFormation& f, const CloudMask* mask, uint32_t seed, double time_s,
                                       int resolution);

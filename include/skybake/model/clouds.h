@@ -58,16 +58,16 @@ struct CloudLayer {
   double thickness_m = 1500.0;  // top = altitude_m + thickness_m
   CloudType type = CloudType::kCumulus;
   std::array<double, 4> profile = CloudTypeProfile(CloudType::kCumulus);  // type = "custom" sets it
-  double coverage = 0.5;        // 0: no cloud, 0.5: the weather map as is, 1: overcast
-  double density_per_m = 0.05;  // extinction at full density, 1/m
-  double albedo = 0.99;         // single-scattering albedo
-  double shape_amount = 1.0;    // 0: a flat slab, 1: the full Perlin-Worley shape
-  double shape_size_m = 4000.0; // edge of one tile of the shape noise
-  double detail_amount = 0.35;  // erosion by the detail noise, 0..1
-  double detail_size_m = 400.0; // edge of one tile of the detail noise
-  std::array<double, 2> wind_m_s = {0.0, 0.0};           // [east, north] at the bottom
-  std::array<double, 2> shear_m_s_per_km = {0.0, 0.0};   // extra wind per km above the bottom
-  std::optional<uint32_t> seed;  // aoas.seed when unset
+  double coverage = 0.5;                                // 0: no cloud, 0.5: the weather map as is, 1: overcast
+  double density_per_m = 0.05;                          // extinction at full density, 1/m
+  double albedo = 0.99;                                 // single-scattering albedo
+  double shape_amount = 1.0;                            // 0: a flat slab, 1: the full Perlin-Worley shape
+  double shape_size_m = 4000.0;                         // edge of one tile of the shape noise
+  double detail_amount = 0.35;                          // erosion by the detail noise, 0..1
+  double detail_size_m = 400.0;                         // edge of one tile of the detail noise
+  std::array<double, 2> wind_m_s = {0.0, 0.0};          // [east, north] at the bottom
+  std::array<double, 2> shear_m_s_per_km = {0.0, 0.0};  // extra wind per km above the bottom
+  std::optional<uint32_t> seed;                         // aoas.seed when unset
   // Weather map: procedural tiling noise of this extent, or an image.
   double weather_size_m = 30000.0;  // edge of one tile of the procedural weather map
   // false (default): the shape, detail and procedural weather are read
@@ -75,8 +75,8 @@ struct CloudLayer {
   // layer never repeats; true: they repeat with their tile sizes (a cloud
   // shadow map of whole tiles then wraps without a seam, CloudShadowTiles).
   bool tiling = false;
-  std::string weather_image;        // EXR or PNG; R = coverage (0..1); "" = procedural
-  std::array<double, 2> weather_extent_m = {30000.0, 30000.0};  // [east, north] size of the image
+  std::string weather_image;                                      // EXR or PNG; R = coverage (0..1); "" = procedural
+  std::array<double, 2> weather_extent_m = {30000.0, 30000.0};    // [east, north] size of the image
   std::array<double, 2> weather_origin_m = {-15000.0, -15000.0};  // [east, north] of its south-west corner
   CloudFormation formation;  // [cloud_layer.formation]: coverage from the automaton (cloud_formation.h)
   // type = "cirrus" only: the streaks' length over their width (the noise
@@ -91,16 +91,16 @@ std::array<double, 2> CirrusStreakDirection(const CloudLayer& layer);
 // Cloud sampling settings; quality.preset sets them, [quality] cloud_* keys
 // refine them.
 struct CloudQuality {
-  int view_steps = 48;          // view samples per layer crossing of a texel
-  int light_steps = 24;         // samples toward the Sun per lit view sample
+  int view_steps = 48;   // view samples per layer crossing of a texel
+  int light_steps = 24;  // samples toward the Sun per lit view sample
   // Light samples nearest the view sample that read the volumes trilinearly;
   // the farther ones (and the bands above) read the nearest voxel, 8 times
   // fewer loads. >= light_steps: every light sample trilinear.
   int light_trilinear_steps = 8;
-  int octaves = 8;              // Wrenninge multiple-scattering octaves
-  int shape_resolution = 64;    // shape noise volume edge, voxels
-  int detail_resolution = 32;   // detail noise volume edge, voxels
-  int weather_resolution = 256; // procedural weather map edge, texels
+  int octaves = 8;                 // Wrenninge multiple-scattering octaves
+  int shape_resolution = 64;       // shape noise volume edge, voxels
+  int detail_resolution = 32;      // detail noise volume edge, voxels
+  int weather_resolution = 256;    // procedural weather map edge, texels
   double max_distance_km = 300.0;  // no cloud beyond this distance from the viewer
   // Cloud panorama height over the finest view's (cloud_panorama.h); 0: every
   // view marches its own texels.
@@ -233,8 +233,7 @@ struct CloudInputs {
 // clouds by wind x time_s (no re-randomising per frame). A layer with a
 // formation runs on the formation's clock instead (FormationTimeSeconds of
 // clouds.local_clock_s, cloud_formation.h): its wind, drift and lattice.
-CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir,
-                          double time_s);
+CloudInputs ToCloudInputs(const CloudSettings& clouds, uint32_t aoas_seed, const std::string& style_dir, double time_s);
 
 // Floats of the noise buffer (shape, detail and weather of every active
 // layer, then the empty-space bounds of every layer), and where each part of

@@ -21,10 +21,9 @@ using glm::abs;
 using glm::acos;
 using glm::asin;
 using glm::atan;
-using glm::atan;
-using glm::cross;
 using glm::clamp;
 using glm::cos;
+using glm::cross;
 using glm::dot;
 using glm::exp;
 using glm::exp2;
@@ -42,25 +41,23 @@ using glm::sqrt;
 // GLSL converts double literals to float implicitly; these overloads do the
 // same for scalar built-ins when Real is float (mixed float/double arguments).
 template <class A, class B>
-inline Real max(A a, B b) requires(std::is_arithmetic_v<A> && std::is_arithmetic_v<B> &&
-                                   !std::is_same_v<A, B>) {
+inline Real max(A a, B b) requires(std::is_arithmetic_v<A>&& std::is_arithmetic_v<B> && !std::is_same_v<A, B>) {
   return glm::max(Real(a), Real(b));
 }
 template <class A, class B>
-inline Real min(A a, B b) requires(std::is_arithmetic_v<A> && std::is_arithmetic_v<B> &&
-                                   !std::is_same_v<A, B>) {
+inline Real min(A a, B b) requires(std::is_arithmetic_v<A>&& std::is_arithmetic_v<B> && !std::is_same_v<A, B>) {
   return glm::min(Real(a), Real(b));
 }
 template <class A, class B, class C>
-inline Real clamp(A x, B lo, C hi) requires(std::is_arithmetic_v<A> && std::is_arithmetic_v<B> &&
-                                            std::is_arithmetic_v<C> &&
-                                            !(std::is_same_v<A, B> && std::is_same_v<B, C>)) {
+inline Real clamp(A x, B lo,
+                  C hi) requires(std::is_arithmetic_v<A>&& std::is_arithmetic_v<B>&& std::is_arithmetic_v<C> &&
+                                 !(std::is_same_v<A, B> && std::is_same_v<B, C>)) {
   return glm::clamp(Real(x), Real(lo), Real(hi));
 }
 template <class A, class B, class C>
-inline Real smoothstep(A lo, B hi, C x) requires(std::is_arithmetic_v<A> && std::is_arithmetic_v<B> &&
-                                                 std::is_arithmetic_v<C> &&
-                                                 !(std::is_same_v<A, B> && std::is_same_v<B, C>)) {
+inline Real smoothstep(A lo, B hi,
+                       C x) requires(std::is_arithmetic_v<A>&& std::is_arithmetic_v<B>&& std::is_arithmetic_v<C> &&
+                                     !(std::is_same_v<A, B> && std::is_same_v<B, C>)) {
   return glm::smoothstep(Real(lo), Real(hi), Real(x));
 }
 // GLSL multiplies a float vector by a double literal (the literal becomes

@@ -40,9 +40,9 @@ struct GeoLocation {
 };
 
 struct SolarPosition {
-  double elevation_deg = 0.0;  // above the horizon (90 - zenith)
-  double azimuth_deg = 0.0;    // clockwise from North, [0, 360)
-  double julian_day_ut = 0.0;  // the instant, Julian day (UT)
+  double elevation_deg = 0.0;           // above the horizon (90 - zenith)
+  double azimuth_deg = 0.0;             // clockwise from North, [0, 360)
+  double julian_day_ut = 0.0;           // the instant, Julian day (UT)
   glm::dvec3 direction{0.0, 1.0, 0.0};  // unit vector towards the Sun, world frame
 };
 

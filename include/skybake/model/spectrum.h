@@ -26,9 +26,9 @@
 
 namespace skybake {
 
-constexpr int kRgbWavelengths = 3;       // quality.wavelengths = 3: the 680/550/440 nm path
+constexpr int kRgbWavelengths = 3;  // quality.wavelengths = 3: the 680/550/440 nm path
 constexpr int kMinWavelengthBins = 4;
-constexpr int kMaxWavelengthBins = 48;   // the tables' 10 nm spacing
+constexpr int kMaxWavelengthBins = 48;  // the tables' 10 nm spacing
 constexpr double kSpectralLowerNm = 355.0;
 constexpr double kSpectralUpperNm = 835.0;
 constexpr double kLumensPerWatt = 683.0;  // maximum luminous efficacy (CIE)

@@ -27,7 +27,6 @@ double ExposureFromEv100(double ev100);
 double AutoEv100(const std::vector<float>& latlong_rgba, int width, int height);
 
 // Exposes, tone maps and encodes an RGBA float image to 8-bit sRGB RGB.
-std::vector<uint8_t> TonemapToSrgb8(const std::vector<float>& rgba, int width, int height,
-                                    double exposure);
+std::vector<uint8_t> TonemapToSrgb8(const std::vector<float>& rgba, int width, int height, double exposure);
 
 }  // namespace skybake

@@ -34,7 +34,7 @@ struct BakedFile {
 
 // What one frame of a bake produced.
 struct FrameResult {
-  int number = 1;                    // in file names; 0 for a single bake (no number)
+  int number = 1;  // in file names; 0 for a single bake (no number)
   std::optional<CivilTime> time;
   glm::dvec3 sun_direction{0, 1, 0};
   double sun_elevation_deg = 0.0;
@@ -44,7 +44,7 @@ struct FrameResult {
   ShRgb sh_irradiance_without_sun{};  // E_lm of the sky alone
   Rgb sun_irradiance{0, 0, 0};        // transmitted sun at the observer, output units x sr
   double sun_illuminance_lux = 0.0;
-  std::optional<MoonRecord> moon;     // with night.moon or night.moonlight (pipeline/night_sky.h)
+  std::optional<MoonRecord> moon;  // with night.moon or night.moonlight (pipeline/night_sky.h)
   double render_seconds = 0.0;
   double write_seconds = 0.0;
   std::vector<PassTiming> gpu_passes;
@@ -57,13 +57,13 @@ struct BakeResult {
   std::vector<StageReport> stages;
   std::vector<PassTiming> gpu_passes;  // LUT and render passes, GPU timestamps
   RenderCounters counters;
-  double half_scale = 1.0;   // power-of-two factor applied to fit half range
+  double half_scale = 1.0;  // power-of-two factor applied to fit half range
   double preview_ev100 = 0.0;
   int validation_messages = 0;
   std::string manifest_path;
-  int renderer_builds = 0;  // SkyRenderer constructions (new shader variants or LUT sizes)
-  int atmosphere_updates = 0;  // atmosphere changes served by the same pipelines (new uniforms and LUTs)
-  int manifest_writes = 0;     // progress manifests written during the bake (the final one apart)
+  int renderer_builds = 0;              // SkyRenderer constructions (new shader variants or LUT sizes)
+  int atmosphere_updates = 0;           // atmosphere changes served by the same pipelines (new uniforms and LUTs)
+  int manifest_writes = 0;              // progress manifests written during the bake (the final one apart)
   uint64_t manifest_bytes_written = 0;  // their bytes: linear in the frames, not quadratic
   std::vector<std::string> removed_temporaries;  // left by a killed bake, removed before baking
 };

@@ -21,8 +21,8 @@ namespace skybake {
 struct RgbaImage {
   int width = 0;
   int height = 0;
-  std::vector<float> rgba;        // RGBA float texels, rows from the top; empty when `view` is set
-  const float* view = nullptr;    // or texels held elsewhere (SkyRenderer::RenderInPlace), laid out as `rgba`
+  std::vector<float> rgba;      // RGBA float texels, rows from the top; empty when `view` is set
+  const float* view = nullptr;  // or texels held elsewhere (SkyRenderer::RenderInPlace), laid out as `rgba`
   const float* data() const { return view ? view : rgba.data(); }
   size_t texels() const { return size_t(width) * size_t(height); }
 };
@@ -32,10 +32,10 @@ constexpr double kHalfMax = 65504.0;
 struct ExrWriteOptions {
   PixelType pixel_type = PixelType::kHalf;
   std::string compression = "zip";
-  int zip_level = kDefaultZipLevel;  // deflate level 1..9 of zip and zips (docs/performance.md)
-  int envmap = -1;               // -1: none; 0: ENVMAP_LATLONG; 1: ENVMAP_CUBE
-  double scale = 1.0;            // multiplies every value before writing
-  double white_luminance = 0.0;  // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
+  int zip_level = kDefaultZipLevel;               // deflate level 1..9 of zip and zips (docs/performance.md)
+  int envmap = -1;                                // -1: none; 0: ENVMAP_LATLONG; 1: ENVMAP_CUBE
+  double scale = 1.0;                             // multiplies every value before writing
+  double white_luminance = 0.0;                   // cd/m^2 of RGB (1,1,1) after scaling; 0: not written
   std::map<std::string, std::string> attributes;  // provenance string attributes
   // The `chromaticities` attribute: CIE xy of red, green, blue and white
   // (Rec.709 and D65 unless the values are in another space, ACEScg say).

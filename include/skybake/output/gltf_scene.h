@@ -42,9 +42,9 @@
 namespace skybake {
 
 struct DomeMesh {
-  std::vector<glm::vec3> positions;  // metres
-  std::vector<glm::vec2> uvs;        // glTF texture coordinates (origin top-left)
-  std::vector<uint32_t> indices;     // triangles, counter-clockwise seen from inside
+  std::vector<glm::vec3> positions;    // metres
+  std::vector<glm::vec2> uvs;          // glTF texture coordinates (origin top-left)
+  std::vector<uint32_t> indices;       // triangles, counter-clockwise seen from inside
   std::vector<glm::dvec3> directions;  // unit direction of each vertex from the centre, before flattening
 };
 
@@ -60,26 +60,26 @@ glm::dvec2 LatLongUvFromDirection(const glm::dvec3& d, int texture_width, int te
 glm::dquat SunNodeRotation(const glm::dvec3& sun_direction);
 
 struct SceneSun {
-  double time_s = 0.0;           // animation time of this key
-  glm::dvec3 direction{0, 1, 0}; // unit, towards the Sun
-  double illuminance_lux = 0.0;  // transmitted sun at the observer
-  Rgb color{1.0, 1.0, 1.0};      // linear Rec.709, max channel 1
+  double time_s = 0.0;            // animation time of this key
+  glm::dvec3 direction{0, 1, 0};  // unit, towards the Sun
+  double illuminance_lux = 0.0;   // transmitted sun at the observer
+  Rgb color{1.0, 1.0, 1.0};       // linear Rec.709, max channel 1
 };
 
 struct SceneDescription {
-  std::string name;                // base name: name.gltf, name.bin, name.glb
+  std::string name;  // base name: name.gltf, name.bin, name.glb
   std::string out_dir;
-  std::string texture_file;        // the PNG, a file name inside out_dir
+  std::string texture_file;  // the PNG, a file name inside out_dir
   int texture_width = 0;
   int texture_height = 0;
   GltfSettings dome;
-  std::vector<SceneSun> suns;      // 1 for a bake, one per frame for a sequence
-  int light_frame = 0;             // which sun sets the light's colour and intensity
+  std::vector<SceneSun> suns;  // 1 for a bake, one per frame for a sequence
+  int light_frame = 0;         // which sun sets the light's colour and intensity
   // The Moon as a second directional light (night.moonlight), one key per
   // frame that has it; its intensity and colour are the brightest key's
   // (a light's intensity is not animated in core glTF). Empty: no Moon.
   std::vector<SceneSun> moons;
-  std::string extras_json;         // JSON object merged into the scene's extras (skybake provenance)
+  std::string extras_json;  // JSON object merged into the scene's extras (skybake provenance)
   // The same object as nlohmann's dump(2) writes it, or empty (then made
   // from extras_json): the writer puts the texts in place, never holding the
   // object in its JSON forms.
@@ -87,7 +87,7 @@ struct SceneDescription {
   // EXT_lights_image_based (gltf_ibl.h): levels x 6 RGBD PNGs in out_dir, level-major,
   // +X -X +Y -Y +Z -Z; none: no image-based light.
   std::vector<std::string> ibl_images;
-  ShRgb ibl_sh{};                  // E_lm of the sky without the Sun, the bake's units
+  ShRgb ibl_sh{};  // E_lm of the sky without the Sun, the bake's units
   // The ground plane textured with a frame's cloud shadow map (cloud_shadow.h):
   // the PNG in out_dir and where the map lies. None: no ground plane.
   std::string ground_texture_file;

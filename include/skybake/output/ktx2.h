@@ -25,8 +25,8 @@ namespace skybake {
 
 struct Ktx2Options {
   KtxFormat format = KtxFormat::kRgba16f;
-  int zstd_level = 0;    // 0: none; else the zstd level of each mip level's data
-  double scale = 1.0;    // multiplies every value before it is encoded
+  int zstd_level = 0;                           // 0: none; else the zstd level of each mip level's data
+  double scale = 1.0;                           // multiplies every value before it is encoded
   std::map<std::string, std::string> metadata;  // key/value data (UTF-8 strings)
   uint32_t primaries = 1;  // the DFD's colorPrimaries (Khronos Data Format 1.3, khr_df_primaries_e): 1 BT.709
 };

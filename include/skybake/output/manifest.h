@@ -45,8 +45,8 @@ struct ManifestFile {
 };
 
 struct ManifestFrame {
-  int number = 0;              // in file names; 0 for a single bake
-  std::string style_sha256;    // of the frame's resolved style TOML
+  int number = 0;                   // in file names; 0 for a single bake
+  std::string style_sha256;         // of the frame's resolved style TOML
   std::optional<std::string> time;  // ISO 8601 with UTC offset, for clock-time schedules
   double hours_from_start = 0.0;
   double animation_time_s = 0.0;  // the glTF sun key: hours of clock time, else the frame's index
@@ -60,8 +60,8 @@ struct ManifestFrame {
   // The style's sun.angular_radius_rad of the frame, recorded (as
   // sun.angular_radius_rad) only with the USD layer, whose Sun takes it.
   std::optional<double> sun_angular_radius_rad;
-  std::optional<MoonRecord> moon;   // with the night sky's Moon; absent otherwise
-  std::vector<ManifestFile> files;  // in the order they are written
+  std::optional<MoonRecord> moon;               // with the night sky's Moon; absent otherwise
+  std::vector<ManifestFile> files;              // in the order they are written
   std::optional<CloudShadowInfo> cloud_shadow;  // where the frame's cloud shadow map lies (cloud_shadow.h)
 };
 
@@ -83,23 +83,23 @@ struct ManifestUsd {
 };
 
 struct Manifest {
-  std::string version;           // SKYBAKE_VERSION
-  std::string commit;            // the git commit skybake was built from, "unknown" outside git
-  std::string style, schedule;   // paths as given on the command line (recorded in every EXR too)
-  std::string sequence_sha256;   // every frame's number, time, sun and resolved style: one bake, one value
+  std::string version;          // SKYBAKE_VERSION
+  std::string commit;           // the git commit skybake was built from, "unknown" outside git
+  std::string style, schedule;  // paths as given on the command line (recorded in every EXR too)
+  std::string sequence_sha256;  // every frame's number, time, sun and resolved style: one bake, one value
   std::string units;
   double exposure_ev100 = 0.0;
   std::string exposure_source;
-  int texture_frame = 0;         // the reference frame (highest sun)
+  int texture_frame = 0;  // the reference frame (highest sun)
   double half_scale = 1.0;
   std::optional<GeoLocation> place;
   std::optional<FrameRange> sequence;  // every frame of the schedule; unset for a single bake
   std::optional<FrameRange> part;      // the frames of a part (--frames, --shard); unset for a whole bake
   ManifestScene gltf;
   ManifestUsd usd;
-  std::vector<ManifestFrame> frames;   // by frame number
-  bool complete = false;               // every frame of the bake (or part) is done
-  std::vector<ManifestFile> scene;     // the glTF scene's files and the USD layer, once written
+  std::vector<ManifestFrame> frames;  // by frame number
+  bool complete = false;              // every frame of the bake (or part) is done
+  std::vector<ManifestFile> scene;    // the glTF scene's files and the USD layer, once written
 };
 
 // manifest.json for a whole bake, manifest.shard-0003-0004.json for the part
@@ -107,7 +107,6 @@ struct Manifest {
 // timings.json and timings.shard-0003-0004.json.
 std::string ManifestFileName(const std::optional<FrameRange>& part);
 std::string TimingsFileName(const std::optional<FrameRange>& part);
-
 
 // One frame's line of the text whose SHA-256 is a manifest's
 // sequence_sha256: number, ISO 8601 time ("" without), sun direction,
@@ -181,13 +180,13 @@ struct TimingsSpools {
 };
 std::string TimingsStageText(const StageReport& stage);
 std::string TimingsFrameText(const FrameResult& frame);
-void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds,
-                  const std::string& path, const TimingsSpools* spools = nullptr);
+void WriteTimings(const BakeResult& result, const std::string& out_dir, double total_seconds, const std::string& path,
+                  const TimingsSpools* spools = nullptr);
 
 struct MergeOptions {
-  std::string dir;                // holds the parts' manifests and files
-  bool verify_checksums = true;   // SHA-256 of every listed file; sizes only when false
-  bool force = false;             // replace an existing manifest.json and scene
+  std::string dir;               // holds the parts' manifests and files
+  bool verify_checksums = true;  // SHA-256 of every listed file; sizes only when false
+  bool force = false;            // replace an existing manifest.json and scene
 };
 
 struct MergeResult {

@@ -51,11 +51,11 @@ struct UsdDistantKey {
 };
 
 struct UsdFrame {
-  int number = 0;                 // frame number, the time code of a sequence's samples
-  std::string latlong_file;       // the latlong EXR, a plain file name beside the layer
-  double texture_scale = 1.0;     // its skybake:scale (stored value = cd/m^2 x scale)
+  int number = 0;                      // frame number, the time code of a sequence's samples
+  std::string latlong_file;            // the latlong EXR, a plain file name beside the layer
+  double texture_scale = 1.0;          // its skybake:scale (stored value = cd/m^2 x scale)
   std::string color_space = "rec709";  // its skybake:color_space (output.color_space)
-  std::string time;               // ISO 8601, or "" without clock times
+  std::string time;                    // ISO 8601, or "" without clock times
   double sun_elevation_deg = 0.0;
   double sun_azimuth_deg = 0.0;
   std::string style_sha256;
@@ -64,7 +64,7 @@ struct UsdFrame {
 };
 
 struct UsdLayerDescription {
-  std::string name;     // NAME.usda
+  std::string name;  // NAME.usda
   std::string out_dir;
   bool sequence = false;  // time samples at the frame numbers
   std::vector<UsdFrame> frames;

@@ -23,10 +23,10 @@ namespace skybake {
 
 struct GalleryOptions {
   std::string out_dir = "out/gallery";
-  int latlong_height = 192;             // each style's latlong is 2H x H
+  int latlong_height = 192;  // each style's latlong is 2H x H
   int columns = 2;
-  std::vector<std::string> overrides;   // --set, applied to every style
-  BakeOptions bake;                     // device, validation, progress; bake.force replaces a previous gallery
+  std::vector<std::string> overrides;  // --set, applied to every style
+  BakeOptions bake;                    // device, validation, progress; bake.force replaces a previous gallery
 };
 
 struct GalleryEntry {

@@ -82,7 +82,7 @@ class StarGrid {
   // false when the cone holds a hemisphere or more (every cell).
   template <typename Cells>
   bool ForCellsWithin(const glm::dvec3& direction, double radius_rad, Cells cells) const;
-  std::vector<double> prefix_;  // per row, kColumns + 1 running sums
+  std::vector<double> prefix_;   // per row, kColumns + 1 running sums
   std::vector<uint32_t> first_;  // the stars of cell k: stars_[first_[k], first_[k + 1])
   std::vector<Star> stars_;
   double total_ = 0.0;
@@ -98,7 +98,7 @@ struct RectCone {
   // 2 sqrt 2 / n on the face plane, or a latitude step plus a longitude
   // step at the widest row involved)
   double reach_rad = 0.0;
-  double min_solid_angle = 0.0;  // sr, its smallest texel's (a corner's)
+  double min_solid_angle = 0.0;         // sr, its smallest texel's (a corner's)
   float min_mu = -1.0f, max_mu = 1.0f;  // holds mu = cos(zenith angle) of its texels
 };
 RectCone ConeOfRect(const ViewRequest& view, int x0, int x1, int y0, int y1);
@@ -111,7 +111,7 @@ struct UnplacedLight {
   double min_source_mu = -1.0;      // every star source is above it
   double moon_total = 0.0;          // the largest channels of the Moon's samples, summed
   glm::dvec3 moon_centre{0.0, 1.0, 0.0};
-  double moon_radius_rad = 0.0;     // every sample is within it of the centre
+  double moon_radius_rad = 0.0;               // every sample is within it of the centre
   const std::vector<Rgb>* airglow = nullptr;  // null or empty: none
   // With it (and `stars`), a single texel the bound above does not clear
   // is looked at star by star: the grid's stars near it placed and

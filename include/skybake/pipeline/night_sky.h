@@ -174,10 +174,10 @@ class SplatTiles {
   std::vector<float> mu_range_;
 };
 struct TileBound {
-  bool splat = false;            // some tile a source reaches may take an addition
-  bool airglow = false;          // some tile may take the glow
-  std::vector<size_t> sources;   // the sources with a target in such a tile, increasing
-  size_t tiles_read = 0;         // tiles whose texels were read
+  bool splat = false;           // some tile a source reaches may take an addition
+  bool airglow = false;         // some tile may take the glow
+  std::vector<size_t> sources;  // the sources with a target in such a tile, increasing
+  size_t tiles_read = 0;        // tiles whose texels were read
 };
 // `airglow`: the glow's table (AirglowTable), or empty.
 TileBound BoundByTiles(const ViewRequest& view, const SplatTiles& tiles, const std::vector<PointSource>& sources,
@@ -194,8 +194,7 @@ float RectFloor(const float* rgba, int width, int x0, int x1, int y0, int y1);
 // read linearly; zero where the ray meets the ground.
 class TransmittanceTable {
  public:
-  TransmittanceTable(const AtmosphereParams& atmosphere, const QualitySettings& quality,
-                     const EffectSettings& effects);
+  TransmittanceTable(const AtmosphereParams& atmosphere, const QualitySettings& quality, const EffectSettings& effects);
   Rgb At(double mu) const;
   // The largest entry of any channel: no At is above it.
   double LargestEntry() const;
@@ -209,13 +208,13 @@ class TransmittanceTable {
 
 // What the night adds to one frame.
 struct NightFrame {
-  std::vector<PointSource> sources;   // stars and samples of the Moon's disc, attenuated
-  size_t stars = 0;                   // of which stars
-  std::optional<MoonState> moon;      // with night.moon or night.moonlight
-  Rgb moon_irradiance{0.0, 0.0, 0.0}; // the Moon at the observer, output units x sr (after the atmosphere)
-  double moon_illuminance_lux = 0.0;  // the same as illuminance
-  double moonlight_scale = 0.0;       // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
-  bool daylight = false;              // the Sun above the horizon: splats go through SplatBound
+  std::vector<PointSource> sources;    // stars and samples of the Moon's disc, attenuated
+  size_t stars = 0;                    // of which stars
+  std::optional<MoonState> moon;       // with night.moon or night.moonlight
+  Rgb moon_irradiance{0.0, 0.0, 0.0};  // the Moon at the observer, output units x sr (after the atmosphere)
+  double moon_illuminance_lux = 0.0;   // the same as illuminance
+  double moonlight_scale = 0.0;        // E_moon / E_sun at the top of the atmosphere; 0: no moonlit sky this frame
+  bool daylight = false;               // the Sun above the horizon: splats go through SplatBound
   // A day frame's stars before placement (night_prune.h): `sources` holds
   // the Moon's samples alone and `stars` is 0 until a view needs the stars
   // (PendingStars::Placed). Null when the stars are placed (or off).

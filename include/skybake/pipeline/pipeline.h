@@ -43,11 +43,11 @@ using FrameProgressCallback = std::function<void(const FrameProgress&)>;
 struct BakeOptions {
   std::string out_dir = "out";
   VulkanOptions vulkan;
-  ShaderSwitches shaders;     // the CLI's diagnostic switches (from the environment, read in main)
+  ShaderSwitches shaders;  // the CLI's diagnostic switches (from the environment, read in main)
   // The star catalogue of a style whose night.star_catalogue is "" (main:
   // $SKYBAKE_STAR_CATALOGUE when set).
   std::string star_catalogue = DefaultStarCataloguePath();
-  ProgressCallback progress;  // may be empty
+  ProgressCallback progress;             // may be empty
   FrameProgressCallback frame_progress;  // may be empty
   // The git commit of the running binary ("unknown" outside git; main:
   // `skybake --version`'s), recorded in the manifest beside the version.
@@ -59,8 +59,8 @@ struct BakeOptions {
   // scene. Exposure, half scale and the scene's texture frame still come
   // from every frame, so a part's files equal the same frames of a whole bake.
   std::optional<FrameRange> frames;
-  double max_memory_mib = 4096.0;       // budget for one frame's host + device memory (README "Limits")
-  double max_frame_seconds = 3600.0;    // budget for one frame's estimated lavapipe render time
+  double max_memory_mib = 4096.0;     // budget for one frame's host + device memory (README "Limits")
+  double max_frame_seconds = 3600.0;  // budget for one frame's estimated lavapipe render time
   // What BakeResult keeps of each frame. On (the library's default): frames,
   // each frame's files in files, every stage in stages. Off (the CLI): a
   // sequence's memory stays flat however long it is: each frame's files go
@@ -78,9 +78,9 @@ struct BakeOptions {
 
 // Estimated peak memory and lavapipe time of one frame of `style`.
 struct ResourceEstimate {
-  double memory_mib = 0.0;      // device output buffer, host copies, LUTs, encoded files
-  double samples = 0.0;         // ray-march samples (texels x steps, LUTs included)
-  double seconds = 0.0;         // samples / kLavapipeSamplesPerSecond
+  double memory_mib = 0.0;  // device output buffer, host copies, LUTs, encoded files
+  double samples = 0.0;     // ray-march samples (texels x steps, LUTs included)
+  double seconds = 0.0;     // samples / kLavapipeSamplesPerSecond
 };
 ResourceEstimate EstimateResources(const SkyStyle& style);
 
@@ -112,8 +112,7 @@ BakeResult BakeStyle(const SkyStyle& style, const BakeOptions& options);
 // half-float scale for the whole sequence. Writes one glTF scene with the
 // sun animated across the frames, manifest.json and timings.json; with
 // options.frames, only those frames and their part's manifest (manifest.h).
-BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& schedule,
-                        const BakeOptions& options);
+BakeResult BakeSequence(const std::vector<SkyStyle>& styles, const Schedule& schedule, const BakeOptions& options);
 
 // A frame's images and encoded files (up to 34 MB each) are allocated and
 // freed every frame. glibc serves blocks above its mmap threshold (at most

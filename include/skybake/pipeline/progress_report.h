@@ -90,8 +90,8 @@ class ProgressReport {
   int done_ = 0;
   double seconds_per_frame_ = 0.0;  // as of the last frame done
   Clock::time_point first_frame_start_, frame_start_;
-  std::string stage_;          // the live line's stage: "rendering", then "IBL done" (the last one finished)
-  size_t live_width_ = 0;      // characters of the live line on the terminal (0: none shown)
+  std::string stage_;      // the live line's stage: "rendering", then "IBL done" (the last one finished)
+  size_t live_width_ = 0;  // characters of the live line on the terminal (0: none shown)
 };
 
 }  // namespace skybake

@@ -55,7 +55,7 @@ struct FramePlan {
 };
 
 struct RenderPlan {
-  std::vector<FramePlan> frames;    // every frame of the sequence, in order; one for a single bake
+  std::vector<FramePlan> frames;       // every frame of the sequence, in order; one for a single bake
   const Schedule* schedule = nullptr;  // none for a single bake
   // A schedule's frames share one exposure and one half-float scale, chosen
   // before any file is written (ChooseSequenceExposure); a single bake's
@@ -69,8 +69,8 @@ struct RenderPlan {
 
   bool Bakes(const FramePlan& frame) const { return !part || part->Contains(frame.number); }
   const SkyStyle& first() const { return *frames.front().style; }
-  std::vector<const SkyStyle*> styles() const;       // every frame's
-  std::vector<SkyStyle> BakedStyles() const;         // the frames this run bakes, for PlanPasses
+  std::vector<const SkyStyle*> styles() const;  // every frame's
+  std::vector<SkyStyle> BakedStyles() const;    // the frames this run bakes, for PlanPasses
 };
 
 // A single bake of `style` at its own sun.

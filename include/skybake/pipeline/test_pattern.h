@@ -32,7 +32,7 @@ struct TestPatternOptions {
   std::string out_dir = "out";
   std::string engine = "none";  // a preset name, or none: skybake's own faces, strip and latlong
   std::string basename = "sky";
-  int size = 256;                // cube face edge; the latlong is 2N x N
+  int size = 256;  // cube face edge; the latlong is 2N x N
   bool force = false;
   double max_memory_mib = 4096.0;  // budget (README "Limits"); over it, BudgetError (exit 7) before any file
 };

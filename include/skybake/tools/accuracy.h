@@ -38,12 +38,13 @@ class ConvergedReference {
 void GaussLegendre(int n, std::vector<double>& nodes, std::vector<double>& weights);
 
 struct AccuracyStudyOptions {
-  std::string out_dir = "docs";   // accuracy.md, accuracy.csv, accuracy.png, kider2014.csv
+  std::string out_dir = "docs";  // accuracy.md, accuracy.csv, accuracy.png, kider2014.csv
   std::string shared_dir = "../shared";
-  bool quick = false;             // fewer cases and directions (for tests)
+  bool quick = false;                // fewer cases and directions (for tests)
   double observer_altitude_m = 0.0;  // the study's observer (0 m and 8000 m in docs/accuracy.md)
-  std::string only;               // when set, only the cases whose name contains it
-  std::string study = "all";      // "sky" (integrators, Kider 2014), "clouds" (tools/cloud_study.h), "spectral", "twilight" or "all"
+  std::string only;                  // when set, only the cases whose name contains it
+  std::string study =
+      "all";  // "sky" (integrators, Kider 2014), "clouds" (tools/cloud_study.h), "spectral", "twilight" or "all"
   std::function<void(const std::string&)> progress;
 };
 

@@ -31,11 +31,11 @@ struct CloudStudyOptions {
 struct CloudStudyCase {
   std::string name;
   CloudQuality quality;
-  double mean_error = 0.0;  // worst over the sun elevations of mean |L - L_ref| / mean L_ref
-  double rmse = 0.0;        // the same elevations' worst RMSE / mean L_ref
-  double ms_per_mp = 0.0;   // the cloud passes' GPU time per megapixel of output, median (wall time on lavapipe)
+  double mean_error = 0.0;     // worst over the sun elevations of mean |L - L_ref| / mean L_ref
+  double rmse = 0.0;           // the same elevations' worst RMSE / mean L_ref
+  double ms_per_mp = 0.0;      // the cloud passes' GPU time per megapixel of output, median (wall time on lavapipe)
   double cpu_ms_per_mp = 0.0;  // the process's CPU time of a render per megapixel, median: the front's cost
-  bool pareto = false;      // on the front of (cpu_ms_per_mp, mean_error) among the march cases
+  bool pareto = false;         // on the front of (cpu_ms_per_mp, mean_error) among the march cases
 };
 
 // How far the reference is from converged: its error measure between the
@@ -49,8 +49,8 @@ struct CloudConvergence {
 
 struct CloudPresetChoice {
   std::string preset;
-  double bound = 0.0;                  // on mean_error
-  int choice = -1;      // index into CloudStudyResult::cases; -1 when none meets the bound
+  double bound = 0.0;  // on mean_error
+  int choice = -1;     // index into CloudStudyResult::cases; -1 when none meets the bound
 };
 
 struct CloudStudyResult {

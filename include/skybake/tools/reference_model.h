@@ -19,9 +19,8 @@ class ReferenceModel {
  public:
   // `aoas`: the per-texel aesthetic principles, read from the same packed
   // uniform the GPU gets (so both sides use the same float parameters).
-  ReferenceModel(const AtmosphereParams& atmosphere, const QualitySettings& quality,
-                 const EffectSettings& effects, const Rgb& output_scale,
-                 const AoasInputs& aoas = AoasInputs());
+  ReferenceModel(const AtmosphereParams& atmosphere, const QualitySettings& quality, const EffectSettings& effects,
+                 const Rgb& output_scale, const AoasInputs& aoas = AoasInputs());
   ~ReferenceModel();
   ReferenceModel(ReferenceModel&&) noexcept;
 
@@ -55,13 +54,12 @@ class ReferenceModel {
   const std::vector<glm::dvec3>& transmittance_lut() const;
   const std::vector<glm::dvec3>& multiscattering_lut() const;
 
- // Implementation (the shared code instantiated in double); public so that
+  // Implementation (the shared code instantiated in double); public so that
   // helpers in reference_model.cc can name it.
   struct Impl;
 
  private:
   Impl* impl_;
 };
-
 
 }  // namespace skybake
