@@ -1,5 +1,6 @@
 // The resource estimate of one frame and the budget check (pipeline.h).
 #include <algorithm>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -72,7 +73,7 @@ ResourceEstimate EstimateResources(const SkyStyle& style) {
   // The style pass (the AOAS saturation clouds and shapes, the night floor
   // on the combined colour) has one more such buffer; with cloud layers, the
   // style's change of the colour is one more on the host.
-  const double groups = q.wavelengths > kRgbWavelengths ? double((q.wavelengths + 2) / 3) : 1.0;
+  const double groups = q.wavelengths > kRgbWavelengths ? std::ceil(q.wavelengths / 3.0) : 1.0;
   const bool style_pass = style.aoas.clouds.enabled || style.aoas.shapes.enabled || style.effects.night_dimming;
   const double style_buffers = style_pass ? (ActiveCloudLayers(style.clouds).empty() ? 1.0 : 2.0) : 0.0;
   const double spectral_buffers = q.wavelengths > kRgbWavelengths ? 16.0 * (groups + style_buffers) * texels : 0.0;
