@@ -6,6 +6,7 @@
 
 #include <ImfArray.h>
 #include <ImfIO.h>
+#include <ImfInputFile.h>
 #include <ImfRgbaFile.h>
 #include <fmt/format.h>
 
@@ -65,6 +66,20 @@ std::string ReadExrRgba(const std::string& path, int& width, int& height, std::v
     height = int(h);
   } catch (const std::exception& e) {
     rgba.clear();
+    return fmt::format("is not an OpenEXR file ({})", e.what());
+  }
+  return "";
+}
+
+std::string ExrSizeOfBytes(const std::string& bytes, int& width, int& height) {
+  width = height = 0;
+  try {
+    ByteStream stream(bytes);
+    Imf::InputFile in(stream);
+    const Imath::Box2i window = in.header().dataWindow();
+    width = window.max.x - window.min.x + 1;
+    height = window.max.y - window.min.y + 1;
+  } catch (const std::exception& e) {
     return fmt::format("is not an OpenEXR file ({})", e.what());
   }
   return "";

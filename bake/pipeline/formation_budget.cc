@@ -68,33 +68,34 @@ FrameWork FrameFormationWork(const FramePlan& frame, std::map<std::string, doubl
   return work;
 }
 
+// Each baked frame's work in the order the bake runs them: the reference
+// frame's sky first (the sequence's exposure), then the frames; a frame's
+// steps continue from the lattice the one before left.
+template <typename Visit>
+void ForEachFrameWork(const RenderPlan& plan, Visit visit) {
+  std::map<std::string, double> cache;
+  if (plan.sequence && plan.exposed && plan.reference < plan.frames.size())
+    FrameFormationWork(plan.frames[plan.reference], cache);
+  for (const FramePlan& frame : plan.frames)
+    if (plan.Bakes(frame)) visit(frame, FrameFormationWork(frame, cache));
+}
+
 }  // namespace
 
 FormationEstimate EstimateFormationWork(const RenderPlan& plan) {
   FormationEstimate busiest;
-  std::map<std::string, double> cache;
-  // The reference frame's sky is rendered first (the sequence's exposure).
-  if (plan.sequence && plan.exposed && plan.reference < plan.frames.size())
-    FrameFormationWork(plan.frames[plan.reference], cache);
-  for (const FramePlan& frame : plan.frames) {
-    if (!plan.Bakes(frame)) continue;
-    const FrameWork work = FrameFormationWork(frame, cache);
+  ForEachFrameWork(plan, [&](const FramePlan& frame, const FrameWork& work) {
     if (work.cell_updates > busiest.cell_updates) {
       busiest.cell_updates = work.cell_updates;
       busiest.seconds = work.cell_updates * kSecondsPerCellStep;
       busiest.frame = frame.Label();
     }
-  }
+  });
   return busiest;
 }
 
 FormationEstimate CheckFormationBudget(const RenderPlan& plan, const BakeOptions& options) {
-  std::map<std::string, double> cache;
-  if (plan.sequence && plan.exposed && plan.reference < plan.frames.size())
-    FrameFormationWork(plan.frames[plan.reference], cache);
-  for (const FramePlan& frame : plan.frames) {
-    if (!plan.Bakes(frame)) continue;
-    const FrameWork work = FrameFormationWork(frame, cache);
+  ForEachFrameWork(plan, [&](const FramePlan& frame, const FrameWork& work) {
     const double seconds = work.cell_updates * kSecondsPerCellStep;
     const double march = EstimateResources(*frame.style).seconds;
     if (seconds > 0.0 && !(seconds + march <= options.max_frame_seconds))
@@ -104,7 +105,7 @@ FormationEstimate CheckFormationBudget(const RenderPlan& plan, const BakeOptions
           "steps_per_hour or cells, put the schedule's frames closer in clock time, or raise --max-frame-seconds "
           "(README \"Limits\")",
           frame.Label(), work.cell_updates, work.layers, seconds, march, options.max_frame_seconds));
-  }
+  });
   return EstimateFormationWork(plan);
 }
 

@@ -11,13 +11,11 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfIO.h>
-#include <OpenEXR/ImfInputFile.h>
 
 #include "skybake/base/file_door.h"
 #include "skybake/input/config.h"
 #include "skybake/output/exr_io.h"
+#include "skybake/output/exr_read.h"
 #include "skybake/output/manifest.h"
 #include "skybake/pipeline/pipeline.h"
 
@@ -51,24 +49,6 @@ std::string FolderFile(const fs::path& dir, const std::string& name, const std::
         fmt::format("cannot read {}: it {}: bake the folder again", EscapedText((dir / name).string()), problem));
   return bytes;
 }
-
-// The data window's size of an OpenEXR file held in memory.
-class MemoryStream : public Imf::IStream {
- public:
-  explicit MemoryStream(const std::string& bytes) : Imf::IStream("memory"), bytes_(bytes) {}
-  bool read(char c[], int n) override {
-    if (n < 0 || at_ + uint64_t(n) > bytes_.size()) throw std::runtime_error("the file ends early");
-    std::memcpy(c, bytes_.data() + at_, size_t(n));
-    at_ += uint64_t(n);
-    return at_ < bytes_.size();
-  }
-  uint64_t tellg() override { return at_; }
-  void seekg(uint64_t pos) override { at_ = pos; }
-
- private:
-  const std::string& bytes_;
-  uint64_t at_ = 0;
-};
 
 std::string Base64(const std::string& bytes) {
   static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -358,16 +338,8 @@ json FrameEntries(const std::vector<Frame>& frames, const fs::path& dir, double 
       for (int i = 16; i < 20; ++i) width = (width << 8) | uint8_t(data[size_t(i)]);
       for (int i = 20; i < 24; ++i) height = (height << 8) | uint8_t(data[size_t(i)]);
     } else {
-      try {
-        MemoryStream stream(data);
-        Imf::InputFile in(stream);
-        const Imath::Box2i window = in.header().dataWindow();
-        width = window.max.x - window.min.x + 1;
-        height = window.max.y - window.min.y + 1;
-      } catch (const std::exception& e) {
-        throw OutputError(fmt::format("{} is not an OpenEXR file ({}): bake the folder again",
-                                      EscapedText((dir / f.file).string()), e.what()));
-      }
+      if (const std::string problem = ExrSizeOfBytes(data, width, height); !problem.empty())
+        throw OutputError(fmt::format("{} {}: bake the folder again", EscapedText((dir / f.file).string()), problem));
     }
     json entry = {{"type", f.type}, {"label", f.label}, {"scale", f.scale}, {"width", width}, {"height", height}};
     if (embed) entry["data"] = Base64(data);

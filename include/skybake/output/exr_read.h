@@ -23,4 +23,8 @@ inline constexpr uint64_t kMaxExrPixels = uint64_t(1) << 28;
 // not a regular file", "is not an OpenEXR file (...)").
 std::string ReadExrRgba(const std::string& path, int& width, int& height, std::vector<float>& rgba);
 
+// The data window's size of an OpenEXR file already read into `bytes`
+// (the viewer page's frames): "" or the problem, as for ReadExrRgba.
+std::string ExrSizeOfBytes(const std::string& bytes, int& width, int& height);
+
 }  // namespace skybake
