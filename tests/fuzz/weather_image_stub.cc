@@ -1,6 +1,7 @@
 // The fuzz build parses styles without the OpenImageIO module: a weather
 // image or a formation's density mask is reported as unreadable, so the
 // parser's error path for it runs.
+#include <optional>
 #include <stdexcept>
 
 #include "skybake/model/cloud_formation.h"
@@ -21,6 +22,10 @@ std::string CheckCloudMask(const std::string&, const CloudFormation&) {
 // ToCloudInputs (model/clouds.cc) is never called by the parsers.
 void ApplyCloudFormation(const CloudLayer&, uint32_t, int, double, const std::string&, gpu::GpuCloudLayer&,
                          std::vector<float>&, int) {
+  throw std::logic_error("cloud formations are not simulated in the fuzz build");
+}
+
+double FormationTimeSeconds(const CloudFormation&, std::optional<double>, double) {
   throw std::logic_error("cloud formations are not simulated in the fuzz build");
 }
 
