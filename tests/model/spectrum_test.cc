@@ -229,6 +229,7 @@ TEST(SpectrumTest, NamedWavelengthsKeepTheStylesCoefficients) {
   // as they are; the second of 4 bins, 475..595 nm, the mean of the 12 rows
   // 480..590 nm.
   const auto demo = ReadCsv(testing::SharedDir() + "/groundtruth/constants/bruneton2017_demo_spectra.csv");
+  ASSERT_GT(demo.size(), 48u) << "the 48 rows of the demo spectra";
   const std::vector<SpectralGroup> g48 = SpectralGroups(AtmosphereParams(), WavelengthBins(48));
   for (int k = 0; k < 48; ++k)
     EXPECT_NEAR(g48[k / 3].atmosphere.solar_irradiance[k % 3], std::stod(demo[1 + k][1]), 2e-4) << k;
