@@ -3,8 +3,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 
 #include <Imath/half.h>
@@ -12,9 +10,14 @@
 #include <zstd.h>
 
 #include "skybake/base/errors.h"
+#include "skybake/base/file_door.h"
 
 namespace skybake {
 namespace {
+
+// 1 GiB: over 15 times the largest KTX2 skybake writes (ibl.size at most
+// 1024: an rgba16f cube with every level, 6 x 1024^2 x 8 x 4/3 = 67 MB).
+constexpr uint64_t kMaxKtx2Bytes = uint64_t(1) << 30;
 
 uint32_t Get32(const std::string& b, size_t at) {
   uint32_t v = 0;
@@ -61,9 +64,11 @@ std::vector<Ktx2Level> ReadKtx2Rgb(const std::string& path) {
   auto fail = [&](const std::string& why) {
     return OutputError(fmt::format("{} cannot be read back as KTX2: {}", path, why));
   };
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw fail("it cannot be opened");
-  const std::string b((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Through the door (file_door.h), as the EXRs are: a FIFO, a device or a
+  // link planted at the name is refused, not waited on or followed.
+  std::string b;
+  if (const std::string problem = ReadRegularFile(path, kMaxKtx2Bytes, FileLinks::kRefuse, b); !problem.empty())
+    throw fail("it " + problem);
   constexpr uint8_t kIdentifier[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
   if (b.size() < 80 || std::memcmp(b.data(), kIdentifier, 12) != 0) throw fail("no KTX2 identifier");
   const uint32_t format = Get32(b, 12), width = Get32(b, 20), height = Get32(b, 24), faces = Get32(b, 36);
